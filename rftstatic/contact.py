@@ -1,0 +1,323 @@
+"""Contact of the sheet's nodes with rigid obstacles: penalty (statics) and kinematic (explicit dynamics).
+
+Penalty contact (Sze & Zhou 2016, §4.5; Liu & Sze 2009). Every node ``n`` with nodal area ``A_n`` and
+every obstacle with signed distance ``phi`` (``phi < 0`` inside) contribute
+
+    E = sum_n sum_obstacles 1/2 k A_n min(phi(x_n), 0)^2                      [J]
+
+to the total potential energy. Its gradient ``f_n = k A_n min(phi, 0) n`` (``n = grad phi``) is what
+:meth:`PenaltyContact.force` returns, i.e. an internal-force term of the residual
+``R = f_int + f_contact - P``; the force the obstacle exerts on the sheet is ``-f_n = k A_n |phi| n``
+(outward). Its derivative is node-diagonal,
+
+    K_n = d f_n / d x_n = k A_n (n n^T + phi H)     for phi < 0,  0 otherwise,
+
+with ``H`` the Hessian of ``phi`` (:meth:`rftstatic.obstacles.Obstacle.normal_gradient`); the global
+tangent only needs these ``(N, 3, 3)`` diagonal blocks. The ``phi H`` term is negative semi-definite on a
+convex obstacle (it softens the tangential directions on a sphere or a rounded edge) and is tiny next to
+``n n^T`` because ``|phi| << 1 / |H|``.
+
+A node pressed with a contact pressure ``p`` [Pa] penetrates ``p / k`` (:func:`estimate_penetration`);
+:func:`auto_penalty` chooses ``k`` from the fabric and the element size so that this stays a small
+fraction of the element size.
+
+Kinematic contact (§6.3): after an explicit time step a penetrated node is moved to its closest surface
+point and the inward normal component of its velocity is removed (:func:`kinematic_contact`).
+
+Nothing here depends on the obstacles' types: only ``signed_distance`` and ``normal_gradient`` are used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from .obstacles import Obstacle
+
+__all__ = [
+    "PenaltyContact",
+    "ContactState",
+    "auto_penalty",
+    "estimate_penetration",
+    "kinematic_contact",
+]
+
+
+def _as_list(obstacles: Obstacle | Iterable[Obstacle]) -> list[Obstacle]:
+    """Obstacles as a list; a single obstacle is accepted. Raise naming a bad entry."""
+    items = [obstacles] if hasattr(obstacles, "signed_distance") else list(obstacles)
+    for i, ob in enumerate(items):
+        if not (hasattr(ob, "signed_distance") and hasattr(ob, "normal_gradient")):
+            raise ValueError(
+                f"obstacles[{i}] = {ob!r} is not an obstacle (needs signed_distance and normal_gradient)"
+            )
+    return items
+
+
+def _as_points(x, n_nodes: int | None = None, name: str = "x") -> np.ndarray:
+    arr = np.asarray(x, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 3 or (n_nodes is not None and arr.shape[0] != n_nodes):
+        want = "(N, 3)" if n_nodes is None else f"({n_nodes}, 3)"
+        raise ValueError(f"{name} must have shape {want}, got shape {arr.shape}")
+    return arr
+
+
+def _positive(name: str, value, *, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        raise ValueError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """Penalty contact evaluated at one configuration.
+
+    Attributes
+    ----------
+    energy : contact energy [J]
+    force : (N, 3) gradient of the energy, ``dE/dx`` [N]
+    tangent_blocks : (N, 3, 3) node-diagonal blocks of ``d force / dx`` [N/m]
+    gap : (N,) smallest signed distance over the obstacles [m]
+    active : (N,) node penetrates at least one obstacle
+    """
+
+    energy: float
+    force: np.ndarray
+    tangent_blocks: np.ndarray
+    gap: np.ndarray
+    active: np.ndarray
+
+    @property
+    def max_penetration(self) -> float:
+        """Largest penetration depth ``max(0, -min gap)`` [m]."""
+        return float(max(0.0, -self.gap.min())) if self.gap.size else 0.0
+
+    @property
+    def n_active(self) -> int:
+        """Number of penetrating nodes."""
+        return int(np.count_nonzero(self.active))
+
+
+class PenaltyContact:
+    """Node-to-obstacle penalty contact, ``E = sum 1/2 k A_n min(phi, 0)^2``.
+
+    Parameters
+    ----------
+    obstacles : an obstacle or a sequence of them (anything with ``signed_distance`` and
+        ``normal_gradient``)
+    node_area : (N,) area attributed to each node, e.g. a third of its triangles' areas [m^2]
+    stiffness : penalty stiffness ``k`` (pressure per penetration depth) [N/m^3]; see :func:`auto_penalty`
+
+    Notes
+    -----
+    The four methods :meth:`energy`, :meth:`force`, :meth:`tangent_blocks` and :meth:`gaps` each
+    evaluate the signed distances once; :meth:`evaluate` returns all of them from one evaluation and is
+    what a Newton iteration should call.
+    """
+
+    def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float):
+        self.obstacles = _as_list(obstacles)
+        area = np.asarray(node_area, dtype=float)
+        if area.ndim != 1:
+            raise ValueError(f"node_area must have shape (N,), got shape {area.shape}")
+        bad = ~np.isfinite(area) | (area < 0)
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"node_area must be finite and >= 0, got node_area[{i}] = {area[i]!r}")
+        self.node_area = area
+        self.stiffness = _positive("stiffness", stiffness)
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of nodes ``N``."""
+        return self.node_area.shape[0]
+
+    def _distances(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Signed distances ``(M, N)`` [m] and normals ``(M, N, 3)`` for the ``M`` obstacles."""
+        x = _as_points(x, self.n_nodes)
+        if not self.obstacles:
+            return np.full((0, x.shape[0]), np.inf), np.zeros((0, x.shape[0], 3))
+        phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
+        return np.stack(phis), np.stack(normals)
+
+    def evaluate(self, x: np.ndarray, *, tangent: bool = True) -> ContactState:
+        """Energy, force, tangent blocks and gaps at positions ``x``.
+
+        Parameters
+        ----------
+        x : (N, 3) current nodal positions [m]
+        tangent : also compute the tangent blocks (else they are zeros)
+
+        Returns
+        -------
+        ContactState
+        """
+        x = _as_points(x, self.n_nodes)
+        phi, normal = self._distances(x)
+        pen = np.minimum(phi, 0.0)  # (M, N)
+        ka = self.stiffness * self.node_area  # (N,) [N/m]
+        energy = 0.5 * float(np.sum(ka * np.sum(pen**2, axis=0)))
+        force = np.einsum("n,mn,mni->ni", ka, pen, normal)
+        blocks = np.zeros((x.shape[0], 3, 3))
+        if tangent:
+            for m, ob in enumerate(self.obstacles):
+                act = pen[m] < 0.0
+                if not np.any(act):
+                    continue
+                H = ob.normal_gradient(x[act])
+                nn = np.einsum("ni,nj->nij", normal[m, act], normal[m, act])
+                blocks[act] += ka[act, None, None] * (nn + pen[m, act, None, None] * H)
+        gap = phi.min(axis=0) if phi.shape[0] else np.full(x.shape[0], np.inf)
+        return ContactState(energy, force, blocks, gap, np.any(pen < 0.0, axis=0))
+
+    def energy(self, x: np.ndarray) -> float:
+        """Contact energy ``sum 1/2 k A_n min(phi, 0)^2`` [J] at ``x (N, 3)`` [m]."""
+        return self.evaluate(x, tangent=False).energy
+
+    def force(self, x: np.ndarray) -> np.ndarray:
+        """Gradient of the contact energy, ``(N, 3)`` [N], at ``x (N, 3)`` [m].
+
+        ``k A_n min(phi, 0) n`` summed over the obstacles; it points into the obstacle, so it is the
+        contact term of the residual (the obstacle pushes the sheet with its negative).
+        """
+        return self.evaluate(x, tangent=False).force
+
+    def tangent_blocks(self, x: np.ndarray) -> np.ndarray:
+        """Node-diagonal blocks ``(N, 3, 3)`` [N/m] of ``d force / dx`` at ``x (N, 3)`` [m].
+
+        ``k A_n (n n^T + phi H)`` for each obstacle the node penetrates; symmetric.
+        """
+        return self.evaluate(x).tangent_blocks
+
+    def gaps(self, x: np.ndarray) -> np.ndarray:
+        """Smallest signed distance of each node over the obstacles, ``(N,)`` [m] (``inf`` if none)."""
+        x = _as_points(x, self.n_nodes)
+        phi, _ = self._distances(x)
+        return phi.min(axis=0) if phi.shape[0] else np.full(x.shape[0], np.inf)
+
+    def max_penetration(self, x: np.ndarray) -> float:
+        """Largest penetration depth ``max(0, -min gap)`` [m] at ``x (N, 3)`` [m]."""
+        gap = self.gaps(x)
+        return float(max(0.0, -gap.min())) if gap.size else 0.0
+
+    def active(self, x: np.ndarray) -> np.ndarray:
+        """``(N,)`` bool: node penetrates at least one obstacle at ``x (N, 3)`` [m]."""
+        return self.gaps(x) < 0.0
+
+
+def auto_penalty(
+    *,
+    membrane_rigidity: float,
+    bending_rigidity: float,
+    weight: float,
+    h: float,
+    factor: float = 1.0,
+    target: float = 1e-3,
+    pressure_factor: float = 10.0,
+) -> float:
+    """Penalty stiffness from the fabric and the element size.
+
+    Parameters
+    ----------
+    membrane_rigidity : tensile rigidity ``C`` (largest of warp/weft) [N/m]
+    bending_rigidity : bending rigidity ``B`` [N m]
+    weight : weight per unit area ``w`` [N/m^2]
+    h : element size (edge length) near the contact [m]
+    factor : multiplier on the result (``> 1`` stiffer, less penetration, worse conditioning)
+    target : admissible penetration as a fraction of ``h`` under the design pressure
+    pressure_factor : design contact pressure in units of ``w``
+
+    Returns
+    -------
+    k : penalty stiffness [N/m^3]
+
+    Notes
+    -----
+    A node carries area ``~h^2``, so its penalty spring is ``k h^2`` [N/m] and a contact pressure
+    ``p`` makes it penetrate ``d = p / k``. Three conditions are combined,
+
+        k = factor * max(C / h^2,  B / h^4,  pressure_factor * w / (target * h)).
+
+    * ``C / h^2``: the node's penalty spring equals the membrane stiffness of its elements (``~C``), so
+      the contact does not dominate the tangent's conditioning, yet is as stiff as the sheet in-plane;
+    * ``B / h^4``: the same with the bending stiffness ``B / h^2`` of a node (never the largest for
+      fabrics, kept for stiff plates);
+    * ``pressure_factor * w / (target * h)``: under the design pressure ``p = pressure_factor * w`` the
+      penetration is at most ``target * h``. The default ``p = 10 w`` covers the line load at a pedestal's
+      edge: a hanging length ``L`` pulls with tension ``~w L`` spread over one element, ``p ~ w L / h``.
+
+    For the wool of §4 (``C = 1096.6 N/m``, ``B = 8.14e-6 N m``, ``w = 1.863 N/m^2``) at ``h = 5 mm``:
+    ``C / h^2 = 4.4e7``, ``B / h^4 = 1.3e4``, ``10 w / (1e-3 h) = 3.7e6`` so ``k = 4.4e7 N/m^3`` and
+    ``10 w`` penetrates ``4.2e-7 m = 8.5e-5 h``.
+    """
+    c = _positive("membrane_rigidity", membrane_rigidity, allow_zero=True)
+    b = _positive("bending_rigidity", bending_rigidity, allow_zero=True)
+    w = _positive("weight", weight, allow_zero=True)
+    h = _positive("h", h)
+    factor = _positive("factor", factor)
+    target = _positive("target", target)
+    pressure_factor = _positive("pressure_factor", pressure_factor, allow_zero=True)
+    k = factor * max(c / h**2, b / h**4, pressure_factor * w / (target * h))
+    if not k > 0:
+        raise ValueError(
+            "membrane_rigidity, bending_rigidity and weight (with pressure_factor) are all zero; "
+            "give at least one of them > 0"
+        )
+    return k
+
+
+def estimate_penetration(pressure, k: float):
+    """Penetration ``pressure / k`` [m] of a node pressed with ``pressure`` [Pa] on a penalty ``k`` [N/m^3].
+
+    ``pressure`` may be a number or an array; ``k > 0``.
+    """
+    k = _positive("k", k)
+    p = np.asarray(pressure, dtype=float)
+    if np.any(p < 0) or not np.all(np.isfinite(p)):
+        raise ValueError(f"pressure must be finite and >= 0, got {pressure!r}")
+    out = p / k
+    return float(out) if out.ndim == 0 else out
+
+
+def kinematic_contact(
+    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Kinematic contact correction after an explicit step (§6.3).
+
+    Each penetrated node (``phi < 0``) is moved to its closest surface point ``x - phi n`` and the inward
+    part of its normal velocity is removed (``v <- v - min(v.n, 0) n``); tangential and outward
+    velocities are kept (frictionless, no rebound). Obstacles are treated one after the other.
+
+    Parameters
+    ----------
+    obstacles : an obstacle or a sequence of them
+    x : (N, 3) nodal positions at the end of the step [m]
+    v : (N, 3) nodal velocities [m/s]
+
+    Returns
+    -------
+    x_new : (N, 3) corrected positions [m]
+    v_new : (N, 3) corrected velocities [m/s]
+    n_active : number of nodes that were corrected
+    """
+    items = _as_list(obstacles)
+    x_new = _as_points(x).copy()
+    v_new = _as_points(v, x_new.shape[0], name="v").copy()
+    touched = np.zeros(x_new.shape[0], dtype=bool)
+    for ob in items:
+        phi, normal = ob.signed_distance(x_new)
+        act = phi < 0.0
+        if not np.any(act):
+            continue
+        n = normal[act]
+        x_new[act] -= phi[act, None] * n
+        vn = np.einsum("ni,ni->n", v_new[act], n)
+        v_new[act] -= np.minimum(vn, 0.0)[:, None] * n
+        touched |= act
+    return x_new, v_new, int(np.count_nonzero(touched))
