@@ -263,7 +263,8 @@ class Sphere(Obstacle):
         d = _as_points(x) - self.centre
         dist = np.linalg.norm(d, axis=1)
         at_centre = dist == 0.0
-        normal = np.where(at_centre[:, None], np.array([0.0, 0.0, 1.0]), d / np.where(at_centre, 1.0, dist)[:, None])
+        normal = d / np.where(at_centre, 1.0, dist)[:, None]
+        normal[at_centre] = (0.0, 0.0, 1.0)
         return dist, normal, at_centre
 
     def signed_distance(self, x):
@@ -442,8 +443,9 @@ class RoundPedestal(Obstacle):
         _, g, G, J, e, rho, on_axis = self._parts(x)
         H = np.einsum("nai,nab,nbj->nij", J, G, J)
         pxy = np.diag([1.0, 1.0, 0.0])
-        curv = (pxy - np.einsum("ni,nj->nij", e, e)) * np.where(on_axis, 0.0, g[:, 0] / np.where(on_axis, 1.0, rho))[:, None, None]
-        return H + curv
+        # d e / d x = (P_xy - e e^T) / rho: the wall's curvature around the axis, dropped on the axis.
+        coef = np.where(on_axis, 0.0, g[:, 0] / np.where(on_axis, 1.0, rho))
+        return H + coef[:, None, None] * (pxy - np.einsum("ni,nj->nij", e, e))
 
     def bounding_box(self):
         lo = np.array([*(self.centre_xy - self.radius), self.top_z - self.height])
@@ -460,24 +462,25 @@ class RoundPedestal(Obstacle):
         }
 
 
-# Scene tables: type name -> (class, {scene key: (constructor argument, is a length, required)}).
-_SPECS: dict[str, tuple[type, dict[str, tuple[str, bool, bool]]]] = {
-    "floor": (Floor, {"height": ("height", True, False)}),
-    "sphere": (Sphere, {"centre": ("centre", True, True), "radius": ("radius", True, True)}),
+# Scene tables: type name -> (class, {scene key: (constructor argument, required)}). Every value is a
+# length (or a list of lengths) in scene units.
+_SPECS: dict[str, tuple[type, dict[str, tuple[str, bool]]]] = {
+    "floor": (Floor, {"height": ("height", False)}),
+    "sphere": (Sphere, {"centre": ("centre", True), "radius": ("radius", True)}),
     "square-pedestal": (SquarePedestal, {
-        "centre": ("centre_xy", True, False),
-        "half_width": ("half_width", True, False),
-        "size": ("size", True, False),
-        "top": ("top_z", True, False),
-        "edge_radius": ("edge_radius", True, False),
-        "height": ("height", True, False),
+        "centre": ("centre_xy", False),
+        "half_width": ("half_width", False),
+        "size": ("size", False),
+        "top": ("top_z", False),
+        "edge_radius": ("edge_radius", False),
+        "height": ("height", False),
     }),
     "round-pedestal": (RoundPedestal, {
-        "centre": ("centre_xy", True, False),
-        "radius": ("radius", True, True),
-        "top": ("top_z", True, False),
-        "edge_radius": ("edge_radius", True, False),
-        "height": ("height", True, False),
+        "centre": ("centre_xy", False),
+        "radius": ("radius", True),
+        "top": ("top_z", False),
+        "edge_radius": ("edge_radius", False),
+        "height": ("height", False),
     }),
 }
 _DEFAULTS = {"centre_xy": (0.0, 0.0)}
@@ -501,7 +504,9 @@ def _scale(key: str, value: Any, factor: float, where: str) -> Any:
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"{where}: key {key!r} must be a number or a list of numbers, got {value!r}") from None
+        raise ValueError(
+            f"{where}: key {key!r} must be a number or a list of numbers, got {value!r}"
+        ) from None
     scaled = arr * factor
     return float(scaled) if scaled.ndim == 0 else scaled
 
@@ -548,14 +553,13 @@ def from_spec(spec: Mapping[str, Any], length_scale: float = 1.0) -> Obstacle:
     unknown = sorted(set(spec) - set(keys) - {"type"})
     if unknown:
         raise ValueError(f"{where}: unknown key(s) {unknown}; allowed keys are {sorted(keys)}")
-    missing = [key for key, (_, _, required) in keys.items() if required and key not in spec]
+    missing = [key for key, (_, required) in keys.items() if required and key not in spec]
     if missing:
         raise ValueError(f"{where}: missing key(s) {missing}")
     kwargs = {}
-    for key, (arg, is_length, _) in keys.items():
+    for key, (arg, _) in keys.items():
         if key in spec:
-            value = spec[key]
-            kwargs[arg] = _scale(key, value, factor if is_length else 1.0, where)
+            kwargs[arg] = _scale(key, spec[key], factor, where)
         elif arg in _DEFAULTS:
             kwargs[arg] = _DEFAULTS[arg]
     try:
@@ -563,7 +567,7 @@ def from_spec(spec: Mapping[str, Any], length_scale: float = 1.0) -> Obstacle:
     except ValueError as err:
         message = str(err)
         first = message.split(" ", 1)[0]
-        for key, (arg, _, _) in keys.items():
+        for key, (arg, _) in keys.items():
             if first == arg and key in spec:
                 raise ValueError(
                     f"{where}: key {key!r} = {spec[key]!r} is invalid: {message} "

@@ -94,7 +94,8 @@ def test_several_obstacles_add_up_and_evaluate_agrees():
     assert isinstance(state, ContactState)
     assert state.energy == pytest.approx(sum(p.energy(x) for p in parts), rel=1e-14)
     np.testing.assert_allclose(state.force, sum(p.force(x) for p in parts), rtol=1e-14, atol=0)
-    np.testing.assert_allclose(state.tangent_blocks, sum(p.tangent_blocks(x) for p in parts), rtol=1e-14, atol=0)
+    blocks = sum(p.tangent_blocks(x) for p in parts)
+    np.testing.assert_allclose(state.tangent_blocks, blocks, rtol=1e-14, atol=0)
     gaps = np.minimum(*(ob.signed_distance(x)[0] for ob in obstacles))
     np.testing.assert_array_equal(state.gap, gaps)
     np.testing.assert_array_equal(both.active(x), gaps < 0)
@@ -184,9 +185,9 @@ def test_kinematic_contact_on_sphere_is_radial():
         (lambda: PenaltyContact([Floor()], np.ones((3, 1)), 1.0), "node_area"),
         (lambda: PenaltyContact(["floor"], np.ones(3), 1.0), "obstacles[0]"),
         (lambda: PenaltyContact(Floor(), np.ones(3), 1.0).force(np.zeros((4, 3))), "(3, 3)"),
-        (lambda: auto_penalty(membrane_rigidity=-1.0, bending_rigidity=0.0, weight=1.0, h=0.01), "membrane_rigidity"),
+        (lambda: auto_penalty(membrane_rigidity=-1.0, bending_rigidity=0, weight=1, h=0.01), "membrane_rigidity"),
         (lambda: auto_penalty(membrane_rigidity=1.0, bending_rigidity=0.0, weight=1.0, h=0.0), "h"),
-        (lambda: auto_penalty(membrane_rigidity=1.0, bending_rigidity="x", weight=1.0, h=0.01), "bending_rigidity"),
+        (lambda: auto_penalty(membrane_rigidity=1.0, bending_rigidity="x", weight=1, h=0.01), "bending_rigidity"),
         (lambda: auto_penalty(membrane_rigidity=0.0, bending_rigidity=0.0, weight=0.0, h=0.01), "all zero"),
         (lambda: estimate_penetration(1.0, 0.0), "k"),
         (lambda: estimate_penetration(-1.0, 1.0), "pressure"),

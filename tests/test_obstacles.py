@@ -165,7 +165,8 @@ def test_floor():
 
 
 def test_from_spec_scales_and_round_trips():
-    ped = from_spec({"type": "round-pedestal", "centre": [0, 0], "radius": 10, "top": 0, "edge_radius": 0.5}, 0.01)
+    spec = {"type": "round-pedestal", "centre": [0, 0], "radius": 10, "top": 0, "edge_radius": 0.5}
+    ped = from_spec(spec, 0.01)
     assert isinstance(ped, RoundPedestal) and isinstance(ped, Obstacle)
     assert ped.radius == pytest.approx(0.1) and ped.edge_radius == pytest.approx(0.005)
     assert np.isinf(ped.height)
@@ -175,7 +176,8 @@ def test_from_spec_scales_and_round_trips():
     sphere = from_spec({"type": "sphere", "centre": [0, 0, -5], "radius": 5}, 0.01)
     np.testing.assert_allclose(sphere.centre, [0, 0, -0.05])
     x = np.random.default_rng(4).uniform(-0.2, 0.2, size=(50, 3))
-    for obstacle in [ped, sq, sphere, from_spec({"type": "floor", "height": -3}, 0.01), *_obstacles().values()]:
+    floor = from_spec({"type": "floor", "height": -3}, 0.01)
+    for obstacle in [ped, sq, sphere, floor, *_obstacles().values()]:
         d = obstacle.as_dict()
         assert d["type"] in obstacle_types()
         again = from_spec(d, 1.0)
@@ -198,7 +200,10 @@ def test_from_spec_scales_and_round_trips():
         ({"type": "square-pedestal", "size": [1, 2, 3]}, ["'size'", "shape"]),
         ({"type": "sphere", "centre": [0, 0], "radius": 1}, ["'centre'", "shape (3,)"]),
         ({"type": "sphere", "centre": "origin", "radius": 1}, ["'centre'", "origin"]),
-        ({"type": "round-pedestal", "radius": 1, "edge_radius": 0.5, "height": 0.5}, ["'height'", "edge_radius"]),
+        (
+            {"type": "round-pedestal", "radius": 1, "edge_radius": 0.5, "height": 0.5},
+            ["'height'", "edge_radius"],
+        ),
     ],
 )
 def test_from_spec_errors_name_the_key(spec, words):
