@@ -178,12 +178,14 @@ class Domain:
         loops = list(loops)
         if not loops:
             raise MeshingError("a Domain needs at least the outer loop")
+        for k, lp in enumerate(loops):
+            if lp.is_circle and not (np.isfinite(lp.radius) and lp.radius > 0):
+                raise MeshingError(f"loop {k}: circle radius {lp.radius!r} must be positive [m]")
+        self.loops = tuple(loops)
+        self._check_crossings()
         norm = []
         for k, lp in enumerate(loops):
             want = 1 if k == 0 else -1
-            if lp.is_circle:
-                if not (np.isfinite(lp.radius) and lp.radius > 0):
-                    raise MeshingError(f"loop {k}: circle radius {lp.radius!r} must be positive [m]")
             if abs(lp.signed_area) <= 0:
                 raise MeshingError(f"loop {k} has zero area; give at least 3 non-collinear vertices")
             if np.sign(lp.signed_area) != want:
@@ -192,7 +194,7 @@ class Domain:
                 lp = Loop(vertices=lp.vertices, orientation=want)
             norm.append(lp)
         self.loops = tuple(norm)
-        self._validate()
+        self._check_nesting()
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -304,7 +306,7 @@ class Domain:
         return f"Domain(outer={kinds[0]}, holes={kinds[1:]})"
 
     # ------------------------------------------------------------------ checks
-    def _validate(self):
+    def _check_crossings(self):
         polys = [lp.polyline() for lp in self.loops]
         p1 = np.concatenate(polys)
         p2 = np.concatenate([np.roll(v, -1, axis=0) for v in polys])
@@ -327,6 +329,9 @@ class Domain:
                     f"({p1[i][0]:g}, {p1[i][1]:g})-({p2[i][0]:g}, {p2[i][1]:g}) touches or crosses segment "
                     f"{local[j]} of loop {loop_id[j]} ({p1[j][0]:g}, {p1[j][1]:g})-({p2[j][0]:g}, {p2[j][1]:g}); "
                     "fix the coordinates so that loops are simple and disjoint")
+
+    def _check_nesting(self):
+        polys = [lp.polyline() for lp in self.loops]
         outer = polys[0]
         for k in range(1, len(polys)):
             p = polys[k][0]

@@ -37,10 +37,12 @@ from .errors import MeshingError
 
 __all__ = ["advance_front"]
 
-_NEAR = 0.7        # existing nodes within _NEAR * delta of P beat P
+_NEAR = 0.8        # existing nodes within _NEAR * delta of P beat P
 _CLEAR_NODE = 0.55  # a new point keeps this * delta from front nodes
 _CLEAR_EDGE = 0.35  # ... and this * delta from front edges
 _MAX_DEFER = 12    # an edge may be postponed this often before giving up
+_SHRINK = 0.7      # delta >= _SHRINK * |ab|
+_GROW = 1.4        # delta <= _GROW * |ab|
 
 
 def bucket_size(size_field):
@@ -183,10 +185,12 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
         ux = -dy / L
         uy = dx / L
         h = h_at(mx, my)
-        d = 0.7 * L if h < 0.7 * L else (1.4 * L if h > 1.4 * L else h)
+        lo = _SHRINK * L
+        hi = _GROW * L
+        d = lo if h < lo else (hi if h > hi else h)
         ht = sqrt(d * d - 0.25 * L * L)
         h = 0.5 * (h + h_at(mx + ux * ht, my + uy * ht))
-        d = 0.7 * L if h < 0.7 * L else (1.4 * L if h > 1.4 * L else h)
+        d = lo if h < lo else (hi if h > hi else h)
         ht = sqrt(d * d - 0.25 * L * L)
         px = mx + ux * ht
         py = my + uy * ht

@@ -16,9 +16,8 @@ every pair of 8-neighbouring grid nodes p, q::
 
 i.e. the size is Lipschitz with slope ``g - 1``.  Two elements of size h lying
 one element length apart therefore differ in size by at most the factor g,
-independently of the grid spacing.  The limiting is computed by exact
-cumulative-minimum sweeps along rows and columns plus diagonal relaxation,
-repeated until nothing changes (vectorised, O(grid size) per sweep).
+independently of the grid spacing.  The limiting is exact and costs two
+raster passes, vectorised along the rows (see :func:`limit_gradation`).
 """
 
 from __future__ import annotations
@@ -62,15 +61,19 @@ def _clamp(values, h_lower, h_upper):
     return values
 
 
-def _cummin(a, axis, reverse=False):
-    if reverse:
-        a = np.flip(a, axis)
-        return np.flip(np.minimum.accumulate(a, axis=axis), axis)
-    return np.minimum.accumulate(a, axis=axis)
+def _row_sweep(r, ramp):
+    """Exact in-row limiting r[j] <= r[k] + slope |j - k| via cumulative minima."""
+    r = np.minimum(r, np.minimum.accumulate(r - ramp) + ramp)
+    return np.minimum(r, np.minimum.accumulate((r + ramp)[::-1])[::-1] - ramp)
 
 
 def limit_gradation(values, spacing, gradation):
     """Lower a grid size field until neighbouring sizes obey the gradation.
+
+    Two raster passes (top-down then bottom-up), each row first relaxed from
+    its three neighbours in the previous row and then swept exactly along the
+    row; as for chamfer distance transforms this is exact, because a shortest
+    8-neighbour path is monotone in both grid directions.
 
     Parameters
     ----------
@@ -81,32 +84,23 @@ def limit_gradation(values, spacing, gradation):
 
     Returns
     -------
-    (nx, ny) limited sizes [m], everywhere <= ``values``.
+    (nx, ny) limited sizes [m]: the largest field <= ``values`` obeying the limit.
     """
     if not (np.isfinite(gradation) and gradation >= 1.0):
         raise MeshingError(f"gradation = {gradation!r} must be a ratio >= 1 (e.g. 1.3)")
     h = np.array(values, dtype=float, copy=True)
-    slope = (gradation - 1.0) * spacing
-    if np.isinf(slope) or h.size == 1:
-        return h
-    ramp_x = slope * np.arange(h.shape[0])[:, None]
-    ramp_y = slope * np.arange(h.shape[1])[None, :]
-    diag = np.sqrt(2.0) * slope
-    for _ in range(10 * max(h.shape)):
-        old = h.copy()
-        # exact 1D distance limiting along rows/columns via cumulative minima
-        h = np.minimum(h, _cummin(h - ramp_x, 0) + ramp_x)
-        h = np.minimum(h, _cummin(h + ramp_x, 0, reverse=True) - ramp_x)
-        h = np.minimum(h, _cummin(h - ramp_y, 1) + ramp_y)
-        h = np.minimum(h, _cummin(h + ramp_y, 1, reverse=True) - ramp_y)
-        for sx, sy in ((1, 1), (1, -1)):
-            for _sweep in range(2):
-                a = h[1:, 1:] if sy == 1 else h[1:, :-1]
-                b = h[:-1, :-1] if sy == 1 else h[:-1, 1:]
-                np.minimum(a, b + diag, out=a)
-                np.minimum(b, a + diag, out=b)
-        if np.array_equal(old, h):
-            break
+    a = (gradation - 1.0) * spacing
+    d = np.sqrt(2.0) * a
+    ramp = a * np.arange(h.shape[1])
+    nx = h.shape[0]
+    h[0] = _row_sweep(h[0], ramp)
+    for rows in (range(1, nx), range(nx - 2, -1, -1)):
+        for i in rows:
+            prev = h[i - 1] if rows.step == 1 else h[i + 1]
+            r = np.minimum(h[i], prev + a)
+            r[1:] = np.minimum(r[1:], prev[:-1] + d)
+            r[:-1] = np.minimum(r[:-1], prev[1:] + d)
+            h[i] = _row_sweep(r, ramp)
     return h
 
 
