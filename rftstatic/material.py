@@ -1,0 +1,172 @@
+"""Fabric and shell rigidities: the membrane matrix D^m (Eq. 15) and bending matrix D^b (Eq. 4).
+
+Strain and curvature vectors are (e_xx, e_yy, 2 e_xy) and (k_xx, k_yy, 2 k_xy) with x along the
+warp (method.md). A fabric cut on the bias has its warp at an angle to the global X axis; the
+matrices are then rotated into global axes once, here, so the element code never sees the angle.
+All rigidities are per unit width: tensile/shear [N/m], bending/twisting [N m].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .units import STANDARD_GRAVITY, UnitSystem
+
+
+def voigt_rotation(angle: float) -> np.ndarray:
+    """Strain transformation T with e_material = T @ e_global for engineering Voigt vectors.
+
+    Parameters
+    ----------
+    angle : float
+        Angle of the material 1-axis (warp) measured from the global X axis [rad].
+    """
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array(
+        [
+            [c * c, s * s, c * s],
+            [s * s, c * c, -c * s],
+            [-2 * c * s, 2 * c * s, c * c - s * s],
+        ]
+    )
+
+
+def _orthotropic(d11, d22, d12, d33) -> np.ndarray:
+    return np.array([[d11, d12, 0.0], [d12, d22, 0.0], [0.0, 0.0, d33]])
+
+
+@dataclass(frozen=True)
+class Material:
+    """Membrane and bending rigidities in global axes, and the areal weight.
+
+    Attributes
+    ----------
+    Dm : (3, 3) membrane rigidity in global axes [N/m]
+    Db : (3, 3) bending rigidity in global axes [N m]
+    weight : areal weight under standard gravity [N/m^2]
+    name : label for summaries
+    """
+
+    Dm: np.ndarray
+    Db: np.ndarray
+    weight: float
+    name: str = "material"
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        for key in ("Dm", "Db"):
+            D = np.asarray(getattr(self, key), dtype=float)
+            if D.shape != (3, 3) or not np.allclose(D, D.T):
+                raise ValueError(f"{self.name}: {key} must be a symmetric 3x3 matrix, got {D!r}")
+            if np.linalg.eigvalsh(D).min() < -1e-12 * np.abs(D).max():
+                raise ValueError(
+                    f"{self.name}: {key} is not positive semi-definite (eigenvalues "
+                    f"{np.linalg.eigvalsh(D)}); check the coupling terms C12/B12 or the Poisson ratio"
+                )
+            object.__setattr__(self, key, D)
+        if self.weight < 0:
+            raise ValueError(f"{self.name}: weight must be >= 0, got {self.weight}")
+
+    @property
+    def mass_per_area(self) -> float:
+        """Areal mass density [kg/m^2] (weight under standard gravity)."""
+        return self.weight / STANDARD_GRAVITY
+
+    @property
+    def membrane_scale(self) -> float:
+        """Largest membrane rigidity [N/m] (for penalty and time-step estimates)."""
+        return float(np.linalg.eigvalsh(self.Dm).max())
+
+    @property
+    def bending_scale(self) -> float:
+        """Largest bending rigidity [N m]."""
+        return float(np.linalg.eigvalsh(self.Db).max())
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "Dm_N_per_m": self.Dm.tolist(),
+            "Db_N_m": self.Db.tolist(),
+            "weight_N_per_m2": self.weight,
+            **self.info,
+        }
+
+
+def fabric(
+    *,
+    C_warp: float,
+    C_weft: float,
+    C_shear: float,
+    B_warp: float,
+    B_weft: float,
+    B_twist: float,
+    weight: float,
+    C12: float = 0.0,
+    B12: float = 0.0,
+    warp_angle: float = 0.0,
+    name: str = "fabric",
+) -> Material:
+    """Orthotropic woven fabric (Kang & Yu's rigidities), in SI.
+
+    Parameters
+    ----------
+    C_warp, C_weft, C_shear, C12 : tensile, shear and coupling rigidity [N/m]
+    B_warp, B_weft, B_twist, B12 : bending, twisting and coupling rigidity [N m]
+    weight : areal weight [N/m^2]
+    warp_angle : angle of the warp from the global X axis [rad]
+    """
+    T = voigt_rotation(warp_angle)
+    Dm = T.T @ _orthotropic(C_warp, C_weft, C12, C_shear) @ T
+    Db = T.T @ _orthotropic(B_warp, B_weft, B12, B_twist) @ T
+    info = {"warp_angle_deg": float(np.degrees(warp_angle))}
+    return Material(Dm=Dm, Db=Db, weight=weight, name=name, info=info)
+
+
+def isotropic_shell(*, E: float, nu: float, thickness: float, weight: float = 0.0, name="shell") -> Material:
+    """Isotropic thin shell: C = E h / (1 - nu^2), D = E h^3 / (12 (1 - nu^2)).
+
+    Parameters
+    ----------
+    E : Young's modulus [Pa]; nu : Poisson ratio [-]; thickness : [m]; weight : [N/m^2]
+    """
+    if not (-1.0 < nu < 0.5):
+        raise ValueError(f"{name}: Poisson ratio nu must lie in (-1, 0.5), got {nu}")
+    if E <= 0 or thickness <= 0:
+        raise ValueError(f"{name}: E and thickness must be positive, got E={E}, thickness={thickness}")
+    C = E * thickness / (1 - nu**2)
+    D = E * thickness**3 / (12 * (1 - nu**2))
+    shape = np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, (1 - nu) / 2]])
+    info = {"E": E, "nu": nu, "thickness": thickness}
+    return Material(Dm=C * shape, Db=D * shape, weight=weight, name=name, info=info)
+
+
+# Kang & Yu (1995) wool, used throughout §4 of the paper, in the paper's units (cm, gf).
+WOOL_KANG_YU_CM_GF = dict(
+    C_warp=1118.2, C_weft=759.5, C_shear=41.8, B_warp=0.083, B_weft=0.063, B_twist=0.027, weight=0.019
+)
+
+PRESETS = {"wool-kang-yu": ("cm-gf-s", WOOL_KANG_YU_CM_GF)}
+
+_FABRIC_KINDS = {
+    "C_warp": "line_force", "C_weft": "line_force", "C_shear": "line_force", "C12": "line_force",
+    "B_warp": "moment", "B_weft": "moment", "B_twist": "moment", "B12": "moment",
+    "weight": "pressure",
+}
+
+
+def fabric_from_units(values: dict, units: UnitSystem, *, warp_angle_deg=0.0, name="fabric") -> Material:
+    """Build a :func:`fabric` from rigidities given in ``units`` (e.g. the paper's cm-gf-s)."""
+    si = {k: units.to_si(float(v), _FABRIC_KINDS[k]) for k, v in values.items()}
+    return fabric(**si, warp_angle=np.radians(warp_angle_deg), name=name)
+
+
+def preset(name: str, *, warp_angle_deg: float = 0.0, **overrides) -> Material:
+    """A named fabric preset (``"wool-kang-yu"``), optionally rotated and with overrides in its units."""
+    from .units import unit_system
+
+    if name not in PRESETS:
+        raise ValueError(f'unknown material preset "{name}"; known: {", ".join(PRESETS)}')
+    units_name, values = PRESETS[name]
+    return fabric_from_units({**values, **overrides}, unit_system(units_name), warp_angle_deg=warp_angle_deg, name=name)

@@ -1,0 +1,197 @@
+"""The RF model: everything that is built once per mesh, and the total potential energy.
+
+``Model`` owns the mesh, its patches and image-node rules, the material, the constant bending
+stiffness K_b (Eq. 13), the membrane operator of RFT3 or RFT6, supports, the external load and the
+contact term. Its methods evaluate, for a displacement field ``U (N, 3)`` [m] and a load factor
+``lam``, the total potential energy (method.md)
+
+    Pi(U) = E_b + E_m + E_c - lam P . U,
+
+its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
+The state is only ``U``; solvers are functions of (model, U).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from .assembly import AssemblyPlan, scatter_forces, scatter_matrices
+from .material import Material
+from .membrane import ELEMENTS, membrane_operator
+from .mesh import TriMesh
+from .patch import bending_stiffness, build_patches, curvature
+
+
+@dataclass
+class Supports:
+    """Prescribed (zero) displacements.
+
+    Attributes
+    ----------
+    clamped : node indices held fixed with zero slope across clamped edges (image rule U_img = U_c)
+    pinned : node indices held fixed, free to rotate
+    fixed : (N, 3) bool, further single components held fixed (e.g. in-plane rigid modes)
+    """
+
+    clamped: np.ndarray
+    pinned: np.ndarray
+    fixed: np.ndarray
+
+    @classmethod
+    def none(cls, n_nodes):
+        empty = np.zeros(0, dtype=np.int64)
+        return cls(empty, empty.copy(), np.zeros((n_nodes, 3), dtype=bool))
+
+    def fixed_mask(self) -> np.ndarray:
+        m = self.fixed.copy()
+        m[self.clamped] = True
+        m[self.pinned] = True
+        return m
+
+
+def gravity_load(mesh: TriMesh, weight: float, direction=(0.0, 0.0, -1.0)) -> np.ndarray:
+    """Nodal weight ``(N, 3)`` [N] of a sheet of areal weight ``weight`` [N/m^2] (a third per vertex)."""
+    return np.outer(mesh.node_area * weight, np.asarray(direction, float))
+
+
+def edge_load(mesh: TriMesh, edges: np.ndarray, force_per_length) -> np.ndarray:
+    """Nodal forces ``(N, 3)`` [N] of a uniform line load [N/m] on ``edges (B, 2)`` (half per end)."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    length = np.linalg.norm(mesh.X[edges[:, 1]] - mesh.X[edges[:, 0]], axis=1)
+    w = np.repeat(0.5 * length, 2)
+    P = np.zeros((mesh.n_nodes, 3))
+    share = np.bincount(edges.ravel(), w, minlength=mesh.n_nodes)
+    return P + np.outer(share, np.asarray(force_per_length, float))
+
+
+class Model:
+    """An RF triangle model of a flat fabric sheet (see module docstring).
+
+    Parameters
+    ----------
+    mesh : reference mesh [m]
+    material : rigidities and weight (SI)
+    element : ``"RFT3"`` or ``"RFT6"``
+    supports : prescribed displacements (default: none)
+    load : (N, 3) external nodal load at load factor 1 [N] (default: zero)
+    contact : an object with ``energy(x)``, ``force(x)``, ``tangent_blocks(x)`` (penalty contact)
+    membrane : include the membrane energy (``False`` gives the linear Kirchhoff plate)
+    """
+
+    def __init__(self, mesh: TriMesh, material: Material, *, element="RFT6", supports=None, load=None,
+                 contact=None, membrane=True):
+        if element not in ELEMENTS:
+            raise ValueError(f'unknown element "{element}"; use one of {", ".join(ELEMENTS)}')
+        self.mesh = mesh
+        self.material = material
+        self.element = element
+        self.supports = supports if supports is not None else Supports.none(mesh.n_nodes)
+        self.load = np.zeros((mesh.n_nodes, 3)) if load is None else np.asarray(load, float)
+        if self.load.shape != (mesh.n_nodes, 3):
+            raise ValueError(f"load must have shape ({mesh.n_nodes}, 3), got {self.load.shape}")
+        self.contact = contact
+        self.with_membrane = bool(membrane)
+        self.fixed = self.supports.fixed_mask()
+        self.free = ~self.fixed
+        self.patches = build_patches(mesh, clamped_nodes=self.supports.clamped)
+        self.Kb = bending_stiffness(mesh, self.patches, material.Db)
+        self.membrane = membrane_operator(element, mesh, self.patches)
+
+    # --- constant structures, built on first use ------------------------------------------------
+    @cached_property
+    def plan(self) -> AssemblyPlan:
+        return AssemblyPlan(self.patches.nodes, self.mesh.n_nodes, self.free)
+
+    @cached_property
+    def _bending_data(self) -> np.ndarray:
+        return self.plan.scalar_kron_data(self.Kb)
+
+    @cached_property
+    def _membrane_map(self) -> np.ndarray:
+        return self.plan.element_map(self.membrane.nodes)
+
+    @property
+    def X3(self) -> np.ndarray:
+        """(N, 3) reference positions [m]."""
+        return self.mesh.X3
+
+    def positions(self, U) -> np.ndarray:
+        return self.X3 + U
+
+    # --- energy and its derivatives -------------------------------------------------------------
+    def energies(self, U, lam=1.0) -> dict:
+        """Parts of the total potential [J]: bending, membrane, contact, external work, total."""
+        Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
+        Em = self.membrane.energy(U, self.material.Dm) if self.with_membrane else 0.0
+        Ec = self.contact.energy(self.positions(U)) if self.contact is not None else 0.0
+        W = lam * float(np.einsum("ni,ni->", self.load, U))
+        return {"bending": Eb, "membrane": Em, "contact": Ec, "external_work": W,
+                "total": Eb + Em + Ec - W}
+
+    def potential(self, U, lam=1.0) -> float:
+        """Total potential energy Pi(U) [J]."""
+        return self.energies(U, lam)["total"]
+
+    def internal_force(self, U) -> np.ndarray:
+        """Internal (bending + membrane + contact) force ``(N, 3)`` [N], the gradient of the stored energy."""
+        f = self.Kb @ U
+        if self.with_membrane:
+            fe = self.membrane.element_forces(U, self.material.Dm)
+            f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
+        if self.contact is not None:
+            f += self.contact.force(self.positions(U))
+        return f
+
+    def residual(self, U, lam=1.0) -> np.ndarray:
+        """Out-of-balance force ``dPi/dU (N, 3)`` [N]; zero at equilibrium on the free dofs."""
+        return self.internal_force(U) - lam * self.load
+
+    def tangent(self, U, *, psd=False, shift=0.0):
+        """Residual ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m].
+
+        ``psd=True`` drops compressive stress from the geometric stiffness (positive semi-definite
+        membrane tangent); ``shift`` adds ``shift * I`` (Levenberg-Marquardt).
+        """
+        plan = self.plan
+        data = self._bending_data.copy()
+        f = self.Kb @ U
+        x = self.positions(U)
+        if self.with_membrane:
+            fe, ke = self.membrane.element_tangents(U, self.material.Dm, psd=psd)
+            f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
+            data += scatter_matrices(self._membrane_map, ke, plan.nnz)
+        if self.contact is not None:
+            f += self.contact.force(x)
+            data += scatter_matrices(plan.diag_positions, self.contact.tangent_blocks(x), plan.nnz)
+        if shift:
+            data += scatter_matrices(plan.diag_positions, shift * np.broadcast_to(np.eye(3), (self.mesh.n_nodes, 3, 3)), plan.nnz)
+        return f, plan.free_matrix(data)
+
+    # --- post-processing ------------------------------------------------------------------------
+    def curvature(self, U) -> np.ndarray:
+        """(E, 3) element curvature (k_xx, k_yy, 2 k_xy) [1/m], Eq. 7."""
+        return curvature(self.patches, U, self.positions(U))
+
+    def membrane_strain(self, U) -> np.ndarray:
+        """(E, 3) averaged Green membrane strain (e_xx, e_yy, 2 e_xy) [-]."""
+        return self.membrane.strain(U)
+
+    def relative_curvature(self, U) -> np.ndarray:
+        """(E,) |kappa| h, the relative curvature of §2.2 and §5.1 [-]."""
+        k = self.curvature(U)
+        mag = np.sqrt(k[:, 0] ** 2 + k[:, 1] ** 2 + 0.5 * k[:, 2] ** 2)
+        return mag * self.mesh.element_size
+
+    def summary(self) -> dict:
+        return {
+            "element": self.element,
+            "nodes": self.mesh.n_nodes,
+            "elements": self.mesh.n_elements,
+            "free_dofs": int(self.free.sum()),
+            "clamped_nodes": int(len(self.supports.clamped)),
+            "pinned_nodes": int(len(self.supports.pinned)),
+            "membrane": self.with_membrane,
+        }

@@ -1,0 +1,344 @@
+"""Static drape: load-scaled Newton iteration on the total potential energy (method.md, §4).
+
+The gravity/load factor ``lam`` rises from 0 to 1 in adaptive increments. At each increment a
+Newton iteration minimises Pi(U) = E_b + E_m + E_c - lam P.U:
+
+1. tangent: the exact Hessian first; if the Cholesky factorisation finds it indefinite (membrane
+   compression) or the step is not a descent direction, the compressive stress is dropped from the
+   geometric stiffness (positive semi-definite membrane tangent), and if needed a
+   Levenberg-Marquardt shift is added;
+2. the step is scaled so that no node moves more than ``max_step`` (the "simple scaling" of Liu &
+   Sze 2009), which keeps the first steps from a flat start in range;
+3. an Armijo backtracking line search on Pi makes every accepted step lower the energy;
+4. convergence needs both the force residual ``|r| <= rtol |lam P|`` and the energy criterion
+   ``|d . r_new| <= etol |d_1 . r_0|`` (work of the residual on the last step, Bathe).
+An increment that does not converge is cut back (``increment / 4``) from the last equilibrium;
+below ``min_increment`` the solve stops with :class:`ConvergenceError`, which carries the last
+equilibrium, labelled as not converged.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from .linsolve import LinearSolveError, NotPositiveDefinite, make_solver
+from .progress import Progress
+
+log = logging.getLogger(__name__)
+
+
+class ConvergenceError(RuntimeError):
+    """The static solve failed; ``result`` holds the last equilibrium reached (not converged)."""
+
+    def __init__(self, message, result=None):
+        super().__init__(message)
+        self.result = result
+
+
+@dataclass(frozen=True, kw_only=True)
+class StaticOptions:
+    """Options of :func:`solve_static` (scene table ``[solver]``).
+
+    Attributes
+    ----------
+    initial_increment, min_increment, max_increment : load-factor increments [-]
+    max_iterations : Newton iterations per increment
+    rtol : force tolerance, relative to the applied load |lam P| [-], at full load
+    intermediate_rtol : looser force tolerance for the increments on the way to full load [-]
+    etol : energy tolerance, relative to the first step's energy increment [-]
+    max_step : cap on the largest nodal increment per Newton iteration [m]; ``None``: 10 % of the
+        sheet's diagonal
+    increment_displacement : target largest nodal displacement per load increment [m], from which
+        the next increment is sized by the secant (first: tangent) rate d|U|/d lam; ``None``: 5 %
+        of the sheet's diagonal. Halved or grown with the Newton iteration count.
+    line_search : Armijo backtracking on Pi
+    tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
+    linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
+    max_load_steps : give up after this many increments
+    perturbation : amplitude of a seeded random out-of-plane start, in element sizes [-]
+    seed : seed of that perturbation
+    """
+
+    initial_increment: float = 0.1
+    min_increment: float = 1e-5
+    max_increment: float = 1.0
+    max_iterations: int = 30
+    rtol: float = 1e-7
+    intermediate_rtol: float = 0.1
+    etol: float = 1e-12
+    max_step: float | None = None
+    increment_displacement: float | None = None
+    line_search: bool = True
+    tangent: str = "auto"
+    linear_solver: str = "auto"
+    max_load_steps: int = 2000
+    perturbation: float = 0.0
+    seed: int = 0
+    progress: bool = True
+
+    def __post_init__(self):
+        if self.tangent not in ("auto", "exact", "psd"):
+            raise ValueError(f'solver.tangent must be "auto", "exact" or "psd", got "{self.tangent}"')
+        if not (0 < self.min_increment <= self.initial_increment <= self.max_increment <= 1):
+            raise ValueError(
+                "need 0 < min_increment <= initial_increment <= max_increment <= 1, got "
+                f"{self.min_increment}, {self.initial_increment}, {self.max_increment}")
+        if self.rtol <= 0 or self.max_iterations < 1:
+            raise ValueError(f"need rtol > 0 and max_iterations >= 1, got {self.rtol}, {self.max_iterations}")
+
+
+@dataclass
+class StaticResult:
+    """Outcome of :func:`solve_static`.
+
+    Attributes
+    ----------
+    U : (N, 3) displacements of the last equilibrium [m]
+    lam : load factor reached [-]
+    converged : True only if lam = 1 was reached in equilibrium
+    load_steps : one record per accepted increment (load factor, iterations, residual, tangents)
+    """
+
+    U: np.ndarray
+    lam: float
+    converged: bool
+    load_steps: list = field(default_factory=list)
+    iterations: int = 0
+    cutbacks: int = 0
+    linear_solver: str = ""
+    wall_time: float = 0.0
+    energies: dict = field(default_factory=dict)
+    residual: float = float("nan")
+    stable: bool | None = None
+    message: str = ""
+    tangent_modes: dict = field(default_factory=dict)
+    seed: int | None = None
+
+    def summary(self) -> dict:
+        d = {k: v for k, v in asdict(self).items() if k != "U"}
+        d["load_step_count"] = len(self.load_steps)
+        return d
+
+
+@dataclass
+class _Newton:
+    converged: bool
+    U: np.ndarray
+    iterations: int
+    residual: float
+    reason: str = ""
+    stable: bool | None = None
+
+
+def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
+    """Solve the static equilibrium of ``model`` under its full load (see module docstring).
+
+    Parameters
+    ----------
+    model : :class:`rftstatic.model.Model`
+    U0 : (N, 3) start [m] (default: the flat reference, optionally perturbed)
+    options : :class:`StaticOptions`
+    callback : called as ``callback(lam, U)`` after every converged increment (checkpoints, frames)
+
+    Raises
+    ------
+    ConvergenceError
+        when an increment cannot converge even at ``min_increment``; ``.result`` holds the last
+        equilibrium (``converged=False``).
+    """
+    opts = options or StaticOptions()
+    t0 = time.perf_counter()
+    n = model.mesh.n_nodes
+    free = model.free.ravel()
+    U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
+    seed = None
+    if opts.perturbation and U0 is None:
+        seed = opts.seed
+        rng = np.random.default_rng(seed)
+        h = model.mesh.element_size.mean()
+        U[:, 2] += opts.perturbation * h * rng.uniform(-1, 1, n) * model.free[:, 2]
+    solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
+    max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
+    target = opts.increment_displacement if opts.increment_displacement is not None else 0.05 * diagonal
+    result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
+    modes = {"exact": 0, "psd": 0, "shift": 0}
+    lam = 0.0
+    dlam = _first_increment(model, U, opts, solver, target)
+    U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
+    bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
+    try:
+        while lam < 1.0:
+            if len(result.load_steps) >= opts.max_load_steps:
+                raise ConvergenceError(
+                    f"load factor {lam:.6g}: {opts.max_load_steps} load increments used without reaching "
+                    "full load; raise solver.max_load_steps or solver.initial_increment")
+            lam_next = min(1.0, lam + dlam)
+            start = U
+            if U_prev is not None:  # secant predictor along the equilibrium path
+                start = U + (lam_next - lam) / (lam - lam_prev) * (U - U_prev)
+            nt = _newton(model, start, lam_next, opts, solver, max_step, modes)
+            result.iterations += nt.iterations
+            if nt.converged:
+                U_prev, lam_prev = U, lam
+                lam, U = lam_next, nt.U
+                result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
+                                          "increment": dlam})
+                result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
+                bar.update(lam, f"it {nt.iterations}")
+                if callback is not None:
+                    callback(lam, U)
+                if nt.iterations <= 4:
+                    target *= 1.5
+                elif nt.iterations >= 10:
+                    target *= 0.5
+                rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
+                grow = 2.0 * (lam - lam_prev)  # never more than double the last increment
+                dlam = float(np.clip(target / max(rate, 1e-300), opts.min_increment, min(opts.max_increment, grow)))
+                continue
+            result.cutbacks += 1
+            log.info("load factor %.6g: %s after %d iterations (|r| = %.3e); cutting back the increment",
+                     lam_next, nt.reason, nt.iterations, nt.residual)
+            dlam /= 4.0
+            target /= 4.0
+            if dlam < opts.min_increment:
+                raise ConvergenceError(
+                    f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
+                    f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
+                    f"min_increment = {opts.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
+        result.converged = True
+        result.message = "converged"
+    except ConvergenceError as exc:
+        result.message = str(exc)
+        exc.result = result
+        raise
+    finally:
+        bar.close()
+        result.tangent_modes = dict(modes)
+        result.wall_time = time.perf_counter() - t0
+        result.energies = model.energies(result.U, result.lam)
+    return result
+
+
+def _first_increment(model, U, opts, solver, target) -> float:
+    """First load increment: the tangent displacement rate d|U|/d lam at the start, scaled to ``target``."""
+    free = model.free.ravel()
+    P = model.load.ravel()[free]
+    if not np.any(P):
+        return opts.initial_increment
+    try:
+        _, K = model.tangent(U, psd=True)
+        du = np.zeros(3 * model.mesh.n_nodes)
+        du[free] = solver.solve(K, P)
+    except (NotPositiveDefinite, LinearSolveError):
+        return opts.initial_increment
+    rate = float(np.linalg.norm(du.reshape(-1, 3), axis=1).max())
+    return float(np.clip(target / max(rate, 1e-300), opts.min_increment, opts.initial_increment))
+
+
+def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
+    """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified)."""
+    rtol = opts.rtol if lam >= 1.0 else max(opts.rtol, opts.intermediate_rtol)
+    etol = opts.etol if lam >= 1.0 else max(opts.etol, opts.intermediate_rtol**2)
+    free = model.free.ravel()
+    P = model.load
+    # a floor keeps the tolerance above round-off for vanishing loads
+    ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
+    U = U.copy()
+    Pi = model.potential(U, lam)
+    r = (model.residual(U, lam)).ravel()[free]
+    rnorm = float(np.linalg.norm(r))
+    if not np.isfinite(rnorm):
+        return _Newton(False, U, 0, rnorm, "non-finite residual")
+    work0 = None
+    last_work = np.inf
+    stable = None
+    for it in range(1, opts.max_iterations + 1):
+        if rnorm <= rtol * ref and (it > 1 and last_work <= etol * work0):
+            return _Newton(True, U, it - 1, rnorm, stable=stable)
+        try:
+            d, mode = _direction(model, U, lam, r, opts, solver, modes)
+        except LinearSolveError as exc:
+            return _Newton(False, U, it, rnorm, f"linear solve failed ({exc})")
+        stable = (mode == "exact") if solver.detects_indefinite else None
+        dfull = np.zeros(3 * model.mesh.n_nodes)
+        dfull[free] = d
+        step = dfull.reshape(-1, 3)
+        biggest = float(np.linalg.norm(step, axis=1).max())
+        if biggest > max_step:
+            step *= max_step / biggest
+        slope = float(r @ step.ravel()[free])
+        alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts)
+        if alpha is None:
+            return _Newton(False, U, it, rnorm, "line search found no decrease of the energy")
+        U = U + alpha * step
+        Pi = Pi_new
+        r_new = model.residual(U, lam).ravel()[free]
+        work = abs(float(alpha * step.ravel()[free] @ r_new))
+        if work0 is None:
+            work0 = max(abs(alpha * slope), 1e-300)
+        last_work = work
+        r = r_new
+        rnorm = float(np.linalg.norm(r))
+        if not np.isfinite(rnorm):
+            return _Newton(False, U, it, rnorm, "non-finite residual")
+    if rnorm <= rtol * ref and last_work <= etol * work0:
+        return _Newton(True, U, opts.max_iterations, rnorm, stable=stable)
+    return _Newton(False, U, opts.max_iterations, rnorm, f"no convergence in {opts.max_iterations} iterations")
+
+
+def _direction(model, U, lam, r, opts, solver, modes):
+    """Newton direction on the free dofs, with the indefinite-tangent safeguard."""
+    sequence = {"auto": ["exact", "psd", "shift"], "exact": ["exact", "shift"], "psd": ["psd", "shift"]}[opts.tangent]
+    last_error = None
+    for mode in sequence:
+        shifts = [0.0] if mode != "shift" else None
+        if mode == "shift":
+            _, K = model.tangent(U, psd=True)
+            scale = float(np.abs(K.diagonal()).mean())
+            shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0)]
+        for shift in shifts:
+            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift)
+            try:
+                d = solver.solve(K, -r)
+            except NotPositiveDefinite as exc:
+                last_error = exc
+                continue
+            if not np.all(np.isfinite(d)):
+                last_error = LinearSolveError("non-finite step")
+                continue
+            if float(r @ d) < 0.0 or not np.any(r):
+                modes[mode] += 1
+                return d, mode
+            last_error = LinearSolveError("the step is not a descent direction of the energy")
+    raise LinearSolveError(str(last_error))
+
+
+def _line_search(model, U, step, lam, Pi0, slope, opts, max_trials=12):
+    """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""
+    if not opts.line_search:
+        return 1.0, model.potential(U + step, lam)
+    parts = model.energies(U, lam)
+    scale = abs(parts["bending"]) + abs(parts["membrane"]) + abs(parts["contact"]) + abs(parts["external_work"])
+    if abs(slope) <= 1e-10 * scale:
+        # the predicted decrease is below what the energy can resolve: near the solution the Newton
+        # step is reliable, and the force residual (not the energy) decides convergence
+        return 1.0, model.potential(U + step, lam)
+    roundoff = 1e-13 * scale
+    alpha = 1.0
+    for _ in range(max_trials):
+        Pi = model.potential(U + alpha * step, lam)
+        if np.isfinite(Pi) and Pi <= Pi0 + 1e-4 * alpha * slope + roundoff:
+            return alpha, Pi
+        # minimiser of the quadratic through Pi0, slope and Pi(alpha), safeguarded
+        if np.isfinite(Pi):
+            denom = 2.0 * (Pi - Pi0 - slope * alpha)
+            a_q = -slope * alpha * alpha / denom if denom > 0 else 0.5 * alpha
+            alpha = float(np.clip(a_q, 0.1 * alpha, 0.5 * alpha))
+        else:
+            alpha *= 0.1
+    return None, Pi0
