@@ -35,12 +35,23 @@ def _cases(n_nodes):
     square = Domain.rectangle(0.0, 0.0, 1.0, 1.0)
     h = np.sqrt(2.0 / (np.sqrt(3.0) * n_nodes))
     yield "square uniform", square, BackgroundGrid.uniform(h, square)
-    # graded disc, sizes 1:20 from a point source; scale h0 to hit n_nodes roughly
+    # graded disc, sizes 1:20 from a point source; h0 tuned so that the
+    # equilateral node density 2 / (sqrt(3) h^2) integrates to n_nodes
     disc = Domain.disc(0.0, 0.0, 1.0)
-    h0 = 0.12 * h * np.sqrt(np.pi)
-    f = BackgroundGrid.from_function(
-        lambda x, y: np.minimum(20 * h0, h0 + 0.25 * np.hypot(x - 0.5, y)), disc, spacing=min(0.01, h0))
-    yield "disc graded 1:20", disc, f
+    x, y = np.meshgrid(np.linspace(-1, 1, 401), np.linspace(-1, 1, 401))
+    inside = np.hypot(x, y) <= 1.0
+    r = np.hypot(x - 0.5, y)[inside]
+
+    def field(h0):
+        return lambda x, y: np.minimum(20 * h0, h0 + 0.25 * np.hypot(x - 0.5, y))
+
+    lo, hi = 1e-5, 0.5
+    for _ in range(60):
+        h0 = np.sqrt(lo * hi)
+        n = np.sum(2.0 / (np.sqrt(3.0) * np.minimum(20 * h0, h0 + 0.25 * r) ** 2)) * (2.0 / 400) ** 2
+        lo, hi = (h0, hi) if n > n_nodes else (lo, h0)
+    spacing = min(0.01, h0)
+    yield "disc graded 1:20", disc, BackgroundGrid.from_function(field(h0), disc, spacing=spacing)
 
 
 def main(argv=None):

@@ -129,7 +129,9 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
             lst.append(n)
 
     SHIFT = 1 << 32
-    front = {}      # edge key a*SHIFT+b -> sequence number of its heap entry
+    # edge key a*SHIFT+b -> record (key, a, b, ax, ay, bx, by, seq); buckets hold
+    # the records, so a record is alive while the front maps its key to it
+    front = {}
     deg = [0] * nb  # number of front edges at each node
     heap = []
     seq = 0
@@ -139,7 +141,8 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
         ax, ay, bx, by = X[a], Y[a], X[b], Y[b]
         key = a * SHIFT + b
         seq += 1
-        front[key] = seq
+        rec = (key, a, b, ax, ay, bx, by, seq)
+        front[key] = rec
         deg[a] += 1
         deg[b] += 1
         heapq.heappush(heap, (math.hypot(bx - ax, by - ay), seq, a, b))
@@ -151,9 +154,9 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
             for k in range(i * ncy + j0, i * ncy + j1 + 1):
                 lst = edge_cells[k]
                 if lst is None:
-                    edge_cells[k] = [key]
+                    edge_cells[k] = [rec]
                 else:
-                    lst.append(key)
+                    lst.append(rec)
 
     for n in range(nb):
         add_node(n)
@@ -170,7 +173,8 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
     while heap:
         L, s, a, b = heapq.heappop(heap)
         key = a * SHIFT + b
-        if front.get(key) != s:
+        rec = front.get(key)
+        if rec is None or rec[7] != s:
             continue
         steps += 1
         if steps > max_steps:
@@ -210,7 +214,7 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
         if j1 >= ncy:
             j1 = ncy - 1
         lnodes = []
-        lkeys = set()
+        ledges = []     # may hold an edge twice (it spans two cells): harmless
         for i in range(i0, i1 + 1):
             base = i * ncy
             for k in range(base + j0, base + j1 + 1):
@@ -222,15 +226,10 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
                     lnodes.extend(alive)
                 lst = edge_cells[k]
                 if lst:
-                    alive = [e for e in lst if e in front]
+                    alive = [r for r in lst if front.get(r[0]) is r]
                     if len(alive) != len(lst):
                         edge_cells[k] = alive
-                    lkeys.update(alive)
-        lkeys.discard(key)
-        ledges = []
-        for e in lkeys:
-            p, q = divmod(e, SHIFT)
-            ledges.append((p, q, X[p], Y[p], X[q], Y[q]))
+                    ledges.extend(alive)
         tol = 1e-9 * L * L
         eps = 1e-6 * L
 
@@ -242,7 +241,7 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
             xmax = max(ax, bx, cx)
             ymin = min(ay, by, cy)
             ymax = max(ay, by, cy)
-            for p, q, ppx, ppy, qqx, qqy in ledges:
+            for _k, p, q, ppx, ppy, qqx, qqy, _s in ledges:
                 if (ppx < xmin and qqx < xmin) or (ppx > xmax and qqx > xmax) or \
                    (ppy < ymin and qqy < ymin) or (ppy > ymax and qqy > ymax):
                     continue
@@ -290,7 +289,9 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
                 if ex * ex + ey * ey < rn:
                     return False
             re = (_CLEAR_EDGE * dd) ** 2
-            for p, q, ppx, ppy, qqx, qqy in ledges:
+            for ek, p, q, ppx, ppy, qqx, qqy, _s in ledges:
+                if ek == key:
+                    continue
                 sx = qqx - ppx
                 sy = qqy - ppy
                 t = ((qx - ppx) * sx + (qy - ppy) * sy) / (sx * sx + sy * sy)
@@ -346,7 +347,12 @@ def advance_front(bpoints, bedges, size_field, *, max_steps=None):
                     "the boundary is too coarse for the holes/corners nearby")
             deferred[key] = n_def
             seq += 1
-            front[key] = seq
+            rec = rec[:7] + (seq,)
+            front[key] = rec
+            for i in range(int((min(ax, bx) - bx0) * cinv), int((max(ax, bx) - bx0) * cinv) + 1):
+                for k in range(i * ncy + int((min(ay, by) - by0) * cinv),
+                               i * ncy + int((max(ay, by) - by0) * cinv) + 1):
+                    edge_cells[k].append(rec)
             heapq.heappush(heap, (L * (1.0 + 0.5 * n_def), seq, a, b))
             continue
 
