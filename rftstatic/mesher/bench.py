@@ -50,8 +50,7 @@ def _cases(n_nodes):
         h0 = np.sqrt(lo * hi)
         n = np.sum(2.0 / (np.sqrt(3.0) * np.minimum(20 * h0, h0 + 0.25 * r) ** 2)) * (2.0 / 400) ** 2
         lo, hi = (h0, hi) if n > n_nodes else (lo, h0)
-    spacing = min(0.01, h0)
-    yield "disc graded 1:20", disc, BackgroundGrid.from_function(field(h0), disc, spacing=spacing)
+    yield "disc graded 1:20", disc, BackgroundGrid.from_function(field(h0), disc, spacing=0.005)
 
 
 def main(argv=None):
