@@ -103,8 +103,11 @@ def meshed(request):
 
 
 def test_conforming_triangulation(meshed):
-    _, domain, _, res = meshed
+    _, domain, field, res = meshed
     assert_conforming(res, domain)
+    # smoothing never moved a boundary node off its discretised position
+    bp, be, _ = domain.discretise(field)
+    assert np.array_equal(res.points[res.boundary], bp) and np.array_equal(res.boundary_edges, be)
 
 
 def test_quality_targets(meshed):
@@ -291,3 +294,13 @@ def test_bench_main_runs_small(capsys):
     bench.main(["--nodes", "300"])
     out = capsys.readouterr().out
     assert "tri/s" in out
+
+
+@pytest.mark.slow
+def test_speed_20k_nodes():
+    """Requirement: >= 5000 triangles/s; a 20k-node mesh in seconds (timed, hence slow)."""
+    d = Domain.rectangle(0.0, 0.0, 1.0, 1.0)
+    res = generate(d, np.sqrt(2.0 / (np.sqrt(3.0) * 20_000)))
+    assert 18_000 < res.quality.n_nodes < 22_000
+    assert res.quality.triangles_per_second >= 5_000
+    assert res.quality.wall_time < 20.0
