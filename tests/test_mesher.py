@@ -304,3 +304,13 @@ def test_speed_20k_nodes():
     assert 18_000 < res.quality.n_nodes < 22_000
     assert res.quality.triangles_per_second >= 5_000
     assert res.quality.wall_time < 20.0
+
+
+def test_loop_orientation_is_normalised():
+    outer_cw = [[0, 0], [0, 1], [1, 1], [1, 0]]
+    hole_ccw = [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6], [0.4, 0.6]]
+    d = Domain.polygon(outer_cw, holes=[hole_ccw])
+    assert d.loops[0].signed_area > 0 > d.loops[1].signed_area
+    assert d.area == pytest.approx(1.0 - 0.04)
+    res = generate(d, 0.1)
+    assert_conforming(res, d)
