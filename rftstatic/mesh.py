@@ -228,7 +228,7 @@ def _signed_area2(X, tri):
 # --- generators ------------------------------------------------------------------------------
 
 
-def rectangle(lx, ly, nx, ny, *, origin=(0.0, 0.0), pattern="alternate", z0=0.0) -> TriMesh:
+def rectangle(lx, ly, nx, ny, *, origin=(0.0, 0.0), pattern="right", z0=0.0) -> TriMesh:
     """Structured triangulation of a ``lx`` x ``ly`` rectangle with ``nx`` x ``ny`` nodes.
 
     Parameters

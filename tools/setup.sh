@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Set up rftstatic on a fresh Debian machine: SuiteSparse headers and OpenBLAS (when root), then the
+# package with CHOLMOD and the test tools. Safe to run again: it skips what is already there.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY=${PYTHON:-python3}
+if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+  if ! dpkg -s libsuitesparse-dev libopenblas0-pthread >/dev/null 2>&1; then
+    echo "setup: installing libsuitesparse-dev (CHOLMOD headers) and OpenBLAS with apt-get" >&2
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libsuitesparse-dev libopenblas0-pthread >/dev/null
+  fi
+fi
+if ! "$PY" -m pip install -q -e ".[cholmod,test]"; then
+  echo "setup: scikit-sparse (CHOLMOD) did not build; installing without it (scipy's solver is used)" >&2
+  "$PY" -m pip install -q -e ".[test]"
+fi
