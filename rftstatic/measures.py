@@ -70,16 +70,19 @@ def shadow_area(x: np.ndarray, tri: np.ndarray, resolution: int = 2000) -> float
     -----
     Accuracy: the covered length L(y) is piecewise linear in y, with kinks only at node
     heights, so the mid-point rule is exact on every strip without a kink; a strip with a
-    kink errs by at most |ΔL'|·Δy²/8. The total error is therefore bounded by
-    Σ|ΔL'|·Δy²/8, second order in Δy = (y_max − y_min)/resolution: for a convex outline it is
-    at most (perimeter/width-scale)·Δy²/4, below 1e-6 relative for a disc at the default
-    2000 lines, and zero for polygons whose vertices lie between scan lines' kinks
-    (e.g. an axis-aligned square). Cost and memory grow with Σ over triangles of the scan
-    lines each crosses (about 2·A_sheet/(Δy·mean edge) pairs).
+    kink errs by at most |ΔL'|·Δy²/8, Δy = (y_max − y_min)/resolution. The result is exact
+    (to rounding) for an axis-aligned rectangle and within Σ|ΔL'|·Δy²/8 for any polygon
+    (tested on rotated squares). On a finely polygonised round outline the top and bottom
+    strips, where the outline turns horizontal, dominate: a disc comes out within 4e-6
+    (relative) at the default 2000 lines and 3e-5 at 500 (measured).
+
+    Cost and memory grow with the number of (triangle, scan line) pairs, about
+    A_sheet/(Δy·mean edge): 80 000 triangles at 2000 lines take about 0.7 s.
     """
     x, tri = _check_mesh(x, tri, "shadow_area")
     if int(resolution) < 1:
-        raise ValueError(f"shadow_area: resolution = {resolution!r}; use a positive number of scan lines")
+        raise ValueError(f"shadow_area: resolution = {resolution!r}; "
+                         "use a positive number of scan lines")
     n = int(resolution)
     p = x[tri][:, :, :2]                                    # (E, 3, 2)
     y0, y1 = p[..., 1].min(), p[..., 1].max()
