@@ -56,7 +56,7 @@ class ElasticaError(RuntimeError):
     """The elastica boundary-value problem did not converge."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)   # arrays inside: compare by identity
 class ElasticaSolution:
     """A solved heavy elastica, nondimensional (lengths / L, s̄ = s / L).
 
