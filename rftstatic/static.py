@@ -11,7 +11,7 @@ Newton iteration minimises Pi(U) = E_b + E_m + E_c - lam P.U:
    Sze 2009), which keeps the first steps from a flat start in range;
 3. an Armijo backtracking line search on Pi makes every accepted step lower the energy;
 4. convergence needs both the force residual ``|r| <= rtol |lam P|`` and the energy criterion
-   ``|d . r_new| <= etol |d_1 . r_0|`` (work of the residual on the last step, Bathe).
+   ``|d . r_new| <= etol max(|d_1 . r_0|, |lam P.U|)`` (work of the residual on the last step).
 An increment that does not converge is cut back (``increment / 4``) from the last equilibrium;
 below ``min_increment`` the solve stops with :class:`ConvergenceError`, which carries the last
 equilibrium, labelled as not converged.
@@ -49,7 +49,8 @@ class StaticOptions:
     max_iterations : Newton iterations per increment
     rtol : force tolerance, relative to the applied load |lam P| [-], at full load
     intermediate_rtol : looser force tolerance for the increments on the way to full load [-]
-    etol : energy tolerance, relative to the first step's energy increment [-]
+    etol : energy tolerance on the work of the residual over the last step, relative to the larger
+        of the first step's work and the work of the applied load [-]
     max_step : cap on the largest nodal increment per Newton iteration [m]; ``None``: 10 % of the
         sheet's diagonal
     increment_displacement : target largest nodal displacement per load increment [m], from which
@@ -280,7 +281,9 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
         r_new = model.residual(U, lam).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r_new))
         if work0 is None:
-            work0 = max(abs(alpha * slope), 1e-300)
+            # energy scale: the first step's work or the work of the load so far, whichever is larger
+            # (a good predictor makes the first step tiny; round-off must not stall the criterion)
+            work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))), 1e-300)
         last_work = work
         r = r_new
         rnorm = float(np.linalg.norm(r))

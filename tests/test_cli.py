@@ -1,0 +1,67 @@
+"""Scenes and the command line: runs, outputs, and errors that name the file, key and value."""
+
+import json
+
+import pytest
+
+from rftstatic.cli import main
+from rftstatic.scene import SceneError, load_scene
+
+
+def test_list_shows_the_strip(capsys):
+    assert main(["list"]) == 0
+    assert "strip" in capsys.readouterr().out
+
+
+def test_case_with_overrides_writes_summary_vtu_and_views(tmp_path, capsys):
+    out = tmp_path / "strip"
+    code = main(["case", "strip", "--set", "element=RFT3", "--set", "mesh.nodes=[11, 3]", "--out", str(out)])
+    assert code == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["element"] == "RFT3" and s["nodes"] == 33 and s["elements"] == 40
+    assert s["converged"] is True and s["load_steps"] >= 1 and s["newton_iterations"] >= s["load_steps"]
+    assert s["units"] == "cm-gf-s" and s["linear_solver"] in ("cholmod", "scipy")
+    tip = s["probes"]["tip"]
+    assert tip["reference"] == pytest.approx([5.0, 0.0, 0.0])
+    # the tip hangs: about 1.8 cm from the clamp and 4.3 cm below it (heavy elastica: 1.77, -4.34)
+    assert 1.5 < tip["deformed"][0] < 2.1 and -4.6 < tip["deformed"][2] < -4.0
+    for name in ("deformed.vtu", "view_side.png", "view_top.png", "view_iso.png"):
+        assert (out / name).stat().st_size > 0
+
+
+def test_case_accepts_a_path(tmp_path):
+    scene = tmp_path / "mine.toml"
+    scene.write_text('units = "cm-gf-s"\n[mesh]\nsize = [2.0, 1.0]\nnodes = [5, 3]\n'
+                     '[[supports]]\nkind = "clamped"\nbox = [-1.0, -1.0, -1.0, 1.0]\n')
+    assert main(["case", str(scene), "--out", str(tmp_path / "o"), "--no-figures"]) == 0
+
+
+@pytest.mark.parametrize("override,fragment", [
+    ("mesh.sise=[1, 2]", "mesh.sise: unknown key"),
+    ("element=RFT9", 'element: "RFT9" is not an element'),
+    ("mesh.nodes=3", "mesh.nodes: expected list"),
+    ("units=furlongs", "unknown unit system"),
+    ("solver.rtol=[1]", "solver.rtol: expected"),
+])
+def test_bad_scene_values_name_file_and_key(override, fragment):
+    with pytest.raises(SceneError) as info:
+        load_scene("strip", [override])
+    assert "strip.toml" in str(info.value) and fragment in str(info.value)
+
+
+def test_cli_reports_scene_errors_without_traceback(capsys):
+    assert main(["case", "strip", "--set", "mesh.kind=hexagon", "--no-figures", "--out", "/tmp/x"]) == 2
+    err = capsys.readouterr().err
+    assert "mesh.kind" in err and "hexagon" in err and "Traceback" not in err
+
+
+def test_unknown_scene_lists_known_ones():
+    with pytest.raises(SceneError, match="known scenes: .*strip"):
+        load_scene("no-such-scene")
+
+
+def test_support_box_without_nodes_is_an_error(tmp_path):
+    with pytest.raises(SceneError, match=r"supports.0.box.*contains no node"):
+        from rftstatic.build import build_model
+
+        build_model(load_scene("strip", ["supports.0.box=[9.0, 9.0, 9.0, 9.0]"]))
