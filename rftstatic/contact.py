@@ -113,6 +113,12 @@ class PenaltyContact:
         ``normal_gradient``)
     node_area : (N,) area attributed to each node, e.g. a third of its triangles' areas [m^2]
     stiffness : penalty stiffness ``k`` (pressure per penetration depth) [N/m^3]; see :func:`auto_penalty`
+    smoothing : width ``eps`` [m] of a C^2 onset of the penalty (0: the plain quadratic penalty).
+        With ``eps > 0`` the energy density per node is ``k (eps - phi)^3 / (6 eps)`` for
+        ``0 <= phi < eps`` and ``k (eps^2/6 - eps phi/2 + phi^2/2)`` for ``phi < 0``: value, slope and
+        curvature are continuous, so the Hessian does not jump when a node touches or leaves the
+        obstacle and Newton keeps its quadratic convergence while the contact set settles. A node
+        resting under a pressure ``p`` sits at ``phi = eps/2 - p/k``.
 
     Notes
     -----
@@ -121,8 +127,10 @@ class PenaltyContact:
     what a Newton iteration should call.
     """
 
-    def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float):
+    def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float,
+                 smoothing: float = 0.0):
         self.obstacles = _as_list(obstacles)
+        self.smoothing = _positive("smoothing", smoothing, allow_zero=True)
         area = np.asarray(node_area, dtype=float)
         if area.ndim != 1:
             raise ValueError(f"node_area must have shape (N,), got shape {area.shape}")
@@ -160,21 +168,37 @@ class PenaltyContact:
         """
         x = _as_points(x, self.n_nodes)
         phi, normal = self._distances(x)
-        pen = np.minimum(phi, 0.0)  # (M, N)
+        e, d1, d2 = self._density(phi)  # energy density, d/dphi, d2/dphi2 per unit k A  (M, N)
         ka = self.stiffness * self.node_area  # (N,) [N/m]
-        energy = 0.5 * float(np.sum(ka * np.sum(pen**2, axis=0)))
-        force = np.einsum("n,mn,mni->ni", ka, pen, normal)
+        energy = float(np.sum(ka * np.sum(e, axis=0)))
+        force = np.einsum("n,mn,mni->ni", ka, d1, normal)
         blocks = np.zeros((x.shape[0], 3, 3))
         if tangent:
             for m, ob in enumerate(self.obstacles):
-                act = pen[m] < 0.0
+                # touching nodes (phi = 0) get the one-sided Hessian too: a sheet laid on a support
+                # then starts with the support's stiffness instead of a singular tangent
+                act = phi[m] <= self.smoothing
                 if not np.any(act):
                     continue
                 H = ob.normal_gradient(x[act])
                 nn = np.einsum("ni,nj->nij", normal[m, act], normal[m, act])
-                blocks[act] += ka[act, None, None] * (nn + pen[m, act, None, None] * H)
+                blocks[act] += ka[act, None, None] * (d2[m, act, None, None] * nn + d1[m, act, None, None] * H)
         gap = phi.min(axis=0) if phi.shape[0] else np.full(x.shape[0], np.inf)
-        return ContactState(energy, force, blocks, gap, np.any(pen < 0.0, axis=0))
+        return ContactState(energy, force, blocks, gap, np.any(phi < 0.0, axis=0))
+
+    def _density(self, phi):
+        eps = self.smoothing
+        inside = phi < 0.0
+        if eps == 0.0:
+            pen = np.where(inside, phi, 0.0)
+            return 0.5 * pen**2, pen, np.where(phi <= 0.0, 1.0, 0.0)
+        onset = (phi >= 0.0) & (phi < eps)
+        a = np.where(onset, eps - phi, 0.0)
+        p = np.where(inside, phi, 0.0)
+        e = np.where(onset, a**3 / (6 * eps), 0.0) + np.where(inside, eps**2 / 6 - eps * p / 2 + p**2 / 2, 0.0)
+        d1 = np.where(onset, -(a**2) / (2 * eps), 0.0) + np.where(inside, p - eps / 2, 0.0)
+        d2 = np.where(onset, a / eps, 0.0) + np.where(inside, 1.0, 0.0)
+        return e, d1, d2
 
     def energy(self, x: np.ndarray) -> float:
         """Contact energy ``sum 1/2 k A_n min(phi, 0)^2`` [J] at ``x (N, 3)`` [m]."""

@@ -164,8 +164,9 @@ class Model:
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
             data += scatter_matrices(self._membrane_map, ke, plan.nnz)
         if self.contact is not None:
-            f += self.contact.force(x)
-            data += scatter_matrices(plan.diag_positions, self.contact.tangent_blocks(x), plan.nnz)
+            state = self.contact.evaluate(x)
+            f += state.force
+            data += scatter_matrices(plan.diag_positions, state.tangent_blocks, plan.nnz)
         if shift:
             data += scatter_matrices(plan.diag_positions, shift * np.broadcast_to(np.eye(3), (self.mesh.n_nodes, 3, 3)), plan.nnz)
         return f, plan.free_matrix(data)

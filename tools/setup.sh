@@ -11,7 +11,7 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libsuitesparse-dev libopenblas0-pthread >/dev/null
   fi
 fi
-if ! "$PY" -m pip install -q -e ".[cholmod,test]"; then
+if ! "$PY" -m pip install -q -e ".[cholmod,fast,test]"; then
   echo "setup: scikit-sparse (CHOLMOD) did not build; installing without it (scipy's solver is used)" >&2
-  "$PY" -m pip install -q -e ".[test]"
+  "$PY" -m pip install -q -e ".[fast,test]" || "$PY" -m pip install -q -e ".[test]"
 fi
