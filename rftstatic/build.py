@@ -215,7 +215,8 @@ def build_contact(scene: Scene, mesh, material, supports: Supports):
         raise scene.error("contact.penalty", f'expected "auto" or a positive number, got {penalty!r}')
     if c.get("hold_inplane", True):
         hold_inplane_rigid_modes(mesh, supports)
-    return PenaltyContact(obstacles, mesh.node_area, k), obstacles
+    smoothing = c.get("smoothing", 0.05) * h
+    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=smoothing), obstacles
 
 
 def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:

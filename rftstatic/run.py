@@ -116,7 +116,7 @@ def drape_summary(scene, model, extras, U) -> dict:
     disc_area = None
     obstacles = extras["obstacles"]
     if obstacles:
-        disc_area = _support_area(obstacles[0]) 
+        disc_area = _support_area(obstacles[0])
     centre = obstacles[0].as_dict().get("centre", [0.0, 0.0])[:2] if obstacles else [0.0, 0.0]
     m = drape_measures(x, model.mesh.tri, sheet_area=float(model.mesh.area.sum()), disc_area=disc_area,
                        centre=np.asarray(centre, float), curvature=model.curvature(U), h=model.mesh.element_size)
@@ -136,15 +136,18 @@ def _support_area(obstacle) -> float | None:
     return None
 
 
+_LENGTH_KEYS = ("boundary_radius_min", "boundary_radius_mean", "boundary_radius_max", "max_dihedral_at",
+                "max_relative_curvature_at")
+
+
 def _scale_lengths(m: dict, u: float) -> dict:
-    out = {}
-    for k, v in m.items():
-        if k.endswith("_m") and isinstance(v, (int, float)):
-            out[k[:-2]] = v / u
-        elif k.endswith("_m2") and isinstance(v, (int, float)):
-            out[k[:-3]] = v / u**2
-        else:
-            out[k] = v
+    """Drape measures from SI to the scene's length unit."""
+    out = dict(m)
+    if "shadow_area" in out:
+        out["shadow_area"] = out["shadow_area"] / u**2
+    for key in _LENGTH_KEYS:
+        if key in out and out[key] is not None:
+            out[key] = (np.asarray(out[key], float) / u).tolist()
     return out
 
 

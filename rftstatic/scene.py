@@ -76,6 +76,7 @@ SCHEMA = {
         "penalty": ((str, *NUM), '"auto" or a penalty stiffness [force/length^3]'),
         "factor": (NUM, "multiplier of the automatic penalty"),
         "hold_inplane": (bool, "hold the in-plane rigid modes of a sheet on a frictionless support"),
+        "smoothing": (NUM, "width of the C2 penalty onset, in mean element sizes (default 0.05)"),
     }, "penalty contact"),
     "solver": ({
         "initial_increment": (NUM, ""), "min_increment": (NUM, ""), "max_increment": (NUM, ""),
@@ -92,6 +93,9 @@ SCHEMA = {
         "alpha": (NUM, "mass damping [1/time]"), "mass_scale": (NUM, "mass scaling factor"),
         "frames": (LIST, "times of the saved frames"), "checkpoint_every": (NUM, "[time]"),
         "rest_tolerance": (NUM, "kinetic-energy ratio at which the sheet is at rest"),
+        "samples": (int, "regular states saved for the VTU series and the GIF"),
+        "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
+        "compare_static": (bool, "relax: report the difference from the static Newton solution"),
     }, "explicit dynamics options"),
     "probes": ([{"name": (str, "probe name"), "at": (LIST, "[x, y] reference point")}], "tracked points"),
     "output": ({

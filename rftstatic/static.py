@@ -60,6 +60,9 @@ class StaticOptions:
     tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
     linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
     max_load_steps : give up after this many increments
+    max_continuations : an increment whose Newton iteration runs out of iterations while the energy
+        is still falling markedly (snap-through into a fold) continues from where it stopped, up to
+        this many times, instead of cutting back
     perturbation : amplitude of a seeded random out-of-plane start, in element sizes [-]
     seed : seed of that perturbation
     """
@@ -77,6 +80,7 @@ class StaticOptions:
     tangent: str = "auto"
     linear_solver: str = "auto"
     max_load_steps: int = 2000
+    max_continuations: int = 10
     perturbation: float = 0.0
     seed: int = 0
     progress: bool = True
@@ -133,6 +137,7 @@ class _Newton:
     residual: float
     reason: str = ""
     stable: bool | None = None
+    descending: bool = False  # the energy still fell markedly over the last iterations
 
 
 def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
@@ -159,9 +164,7 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     seed = None
     if opts.perturbation and U0 is None:
         seed = opts.seed
-        rng = np.random.default_rng(seed)
-        h = model.mesh.element_size.mean()
-        U[:, 2] += opts.perturbation * h * rng.uniform(-1, 1, n) * model.free[:, 2]
+        U[:, 2] += smooth_perturbation(model.mesh, seed, opts.perturbation) * model.free[:, 2]
     solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
     max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
@@ -171,6 +174,8 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     lam = 0.0
     dlam = _first_increment(model, U, opts, solver, target)
     U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
+    continuing = None  # Newton state of an increment that is still snapping through
+    continuations = 0
     bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
     try:
         while lam < 1.0:
@@ -180,11 +185,15 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
                     "full load; raise solver.max_load_steps or solver.initial_increment")
             lam_next = min(1.0, lam + dlam)
             start = U
-            if U_prev is not None:  # secant predictor along the equilibrium path
+            if continuing is not None:
+                start = continuing
+            elif U_prev is not None:  # secant predictor along the equilibrium path
                 start = U + (lam_next - lam) / (lam - lam_prev) * (U - U_prev)
             nt = _newton(model, start, lam_next, opts, solver, max_step, modes)
+            continuing = None
             result.iterations += nt.iterations
             if nt.converged:
+                continuations = 0
                 U_prev, lam_prev = U, lam
                 lam, U = lam_next, nt.U
                 result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
@@ -200,6 +209,12 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
                 rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
                 grow = 2.0 * (lam - lam_prev)  # never more than double the last increment
                 dlam = float(np.clip(target / max(rate, 1e-300), opts.min_increment, min(opts.max_increment, grow)))
+                continue
+            if nt.descending and continuations < opts.max_continuations:
+                continuations += 1
+                continuing = nt.U
+                log.info("load factor %.6g: still descending after %d iterations (snap-through); continuing "
+                         "(%d/%d)", lam_next, nt.iterations, continuations, opts.max_continuations)
                 continue
             result.cutbacks += 1
             log.info("load factor %.6g: %s after %d iterations (|r| = %.3e); cutting back the increment",
@@ -223,6 +238,25 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         result.wall_time = time.perf_counter() - t0
         result.energies = model.energies(result.U, result.lam)
     return result
+
+
+def smooth_perturbation(mesh, seed: int, amplitude: float) -> np.ndarray:
+    """A seeded, smooth out-of-plane start ``(N,)`` [m]: random low Fourier modes of the sheet.
+
+    Six modes with wavelengths between a half and a sixth of the sheet size, scaled so that the
+    largest value is ``amplitude`` mean element sizes. Smooth, so that it tips a symmetric start
+    off its bifurcation without stretching the membrane; the seed is reported with the result.
+    """
+    rng = np.random.default_rng(seed)
+    X = mesh.X - mesh.X.mean(axis=0)
+    size = float(np.ptp(mesh.X, axis=0).max())
+    w = np.zeros(mesh.n_nodes)
+    for _ in range(6):
+        k = 2 * np.pi * rng.uniform(2.0, 6.0) / size
+        direction = rng.normal(size=2)
+        direction /= np.linalg.norm(direction)
+        w += rng.normal() * np.cos(k * X @ direction + rng.uniform(0, 2 * np.pi))
+    return amplitude * float(mesh.element_size.mean()) * w / max(np.abs(w).max(), 1e-300)
 
 
 def _first_increment(model, U, opts, solver, target) -> float:
@@ -258,14 +292,16 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
     work0 = None
     last_work = np.inf
     stable = None
+    mu = 0.0  # Levenberg-Marquardt damping, relative to the mean tangent diagonal
+    Pi_history = [Pi]
     for it in range(1, opts.max_iterations + 1):
         if rnorm <= rtol * ref and (it > 1 and last_work <= etol * work0):
             return _Newton(True, U, it - 1, rnorm, stable=stable)
         try:
-            d, mode = _direction(model, U, lam, r, opts, solver, modes)
+            d, mode = _direction(model, U, lam, r, opts, solver, modes, damping=mu)
         except LinearSolveError as exc:
             return _Newton(False, U, it, rnorm, f"linear solve failed ({exc})")
-        stable = (mode == "exact") if solver.detects_indefinite else None
+        stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
         dfull = np.zeros(3 * model.mesh.n_nodes)
         dfull[free] = d
         step = dfull.reshape(-1, 3)
@@ -278,6 +314,11 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
             return _Newton(False, U, it, rnorm, "line search found no decrease of the energy")
         U = U + alpha * step
         Pi = Pi_new
+        Pi_history.append(Pi)
+        # trust-region-like damping: a step the line search had to shorten (a near-singular or
+        # indefinite direction: a sheet balanced on a sphere, a fold forming) damps the next one;
+        # full steps undo it, so the final iterations are pure Newton
+        mu = max(10.0 * mu, 1e-6) if alpha < 1.0 else (0.1 * mu if mu > 1e-9 else 0.0)
         r_new = model.residual(U, lam).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r_new))
         if work0 is None:
@@ -291,15 +332,27 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
             return _Newton(False, U, it, rnorm, "non-finite residual")
     if rnorm <= rtol * ref and last_work <= etol * work0:
         return _Newton(True, U, opts.max_iterations, rnorm, stable=stable)
-    return _Newton(False, U, opts.max_iterations, rnorm, f"no convergence in {opts.max_iterations} iterations")
+    # still sliding downhill? compare the energy drop of the last third with the scale of the work
+    k = max(2, len(Pi_history) // 3)
+    drop = Pi_history[-k] - Pi_history[-1]
+    descending = drop > 1e-6 * max(work0 or 0.0, abs(lam * float(np.einsum("ni,ni->", P, U))))
+    return _Newton(False, U, opts.max_iterations, rnorm, f"no convergence in {opts.max_iterations} iterations",
+                   descending=descending)
 
 
-def _direction(model, U, lam, r, opts, solver, modes):
-    """Newton direction on the free dofs, with the indefinite-tangent safeguard."""
+def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
+    """Newton direction on the free dofs, with the indefinite-tangent safeguard.
+
+    ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt).
+    """
     sequence = {"auto": ["exact", "psd", "shift"], "exact": ["exact", "shift"], "psd": ["psd", "shift"]}[opts.tangent]
     last_error = None
+    base = 0.0
+    if damping:
+        _, K0 = model.tangent(U, psd=True)
+        base = damping * float(np.abs(K0.diagonal()).mean())
     for mode in sequence:
-        shifts = [0.0] if mode != "shift" else None
+        shifts = [base] if mode != "shift" else None
         if mode == "shift":
             _, K = model.tangent(U, psd=True)
             scale = float(np.abs(K.diagonal()).mean())
