@@ -26,7 +26,16 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
             ox, oy = _pair(scene, "mesh.origin", m.get("origin", [-lx / 2, -ly / 2]))
             return meshmod.rectangle(lx * u, ly * u, nx, ny, origin=(ox * u, oy * u),
                                      pattern=m.get("pattern", "right"), z0=z0)
-        if kind in ("polar", "square-polar"):
+        if kind == "square-polar":
+            nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", [21, 160]), int)
+            cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
+            if "radius" not in m:
+                raise scene.error("mesh.radius", "a square-polar mesh needs its half side as radius")
+            core = m.get("inner_radius")
+            return meshmod.square_polar(m["radius"] * u, nr, nc, centre=(cx * u, cy * u),
+                                        core_radius=None if core is None else core * u,
+                                        pattern=m.get("pattern", "right"), z0=z0)
+        if kind == "polar":
             nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", [11, 40]), int)
             cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
             if "radius" not in m:

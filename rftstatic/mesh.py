@@ -327,6 +327,66 @@ def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern=
     return TriMesh(X, tri, z0=z0, name=f"{kind} {n_radial}x{n_circ}", info=info)
 
 
+def square_polar(half_side, n_radial, n_circ, *, centre=(0.0, 0.0), core_radius=None, pattern="right",
+                 z0=0.0) -> TriMesh:
+    """A square sheet meshed by rings that blend from a circle to the square's edge, around a core.
+
+    This is how we read the paper's "21 x 160" and "31 x 240" node meshes of the 50 x 50 cm sheet
+    on the round pedestal (§4.4, Fig. 10): ``n_radial`` rings of ``n_circ`` nodes; ring 0 is a circle
+    of radius ``core_radius``, the last ring is the square's edge, ring t in between is
+    ``rho(t) [(1 - t) c(theta) + t c(theta) / |c(theta)|_inf]`` with ``rho`` linear in t. A polar fan
+    down to the centre would put slivers, and patches whose six points lie on a line pair (singular,
+    method.md), at the centre; the disc inside ring 0 is instead meshed by our advancing-front mesher
+    with ring 0's nodes as its boundary. The default ``core_radius`` makes the quadrilaterals next to
+    the core square (circumferential spacing = radial spacing).
+
+    Parameters
+    ----------
+    half_side : half the side of the square sheet [m]
+    n_radial, n_circ : rings and nodes per ring
+    core_radius : radius of the unstructured core [m]
+    """
+    from .mesher import Domain, generate
+
+    n_radial, n_circ = int(n_radial), int(n_circ)
+    if n_radial < 2 or n_circ < 8:
+        raise MeshError(f"square_polar needs n_radial >= 2 and n_circ >= 8, got {n_radial}, {n_circ}")
+    R = float(half_side)
+    if core_radius is None:
+        a = 2 * np.pi / n_circ * (n_radial - 1)
+        core_radius = R / (1.0 + a)
+    if not (0 < core_radius < R):
+        raise MeshError(f"core_radius must lie in (0, half_side = {R}), got {core_radius}")
+    theta = 2 * np.pi * np.arange(n_circ) / n_circ
+    c = np.column_stack([np.cos(theta), np.sin(theta)])
+    q = c / np.abs(c).max(axis=1, keepdims=True)
+    t = np.linspace(0.0, 1.0, n_radial)[:, None, None]
+    rho = core_radius + t * (R - core_radius)
+    rings = (rho * ((1 - t) * c + t * q)).reshape(-1, 2)
+    r, k = np.meshgrid(np.arange(n_radial - 1), np.arange(n_circ), indexing="ij")
+    r, k = r.ravel(), k.ravel()
+    a_, b_ = r * n_circ + k, r * n_circ + (k + 1) % n_circ
+    a2, b2 = a_ + n_circ, b_ + n_circ
+    diag = np.ones_like(r, bool) if pattern == "right" else ((r + k) % 2 == 0 if pattern == "alternate" else np.zeros_like(r, bool))
+    t1 = np.where(diag[:, None], np.stack([a_, b_, b2], 1), np.stack([a_, b_, a2], 1))
+    t2 = np.where(diag[:, None], np.stack([a_, b2, a2], 1), np.stack([b_, b2, a2], 1))
+    core = generate(Domain.polygon(rings[:n_circ]), 2 * np.pi * core_radius / n_circ)
+    # core nodes on ring 0 are ring 0's own nodes: match them, append the interior ones
+    from scipy.spatial import cKDTree
+
+    dist, idx = cKDTree(rings[:n_circ]).query(core.points)
+    on_ring = dist < 1e-6 * core_radius
+    remap = np.empty(len(core.points), dtype=np.int64)
+    remap[on_ring] = idx[on_ring]
+    interior = np.flatnonzero(~on_ring)
+    remap[interior] = len(rings) + np.arange(len(interior))
+    X = np.vstack([rings, core.points[interior]]) + np.asarray(centre, float)
+    tri = np.vstack([t1, t2, remap[core.triangles]])
+    info = {"generator": "square-polar", "half_side": R, "nodes_radial_circ": [n_radial, n_circ],
+            "core_radius": core_radius, "core_nodes": int(len(interior))}
+    return TriMesh(X, tri, z0=z0, name=f"square-polar {n_radial}x{n_circ}", info=info)
+
+
 def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
     """Read a flat triangle mesh with meshio (any format it reads).
 
