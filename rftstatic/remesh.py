@@ -1,0 +1,496 @@
+"""Global adaptive remeshing (Sze & Zhou 2016, §5.2, steps a-i), for the static solver and for
+dynamic relaxation.
+
+One remesh (:func:`adapt_mesh` + :func:`transfer_state`):
+
+e. h_target per triangle of the present mesh from its curvature, Eq. 29
+   (:func:`rftstatic.sizefield.target_sizes`);
+f. h_target to the square background grid with a gradation limit
+   (:func:`rftstatic.sizefield.size_field`); the kinematic variables are carried by the old mesh
+   itself (route ``"mesh"``, :mod:`rftstatic.transfer`) or by a background grid (``"grid"``);
+g. a new advancing-front mesh of the flat reference sheet (:func:`rftstatic.mesher.generate`);
+   the sheet's outline is recovered from the old mesh (:func:`reference_domain`): straight sides
+   as polygons, circles exactly, so repeated remeshing does not shrink a disc;
+h. U (and V) at the new nodes, then zero on the new mesh's supports;
+and the model is rebuilt on the new mesh by the caller's factory (for a scene,
+:func:`rftstatic.build.build_model` with ``mesh=``: supports, loads, probes and obstacles are
+defined in reference coordinates, the bending stiffness and the lumped mass follow the mesh).
+
+Drivers:
+
+:func:`remesh_static` (a step beyond the paper, which remeshes only during dynamic relaxation)
+    solve -> size a new mesh from the converged curvature -> transfer U -> solve again at full
+    load from the transferred state, until the node count changes by less than ``tol`` and the
+    largest relative curvature |kappa| h is at most ``kappa_h_max``.
+:func:`remesh_relax` (§6)
+    advance the damped, mass-scaled (s = 100) explicit motion in chunks; remesh every ``every``
+    steps, or as soon as max |kappa| h^2 exceeds ``kappa_h2_max`` (step d), transferring U and V;
+    stop when the sheet is at rest on a mesh that would not change.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .sizefield import check_size_bounds, curvature_magnitude, size_field
+from .transfer import transfer_fields
+
+log = logging.getLogger(__name__)
+
+__all__ = ["reference_domain", "adapt_mesh", "transfer_state", "RemeshRecord", "RemeshStaticResult",
+           "remesh_static", "explicit_advance", "RemeshRelaxResult", "remesh_relax"]
+
+
+# --------------------------------------------------------------------------------------------- one remesh
+def reference_domain(mesh, *, circle_tol=1e-6):
+    """The outline of the flat sheet meshed by ``mesh``, as a mesher :class:`~rftstatic.mesher.Domain`.
+
+    The boundary edges give closed loops (:meth:`Domain.from_segments`, which drops vertices on
+    straight runs, so a rectangle comes back as its four corners). A loop of at least 8 vertices
+    whose distances to their least-squares circle agree within ``circle_tol`` times the radius is
+    replaced by that circle, so that the new boundary nodes lie on the true circle (route "mesh" of
+    the transfer then extrapolates to the few new nodes just outside the old inscribed polygon).
+
+    Parameters
+    ----------
+    mesh : :class:`rftstatic.mesh.TriMesh` (reference coordinates [m])
+    circle_tol : relative radius spread below which a loop is taken as a circle [-]
+    """
+    from .mesher import Domain, Loop
+
+    dom = Domain.from_segments(mesh.X, mesh.boundary_edges)
+    loops, changed = [], False
+    for lp in dom.loops:
+        v = lp.vertices
+        if v is not None and len(v) >= 8:
+            # Kasa fit: x^2 + y^2 = 2 a x + 2 b y + c
+            A = np.column_stack([2 * v, np.ones(len(v))])
+            sol = np.linalg.lstsq(A, (v**2).sum(axis=1), rcond=None)[0]
+            centre = sol[:2]
+            r = np.linalg.norm(v - centre, axis=1)
+            R = float(np.sqrt(sol[2] + centre @ centre))
+            if np.ptp(r) <= circle_tol * R:
+                loops.append(Loop(center=centre, radius=float(r.mean()), orientation=lp.orientation))
+                changed = True
+                continue
+        loops.append(lp)
+    return Domain(loops) if changed else dom
+
+
+def adapt_mesh(mesh, kappa, *, const, h_lower, h_upper, gradation=1.3, domain=None, spacing=None,
+               smooth_iterations=4):
+    """Steps e-g: a new mesh of ``mesh``'s sheet sized by Eq. 29 from the element curvature ``kappa``.
+
+    Parameters
+    ----------
+    mesh : present :class:`rftstatic.mesh.TriMesh` [m]
+    kappa : (E, 3) its element curvature (k_xx, k_yy, 2 k_xy) [1/m] (``model.curvature(U)``)
+    const, h_lower, h_upper : Eq. 29 [m] (:mod:`rftstatic.sizefield`)
+    gradation : gradation limit of the size field (ratio >= 1)
+    domain : mesher Domain of the sheet (default :func:`reference_domain` of ``mesh``)
+    spacing : background-grid spacing [m] (default in :func:`rftstatic.sizefield.size_field`)
+    smooth_iterations : passed to :func:`rftstatic.mesher.generate`
+
+    Returns
+    -------
+    new_mesh : :class:`rftstatic.mesh.TriMesh` in the same plane z0, ``info["quality"]`` the mesher's figures
+    result : :class:`rftstatic.mesher.MeshResult`
+    """
+    from .mesh import TriMesh
+    from .mesher import generate
+
+    if domain is None:
+        domain = reference_domain(mesh)
+    grid = size_field(mesh, kappa, const=const, h_lower=h_lower, h_upper=h_upper, gradation=gradation,
+                      spacing=spacing, region=domain)
+    res = generate(domain, grid, smooth_iterations=smooth_iterations)
+    new = TriMesh(res.points, res.triangles, z0=mesh.z0, name=f"adapted {len(res.points)} nodes",
+                  info={"generator": "advancing-front (remesh)", "quality": res.quality.as_dict()})
+    return new, res
+
+
+def transfer_state(old_model, new_model, U, V=None, *, method="mesh"):
+    """Step h: U (N, 3) [m] and optionally V (N, 3) [m/s] of ``old_model`` at the nodes of ``new_model``.
+
+    Supported dofs of the new model are set to zero (its supports prescribe zero displacement).
+    Returns ``(U_new, V_new)`` (``V_new`` is None when ``V`` is).
+    """
+    fields = [U] if V is None else [U, V]
+    out = transfer_fields(old_model.mesh, new_model.mesh.X, fields, method=method)
+    free = new_model.free
+    U_new = out[0] * free
+    V_new = None if V is None else out[1] * free
+    return U_new, V_new
+
+
+@dataclass
+class RemeshRecord:
+    """One mesh of an adaptive run.
+
+    Attributes
+    ----------
+    cycle : 0 for the initial mesh, then 1, 2, ... per remesh
+    nodes, triangles : size of this mesh
+    quality : the mesher's quality figures (``MeshQuality.as_dict()``; {} for a mesh not made by it)
+    max_kappa_h : largest relative curvature |kappa| h on this mesh when it was left (or at the end) [-]
+    max_kappa_h2 : largest |kappa| h^2 then [m]
+    node_change : |N_next - N| / N of the mesh sized from this one's state [-] (nan if not sized)
+    time, step : simulated time [s] and explicit steps when this mesh was made (remesh_relax)
+    reason : why this mesh was made: "initial", "cycle", "every", "curvature", "rest"
+    wall_time : meshing + solving (or advancing) on this mesh [s]
+    solve : solver figures on this mesh (static: converged, iterations, load_steps, restarted)
+    """
+
+    cycle: int
+    nodes: int
+    triangles: int
+    quality: dict
+    max_kappa_h: float = float("nan")
+    max_kappa_h2: float = float("nan")
+    node_change: float = float("nan")
+    time: float = 0.0
+    step: int = 0
+    reason: str = "initial"
+    wall_time: float = 0.0
+    solve: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def _factory(problem):
+    """``mesh -> (model, extras)`` from a Scene or a callable (``mesh=None``: the initial mesh)."""
+    from .scene import Scene
+
+    if isinstance(problem, Scene):
+        from .build import build_model
+
+        return lambda mesh=None: build_model(problem, mesh=mesh)
+    if not callable(problem):
+        raise TypeError(f"problem must be a Scene or a callable mesh -> model, got {type(problem).__name__}")
+
+    def make(mesh=None):
+        out = problem(mesh)
+        return out if isinstance(out, tuple) else (out, {})
+
+    return make
+
+
+def _curvature_figures(model, U):
+    kappa = model.curvature(U)
+    mag = curvature_magnitude(kappa)
+    h = model.mesh.element_size
+    return kappa, float((mag * h).max()), float((mag * h * h).max())
+
+
+def _check_common(mesh, const, h_lower, h_upper, tol):
+    lo, hi = mesh.X.min(axis=0), mesh.X.max(axis=0)
+    check_size_bounds(const=const, h_lower=h_lower, h_upper=h_upper, extent=float((hi - lo).min()))
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol = {tol!r} must be a positive relative node-count change (e.g. 0.05)")
+
+
+# --------------------------------------------------------------------------------------------- static
+@dataclass
+class RemeshStaticResult:
+    """Outcome of :func:`remesh_static`.
+
+    Attributes
+    ----------
+    result : the :class:`rftstatic.static.StaticResult` on the final mesh (``result.U`` (N, 3) [m])
+    model, extras : the final model and its extras (probes, obstacles)
+    records : one :class:`RemeshRecord` per mesh solved
+    converged : the mesh stopped changing (and |kappa| h <= kappa_h_max) within ``max_cycles``
+    """
+
+    result: object
+    model: object
+    extras: dict
+    records: list
+    converged: bool
+
+    def table(self) -> list[dict]:
+        return [r.as_dict() for r in self.records]
+
+
+def _continuation(options):
+    """Options that solve at full load straight from a transferred equilibrium."""
+    return dataclasses.replace(options, initial_increment=1.0, max_increment=1.0,
+                               min_increment=min(options.min_increment, 1.0),
+                               increment_displacement=1e30, perturbation=0.0)
+
+
+def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, kappa_h_max=0.3,
+                  gradation=1.3, transfer="mesh", options=None, domain=None) -> RemeshStaticResult:
+    """Static solution with global adaptive remeshing (module docstring).
+
+    Parameters
+    ----------
+    problem : :class:`rftstatic.scene.Scene` (rebuilt with ``build_model(scene, mesh=...)``), or a
+        callable ``factory(mesh) -> Model`` or ``-> (Model, extras)``; ``factory(None)`` gives the
+        initial mesh's model
+    const, h_lower, h_upper : Eq. 29 [m]: h_new = sqrt(const / |kappa|) clipped to [h_lower, h_upper]
+    max_cycles : at most this many remeshes after the initial solve
+    tol : stop when the next mesh's node count differs by less than this fraction [-] ...
+    kappa_h_max : ... and the largest |kappa| h on the present mesh is at most this [-]
+    gradation : gradation limit of the size field (ratio >= 1)
+    transfer : ``"mesh"`` or ``"grid"`` (:mod:`rftstatic.transfer`)
+    options : :class:`rftstatic.static.StaticOptions` of the first solve (default: scene's
+        ``[solver]`` table, or the defaults); later solves start from the transferred state at
+        full load (one load step) and fall back to the full load ramp from flat if that fails
+    domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
+
+    Returns
+    -------
+    :class:`RemeshStaticResult`
+
+    Raises
+    ------
+    ValueError
+        bad Eq. 29 parameters (named), ``tol`` or ``max_cycles``
+    rftstatic.static.ConvergenceError
+        when a solve fails even from flat (its ``.result`` is the last equilibrium)
+    """
+    from .scene import Scene
+    from .static import ConvergenceError, StaticOptions, solve_static
+
+    if int(max_cycles) != max_cycles or max_cycles < 0:
+        raise ValueError(f"max_cycles = {max_cycles!r} must be a non-negative integer")
+    if transfer not in ("mesh", "grid"):
+        raise ValueError(f'transfer = "{transfer}" is unknown; use "mesh" or "grid"')
+    make = _factory(problem)
+    if options is None:
+        if isinstance(problem, Scene):
+            from .run import static_options
+
+            options = static_options(problem, progress=False)
+        else:
+            options = StaticOptions(progress=False)
+    t0 = time.perf_counter()
+    model, extras = make(None)
+    _check_common(model.mesh, const, h_lower, h_upper, tol)
+    if domain is None:
+        domain = reference_domain(model.mesh)
+    result = solve_static(model, options=options)
+    records = [RemeshRecord(0, model.mesh.n_nodes, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})),
+                            solve=_static_figures(result, restarted=False))]
+    converged = False
+    for cycle in range(1, int(max_cycles) + 1):
+        kappa, kh, kh2 = _curvature_figures(model, result.U)
+        rec = records[-1]
+        rec.max_kappa_h, rec.max_kappa_h2 = kh, kh2
+        t_mesh = time.perf_counter()
+        new_mesh, _ = adapt_mesh(model.mesh, kappa, const=const, h_lower=h_lower, h_upper=h_upper,
+                                 gradation=gradation, domain=domain)
+        rec.node_change = abs(new_mesh.n_nodes - model.mesh.n_nodes) / model.mesh.n_nodes
+        rec.wall_time = t_mesh - t0
+        log.info("remesh_static cycle %d: %d nodes, max |kappa| h %.3g, next mesh %d nodes (change %.1f %%)",
+                 rec.cycle, rec.nodes, kh, new_mesh.n_nodes, 100 * rec.node_change)
+        if rec.node_change < tol and kh <= kappa_h_max:
+            converged = True
+            break
+        t0 = t_mesh
+        new_model, new_extras = make(new_mesh)
+        U0, _ = transfer_state(model, new_model, result.U, method=transfer)
+        restarted = False
+        try:
+            result = solve_static(new_model, U0=U0, options=_continuation(options))
+        except ConvergenceError as exc:
+            log.info("remesh_static cycle %d: no equilibrium from the transferred state (%s); solving from flat",
+                     cycle, exc)
+            restarted = True
+            result = solve_static(new_model, options=options)
+        model, extras = new_model, new_extras
+        records.append(RemeshRecord(cycle, new_mesh.n_nodes, new_mesh.n_elements, new_mesh.info["quality"],
+                                    reason="cycle", solve=_static_figures(result, restarted=restarted)))
+    rec = records[-1]
+    if not converged:
+        _, rec.max_kappa_h, rec.max_kappa_h2 = _curvature_figures(model, result.U)
+        rec.wall_time = time.perf_counter() - t0
+        log.warning("remesh_static: the mesh still changes after %d cycles (max |kappa| h %.3g)",
+                    max_cycles, rec.max_kappa_h)
+    return RemeshStaticResult(result=result, model=model, extras=extras, records=records, converged=converged)
+
+
+def _static_figures(result, *, restarted):
+    return {"converged": bool(result.converged), "iterations": int(result.iterations),
+            "load_steps": len(result.load_steps), "restarted": restarted, "solve_time": float(result.wall_time)}
+
+
+# --------------------------------------------------------------------------------------------- relaxation
+def explicit_advance(*, alpha, mass_scale=100.0, dt=None, obstacles=(), safety=0.9, backend="auto",
+                     energy_check=False):
+    """An ``advance(model, U, V, n_steps) -> (U, V, t)`` stepper on :func:`rftstatic.explicit.run_explicit`.
+
+    ``V`` is the half-step velocity v_(n-1/2) [m/s] and is passed back in with ``start="given"``, so
+    chunks continue the central-difference sequence exactly. ``t`` is the time advanced [s]. The
+    stable step is estimated once per model (``dt=None``; ``safety`` times the critical step at the
+    state the mesh starts from), with the mass scaled by ``mass_scale`` (§6: 100; the weight is not
+    scaled). ``energy_check=True`` makes every chunk re-estimate the step (a Lanczos run per chunk,
+    and a warning whenever the sheet has stiffened by a few 0.1 % since the mesh's estimate); by
+    default the driver only checks that the state stays finite.
+    """
+    from .explicit import run_explicit
+    from .timestep import stable_time_step
+
+    cache = {}
+
+    def advance(model, U, V, n_steps):
+        step = dt
+        if step is None:
+            if cache.get("model") is not model:
+                est = stable_time_step(model, U, mass_scale=mass_scale, alpha=alpha, safety=safety)
+                cache.update(model=model, dt=est.dt)
+            step = cache["dt"]
+        run = run_explicit(model, t_end=n_steps * step, dt=step, alpha=alpha, mass_scale=mass_scale,
+                           obstacles=obstacles, U0=U, V0=V, start="given", sample_every=max(1, n_steps),
+                           progress=False, energy_check=energy_check, backend=backend)
+        return run.U, run.V, run.t
+
+    advance.mass_scale = mass_scale
+    return advance
+
+
+@dataclass
+class RemeshRelaxResult:
+    """Outcome of :func:`remesh_relax`: final U, V (N, 3) [m, m/s], model and extras, the time [s]
+    and steps advanced, one :class:`RemeshRecord` per mesh, whether the sheet came to rest on a
+    mesh that no longer changes, and how many triggered remeshes were skipped (mesh settled)."""
+
+    U: np.ndarray
+    V: np.ndarray
+    model: object
+    extras: dict
+    t: float
+    steps: int
+    records: list
+    converged: bool
+    skipped: int = 0
+
+
+def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, mass_scale=100.0,
+                 every=None, kappa_h2_max=None, chunk=200, max_steps=100_000, max_remesh=50, tol=0.05,
+                 tol_force=1e-4, tol_kinetic=1e-8, skip_settled=True, gradation=1.3, transfer="mesh",
+                 domain=None, U0=None, V0=None) -> RemeshRelaxResult:
+    """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6).
+
+    The motion is advanced ``chunk`` steps at a time. After each chunk (step d) the mesh is
+    remeshed when ``every`` steps have passed since the last remesh, or when the largest
+    |kappa| h^2 exceeds ``kappa_h2_max`` [m]; U and V are transferred (step h). When the sheet is
+    at rest (out-of-balance force on the free dofs < ``tol_force`` |P| and kinetic energy <
+    ``tol_kinetic`` times its peak on the present mesh, or zero), the mesh it would get is sized:
+    a node-count change below ``tol`` ends the run (converged), otherwise it remeshes and goes on.
+
+    Parameters
+    ----------
+    problem : Scene or ``factory(mesh) -> Model | (Model, extras)`` (as in :func:`remesh_static`)
+    const, h_lower, h_upper : Eq. 29 [m]
+    advance : ``advance(model, U, V, n_steps) -> (U, V, t_advanced)``; default
+        :func:`explicit_advance` with ``alpha``, ``mass_scale`` and the scene's obstacles
+    alpha : mass damping [1/s] of the default stepper (required without ``advance``)
+    mass_scale : mass scaling s of the default stepper and of the kinetic energy [-] (§6: 100)
+    every : remesh every this many steps (None: only on curvature or at rest)
+    kappa_h2_max : remesh when max |kappa| h^2 exceeds this [m] (None: never on curvature)
+    chunk : steps per call of ``advance``
+    max_steps, max_remesh : limits (the run returns ``converged=False`` at max_steps)
+    tol : relative node-count change below which the mesh counts as settled [-] (and, with
+        ``kappa_h2_max``, max |kappa| h^2 <= kappa_h2_max)
+    skip_settled : a remesh triggered by ``every`` or by the curvature is skipped when the mesh is
+        settled. Measured on the clamped strip (s = 100, alpha = 3/s): remeshing every 5000 steps
+        regardless kept the strip swinging for 200 000 steps (each new mesh differs by a few nodes
+        and the transfer restarts the oscillation, as §5 warns); skipping settled meshes, it came
+        to rest.
+    U0, V0 : (N, 3) start on the initial mesh (default zero)
+
+    Returns
+    -------
+    :class:`RemeshRelaxResult`
+    """
+    from .timestep import lumped_mass
+
+    make = _factory(problem)
+    if int(chunk) < 1:
+        raise ValueError(f"chunk = {chunk!r} must be a positive number of steps")
+    if every is not None and int(every) < 1:
+        raise ValueError(f"every = {every!r} must be a positive number of steps or None")
+    if kappa_h2_max is not None and not kappa_h2_max > 0:
+        raise ValueError(f"kappa_h2_max = {kappa_h2_max!r} must be a positive length [m] or None (Eq. 28)")
+    model, extras = make(None)
+    _check_common(model.mesh, const, h_lower, h_upper, tol)
+    if advance is None:
+        if alpha is None:
+            raise ValueError("alpha (mass damping [1/s]) is needed by the default explicit stepper; or pass advance=")
+        advance = explicit_advance(alpha=alpha, mass_scale=mass_scale, obstacles=extras.get("obstacles", ()))
+    if domain is None:
+        domain = reference_domain(model.mesh)
+    N = model.mesh.n_nodes
+    U = np.zeros((N, 3)) if U0 is None else np.array(U0, dtype=float)
+    V = np.zeros((N, 3)) if V0 is None else np.array(V0, dtype=float)
+    t, steps, since, n_remesh, skipped = 0.0, 0, 0, 0, 0
+    peak = 0.0
+    wall = time.perf_counter()
+    records = [RemeshRecord(0, N, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})))]
+    converged = False
+    while steps < max_steps:
+        n = int(min(chunk, max_steps - steps))
+        U, V, dt_adv = advance(model, U, V, n)
+        if not (np.isfinite(U).all() and np.isfinite(V).all()):
+            raise FloatingPointError(f"remesh_relax: non-finite state after step {steps + n} (t = {t:.4g} s) on a "
+                                     f"mesh of {model.mesh.n_nodes} nodes; reduce the time step (safety) or raise alpha")
+        t += float(dt_adv)
+        steps += n
+        since += n
+        kappa, kh, kh2 = _curvature_figures(model, U)
+        mass = lumped_mass(model, mass_scale)
+        kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, V, V))
+        peak = max(peak, kinetic)
+        P = np.where(model.free, model.load, 0.0)
+        r = float(np.linalg.norm(np.where(model.free, model.residual(U), 0.0)))
+        rest = r <= tol_force * max(float(np.linalg.norm(P)), 1e-300) and (kinetic <= tol_kinetic * peak or kinetic == 0)
+        reason = ("rest" if rest else "every" if every is not None and since >= every
+                  else "curvature" if kappa_h2_max is not None and kh2 > kappa_h2_max else None)
+        if reason is None:
+            continue
+        if n_remesh >= max_remesh:
+            if rest:
+                converged = False
+                break
+            continue
+        new_mesh, _ = adapt_mesh(model.mesh, kappa, const=const, h_lower=h_lower, h_upper=h_upper,
+                                 gradation=gradation, domain=domain)
+        rec = records[-1]
+        rec.max_kappa_h, rec.max_kappa_h2 = kh, kh2
+        rec.node_change = abs(new_mesh.n_nodes - model.mesh.n_nodes) / model.mesh.n_nodes
+        settled = rec.node_change < tol and (kappa_h2_max is None or kh2 <= kappa_h2_max)
+        if rest and settled:
+            converged = True
+            break
+        if settled and skip_settled:
+            since = 0
+            skipped += 1
+            continue
+        new_model, new_extras = make(new_mesh)
+        U, V = transfer_state(model, new_model, U, V, method=transfer)
+        model, extras = new_model, new_extras
+        n_remesh += 1
+        since, peak = 0, 0.0
+        now = time.perf_counter()
+        rec.wall_time, wall = now - wall, now
+        records.append(RemeshRecord(n_remesh, new_mesh.n_nodes, new_mesh.n_elements, new_mesh.info["quality"],
+                                    time=t, step=steps, reason=reason))
+        log.info("remesh_relax: t = %.4g s, step %d (%s): %d -> %d nodes, max |kappa| h %.3g",
+                 t, steps, reason, rec.nodes, new_mesh.n_nodes, kh)
+    rec = records[-1]
+    if not np.isfinite(rec.max_kappa_h):
+        _, rec.max_kappa_h, rec.max_kappa_h2 = _curvature_figures(model, U)
+    rec.wall_time = time.perf_counter() - wall
+    if not converged:
+        log.warning("remesh_relax: not at rest on a settled mesh after %d steps (t = %.4g s, %d remeshes)",
+                    steps, t, n_remesh)
+    return RemeshRelaxResult(U=U, V=V, model=model, extras=extras, t=t, steps=steps, records=records,
+                             converged=converged, skipped=skipped)
