@@ -1,0 +1,47 @@
+"""Validation reports (``validate --quick``) and the bench functions on tiny sizes."""
+
+import json
+import math
+
+import pytest
+
+from rftstatic import bench
+from rftstatic.cli import main as cli_main
+from rftstatic.validate.report import observed_rate, time_to_error
+
+
+def test_time_to_error_interpolates_log_log_and_flags_the_unreached():
+    t, e = [1.0, 10.0, 100.0], [0.1, 0.01, 0.001]
+    assert time_to_error(t, e, 0.01) == pytest.approx(10.0)
+    assert time_to_error(t, e, math.sqrt(0.1 * 0.01)) == pytest.approx(math.sqrt(10.0))
+    assert time_to_error(t, e, 1e-4) is None
+    assert time_to_error(t, e, 0.5) == -1.0  # already below on the cheapest mesh
+    assert observed_rate([0.1, 0.05, 0.025], [4e-2, 1e-2, 2.5e-3]) == pytest.approx(2.0)
+
+
+def test_quick_validation_of_strip_and_plates_writes_a_passing_index(tmp_path):
+    # measured ~25 s: strip 14 s, plates 10 s
+    assert cli_main(["validate", "strip", "plates", "--quick", "--out", str(tmp_path)]) == 0
+    index = (tmp_path / "README.md").read_text()
+    rows = [line for line in index.splitlines() if line.startswith("| [")]
+    assert sum("[strip]" in r for r in rows) == 2  # RFT3 and RFT6
+    assert sum("[plates]" in r for r in rows) == 4  # four edge/load cases
+    assert all(r.rstrip().endswith("| pass |") for r in rows)
+    for name in ("strip", "plates"):
+        data = json.loads((tmp_path / f"{name}.json").read_text())
+        assert data["passed"] and data["quick"]
+        for fig in data["figures"]:
+            assert (tmp_path / fig).stat().st_size > 1000
+    strip = json.loads((tmp_path / "strip.json").read_text())
+    alt = [r for r in strip["rows"] if r["case"] == "pattern alternate, alpha 1"][0]
+    right = [r for r in strip["rows"] if r["case"] == "pattern right, alpha 1"][0]
+    assert alt["value"][1] < right["value"][1]  # the alternate pattern is the more flexible
+
+
+def test_bench_functions_on_tiny_sizes():
+    s = bench.bench_strip(11, 3, "RFT3")
+    assert s["converged"] and s["total_s"] > 0
+    n = bench.bench_newton(9)
+    assert n["finite"] and n["assembly_s"] > 0 and n["factorisation_s"] > 0
+    c = bench.bench_construction(12)
+    assert c["triangles"] == 2 * 11 * 11 and c["tracemalloc_peak_mb"] > 0
