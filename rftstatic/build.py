@@ -70,7 +70,7 @@ def _unstructured(scene, m, u, z0):
         lx, ly = _pair(scene, "mesh.size", m.get("size", [1.0, 1.0]))
         ox, oy = _pair(scene, "mesh.origin", m.get("origin", [-lx / 2, -ly / 2]))
         domain = Domain.rectangle(ox * u, oy * u, lx * u, ly * u)
-    res = generate(domain, BackgroundGrid.uniform(domain, h))
+    res = generate(domain, BackgroundGrid.uniform(h, domain))
     return meshmod.TriMesh(res.points, res.triangles, z0=z0, name=f"unstructured h={m['h']}",
                            info={"generator": "advancing-front", "quality": res.quality.as_dict()})
 

@@ -349,8 +349,7 @@ def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
     last_error = None
     base = 0.0
     if damping:
-        _, K0 = model.tangent(U, psd=True)
-        base = damping * float(np.abs(K0.diagonal()).mean())
+        base = damping * _diagonal_scale(model, U)
     for mode in sequence:
         shifts = [base] if mode != "shift" else None
         if mode == "shift":
@@ -372,6 +371,16 @@ def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
                 return d, mode
             last_error = LinearSolveError("the step is not a descent direction of the energy")
     raise LinearSolveError(str(last_error))
+
+
+def _diagonal_scale(model, U) -> float:
+    """Mean diagonal of the tangent [N/m], computed once per model (the scale of the LM damping)."""
+    scale = getattr(model, "_lm_scale", None)
+    if scale is None:
+        _, K0 = model.tangent(U, psd=True)
+        scale = float(np.abs(K0.diagonal()).mean())
+        model._lm_scale = scale
+    return scale
 
 
 def _line_search(model, U, step, lam, Pi0, slope, opts, max_trials=12):
