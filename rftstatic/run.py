@@ -43,6 +43,10 @@ def run_scene(scene: Scene, out_dir, *, progress=True, figures=True) -> dict:
     """Build and solve ``scene``; write the outputs into ``out_dir``; return the summary."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    if scene.get("remesh") is not None:
+        from .remesh_run import run_remesh_scene
+
+        return run_remesh_scene(scene, out, progress=progress, figures=figures)
     t0 = time.perf_counter()
     model, extras = build_model(scene)
     build_time = time.perf_counter() - t0

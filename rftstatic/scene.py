@@ -97,6 +97,17 @@ SCHEMA = {
         "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
         "compare_static": (bool, "relax: report the difference from the static Newton solution"),
     }, "explicit dynamics options"),
+    "remesh": ({
+        "const": (NUM, "const of Eq. 29, |kappa| h^2 = const [length]"),
+        "h_lower": (NUM, "smallest element size [length]"), "h_upper": (NUM, "largest element size [length]"),
+        "gradation": (NUM, "largest size ratio between neighbours one element apart"),
+        "max_cycles": (int, "static route: most remeshing cycles"),
+        "tol": (NUM, "stop when the node count changes by less than this fraction"),
+        "kappa_h_max": (NUM, "static route: largest |kappa| h accepted without remeshing"),
+        "kappa_h2_max": (NUM, "relax route: remesh when max |kappa| h^2 exceeds this [length]"),
+        "every": (int, "relax route: remesh every this many steps"),
+        "transfer": (str, "mesh (interpolation on the old mesh) or grid (background grid, as the paper)"),
+    }, "global adaptive remeshing (§5)"),
     "probes": ([{"name": (str, "probe name"), "at": (LIST, "[x, y] reference point")}], "tracked points"),
     "output": ({
         "views": (LIST, "PNG views: side, top, iso"),
