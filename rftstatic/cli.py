@@ -53,11 +53,17 @@ def main(argv=None) -> int:
             scene = load_scene(args.name, args.set)
             out = Path(args.out) if args.out else Path("out") / scene.name
             if args.resume:
-                scene.data.setdefault("dynamics", {})
-                scene.overrides["resume"] = True
-            summary = run_scene(scene, out, progress=True, figures=not args.no_figures)
-            brief = {k: summary.get(k) for k in ("scene", "element", "nodes", "converged", "load_steps",
-                                                  "newton_iterations", "wall_time_s", "probes")}
+                from .dynamic_run import resume_scene
+
+                summary = resume_scene(scene, out, progress=True, figures=not args.no_figures)
+            else:
+                summary = run_scene(scene, out, progress=True, figures=not args.no_figures)
+            keys = ("scene", "element", "nodes", "converged", "load_steps", "newton_iterations", "wall_time_s",
+                    "probes")
+            if summary.get("analysis", "static") != "static":  # trajectories are too long to print
+                keys = ("scene", "element", "nodes", "analysis", "dt", "steps", "wall_time_s",
+                        "element_steps_per_second", "time_at_rest", "at_rest", "converged")
+            brief = {k: summary.get(k) for k in keys}
             print(json.dumps(brief, indent=1, default=str))
             print(f"outputs written to {out}/")
             return 0
