@@ -94,7 +94,15 @@ class CholmodSolver:
         try:
             self._factor.cholesky_inplace(A)
         except CholmodNotPositiveDefiniteError as exc:
+            self._valid = False
             raise NotPositiveDefinite(str(exc)) from None
+        self._valid = True
+        return self._factor(b)
+
+    def resolve(self, b: np.ndarray) -> np.ndarray:
+        """Solve with the last factorisation (modified Newton)."""
+        if self._factor is None or not getattr(self, "_valid", False):
+            raise LinearSolveError("no factorisation to reuse")
         return self._factor(b)
 
 
@@ -112,7 +120,14 @@ class ScipySolver:
         x = lu.solve(b)
         if not np.all(np.isfinite(x)):
             raise LinearSolveError("SuperLU returned non-finite values (singular tangent)")
+        self._lu = lu
         return x
+
+    def resolve(self, b: np.ndarray) -> np.ndarray:
+        """Solve with the last factorisation (modified Newton)."""
+        if getattr(self, "_lu", None) is None:
+            raise LinearSolveError("no factorisation to reuse")
+        return self._lu.solve(b)
 
 
 class AmgSolver:
@@ -147,7 +162,20 @@ class AmgSolver:
             count[0] += 1
 
         x, info = cg(K, b, rtol=self.rtol, maxiter=self.maxiter, M=ml.aspreconditioner(), callback=cb)
+        self._last = (K, ml)
         self.iterations = count[0]
+        if info != 0:
+            raise LinearSolveError(f"AMG-preconditioned CG did not converge in {self.maxiter} iterations")
+        return x
+
+    def resolve(self, b: np.ndarray) -> np.ndarray:
+        """Solve with the last matrix and hierarchy (modified Newton)."""
+        from scipy.sparse.linalg import cg
+
+        if getattr(self, "_last", None) is None:
+            raise LinearSolveError("no matrix to reuse")
+        K, ml = self._last
+        x, info = cg(K, b, rtol=self.rtol, maxiter=self.maxiter, M=ml.aspreconditioner())
         if info != 0:
             raise LinearSolveError(f"AMG-preconditioned CG did not converge in {self.maxiter} iterations")
         return x
