@@ -130,6 +130,7 @@ class TriMesh:
             raise MeshError(f"{len(unused)} node(s) belong to no triangle (first: node {unused[0]}); remove them")
         object.__setattr__(self, "X", X)
         object.__setattr__(self, "tri", tri)
+        self.topology  # noqa: B018 -- validates the edge structure now (non-manifold edges)
 
     # --- sizes ------------------------------------------------------------------------------
     @property
