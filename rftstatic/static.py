@@ -338,7 +338,7 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
         # trust-region-like damping: a step the line search had to shorten (a near-singular or
         # indefinite direction: a sheet balanced on a sphere, a fold forming) damps the next one;
         # full steps undo it, so the final iterations are pure Newton
-        mu = max(10.0 * mu, 1e-6) if alpha < 1.0 else (0.1 * mu if mu > 1e-9 else 0.0)
+        mu = max(10.0 * mu, 1e-6) if alpha < 1.0 else (0.5 * mu if mu > 1e-9 else 0.0)
         r_new = model.residual(U, lam).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r_new))
         if work0 is None:
