@@ -305,6 +305,7 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
         if rnorm <= rtol * ref and (it > 1 and last_work <= etol * work0):
             return _Newton(True, U, it - 1, rnorm, stable=stable)
         d = None
+        fresh = False
         if reuse and age < opts.reuse_factorisation:
             try:
                 d = solver.resolve(-r)
@@ -322,12 +323,17 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
                 return _Newton(False, U, it, rnorm, f"linear solve failed ({exc})")
             stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
             age = 0
+            fresh = True
+            # curvature of the quadratic model along d: (K + s I) d = -r  =>  d.K.d = -d.r - s d.d
+            dKd = -float(r @ d) - _direction.shift * float(d @ d)
         dfull = np.zeros(3 * model.mesh.n_nodes)
         dfull[free] = d
         step = dfull.reshape(-1, 3)
         biggest = float(np.linalg.norm(step, axis=1).max())
+        cap = 1.0
         if biggest > max_step:
-            step *= max_step / biggest
+            cap = max_step / biggest
+            step *= cap
         slope = float(r @ step.ravel()[free])
         alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts)
         if alpha is None:
@@ -335,10 +341,22 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
         U = U + alpha * step
         Pi = Pi_new
         Pi_history.append(Pi)
-        # trust-region-like damping: a step the line search had to shorten (a near-singular or
-        # indefinite direction: a sheet balanced on a sphere, a fold forming) damps the next one;
-        # full steps undo it, so the final iterations are pure Newton
-        mu = max(10.0 * mu, 1e-6) if alpha < 1.0 else (0.5 * mu if mu > 1e-9 else 0.0)
+        # Levenberg-Marquardt damping as a trust region (More's update): the ratio of the actual to
+        # the predicted energy decrease of a fresh Newton step decides; a step the line search had to
+        # shorten (a near-singular or indefinite direction: a sheet balanced on a sphere, a fold
+        # forming) damps the next one, good steps undo it, so the final iterations are pure Newton
+        if fresh:
+            predicted = -(slope + 0.5 * cap * cap * dKd)
+            actual = Pi_history[-2] - Pi_new if len(Pi_history) > 1 else 0.0
+            tiny = 1e-10 * max(abs(Pi), abs(work0 or 0.0))
+            if alpha == 1.0 and abs(predicted) <= tiny:
+                rho = 1.0  # below what the energy resolves: the residual decides convergence
+            else:
+                rho = actual / predicted if (alpha == 1.0 and predicted > 0) else 0.0
+            if alpha < 1.0 or rho < 0.25:
+                mu = max(4.0 * mu, 1e-6)
+            elif rho > 0.75:
+                mu = mu / 3.0 if mu > 1e-9 else 0.0
         r_new = model.residual(U, lam).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r_new))
         if work0 is None:
@@ -391,6 +409,7 @@ def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
                 continue
             if float(r @ d) < 0.0 or not np.any(r):
                 modes[mode] += 1
+                _direction.shift = shift
                 return d, mode
             last_error = LinearSolveError("the step is not a descent direction of the energy")
     raise LinearSolveError(str(last_error))
