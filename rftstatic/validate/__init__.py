@@ -5,7 +5,8 @@ Every benchmark is a module here with ``run(quick, *, out=None) -> BenchmarkResu
 - ``strip``: the clamped wool strip of §4.1 against the heavy elastica (RFT3, RFT6, warp/weft,
   rigidity ratios, diagonal patterns);
 - ``plates``: square Kirchhoff plates against Timoshenko/Navier (bending only, small load);
-- ``sze2004``: the large-deflection cantilevers and slit annular plate of Sze, Liu & Lo (2004).
+- ``sze2004``: the large-deflection cantilevers and slit annular plate of Sze, Liu & Lo (2004);
+- ``hang20``: the explicit dynamics of §4.6 against fine-mesh and small-step runs.
 
 :func:`main` writes, into ``out`` (default: the repository's ``validation/``), ``NAME.md``,
 ``NAME.json`` and PNG plots per benchmark and the index ``README.md``; it returns 1 when a
@@ -29,6 +30,7 @@ BENCHMARKS = {
     "strip": "clamped wool strip (§4.1) vs heavy elastica",
     "plates": "square plates vs Timoshenko/Navier",
     "sze2004": "Sze, Liu & Lo (2004) large-deflection shells",
+    "hang20": "explicit dynamics of §4.6 vs fine-mesh / small-step runs",
 }
 
 
