@@ -142,7 +142,25 @@ def run_construction(n=708):
           f"[tracemalloc peak {r['tracemalloc_peak_mb']:.0f} MB]")
 
 
-BENCHES = {"strip": run_strip, "newton": run_newton, "construction": run_construction}
+def _lazy(module: str, call):
+    """A bench that lives in another module, imported only when it runs."""
+
+    def run():
+        import importlib
+
+        call(importlib.import_module(f"rftstatic.{module}"))
+
+    return run
+
+
+BENCHES = {
+    "strip": run_strip,
+    "newton": run_newton,
+    "construction": run_construction,
+    "explicit": _lazy("bench_explicit", lambda m: m.main([])),  # element-steps per second
+    "dynamic": _lazy("bench_scenes", lambda m: m.bench_dynamic_scenes()),  # hang-20, hang-100
+    "mesher": _lazy("mesher.bench", lambda m: m.main([])),  # triangles per second
+}
 
 
 def main(names=None) -> int:
