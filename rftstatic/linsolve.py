@@ -87,8 +87,8 @@ class CholmodSolver:
         A = K.T  # CSR of a symmetric matrix = its CSC transpose, no copy
         pattern = (A.shape, A.nnz)
         if self._factor is None or pattern != self._pattern:
-            # measured on drape tangents (2 cores): AMD is fastest below ~10^4 unknowns, METIS above
-            ordering = "amd" if A.shape[0] < 10_000 else "metis"
+            # measured on drape tangents (2 cores): AMD is fastest below ~2000 unknowns, METIS above
+            ordering = "amd" if A.shape[0] < 2_000 else "metis"
             self._factor = analyze(A, mode="supernodal", ordering_method=ordering)
             self._pattern = pattern
         try:
