@@ -30,6 +30,7 @@ BENCHMARKS = {
     "strip": "clamped wool strip (§4.1) vs heavy elastica",
     "plates": "square plates vs Timoshenko/Navier",
     "sze2004": "Sze, Liu & Lo (2004) large-deflection shells",
+    "stability": "stability matrix: stiffness, mesh, load and time-step extremes",
     "hang20": "explicit dynamics of §4.6 vs fine-mesh / small-step runs",
     "remesh_scenes": "adaptive remeshing (§6) vs dense structured static drapes; RFT3/RFT6 at 371 nodes",
 }
