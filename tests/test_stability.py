@@ -1,0 +1,54 @@
+"""Cheap cells of the stability matrix (rftstatic.validate.stability): converge correctly or stop clearly."""
+
+import numpy as np
+import pytest
+
+from rftstatic import static
+from rftstatic.explicit import InstabilityError, run_explicit
+from rftstatic.patch import PatchError
+from rftstatic.timestep import stable_time_step
+from rftstatic.validate import stability as st
+
+
+def test_soft_membrane_strip_matches_heavy_elastica():
+    # C/B = 100 /cm^2 (wool: 1.35e4): the strip stretches by w L / C ~ 1 %, the extensible elastica follows
+    r = st.strip_cell(11, 3, element="RFT3", ratio=1e2)
+    assert r["converged"] and r["error"] < st.strip_tolerance(11)
+
+
+def test_stiff_membrane_strip_converges_correctly_or_stops_clearly():
+    # C/B = 1e9 /cm^2: near the limit of double precision; a wrong converged tip would be a defect
+    try:
+        r = st.strip_cell(11, 3, element="RFT3", ratio=1e9)
+    except static.ConvergenceError as exc:
+        assert "load factor" in str(exc) and exc.result is not None and not exc.result.converged
+    else:
+        assert r["error"] < st.strip_tolerance(11)
+
+
+def test_one_increment_to_full_load_finds_its_own_way():
+    r = st.strip_cell(11, 3, element="RFT3", one_step=True)
+    assert r["converged"] and r["error"] < st.strip_tolerance(11)
+
+
+def test_degenerate_patch_is_reported_with_the_element():
+    with pytest.raises(PatchError, match=r"element \d+ at"):
+        st.strip_cell(21, 5, degenerate=1e-9)
+
+
+def test_explicit_step_above_critical_raises_with_a_working_suggestion():
+    mod, corner = st._hang(7)
+    est = stable_time_step(mod, alpha=5.0)
+    t_end = 300 * est.dt
+    with pytest.raises(InstabilityError) as info:
+        run_explicit(mod, t_end=t_end, dt=1.2 * est.dt, alpha=5.0, progress=False)
+    exc = info.value
+    assert exc.suggested_dt <= est.dt * (1 + 1e-9) and f"{exc.suggested_dt:.4g}" in str(exc)
+    res = run_explicit(mod, t_end=t_end, dt=exc.suggested_dt, alpha=5.0, progress=False)
+    assert np.isfinite(res.U).all()
+
+
+def test_a_cell_over_its_budget_is_a_fail_not_a_hang():
+    cell = st.Cell("test", "budget", "strip_cell", dict(nx=41, ny=9), budget=0.05, tolerance=0.01)
+    rec = st.run_cell(cell)
+    assert rec["verdict"] == "FAIL" and rec["reason"].startswith("hang") and rec["wall_time_s"] < 10
