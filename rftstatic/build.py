@@ -12,6 +12,7 @@ from . import material as mat
 from . import mesh as meshmod
 from .model import Model, Supports, edge_load, gravity_load
 from .scene import Scene
+from .units import unit_system
 
 
 def build_mesh(scene: Scene) -> meshmod.TriMesh:
@@ -94,7 +95,7 @@ def build_material(scene: Scene) -> mat.Material:
             if not m:
                 return base
             _, values = mat.PRESETS[name]
-            pu = mat.unit_system(mat.PRESETS[name][0])
+            pu = unit_system(mat.PRESETS[name][0])
             merged = {k: v * pu.to_si(1.0, mat._FABRIC_KINDS[k]) / units.to_si(1.0, mat._FABRIC_KINDS[k])
                       for k, v in values.items()}
             merged.update(m)

@@ -79,10 +79,13 @@ class Model:
     load : (N, 3) external nodal load at load factor 1 [N] (default: zero)
     contact : an object with ``energy(x)``, ``force(x)``, ``tangent_blocks(x)`` (penalty contact)
     membrane : include the membrane energy (``False`` gives the linear Kirchhoff plate)
+    load_terms : loads with a potential scaled by the load factor, e.g.
+        :class:`rftstatic.loads.LeverMoment` (methods ``potential``, ``force``, ``tangent_blocks``,
+        ``commit``)
     """
 
     def __init__(self, mesh: TriMesh, material: Material, *, element="RFT6", supports=None, load=None,
-                 contact=None, membrane=True):
+                 contact=None, membrane=True, load_terms=()):
         if element not in ELEMENTS:
             raise ValueError(f'unknown element "{element}"; use one of {", ".join(ELEMENTS)}')
         self.mesh = mesh
@@ -93,6 +96,7 @@ class Model:
         if self.load.shape != (mesh.n_nodes, 3):
             raise ValueError(f"load must have shape ({mesh.n_nodes}, 3), got {self.load.shape}")
         self.contact = contact
+        self.load_terms = list(load_terms)
         self.with_membrane = bool(membrane)
         self.fixed = self.supports.fixed_mask()
         self.free = ~self.fixed
@@ -128,6 +132,9 @@ class Model:
         Em = self.membrane.energy(U, self.material.Dm) if self.with_membrane else 0.0
         Ec = self.contact.energy(self.positions(U)) if self.contact is not None else 0.0
         W = lam * float(np.einsum("ni,ni->", self.load, U))
+        if self.load_terms:
+            x = self.positions(U)
+            W -= lam * sum(t.potential(x) for t in self.load_terms)
         return {"bending": Eb, "membrane": Em, "contact": Ec, "external_work": W,
                 "total": Eb + Em + Ec - W}
 
@@ -147,10 +154,13 @@ class Model:
 
     def residual(self, U, lam=1.0) -> np.ndarray:
         """Out-of-balance force ``dPi/dU (N, 3)`` [N]; zero at equilibrium on the free dofs."""
-        return self.internal_force(U) - lam * self.load
+        r = self.internal_force(U) - lam * self.load
+        for term in self.load_terms:
+            r += lam * term.force(self.positions(U))
+        return r
 
-    def tangent(self, U, *, psd=False, shift=0.0):
-        """Residual ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m].
+    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0):
+        """Internal force ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m] at load factor ``lam``.
 
         ``psd=True`` drops compressive stress from the geometric stiffness (positive semi-definite
         membrane tangent); ``shift`` adds ``shift * I`` (Levenberg-Marquardt).
@@ -167,6 +177,9 @@ class Model:
             state = self.contact.evaluate(x)
             f += state.force
             data += scatter_matrices(plan.diag_positions, state.tangent_blocks, plan.nnz)
+        for term in self.load_terms:  # load stiffness of potential loads (not part of f)
+            rows, cols, blocks = term.tangent_blocks(x)
+            data += scatter_matrices(plan.positions(rows, cols), lam * blocks, plan.nnz)
         if shift:
             data += scatter_matrices(plan.diag_positions, shift * np.broadcast_to(np.eye(3), (self.mesh.n_nodes, 3, 3)), plan.nnz)
         return f, plan.free_matrix(data)

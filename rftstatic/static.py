@@ -199,6 +199,8 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
                 continuations = 0
                 U_prev, lam_prev = U, lam
                 lam, U = lam_next, nt.U
+                for term in model.load_terms:  # fix the branch of angle-type potentials
+                    term.commit(model.positions(U))
                 result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
                                           "increment": dlam})
                 result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
@@ -266,7 +268,7 @@ def _first_increment(model, U, opts, solver, target) -> float:
     """First load increment: the tangent displacement rate d|U|/d lam at the start, scaled to ``target``."""
     free = model.free.ravel()
     P = model.load.ravel()[free]
-    if not np.any(P):
+    if not np.any(P) or model.load_terms:
         return opts.initial_increment
     try:
         _, K = model.tangent(U, psd=True)
@@ -286,6 +288,9 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
     etol = opts.etol if lam >= 1.0 else max(opts.etol, opts.intermediate_rtol**2)
     free = model.free.ravel()
     P = model.load
+    if model.load_terms:  # potential loads (end moments) count as applied forces
+        x0 = model.positions(U)
+        P = P - sum(t.force(x0) for t in model.load_terms)
     # a floor keeps the tolerance above round-off for vanishing loads
     ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
     U = U.copy()
@@ -362,7 +367,9 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
         if work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
             # (a good predictor makes the first step tiny; round-off must not stall the criterion)
-            work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))), 1e-300)
+            parts = model.energies(U, lam)
+            work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))),
+                        parts["bending"] + parts["membrane"], 1e-300)
         last_work = work
         # modified Newton: keep the factorisation while it still cuts the residual fast
         rnorm_new = float(np.linalg.norm(r_new))
@@ -394,11 +401,11 @@ def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
     for mode in sequence:
         shifts = [base] if mode != "shift" else None
         if mode == "shift":
-            _, K = model.tangent(U, psd=True)
+            _, K = model.tangent(U, psd=True, lam=lam)
             scale = float(np.abs(K.diagonal()).mean())
             shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0)]
         for shift in shifts:
-            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift)
+            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam)
             try:
                 d = solver.solve(K, -r)
             except NotPositiveDefinite as exc:

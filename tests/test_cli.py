@@ -65,3 +65,12 @@ def test_support_box_without_nodes_is_an_error(tmp_path):
         from rftstatic.build import build_model
 
         build_model(load_scene("strip", ["supports.0.box=[9.0, 9.0, 9.0, 9.0]"]))
+
+
+def test_preset_with_an_override_changes_only_that_rigidity():
+    from rftstatic.build import build_material
+
+    base = build_material(load_scene("strip"))
+    mod = build_material(load_scene("strip", ["material.C_warp=111.82"]))  # gf/cm, a tenth of the wool's
+    assert mod.Dm[0, 0] == pytest.approx(0.1 * base.Dm[0, 0])
+    assert mod.Dm[1, 1] == pytest.approx(base.Dm[1, 1]) and mod.Db[0, 0] == pytest.approx(base.Db[0, 0])

@@ -1,0 +1,82 @@
+"""Load terms with a potential beyond dead nodal forces: the end moment of a strip.
+
+With translational degrees of freedom only, a moment has no rotation to act on. A conservative
+end moment M about the y axis is given the potential
+
+    Pi_M = -lam * sum_k M_k phi_k,     phi_k = atan2(r_z, r_x),   r = x_lever,k - x_tip,k,
+
+where phi_k is the angle, in the x-z plane, of the segment from a tip node to a "lever" node one
+element beyond the tip (the strip extended by one element): the work of a moment on a rotation.
+Its gradient is the follower couple M/|r| perpendicular to r (exactly M on [0, L]), and its Hessian
+is the load stiffness, so the moment enters the Newton solver, its energy line search and its
+safeguards like any other term. phi is tracked continuously through full turns (the roll-up of Sze
+et al. 2004 rotates the end by 2 pi): :meth:`LeverMoment.commit` stores the branch after every
+converged increment.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class LeverMoment:
+    """Conservative end moment about +y on ``(tip, lever)`` node pairs.
+
+    Parameters
+    ----------
+    tip, lever : (K,) node indices: each lever node lies one element beyond its tip node
+    moments : (K,) moment carried by each pair at load factor 1 [N m] (sum = the end moment)
+    """
+
+    def __init__(self, tip, lever, moments):
+        self.tip = np.asarray(tip, dtype=np.int64)
+        self.lever = np.asarray(lever, dtype=np.int64)
+        self.moments = np.asarray(moments, dtype=float)
+        if not (self.tip.shape == self.lever.shape == self.moments.shape):
+            raise ValueError(f"tip, lever and moments must have one entry per pair, got "
+                             f"{self.tip.shape}, {self.lever.shape}, {self.moments.shape}")
+        self.reference = None  # committed angles (K,) [rad]
+
+    def angles(self, x: np.ndarray) -> np.ndarray:
+        """Continuous lever angles ``phi (K,)`` [rad] at positions ``x (N, 3)`` [m]."""
+        r = x[self.lever] - x[self.tip]
+        raw = np.arctan2(r[:, 2], r[:, 0])
+        if self.reference is None:
+            return raw
+        return self.reference + np.angle(np.exp(1j * (raw - self.reference)))
+
+    def commit(self, x: np.ndarray) -> None:
+        """Fix the branch of the angles at a converged state."""
+        self.reference = self.angles(x)
+
+    def potential(self, x: np.ndarray) -> float:
+        """Potential per unit load factor, ``-sum M_k phi_k`` [J]."""
+        return -float(self.moments @ self.angles(x))
+
+    def _grad_hess(self, x):
+        r = x[self.lever] - x[self.tip]
+        rx, rz = r[:, 0], r[:, 2]
+        rho2 = rx * rx + rz * rz
+        g = np.zeros((len(r), 3))
+        g[:, 0], g[:, 2] = -rz / rho2, rx / rho2
+        H = np.zeros((len(r), 3, 3))
+        H[:, 0, 0] = 2 * rx * rz / rho2**2
+        H[:, 0, 2] = H[:, 2, 0] = (rz * rz - rx * rx) / rho2**2
+        H[:, 2, 2] = -2 * rx * rz / rho2**2
+        return g, H
+
+    def force(self, x: np.ndarray) -> np.ndarray:
+        """Gradient of :meth:`potential` ``(N, 3)`` [N]."""
+        g, _ = self._grad_hess(x)
+        f = np.zeros_like(x)
+        np.add.at(f, self.lever, -self.moments[:, None] * g)
+        np.add.at(f, self.tip, self.moments[:, None] * g)
+        return f
+
+    def tangent_blocks(self, x: np.ndarray):
+        """Hessian of :meth:`potential` as ``(rows (4K,), cols (4K,), blocks (4K, 3, 3))`` [N/m]."""
+        _, H = self._grad_hess(x)
+        B = -self.moments[:, None, None] * H
+        rows = np.concatenate([self.lever, self.tip, self.lever, self.tip])
+        cols = np.concatenate([self.lever, self.tip, self.tip, self.lever])
+        return rows, cols, np.concatenate([B, B, -B, -B])
