@@ -7,7 +7,7 @@ with mass scaling (§6, default s = 100), stopped when the sheet is at rest (kin
 ``rest_tolerance`` of its peak and out-of-balance force below ``force_tolerance`` of the load); with
 ``compare_static = true`` the resting state is compared with the static Newton solution.
 
-Obstacles act kinematically (§6.3): the penalty contact and in-plane holds that
+Obstacles act kinematically (§6.3): the penalty contact (and, for true dynamics, the in-plane holds) that
 :func:`rftstatic.build.build_model` adds for the static solver are dropped for these runs.
 
 Outputs in the run folder, every number in the scene's units:
@@ -81,13 +81,22 @@ def dynamics_options(scene) -> dict:
 
 
 def dynamic_model(scene, model, extras):
-    """The model without the static solver's penalty contact and in-plane holds (kinematic contact)."""
+    """The model without the static solver's penalty contact (obstacles act kinematically).
+
+    A true dynamic run also drops the in-plane holds of a sheet on a frictionless support; dynamic
+    relaxation (``analysis = "relax"``) seeks the static drape and keeps them (unless
+    ``contact.hold_inplane = false``), or a slightly asymmetric sheet creeps and spins on the support
+    and never comes to rest.
+    """
     if model.contact is None:
         return model
-    from .build import build_supports
+    from .build import build_supports, hold_inplane_rigid_modes
     from .model import Model
 
-    return Model(model.mesh, model.material, element=model.element, supports=build_supports(scene, model.mesh),
+    supports = build_supports(scene, model.mesh)
+    if scene.get("analysis") == "relax" and scene.get("contact.hold_inplane", True):
+        hold_inplane_rigid_modes(model.mesh, supports)
+    return Model(model.mesh, model.material, element=model.element, supports=supports,
                  load=model.load, contact=None, membrane=model.with_membrane)
 
 
