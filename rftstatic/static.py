@@ -293,6 +293,7 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
         P = P - sum(t.force(x0) for t in model.load_terms)
     # a floor keeps the tolerance above round-off for vanishing loads
     ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
+    atol = 0.0
     U = U.copy()
     Pi = model.potential(U, lam)
     r = (model.residual(U, lam)).ravel()[free]
@@ -307,7 +308,9 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
     reuse = False  # the last factorisation may serve the next step (modified Newton)
     age = 0
     for it in range(1, max_iterations + 1):
-        if rnorm <= rtol * ref and (it > 1 and last_work <= etol * work0):
+        if rtol * ref < rnorm < 1e4 * rtol * ref:  # close: is the rest round-off?
+            atol = _roundoff_floor(model, U)
+        if rnorm <= rtol * ref + atol and (it > 1 and last_work <= etol * work0):
             return _Newton(True, U, it - 1, rnorm, stable=stable)
         d = None
         fresh = False
@@ -378,7 +381,7 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
         rnorm = rnorm_new
         if not np.isfinite(rnorm):
             return _Newton(False, U, it, rnorm, "non-finite residual")
-    if rnorm <= rtol * ref and last_work <= etol * work0:
+    if rnorm <= rtol * ref + atol and last_work <= etol * work0:
         return _Newton(True, U, max_iterations, rnorm, stable=stable)
     # still sliding downhill? compare the energy drop of the last third with the scale of the work
     k = max(2, len(Pi_history) // 3)
@@ -420,6 +423,19 @@ def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
                 return d, mode
             last_error = LinearSolveError("the step is not a descent direction of the energy")
     raise LinearSolveError(str(last_error))
+
+
+def _roundoff_floor(model, U) -> float:
+    """Residual [N] below which round-off rules: 100 eps times the summed magnitudes of the element
+    forces. A membrane 10^8 times stiffer than the bending (per unit area) carries element forces
+    that cancel to a residual far below them; no tolerance relative to the load can be met there."""
+    if not model.with_membrane:
+        return 0.0
+    from .assembly import scatter_forces
+
+    fe = np.abs(model.membrane.element_forces(U, model.material.Dm))
+    fabs = scatter_forces(model.membrane.nodes, fe, model.mesh.n_nodes)
+    return 100 * np.finfo(float).eps * float(np.linalg.norm(fabs.ravel()[model.free.ravel()]))
 
 
 def _diagonal_scale(model, U) -> float:
