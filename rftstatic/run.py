@@ -170,5 +170,8 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
         views = tuple(scene.get("output.views", ["side", "top", "iso"]))
         status = "" if summary.get("converged", True) else " (NOT CONVERGED)"
         title = f"{scene.get('title', scene.name)} - {model.element}, {model.mesh.n_nodes} nodes{status}"
+        from .drape_figures import obstacle_drawers
+
         plot_views(str(out / "view"), model.positions(U) / u, model.mesh.tri, views=views, title=title,
-                   color_by=cell["relative_curvature"])
+                   color_by=cell["relative_curvature"], color_label="|kappa| h",
+                   obstacles_draw=obstacle_drawers(extras.get("obstacles", ()), u))

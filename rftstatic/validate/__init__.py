@@ -33,6 +33,9 @@ BENCHMARKS = {
     "stability": "stability matrix: stiffness, mesh, load and time-step extremes",
     "hang20": "explicit dynamics of §4.6 vs fine-mesh / small-step runs",
     "remesh_scenes": "adaptive remeshing (§6) vs dense structured static drapes; RFT3/RFT6 at 371 nodes",
+    "drape_sq20": "square sheet on a square pedestal (§4.2, Fig. 6): boundary and DC mesh convergence",
+    "drape_sharp": "RFT3 vs RFT6 sharp-fold indicators on coarse meshes (§4.3, §4.5)",
+    "drape_folds": "fold count on the round pedestal (§4.4, Fig. 10)",
 }
 
 
