@@ -248,8 +248,8 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
 def smooth_perturbation(mesh, seed: int, amplitude: float) -> np.ndarray:
     """A seeded, smooth out-of-plane start ``(N,)`` [m]: random low Fourier modes of the sheet.
 
-    Six modes with wavelengths between a half and a sixth of the sheet size, scaled so that the
-    largest value is ``amplitude`` mean element sizes. Smooth, so that it tips a symmetric start
+    Six modes with wavelengths between a half and a sixth of the sheet size, shifted and scaled to
+    lie between 0 and ``amplitude`` mean element sizes (upward, never into an obstacle). Smooth, so that it tips a symmetric start
     off its bifurcation without stretching the membrane; the seed is reported with the result.
     """
     rng = np.random.default_rng(seed)
@@ -261,7 +261,9 @@ def smooth_perturbation(mesh, seed: int, amplitude: float) -> np.ndarray:
         direction = rng.normal(size=2)
         direction /= np.linalg.norm(direction)
         w += rng.normal() * np.cos(k * X @ direction + rng.uniform(0, 2 * np.pi))
-    return amplitude * float(mesh.element_size.mean()) * w / max(np.abs(w).max(), 1e-300)
+    # lift only (0 .. amplitude): a start pushed into an obstacle would meet the full penalty
+    w = (w - w.min()) / max(np.ptp(w), 1e-300)
+    return amplitude * float(mesh.element_size.mean()) * w
 
 
 def _first_increment(model, U, opts, solver, target) -> float:
