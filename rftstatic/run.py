@@ -93,6 +93,8 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "cutbacks": result.cutbacks,
         "solver_path": [{"lam": s["lam"], "iterations": s["iterations"]} for s in result.load_steps],
         "tangent_modes": result.tangent_modes,
+        "route": result.route,
+        "relax": result.relax,
         "stable_minimum": result.stable,
         "perturbation_seed": result.seed,
         "residual": result.residual / u.force,

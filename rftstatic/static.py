@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
 from .linsolve import LinearSolveError, NotPositiveDefinite, make_solver
 from .progress import Progress
+from .units import STANDARD_GRAVITY
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +61,9 @@ class StaticOptions:
     tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
     linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
     max_load_steps : give up after this many increments
+    start : ``"load-steps"`` (load-scaled Newton from the flat start) or ``"relax"`` (dynamic
+        relaxation at full load, then Newton to polish: for drapes with many folds)
+    relax_fallback : when the load steps fail, try dynamic relaxation + Newton before giving up
     reuse_factorisation : how many further steps may reuse a factorisation while the residual keeps
         falling by more than 70 % per step (modified Newton; 0 = full Newton)
     max_continuations : an increment whose Newton iteration runs out of iterations while the energy
@@ -84,11 +88,15 @@ class StaticOptions:
     max_load_steps: int = 2000
     max_continuations: int = 10
     reuse_factorisation: int = 2
+    start: str = "load-steps"
+    relax_fallback: bool = True
     perturbation: float = 0.0
     seed: int = 0
     progress: bool = True
 
     def __post_init__(self):
+        if self.start not in ("load-steps", "relax"):
+            raise ValueError(f'solver.start must be "load-steps" or "relax", got "{self.start}"')
         if self.tangent not in ("auto", "exact", "psd"):
             raise ValueError(f'solver.tangent must be "auto", "exact" or "psd", got "{self.tangent}"')
         if not (0 < self.min_increment <= self.initial_increment <= self.max_increment <= 1):
@@ -125,6 +133,8 @@ class StaticResult:
     message: str = ""
     tangent_modes: dict = field(default_factory=dict)
     seed: int | None = None
+    route: str = "load-steps"
+    relax: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         d = {k: v for k, v in asdict(self).items() if k != "U"}
@@ -146,6 +156,12 @@ class _Newton:
 def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
     """Solve the static equilibrium of ``model`` under its full load (see module docstring).
 
+    The load-scaled Newton iteration is the main route. When it cannot get through (a drape whose
+    many folds snap through one after another) and ``relax_fallback`` is on, or when
+    ``start = "relax"``, dynamic relaxation (§6: damped, mass-scaled explicit motion at full load)
+    brings the sheet near rest and Newton polishes the equilibrium to the same tolerance; the
+    result's ``route`` and ``relax`` record what was done.
+
     Parameters
     ----------
     model : :class:`rftstatic.model.Model`
@@ -156,9 +172,54 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     Raises
     ------
     ConvergenceError
-        when an increment cannot converge even at ``min_increment``; ``.result`` holds the last
-        equilibrium (``converged=False``).
+        when an increment cannot converge even at ``min_increment`` (and the relaxation fallback
+        fails too); ``.result`` holds the last equilibrium (``converged=False``).
     """
+    opts = options or StaticOptions()
+    if opts.start == "relax":
+        return _relax_then_newton(model, opts, callback, first=None)
+    try:
+        return _solve_load_steps(model, U0=U0, options=opts, callback=callback)
+    except ConvergenceError as exc:
+        if not opts.relax_fallback or model.load_terms or not np.any(model.load):
+            raise
+        log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
+        return _relax_then_newton(model, opts, callback, first=exc)
+
+
+def _relax_then_newton(model, opts, callback, *, first):
+    """Dynamic relaxation to near rest at full load, then Newton to the full tolerance."""
+    from .explicit import relax
+
+    t0 = time.perf_counter()
+    size = float(np.ptp(model.mesh.X, axis=0).max())
+    omega1 = np.sqrt(STANDARD_GRAVITY / (0.25 * size))  # pendulum estimate of the lowest drape mode
+    mass_scale = 100.0
+    alpha = 2.0 * omega1 / np.sqrt(mass_scale)  # about critical for that mode of the scaled system
+    rel = relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=1e-2,
+                max_time=100.0 / alpha, progress=opts.progress)
+    info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": rel.t, "steps": rel.steps,
+            "at_rest": rel.converged, "wall_time_s": time.perf_counter() - t0,
+            "after_failure": None if first is None else str(first)}
+    polish = replace(opts, start="load-steps", relax_fallback=False, initial_increment=1.0, max_increment=1.0,
+                     increment_displacement=1e30)
+    try:
+        res = _solve_load_steps(model, U0=rel.U, options=polish, callback=callback)
+    except ConvergenceError as exc:
+        if exc.result is not None:
+            exc.result.route, exc.result.relax = "relax+newton", info
+        raise ConvergenceError(f"{exc} (after dynamic relaxation{'' if first is None else ', which followed: ' + str(first)})",
+                               exc.result) from None
+    res.route, res.relax = "relax+newton", info
+    res.wall_time = time.perf_counter() - t0 + (0.0 if first is None or first.result is None else first.result.wall_time)
+    if first is not None and first.result is not None:
+        res.cutbacks += first.result.cutbacks
+        res.iterations += first.result.iterations
+    return res
+
+
+def _solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
+    """The load-scaled Newton iteration of :func:`solve_static`."""
     opts = options or StaticOptions()
     t0 = time.perf_counter()
     n = model.mesh.n_nodes

@@ -116,7 +116,7 @@ def test_newton_from_a_nearby_state_reaches_round_off_in_three_iterations():
 def test_unconverged_state_is_never_reported_as_converged():
     mod = clamped_strip(11, 3, element="RFT3")
     opts = static.StaticOptions(progress=False, max_iterations=1, min_increment=1e-2, initial_increment=0.5,
-                                max_increment=1.0)
+                                max_increment=1.0, relax_fallback=False)
     with pytest.raises(static.ConvergenceError, match=r"load factor .* iteration .*\|r\| = ") as info:
         static.solve_static(mod, options=opts)
     assert info.value.result is not None and not info.value.result.converged
@@ -129,4 +129,12 @@ def test_other_linear_solvers_agree(solver):
     a = static.solve_static(mod, options=static.StaticOptions(progress=False))
     b = static.solve_static(mod, options=static.StaticOptions(progress=False, linear_solver=solver))
     assert b.linear_solver == solver and b.converged
+    assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
+
+
+def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
+    mod = clamped_strip(11, 3)
+    a = static.solve_static(mod, options=static.StaticOptions(progress=False))
+    b = static.solve_static(mod, options=static.StaticOptions(progress=False, start="relax"))
+    assert a.route == "load-steps" and b.route == "relax+newton" and b.relax["at_rest"]
     assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
