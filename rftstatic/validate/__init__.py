@@ -75,6 +75,29 @@ def main(names, *, quick: bool = False, out=None) -> int:
     return 0 if all(r.passed for r in results) else 1
 
 
+def rebuild_index(out=None) -> Path:
+    """Rewrite the index from every ``NAME.json`` in ``out`` (the reports already on disk)."""
+    import json
+    from types import SimpleNamespace
+
+    from .report import Study
+
+    out = Path(out) if out else default_out()
+    results = []
+    for path in sorted(out.glob("*.json")):
+        d = json.loads(path.read_text(encoding="utf-8"))
+        if "studies" not in d or "name" not in d:
+            continue
+        studies = [Study(s["case"], s["element"], s["h"], s["nodes"], s["error"], s["wall_time"], s["tolerance"])
+                   for s in d["studies"]]
+        results.append(SimpleNamespace(name=d["name"], citation=d.get("citation", ""), reference=d["reference"],
+                                       studies=studies, passed=d.get("passed", True), title=d.get("title", "")))
+    index = out / "README.md"
+    if index.exists():
+        index.unlink()
+    return write_index(results, out, quick=False)
+
+
 def write_index(results, out: Path, *, quick: bool) -> Path:
     """``README.md``: one row per convergence study of every benchmark (rows of earlier runs kept)."""
     path = out / "README.md"
@@ -87,11 +110,16 @@ def write_index(results, out: Path, *, quick: bool) -> Path:
     for res in results:
         key = f"[{res.name}]({res.name}.md)"
         rows[key] = []
+        if not res.studies:  # a benchmark of cells or tables: one row with its verdict
+            verdict = "pass" if res.passed else "**FAIL**"
+            rows[key].append(f"| {key} | {res.citation or res.reference.split('. ')[0]} | "
+                             f"{getattr(res, 'title', '')} | - | - | - | - | see report | {verdict} |")
         for s in res.studies:
             d = s.summary()
             tol = fmt_err(s.tolerance) if s.tolerance is not None else "reported"
             verdict = "reported" if s.tolerance is None else ("pass" if s.passed else "**FAIL**")
-            rows[key].append(f"| {key} | {res.citation or res.reference.split('. ')[0]} | {s.case} | {s.element} | "
+            case = s.case.replace("|", "\\|")
+            rows[key].append(f"| {key} | {res.citation or res.reference.split('. ')[0]} | {case} | {s.element} | "
                              f"{fmt_err(d['finest_error'])} | {d['observed_rate']:.2f} | "
                              f"{fmt_time(d['time_to_1pct'])} / {fmt_time(d['time_to_0p1pct'])} | {tol} | "
                              f"{verdict} |")
