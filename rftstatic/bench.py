@@ -160,6 +160,8 @@ BENCHES = {
     "explicit": _lazy("bench_explicit", lambda m: m.main([])),  # element-steps per second
     "dynamic": _lazy("bench_scenes", lambda m: m.bench_dynamic_scenes()),  # hang-20, hang-100
     "mesher": _lazy("mesher.bench", lambda m: m.main([])),  # triangles per second
+    "drape": _lazy("bench_drape", lambda m: m.main([])),  # static drape scenes, each in a fresh process
+    "remesh": _lazy("bench_remesh", lambda m: m.main([])),  # mesher sizes and the remeshed scenes
 }
 
 
