@@ -469,7 +469,7 @@ def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
         if mode == "shift":
             _, K = model.tangent(U, psd=True, lam=lam)
             scale = float(np.abs(K.diagonal()).mean())
-            shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0)]
+            shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
         for shift in shifts:
             _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam)
             try:
