@@ -4,32 +4,20 @@ import numpy as np
 import pytest
 
 from conftest import clamped_strip
-from rftstatic import material, mesh, model, static
+from rftstatic import static
 from rftstatic.references import plates
 from rftstatic.references.elastica import heavy_elastica
-
-LINEAR = static.StaticOptions(initial_increment=1.0, increment_displacement=1e9, progress=False)
-SHELL = material.isotropic_shell(E=1.0e4, nu=0.3, thickness=0.01)
+from rftstatic.validate.plates import plate_coefficient
 
 
 def plate_centre_coefficient(n, edges, load, *, pattern="right"):
-    """w_centre D / (q a^4) (uniform) or w_centre D / (P a^2) (point) of a unit square plate."""
-    m = mesh.rectangle(1.0, 1.0, n, n, origin=(-0.5, -0.5), pattern=pattern)
-    b = m.boundary_nodes
-    none = np.zeros(0, int)
-    sup = model.Supports(b if edges == "clamped" else none, b if edges == "simply_supported" else none,
-                         np.zeros((m.n_nodes, 3), bool))
-    q = 1e-3  # small: deflection ~ 1e-2 a, where the bending-only plate is the Kirchhoff plate
-    centre = m.nearest_node([[0.0, 0.0]])[0]
-    if load == "uniform":
-        P = model.gravity_load(m, q)
-    else:
-        P = np.zeros((m.n_nodes, 3))
-        P[centre, 2] = -q
-    mod = model.Model(m, SHELL, supports=sup, load=P, membrane=False)
-    res = static.solve_static(mod, options=LINEAR)
-    assert res.converged
-    return -res.U[centre, 2] * SHELL.Db[0, 0] / q, res
+    """w_centre D / (q a^4) (uniform) or w_centre D / (P a^2) (point) of a unit square plate.
+
+    The set-up is the validation's (bending-only Kirchhoff plate, small load, rftstatic.validate.plates).
+    """
+    row = plate_coefficient(n, edges, load, pattern=pattern)
+    assert row["converged"]
+    return row["value"], row
 
 
 def observed_rate(h, err):
@@ -37,8 +25,8 @@ def observed_rate(h, err):
 
 
 def test_linear_problem_converges_in_one_newton_iteration():
-    _, res = plate_centre_coefficient(21, "clamped", "uniform")
-    assert res.iterations == 1 and len(res.load_steps) == 1
+    _, row = plate_centre_coefficient(21, "clamped", "uniform")
+    assert row["iterations"] == 1
 
 
 def test_clamped_plate_uniform_load_matches_timoshenko_with_second_order_rate():
