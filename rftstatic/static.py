@@ -187,6 +187,10 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         return _relax_then_newton(model, opts, callback, first=exc)
 
 
+MAX_RELAX_STEPS = 200_000
+"""Largest number of explicit steps the relaxation route may take before it is not attempted."""
+
+
 def _relax_then_newton(model, opts, callback, *, first):
     """Dynamic relaxation to near rest at full load, then Newton to the full tolerance."""
     from .explicit import relax
@@ -196,8 +200,25 @@ def _relax_then_newton(model, opts, callback, *, first):
     omega1 = np.sqrt(STANDARD_GRAVITY / (0.25 * size))  # pendulum estimate of the lowest drape mode
     mass_scale = 100.0
     alpha = 2.0 * omega1 / np.sqrt(mass_scale)  # about critical for that mode of the scaled system
-    rel = relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=1e-2,
-                max_time=100.0 / alpha, progress=opts.progress)
+    from .explicit import InstabilityError
+    from .timestep import stable_time_step
+
+    max_time = 100.0 / alpha
+    est = stable_time_step(model, mass_scale=mass_scale, alpha=alpha)
+    if max_time / est.dt > MAX_RELAX_STEPS:  # a membrane far stiffer than the bending: too many steps
+        message = (f"dynamic relaxation would need up to {max_time / est.dt:.3g} explicit steps (dt {est.dt:.3g} s); "
+                   f"not attempted (limit {MAX_RELAX_STEPS:g})")
+        if first is not None:
+            raise ConvergenceError(f"{first}; {message}", first.result) from None
+        raise ConvergenceError(message, None)
+    try:
+        rel = relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=1e-2,
+                    max_time=max_time, progress=opts.progress)
+    except InstabilityError as exc:
+        text = f"dynamic relaxation became unstable ({exc})"
+        if first is not None:
+            raise ConvergenceError(f"{first}; {text}", first.result) from None
+        raise ConvergenceError(text, None) from None
     info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": rel.t, "steps": rel.steps,
             "at_rest": rel.converged, "wall_time_s": time.perf_counter() - t0,
             "after_failure": None if first is None else str(first)}

@@ -90,7 +90,7 @@ def end_shear(nx, ny, element, table):
                 err, wall, iterations, converged, {"curve": curve, "at_table": got.tolist(), "message": message})
 
 
-def end_moment(nx, ny, element, table, *, plane=True):
+def end_moment(nx, ny, element, table, *, plane=True, steps_per_table=4):
     """Cantilever rolled up by a conservative end moment (:class:`rftstatic.loads.LeverMoment`).
 
     The strip is extended by one lever element beyond x = L; the moment acts through the potential
@@ -115,7 +115,8 @@ def end_moment(nx, ny, element, table, *, plane=True):
     mod = model.Model(m, _shell(c), element=element, supports=sup,
                       load_terms=[LeverMoment(tip, lever, c.load_max * share)])
     rec = []
-    opts = static.StaticOptions(progress=False, initial_increment=0.0125, max_increment=0.0125,
+    increment = float(np.diff(table["load_fraction"]).min()) / steps_per_table  # 0.0125 by default
+    opts = static.StaticOptions(progress=False, initial_increment=increment, max_increment=increment,
                                 intermediate_rtol=1e-6)
     converged, message, iterations, steps = True, "", 0, 0
     try:
