@@ -162,6 +162,11 @@ class Obstacle(abc.ABC):
     def params(self) -> dict[str, Any]:
         """Defining parameters in metres, keyed as in a scene table (without ``type``)."""
 
+    def footprint(self) -> tuple[float | None, np.ndarray]:
+        """Area [m^2] and centre ``(2,)`` [m] of the support in top view (the "disc" of the drape
+        coefficient); area ``None`` for an unbounded obstacle (a floor)."""
+        return None, np.zeros(2)
+
     def closest_point(self, x: np.ndarray) -> np.ndarray:
         """Closest surface point ``x - phi * normal`` of every point.
 
@@ -282,6 +287,9 @@ class Sphere(Obstacle):
     def params(self):
         return {"centre": self.centre.tolist(), "radius": self.radius}
 
+    def footprint(self):
+        return float(np.pi * self.radius**2), self.centre[:2].copy()
+
 
 def _check_height(height, edge_radius: float, what: str) -> float:
     """Validate a pedestal height [m] (``None`` or ``inf`` = infinitely tall)."""
@@ -385,6 +393,10 @@ class SquarePedestal(Obstacle):
             "height": None if np.isinf(self.height) else self.height,
         }
 
+    def footprint(self):
+        hx, hy = self.half_width
+        return float(4 * hx * hy), self.centre_xy.copy()
+
 
 class RoundPedestal(Obstacle):
     """Vertical circular cylinder (pedestal) whose top (and bottom) rim is rounded by ``edge_radius``.
@@ -460,6 +472,9 @@ class RoundPedestal(Obstacle):
             "edge_radius": self.edge_radius,
             "height": None if np.isinf(self.height) else self.height,
         }
+
+    def footprint(self):
+        return float(np.pi * self.radius**2), self.centre_xy.copy()
 
 
 # Scene tables: type name -> (class, {scene key: (constructor argument, required)}). Every value is a

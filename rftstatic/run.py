@@ -119,27 +119,11 @@ def drape_summary(scene, model, extras, U) -> dict:
 
     u = scene.units.length
     x = model.positions(U)
-    disc_area = None
     obstacles = extras["obstacles"]
-    if obstacles:
-        disc_area = _support_area(obstacles[0])
-    centre = obstacles[0].as_dict().get("centre", [0.0, 0.0])[:2] if obstacles else [0.0, 0.0]
+    disc_area, centre = obstacles[0].footprint() if obstacles else (None, np.zeros(2))
     m = drape_measures(x, model.mesh.tri, sheet_area=float(model.mesh.area.sum()), disc_area=disc_area,
-                       centre=np.asarray(centre, float), curvature=model.curvature(U), h=model.mesh.element_size)
+                       centre=centre, curvature=model.curvature(U), h=model.mesh.element_size)
     return _scale_lengths(m, u)
-
-
-def _support_area(obstacle) -> float | None:
-    d = obstacle.as_dict()
-    t = d.get("type", "")
-    if t == "round-pedestal":
-        return float(np.pi * d["radius"] ** 2)
-    if t == "square-pedestal":
-        hw = np.broadcast_to(np.asarray(d.get("half_width"), float), (2,))
-        return float(4 * hw[0] * hw[1])
-    if t == "sphere":
-        return float(np.pi * d["radius"] ** 2)
-    return None
 
 
 _LENGTH_KEYS = ("boundary_radius_min", "boundary_radius_mean", "boundary_radius_max", "max_dihedral_at",

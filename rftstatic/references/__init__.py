@@ -43,8 +43,22 @@ SZE2004_NAMES = ("end_shear", "end_moment", "slit_annular")
 """Names accepted by :func:`load_sze2004`."""
 
 
+class _IsotropicShellRigidities:
+    """C and D of an isotropic shell with fields E, nu, h (the formulas of the shared README)."""
+
+    @property
+    def C(self) -> float:
+        """Membrane rigidity per unit width, E·h/(1−ν²) [force / length]."""
+        return self.E * self.h / (1.0 - self.nu**2)
+
+    @property
+    def D(self) -> float:
+        """Bending rigidity per unit width, E·h³/(12(1−ν²)) [force·length]."""
+        return self.E * self.h**3 / (12.0 * (1.0 - self.nu**2))
+
+
 @dataclass(frozen=True)
-class CantileverStrip:
+class CantileverStrip(_IsotropicShellRigidities):
     """A cantilever strip of Sze, Liu & Lo (2004), clamped at ``x = 0``.
 
     Attributes
@@ -82,19 +96,10 @@ class CantileverStrip:
         """Bending stiffness of the strip, E·b·h³/12 [force·length²]."""
         return self.E * self.b * self.h**3 / 12.0
 
-    @property
-    def C(self) -> float:
-        """Membrane rigidity per unit width, E·h/(1−ν²) [force / length]."""
-        return self.E * self.h / (1.0 - self.nu**2)
-
-    @property
-    def D(self) -> float:
-        """Bending rigidity per unit width, E·h³/(12(1−ν²)) [force·length]."""
-        return self.E * self.h**3 / (12.0 * (1.0 - self.nu**2))
 
 
 @dataclass(frozen=True)
-class SlitAnnularPlate:
+class SlitAnnularPlate(_IsotropicShellRigidities):
     """The slit annular plate of Sze, Liu & Lo (2004).
 
     A radial slit at θ = 0; one side of it is clamped, the other carries a
@@ -132,15 +137,6 @@ class SlitAnnularPlate:
         """Largest total lifting force, line force × (R_o − R_i) [force]."""
         return self.line_force_max * (self.R_o - self.R_i)
 
-    @property
-    def C(self) -> float:
-        """Membrane rigidity, E·h/(1−ν²) [force / length]."""
-        return self.E * self.h / (1.0 - self.nu**2)
-
-    @property
-    def D(self) -> float:
-        """Bending rigidity, E·h³/(12(1−ν²)) [force·length]."""
-        return self.E * self.h**3 / (12.0 * (1.0 - self.nu**2))
 
 
 END_SHEAR = CantileverStrip(
