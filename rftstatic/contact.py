@@ -125,6 +125,13 @@ class PenaltyContact:
     The four methods :meth:`energy`, :meth:`force`, :meth:`tangent_blocks` and :meth:`gaps` each
     evaluate the signed distances once; :meth:`evaluate` returns all of them from one evaluation and is
     what a Newton iteration should call.
+
+    Candidate list: :meth:`evaluate` computes distances only for the nodes that were within
+    ``margin`` of an obstacle when the list was last refreshed, and refreshes it (one evaluation of
+    every node) once some node has moved more than ``margin / 2`` since. A signed distance changes
+    no faster than the point moves, so a node left out is still more than ``margin / 2 > eps`` away
+    and has no contact energy: the result is exact, and an explicit step (which moves nodes a small
+    fraction of an element) pays for the few nodes near the obstacle instead of all of them.
     """
 
     def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float,
@@ -140,6 +147,11 @@ class PenaltyContact:
             raise ValueError(f"node_area must be finite and >= 0, got node_area[{i}] = {area[i]!r}")
         self.node_area = area
         self.stiffness = _positive("stiffness", stiffness)
+        # list margin [m]: a few onset widths, and half a node spacing so explicit runs refresh seldom
+        spacing = float(np.sqrt(np.mean(area))) if area.size and np.mean(area) > 0 else 0.0
+        self.margin = max(4.0 * self.smoothing, 0.5 * spacing)
+        self._candidates = None  # (indices, positions at refresh, lower bound of the gap at refresh)
+        self.refreshes = 0
 
     @property
     def n_nodes(self) -> int:
@@ -148,7 +160,10 @@ class PenaltyContact:
 
     def _distances(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Signed distances ``(M, N)`` [m] and normals ``(M, N, 3)`` for the ``M`` obstacles."""
-        x = _as_points(x, self.n_nodes)
+        return self._distances_of(_as_points(x, self.n_nodes))
+
+    def _distances_of(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`_distances` for any number of points ``(P, 3)`` [m]."""
         if not self.obstacles:
             return np.full((0, x.shape[0]), np.inf), np.zeros((0, x.shape[0], 3))
         phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
@@ -167,12 +182,16 @@ class PenaltyContact:
         ContactState
         """
         x = _as_points(x, self.n_nodes)
-        phi, normal = self._distances(x)
-        e, d1, d2 = self._density(phi)  # energy density, d/dphi, d2/dphi2 per unit k A  (M, N)
-        ka = self.stiffness * self.node_area  # (N,) [N/m]
+        n = x.shape[0]
+        cand, gap = self._near(x)
+        xc = x[cand]
+        phi, normal = self._distances_of(xc)
+        e, d1, d2 = self._density(phi)  # energy density, d/dphi, d2/dphi2 per unit k A  (M, C)
+        ka = self.stiffness * self.node_area[cand]  # (C,) [N/m]
         energy = float(np.sum(ka * np.sum(e, axis=0)))
-        force = np.einsum("n,mn,mni->ni", ka, d1, normal)
-        blocks = np.zeros((x.shape[0], 3, 3))
+        force = np.zeros((n, 3))
+        force[cand] = np.einsum("n,mn,mni->ni", ka, d1, normal)
+        blocks = np.zeros((n, 3, 3))
         if tangent:
             for m, ob in enumerate(self.obstacles):
                 # touching nodes (phi = 0) get the one-sided Hessian too: a sheet laid on a support
@@ -180,11 +199,33 @@ class PenaltyContact:
                 act = phi[m] <= self.smoothing
                 if not np.any(act):
                     continue
-                H = ob.normal_gradient(x[act])
+                H = ob.normal_gradient(xc[act])
                 nn = np.einsum("ni,nj->nij", normal[m, act], normal[m, act])
-                blocks[act] += ka[act, None, None] * (d2[m, act, None, None] * nn + d1[m, act, None, None] * H)
-        gap = phi.min(axis=0) if phi.shape[0] else np.full(x.shape[0], np.inf)
-        return ContactState(energy, force, blocks, gap, np.any(phi < 0.0, axis=0))
+                blocks[cand[act]] += ka[act, None, None] * (d2[m, act, None, None] * nn + d1[m, act, None, None] * H)
+        active = np.zeros(n, dtype=bool)
+        if phi.shape[0]:
+            gap[cand] = phi.min(axis=0)
+            active[cand] = np.any(phi < 0.0, axis=0)
+        return ContactState(energy, force, blocks, gap, active)
+
+    def _near(self, x):
+        """Indices of the candidate nodes and an ``(N,)`` gap array: exact values are filled in by
+        the caller for the candidates; the others hold a lower bound (> margin / 2) [m]."""
+        n = x.shape[0]
+        if not self.obstacles:
+            return np.arange(0), np.full(n, np.inf)
+        c = self._candidates
+        if c is not None:
+            idx, x_ref, bound = c
+            moved = np.sqrt(np.max(np.einsum("ni,ni->n", x - x_ref, x - x_ref)))
+            if moved <= 0.5 * self.margin:
+                return idx, bound - moved
+        phi, _ = self._distances_of(x)
+        gap = phi.min(axis=0)
+        idx = np.flatnonzero(gap < self.margin)
+        self._candidates = (idx, x.copy(), gap)
+        self.refreshes += 1
+        return idx, gap.copy()
 
     def _density(self, phi):
         eps = self.smoothing

@@ -87,9 +87,10 @@ class CholmodSolver:
         A = K.T  # CSR of a symmetric matrix = its CSC transpose, no copy
         pattern = (A.shape, A.nnz)
         if self._factor is None or pattern != self._pattern:
-            # measured on RF tangents (2 cores): simplicial AMD is fastest below ~5000 unknowns
-            # (strip 11 x 51: 5.5 ms against 13 ms supernodal), supernodal METIS above
-            if A.shape[0] < 5_000:
+            # measured on RF tangents (2 cores): simplicial AMD is fastest for small problems
+            # (strip 11 x 51, 1683 unknowns: 5.5 ms against 13 ms supernodal), supernodal METIS
+            # from a few thousand (pedestal 33 x 33, 3264 unknowns: 22 ms against 53 ms simplicial)
+            if A.shape[0] < 2_500:
                 self._factor = analyze(A, mode="simplicial", ordering_method="amd")
             else:
                 self._factor = analyze(A, mode="supernodal", ordering_method="metis")
