@@ -269,6 +269,7 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
         "residual": float(h["residual"][-1]) / u.force,
         "probes": probes,
         "software": {"rftstatic": __version__, "python": platform.python_version()},
+        "warnings": list(model.warnings),
     }
     if run.contact_nodes:
         summary["contact_nodes"] = run.contact_nodes

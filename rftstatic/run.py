@@ -104,6 +104,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "probes": probes,
         "max_relative_curvature": float(rel_k.max()),
         "software": {"rftstatic": __version__, "python": platform.python_version()},
+        "warnings": list(model.warnings),
     }
     if model.contact is not None:
         x = model.positions(U)

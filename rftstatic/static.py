@@ -249,8 +249,11 @@ def _relax_then_newton(model, opts, callback, *, first):
         info["wall_time_s"] = time.perf_counter() - t0
         stage = {"tol_force": tol_force, "time_s": rel.t, "steps": rel.steps, "at_rest": rel.converged}
         info["stages"].append(stage)
+        # from an early stage Newton gets one round of iterations: a long downhill walk on an indefinite
+        # tangent (a large sheet whose folds still move) is left to the cheaper relaxation
+        stage_opts = polish if last else replace(polish, max_continuations=0, min_increment=1.0)
         try:
-            res = _solve_load_steps(model, U0=U, options=polish, callback=callback)
+            res = _solve_load_steps(model, U0=U, options=stage_opts, callback=callback)
         except ConvergenceError as exc:
             stage["newton"] = str(exc)
             if last or not rel.converged or t_used >= max_time:

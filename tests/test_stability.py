@@ -52,3 +52,26 @@ def test_a_cell_over_its_budget_is_a_fail_not_a_hang():
     cell = st.Cell("test", "budget", "strip_cell", dict(nx=41, ny=9), budget=0.05, tolerance=0.01)
     rec = st.run_cell(cell)
     assert rec["verdict"] == "FAIL" and rec["reason"].startswith("hang") and rec["wall_time_s"] < 10
+
+
+def test_rft6_warns_of_membrane_locking_where_the_strip_stiffens(caplog):
+    """Above LOCKING_WARN an RFT6 model warns (log and ``model.warnings``) and names the fix: the strip
+    of the stability matrix at C/B = 1e6 /cm^2 on 21 x 5 nodes (locking number 8e4, measured 3.3 %
+    too stiff) warns; RFT3 and the paper's wool on the same mesh do not. The matrix then reports an
+    out-of-tolerance answer on a warned model as a limitation, not as a silent wrong answer."""
+    import logging
+
+    from rftstatic.model import LOCKING_WARN, locking_number
+
+    with caplog.at_level(logging.WARNING, logger="rftstatic.model"):
+        coarse = st._strip(21, 5, element="RFT6", ratio=1e6)
+    assert locking_number(coarse.mesh, coarse.material) > LOCKING_WARN
+    assert coarse.warnings and "RFT3" in coarse.warnings[0] and "Refine" in coarse.warnings[0]
+    assert any("membrane locking" in r.message for r in caplog.records)
+    assert not st._strip(21, 5, element="RFT3", ratio=1e6).warnings  # the CST does not lock
+    wool = st._strip(21, 5, element="RFT6")
+    assert locking_number(wool.mesh, wool.material) < LOCKING_WARN and not wool.warnings
+    cell = st.Cell("g", "c", "strip_cell", {}, 10, 0.01)
+    rec = {"converged": True, "error": 0.03}
+    assert st._verdict(cell, rec)[0] == "FAIL"
+    assert st._verdict(cell, dict(rec, warnings=coarse.warnings))[0] == "limitation"
