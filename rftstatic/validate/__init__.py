@@ -6,7 +6,9 @@ Every benchmark is a module here with ``run(quick, *, out=None) -> BenchmarkResu
   rigidity ratios, diagonal patterns);
 - ``plates``: square Kirchhoff plates against Timoshenko/Navier (bending only, small load);
 - ``sze2004``: the large-deflection cantilevers and slit annular plate of Sze, Liu & Lo (2004);
-- ``hang20``: the explicit dynamics of §4.6 against fine-mesh and small-step runs.
+- ``hang20``: the explicit dynamics of §4.6 against fine-mesh and small-step runs;
+- ``peers``: the plates with scikit-fem's Morley and Argyris triangles (optional extra ``peers``) and
+  the published ABAQUS S4R meshes of Sze et al. (2004), error and time side by side.
 
 :func:`main` writes, into ``out`` (default: the repository's ``validation/``), ``NAME.md``,
 ``NAME.json`` and PNG plots per benchmark and the index ``README.md``; it returns 1 when a
@@ -36,6 +38,7 @@ BENCHMARKS = {
     "drape_sq20": "square sheet on a square pedestal (§4.2, Fig. 6): boundary and DC mesh convergence",
     "drape_sharp": "RFT3 vs RFT6 sharp-fold indicators on coarse meshes (§4.3, §4.5)",
     "drape_folds": "fold count on the round pedestal (§4.4, Fig. 10)",
+    "peers": "a general FE code (scikit-fem Morley/Argyris plates; cited ABAQUS S4R) next to RF triangles",
 }
 
 
