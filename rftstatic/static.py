@@ -190,20 +190,24 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
 MAX_RELAX_STEPS = 200_000
 """Largest number of explicit steps the relaxation route may take before it is not attempted."""
 
-RELAX_STAGES = (1.0, 1e-2)
-"""Out-of-balance force, relative to the load ``|P|``, at which the relaxation hands over to Newton;
-the next stage is used only when Newton fails from the previous one."""
+RELAX_NEWTON_ITERATIONS = 10
+"""Newton's ``max_iterations`` (doubled at full load: 20 iterations) from a relaxed state before the
+relaxation resumes; the final handover uses the solver's own budget."""
 
 
 def _relax_then_newton(model, opts, callback, *, first):
     """Dynamic relaxation at full load to near rest, then Newton to the full tolerance.
 
-    The relaxation stops in stages (:data:`RELAX_STAGES`): first when the motion has died down
-    (kinetic energy 1e-4 of its peak) while the out-of-balance force is still of the order of the
-    weight; Newton usually converges from there in a few more iterations than from a tighter rest,
-    and the slow tail of the relaxation (half of its steps on a 33 x 33 drape) is skipped. When Newton
-    does not converge from that state, the relaxation resumes (same displacements and velocities) to
-    the next, tighter stage and Newton tries again.
+    The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while
+    the out-of-balance force is still of the order of the weight (``|r| < |P|``): Newton usually
+    converges from there in a few iterations, and the slow tail of the relaxation (half of its steps
+    on a 33 x 33 drape) is skipped. Newton gets a short budget (:data:`RELAX_NEWTON_ITERATIONS`). When
+    it fails, the relaxation resumes (same displacements and velocities) in chunks of a few damping
+    times; after each chunk the tangent is factorised, and Newton tries again only when it is positive
+    definite (the state is in the basin of a stable minimum: from an indefinite tangent, Newton walks
+    downhill for hundreds of iterations on the PSD tangent, to a point that need not be a minimum —
+    the 80 cm sheet did). The relaxation ends at rest at half the solver's ``rtol`` or at its time
+    limit; Newton then finishes with the solver's own budget.
     """
     from .explicit import InstabilityError, relax
     from .timestep import stable_time_step
@@ -214,6 +218,7 @@ def _relax_then_newton(model, opts, callback, *, first):
     mass_scale = 100.0
     alpha = 2.0 * omega1 / np.sqrt(mass_scale)  # about critical for that mode of the scaled system
     max_time = 100.0 / alpha
+    chunk = 4.0 / alpha  # relaxation between two tangent checks [s]
     est = stable_time_step(model, mass_scale=mass_scale, alpha=alpha)
     if max_time / est.dt > MAX_RELAX_STEPS:  # a membrane far stiffer than the bending: too many steps
         message = (f"dynamic relaxation would need up to {max_time / est.dt:.3g} explicit steps (dt {est.dt:.3g} s); "
@@ -228,43 +233,47 @@ def _relax_then_newton(model, opts, callback, *, first):
         U[:, 2] = smooth_perturbation(model.mesh, seed, opts.perturbation) * model.free[:, 2]
     polish = replace(opts, start="load-steps", relax_fallback=False, initial_increment=1.0, max_increment=1.0,
                      increment_displacement=1e30)
-    info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": 0.0, "steps": 0, "stages": [],
+    short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS)
+    info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": 0.0, "steps": 0, "handovers": [],
             "after_failure": None if first is None else str(first)}
     t_used, peak = 0.0, 0.0
-    for k, tol_force in enumerate(RELAX_STAGES):
-        last = k == len(RELAX_STAGES) - 1
+    tol_force, span = 1.0, max_time  # the first stop: motion died down, |r| < |P|
+    checker = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+
+    def fail(text, result=None):
+        if result is not None:
+            result.route, result.relax, result.seed = "relax+newton", info, seed
+        if first is not None:
+            text = f"{first}; {text}"
+        return ConvergenceError(text, result if result is not None else (first.result if first else None))
+
+    while True:
         try:
             rel = relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=tol_force,
-                        max_time=max(max_time - t_used, 10 * est.dt), U0=U, V0=V, peak_kinetic=peak,
+                        max_time=max(min(span, max_time - t_used), 10 * est.dt), U0=U, V0=V, peak_kinetic=peak,
                         progress=opts.progress)
         except InstabilityError as exc:
-            text = f"dynamic relaxation became unstable ({exc})"
-            if first is not None:
-                raise ConvergenceError(f"{first}; {text}", first.result) from None
-            raise ConvergenceError(text, None) from None
+            raise fail(f"dynamic relaxation became unstable ({exc})") from None
         U, V, peak = rel.U, rel.V, rel.peak_kinetic
         t_used += rel.t
-        info["time_s"], info["steps"] = t_used, info["steps"] + rel.steps
-        info["at_rest"] = rel.converged
-        info["wall_time_s"] = time.perf_counter() - t0
-        stage = {"tol_force": tol_force, "time_s": rel.t, "steps": rel.steps, "at_rest": rel.converged}
-        info["stages"].append(stage)
-        # from an early stage Newton gets one round of iterations: a long downhill walk on an indefinite
-        # tangent (a large sheet whose folds still move) is left to the cheaper relaxation
-        stage_opts = polish if last else replace(polish, max_continuations=0, min_increment=1.0)
+        info.update(time_s=t_used, steps=info["steps"] + rel.steps, at_rest=rel.converged,
+                    wall_time_s=time.perf_counter() - t0)
+        final = (rel.converged and tol_force < 1.0) or t_used >= max_time * (1 - 1e-9)
+        if not final and tol_force < 1.0 and not _positive_definite(model, U, checker):
+            continue  # still outside the basin of a stable minimum: relax on
+        handover = {"time_s": t_used, "steps": info["steps"], "at_rest": rel.converged}
+        info["handovers"].append(handover)
         try:
-            res = _solve_load_steps(model, U0=U, options=stage_opts, callback=callback)
+            res = _solve_load_steps(model, U0=U, options=polish if final else short, callback=callback)
         except ConvergenceError as exc:
-            stage["newton"] = str(exc)
-            if last or not rel.converged or t_used >= max_time:
-                if exc.result is not None:
-                    exc.result.route, exc.result.relax, exc.result.seed = "relax+newton", info, seed
-                raise ConvergenceError(
-                    f"{exc} (after dynamic relaxation{'' if first is None else ', which followed: ' + str(first)})",
-                    exc.result) from None
-            log.info("Newton did not converge from the relaxation stage %d (%s); relaxing further", k + 1, exc)
+            handover["newton"] = str(exc)
+            if final:
+                raise fail(f"{exc} (after dynamic relaxation)", exc.result) from None
+            log.info("Newton did not converge from the relaxed state at t = %.3g s (%s); relaxing further",
+                     t_used, exc)
+            tol_force, span = 0.5 * opts.rtol, chunk
             continue
-        stage["newton"] = f"converged in {res.iterations} iterations"
+        handover["newton"] = f"converged in {res.iterations} iterations"
         break
     res.route, res.relax, res.seed = "relax+newton", info, seed
     res.wall_time = time.perf_counter() - t0 + (0.0 if first is None or first.result is None else first.result.wall_time)
@@ -272,6 +281,18 @@ def _relax_then_newton(model, opts, callback, *, first):
         res.cutbacks += first.result.cutbacks
         res.iterations += first.result.iterations
     return res
+
+
+def _positive_definite(model, U, solver) -> bool:
+    """Whether the exact tangent at full load is positive definite at ``U`` (one factorisation)."""
+    if not solver.detects_indefinite:
+        return True
+    _, K = model.tangent(U, lam=1.0)
+    try:
+        solver.solve(K, np.zeros(K.shape[0]))
+    except (NotPositiveDefinite, LinearSolveError):
+        return False
+    return True
 
 
 def _solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
