@@ -338,6 +338,9 @@ def _contact(model, obstacles, U, V, mass, acc) -> int:
     X3 = model.X3
     x_new, v_new, n_active = kinematic_contact(obstacles, X3 + U, V)
     if n_active:
+        # the projection along the normal must not give a supported dof a velocity (a node held in
+        # x, y on a sphere would otherwise keep a spurious, never damped in-plane speed)
+        v_new *= model.free
         k_before = float(np.einsum("n,ni,ni->", mass, V, V))
         k_after = float(np.einsum("n,ni,ni->", mass, v_new, v_new))
         acc["contact"] += 0.5 * (k_before - k_after)
