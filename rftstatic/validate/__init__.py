@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import importlib
 import logging
+import re
 import time
 from pathlib import Path
 
@@ -107,7 +108,7 @@ def write_index(results, out: Path, *, quick: bool) -> Path:
     rows = {}
     if path.exists():  # keep the rows of benchmarks not rerun this time
         for line in path.read_text(encoding="utf-8").splitlines():
-            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            cells = [c.strip() for c in re.split(r"(?<!\\)\|", line.strip().strip("|"))]  # not at "\|"
             if line.startswith("| [") and len(cells) == 9:
                 rows.setdefault(cells[0], []).append(line)
     for res in results:
