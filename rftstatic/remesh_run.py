@@ -34,6 +34,8 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .remesh import DAMPING
+from .transfer import METHODS
 
 log = logging.getLogger(__name__)
 
@@ -42,7 +44,7 @@ __all__ = ["remesh_options", "run_remesh_scene", "solve_remesh_scene", "summariz
 SAFETY = 0.5
 _LENGTH_KEYS = ("const", "h_lower", "h_upper", "kappa_h2_max")
 _DEFAULTS = {"gradation": 1.3, "max_cycles": 5, "tol": 0.05, "kappa_h_max": 0.3, "transfer": "mesh",
-             "every": None, "kappa_h2_max": None}
+             "every": None, "kappa_h2_max": None, "damping": "fixed"}
 
 
 def remesh_options(scene) -> dict:
@@ -58,8 +60,10 @@ def remesh_options(scene) -> dict:
         raise scene.error("remesh.gradation", f"must be >= 1 (a size ratio), got {r['gradation']!r}")
     if r["h_lower"] > r["h_upper"]:
         raise scene.error("remesh.h_lower", f"h_lower = {r['h_lower']} exceeds h_upper = {r['h_upper']}")
-    if r["transfer"] not in ("mesh", "grid"):
-        raise scene.error("remesh.transfer", f'"{r["transfer"]}" is unknown; use "mesh" or "grid"')
+    if r["transfer"] not in METHODS:
+        raise scene.error("remesh.transfer", f'"{r["transfer"]}" is unknown; use one of {", ".join(METHODS)}')
+    if r["damping"] not in DAMPING:
+        raise scene.error("remesh.damping", f'"{r["damping"]}" is unknown; use one of {", ".join(DAMPING)}')
     for key in ("every", "max_cycles"):
         if r[key] is not None and not (isinstance(r[key], int) and r[key] >= (1 if key == "every" else 0)):
             raise scene.error(f"remesh.{key}", f"must be a {'positive' if key == 'every' else 'non-negative'} "
@@ -165,7 +169,7 @@ def _relax(scene, opts) -> dict:
 
     model0, extras0 = factory(None)
     stepper = explicit_advance(alpha=d["alpha"], mass_scale=d["mass_scale"], dt=d["dt"], safety=SAFETY,
-                               obstacles=tuple(extras0.get("obstacles", ())))
+                               obstacles=tuple(extras0.get("obstacles", ())), damping=opts["damping"])
     track = _Tracker(stepper, d["t_end"])
     first = [(model0, extras0)]
 
@@ -198,18 +202,21 @@ def _relax(scene, opts) -> dict:
     extras = extras0  # probes and obstacles are defined in reference coordinates: the same on every mesh
     return {"route": "remesh_relax", "model": model, "extras": extras, "U": U, "records": records,
             "converged": bool(converged), "meshes": meshes, "t": t, "steps": steps, "skipped": skipped,
-            "dynamics": d}
+            "dynamics": d, "alphas": list(stepper.alphas)}
 
 
 def _with_contact_reaction(model, obstacles):
     """``model`` whose ``residual(U)`` counts the kinematic contact's reaction.
 
-    :func:`rftstatic.remesh.remesh_relax` tests rest with ``model.residual(U)`` = P - F(U), which
+    :func:`rftstatic.remesh.remesh_relax` tests rest with ``model.residual(U)`` = F(U) - P, which
     knows nothing of the kinematic obstacles: the weight carried by a pedestal stays in it and the
     sheet never counts as at rest. At a node touching an obstacle (phi below 1e-3 of the smallest
-    element size) the frictionless reaction balances the part of the residual r = F - P that pushes
-    into the obstacle (n its outward normal), so r -> r - max(r . n, 0) n there. The instance's class is swapped for a subclass with that
-    ``residual``; everything else (forces, mass, step) is the model's own.
+    element size) a frictionless reaction lam n (n the outward normal, lam >= 0) acts; lam is the one
+    that best balances the node's free dofs, lam = max(0, r_f . n_f / |n_f|^2) with r_f, n_f the
+    residual and the normal on the free components (on a fully free node lam = max(r . n, 0); on
+    a node whose x and y are held, e.g. the in-plane hold on top of a sphere, the support takes
+    the in-plane part of lam n), and r -> r - lam n there. The instance's class is swapped for a
+    subclass with that ``residual``; everything else (forces, mass, step) is the model's own.
     """
     if not obstacles:
         return model
@@ -223,7 +230,10 @@ def _with_contact_reaction(model, obstacles):
             for ob in obstacles:
                 phi, n = ob.signed_distance(x)
                 touch = phi <= tol
-                reaction = np.maximum(np.einsum("ni,ni->n", r[touch], n[touch]), 0.0)
+                nf = n[touch] * self.free[touch]
+                nn = np.einsum("ni,ni->n", nf, nf)
+                rn = np.einsum("ni,ni->n", r[touch] * self.free[touch], nf)
+                reaction = np.where(nn > 0, np.maximum(rn, 0.0) / np.where(nn > 0, nn, 1.0), 0.0)
                 r[touch] -= reaction[:, None] * n[touch]
             return r
 
@@ -258,7 +268,9 @@ def summarize(scene, opts, run) -> dict:
     if run["route"] == "remesh_relax":
         d = run["dynamics"]
         summary.update(t=run["t"] / u.time, steps=run["steps"], skipped_remeshes=run["skipped"],
-                       t_end=d["t_end"] / u.time, alpha=d["alpha"] * u.time, mass_scale=d["mass_scale"])
+                       t_end=d["t_end"] / u.time, alpha=d["alpha"] * u.time, mass_scale=d["mass_scale"],
+                       damping=settings["damping"],
+                       alpha_final=(run["alphas"][-1] if run.get("alphas") else d["alpha"]) * u.time)
         P = np.where(model.free, model.load, 0.0)
         r = np.where(model.free, model.residual(U), 0.0)
         summary["residual_relative"] = float(np.linalg.norm(r) / max(np.linalg.norm(P), 1e-300))

@@ -110,7 +110,10 @@ SCHEMA = {
         "kappa_h_max": (NUM, "static route: largest |kappa| h accepted without remeshing"),
         "kappa_h2_max": (NUM, "relax route: remesh when max |kappa| h^2 exceeds this [length]"),
         "every": (int, "relax route: remesh every this many steps"),
-        "transfer": (str, "mesh (interpolation on the old mesh) or grid (background grid, as the paper)"),
+        "transfer": (str, "mesh (interpolation on the old mesh), patch (its RF patch quadratics) or grid "
+                          "(background grid, as the paper)"),
+        "damping": (str, "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's slowest "
+                         "swing, at most dynamics.alpha)"),
     }, "global adaptive remeshing (§5)"),
     "probes": ([{"name": (str, "probe name"), "at": (LIST, "[x, y] reference point")}], "tracked points"),
     "output": ({

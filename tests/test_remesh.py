@@ -5,7 +5,8 @@ import pytest
 
 from rftstatic import material, mesh, model
 from rftstatic.mesher import Domain, generate
-from rftstatic.remesh import adapt_mesh, reference_domain, remesh_relax, remesh_static, transfer_state
+from rftstatic.remesh import (NearObstacle, adapt_mesh, critical_damping, explicit_advance, reference_domain,
+                              remesh_relax, remesh_static, transfer_state)
 from rftstatic.scene import scene_from_dict
 from rftstatic.sizefield import curvature_magnitude, size_field, target_sizes
 from rftstatic.static import StaticOptions, solve_static
@@ -180,10 +181,47 @@ def test_remeshing_a_sheet_at_rest_leaves_it_at_rest(method):
     R = np.eye(3) + np.sin(0.6) * K + (1 - np.cos(0.6)) * K @ K
     rigid = lambda X3: X3 @ R.T + [0.01, -0.02, 0.03] - X3  # noqa: E731
     spin = lambda X3: np.cross([0.0, 0.0, 2.0], X3)          # noqa: E731
-    U, V = transfer_state(old, new, rigid(old.X3), spin(old.X3))
+    U, V = transfer_state(old, new, rigid(old.X3), spin(old.X3), method=method)
     assert np.abs(U - rigid(new.X3)).max() < 1e-14 and np.abs(V - spin(new.X3)).max() < 1e-14
     f = np.linalg.norm(new.internal_force(U), axis=1).max()
     assert new.energies(U)["membrane"] < 1e-20 and f < 1e-9 * mat.weight * 0.05 * 0.01
+
+
+# ------------------------------------------------------------------------------------------ relaxation
+def test_critical_damping_is_that_of_a_hanging_chain():
+    m = _strip()
+    s, g = 100.0, 9.80665
+    U = np.zeros((m.mesh.n_nodes, 3))
+    assert critical_damping(m, U, mass_scale=s, alpha_max=5.0) == 5.0           # not sagged yet
+    U[:, 2] = -0.04 * m.mesh.X[:, 0] / 0.05                                     # 4 cm at the tip
+    a = critical_damping(m, U, mass_scale=s, alpha_max=50.0)
+    # the weight gives the scaled mass g / s: alpha = 2 x 1.2024 sqrt(g / (s l)), l = 4 cm
+    assert np.isclose(a, 2 * 1.2024 * np.sqrt(g / (s * 0.04)), rtol=1e-9)
+    assert critical_damping(m, U, mass_scale=s, alpha_max=1.0) == 1.0           # bounded by alpha
+    # alpha = 5/s at s = 100 is critical for a hang of only 4 (1.2024)^2 g / (s 25) = 2.27 cm
+    hang = 4 * 1.2024**2 * g / (s * 25.0)
+    assert np.isclose(hang, 0.0227, rtol=1e-3)
+    assert np.isclose(critical_damping(m, U * hang / 0.04, mass_scale=s, alpha_max=50.0), 5.0, rtol=1e-6)
+    with pytest.raises(ValueError, match="damping"):
+        explicit_advance(alpha=3.0, damping="adaptive")
+
+
+def test_near_obstacle_gives_the_same_kinematic_contact():
+    from rftstatic.contact import kinematic_contact
+    from rftstatic.obstacles import from_spec
+
+    rng = np.random.default_rng(3)
+    for spec in ({"type": "round-pedestal", "centre": [0, 0], "radius": 0.1, "top": 0.0, "edge_radius": 0.005},
+                 {"type": "sphere", "centre": [0, 0, -0.05], "radius": 0.05}):
+        ob = from_spec(spec)
+        near = NearObstacle(ob, 0.01)
+        x = np.column_stack([rng.uniform(-0.2, 0.2, (2000, 2)), rng.uniform(-0.1, 0.02, 2000)])
+        v = rng.normal(size=x.shape)
+        for _ in range(100):  # random walk of 0.3 mm per step: the list is refreshed every few steps
+            x = x + rng.normal(scale=3e-4, size=x.shape)
+            a, b = kinematic_contact(ob, x, v), kinematic_contact(near, x, v)
+            assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and a[2] == b[2]
+        assert 1 < near.refreshes < 100 and len(near._list[0]) < len(x) / 2
 
 
 # ------------------------------------------------------------------------------------------ drivers
