@@ -113,13 +113,27 @@ class MembraneOperator:
         E, A = self.nodes.shape
         return (self.area[:, None] * np.matmul(S[:, None, :], Bbar)[:, 0]).reshape(E, A, 3)
 
-    def element_tangents(self, U, Dm, *, psd=False):
+    def element_tangents(self, U, Dm, *, psd=False, backend="auto"):
         """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m].
 
         With ``psd=True`` the geometric (initial-stress) part uses the positive part of the stress,
         so the tangent is positive semi-definite under compression (the safeguard of method.md);
         the material part ``Bbar^T D^m Bbar`` is always positive semi-definite.
+        ``backend``: ``"numba"`` (compiled, :mod:`rftstatic._membrane_numba`; 10-20 x faster),
+        ``"numpy"`` (batched matrix products), ``"auto"``: numba when installed.
         """
+        if backend == "auto":
+            backend = "numba" if _numba_available() else "numpy"
+        if backend == "numba":
+            from ._membrane_numba import element_tangents
+
+            E, Q, A, _ = self.G.shape
+            f = np.empty((E, A, 3))
+            K = np.empty((E, A, 3, A, 3))
+            element_tangents(np.ascontiguousarray(self.nodes, dtype=np.int64), np.ascontiguousarray(self.G),
+                             self.area, np.ascontiguousarray(Dm, dtype=float),
+                             np.ascontiguousarray(U, dtype=float), bool(psd), f, K)
+            return f, K
         _, S, Bbar = self._kinematics(U, Dm)
         E, A = self.nodes.shape
         Q = self.G.shape[1]
@@ -136,6 +150,14 @@ class MembraneOperator:
         Km += g[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
         Km *= area[:, None, None, None, None]
         return f, Km
+
+
+def _numba_available() -> bool:
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        return False
+    return True
 
 
 def _green_voigt(H: np.ndarray) -> np.ndarray:

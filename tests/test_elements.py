@@ -123,6 +123,26 @@ def test_tangent_is_gradient_of_force_at_large_deformation(element):
 
 
 @pytest.mark.parametrize("element", ELEMENTS)
+def test_compiled_tangent_equals_the_numpy_tangent(element):
+    """The numba kernel (used by Newton when numba is installed) and the batched numpy products give
+    the same forces and tangents, exact and PSD, with tension, compression and shear in the mix."""
+    pytest.importorskip("numba")
+    m = _mesh()
+    mod = model.Model(m, _material(), element=element)
+    rng = np.random.default_rng(11)
+    shrink = -0.1 * np.c_[mod.X3[:, 0], 0.5 * mod.X3[:, 1], np.zeros(m.n_nodes)]
+    U = shrink + 0.05 * rng.normal(size=mod.X3.shape)
+    Dm = mod.material.Dm
+    for psd in (False, True):
+        f1, K1 = mod.membrane.element_tangents(U, Dm, psd=psd, backend="numpy")
+        f2, K2 = mod.membrane.element_tangents(U, Dm, psd=psd, backend="numba")
+        np.testing.assert_allclose(f2, f1, rtol=0, atol=1e-12 * np.abs(f1).max())
+        np.testing.assert_allclose(K2, K1, rtol=0, atol=1e-12 * np.abs(K1).max())
+    _, Kx = mod.membrane.element_tangents(U, Dm, psd=False, backend="numba")
+    assert np.abs(Kx - K2).max() > 1e-6 * np.abs(Kx).max()  # the mix has compression: PSD differs
+
+
+@pytest.mark.parametrize("element", ELEMENTS)
 def test_psd_tangent_is_positive_semidefinite_under_compression(element):
     m = _mesh()
     mod = model.Model(m, _material(), element=element)
