@@ -177,14 +177,22 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     """
     opts = options or StaticOptions()
     if opts.start == "relax":
-        return _relax_then_newton(model, opts, callback, first=None)
+        return _check_stability(model, _relax_then_newton(model, opts, callback, first=None), opts)
     try:
-        return _solve_load_steps(model, U0=U0, options=opts, callback=callback)
+        return _check_stability(model, _solve_load_steps(model, U0=U0, options=opts, callback=callback), opts)
     except ConvergenceError as exc:
         if not opts.relax_fallback or model.load_terms or not np.any(model.load):
             raise
         log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
-        return _relax_then_newton(model, opts, callback, first=exc)
+        return _check_stability(model, _relax_then_newton(model, opts, callback, first=exc), opts)
+
+
+def _check_stability(model, result, opts):
+    """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact
+    tangent positive definite, one Cholesky factorisation)? None when the linear solver cannot tell."""
+    solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    result.stable = _positive_definite(model, result.U, solver, lam=result.lam) if solver.detects_indefinite else None
+    return result
 
 
 MAX_RELAX_STEPS = 200_000
@@ -283,11 +291,11 @@ def _relax_then_newton(model, opts, callback, *, first):
     return res
 
 
-def _positive_definite(model, U, solver) -> bool:
-    """Whether the exact tangent at full load is positive definite at ``U`` (one factorisation)."""
+def _positive_definite(model, U, solver, lam=1.0) -> bool:
+    """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation)."""
     if not solver.detects_indefinite:
         return True
-    _, K = model.tangent(U, lam=1.0)
+    _, K = model.tangent(U, lam=lam)
     try:
         solver.solve(K, np.zeros(K.shape[0]))
     except (NotPositiveDefinite, LinearSolveError):
