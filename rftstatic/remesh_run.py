@@ -3,7 +3,8 @@
 ``analysis = "static"``
     :func:`rftstatic.remesh.remesh_static`: Newton solve, size a new mesh from the converged
     curvature by Eq. 28-29 (|kappa| h_new^2 = const, h clipped to [h_lower, h_upper]), transfer U,
-    solve again, until the node count changes by less than ``tol`` and max |kappa| h <= ``kappa_h_max``.
+    solve again, until the node count changes by less than ``tol`` (and max |kappa| h <= ``kappa_h_max``
+    when the scene sets it).
 ``analysis = "relax"`` (§6, Figs. 14-16)
     :func:`rftstatic.remesh.remesh_relax`: the damped explicit motion (Eq. 16-22, damping Eq. 27
     with ``[dynamics] alpha``) with the mass scaled by ``[dynamics] mass_scale`` (§6: 100; the weight
@@ -43,7 +44,7 @@ __all__ = ["remesh_options", "run_remesh_scene", "solve_remesh_scene", "summariz
 
 SAFETY = 0.5
 _LENGTH_KEYS = ("const", "h_lower", "h_upper", "kappa_h2_max")
-_DEFAULTS = {"gradation": 1.3, "max_cycles": 5, "tol": 0.05, "kappa_h_max": 0.3, "transfer": "mesh",
+_DEFAULTS = {"gradation": 1.3, "max_cycles": 5, "tol": 0.05, "kappa_h_max": None, "transfer": "mesh",
              "every": None, "kappa_h2_max": None, "damping": "fixed"}
 
 
@@ -54,6 +55,8 @@ def remesh_options(scene) -> dict:
         if key not in r:
             raise scene.error(f"remesh.{key}", f"a [remesh] table needs {key} (Eq. 29, scene length units)")
     for key in ("const", "h_lower", "h_upper", "gradation", "tol", "kappa_h_max"):
+        if key == "kappa_h_max" and r[key] is None:
+            continue
         if not (isinstance(r[key], (int, float)) and r[key] > 0):
             raise scene.error(f"remesh.{key}", f"must be a positive number, got {r[key]!r}")
     if r["gradation"] < 1:
@@ -159,7 +162,7 @@ def _static_opts(scene):
 def _relax(scene, opts) -> dict:
     from .build import build_model
     from .dynamic_run import dynamic_model, dynamics_options
-    from .remesh import RemeshRecord, _curvature_figures, explicit_advance, remesh_relax
+    from .remesh import RemeshRecord, _curvature_figures, explicit_advance, refinable_maxima, remesh_relax
 
     d = dynamics_options(scene)
 
@@ -193,7 +196,9 @@ def _relax(scene, opts) -> dict:
             records.append(RemeshRecord(k, mm.mesh.n_nodes, mm.mesh.n_elements,
                                         dict(mm.mesh.info.get("quality", {})), time=m["t"], step=m["step"],
                                         reason="initial" if k == 0 else "remesh"))
-        _, records[-1].max_kappa_h, records[-1].max_kappa_h2 = _curvature_figures(model, U)
+        kappa, records[-1].max_kappa_h, records[-1].max_kappa_h2 = _curvature_figures(model, U)
+        records[-1].refinable_kappa_h, records[-1].refinable_kappa_h2 = refinable_maxima(
+            model.mesh, kappa, const=opts["const"], h_lower=opts["h_lower"])
         converged, skipped, t, steps = False, 0, track.t, track.steps
         log.warning("remesh relax: t_end = %.4g s reached before the sheet came to rest on a settled mesh",
                     d["t_end"])
@@ -254,6 +259,7 @@ def summarize(scene, opts, run) -> dict:
         d = r.as_dict()
         d["time"] = d["time"] / u.time
         d["max_kappa_h2"] = d["max_kappa_h2"] / u.length
+        d["refinable_kappa_h2"] = d["refinable_kappa_h2"] / u.length
         records.append(d)
     settings = {k: (v / u.length if k in _LENGTH_KEYS and v is not None else v) for k, v in opts.items()}
     summary = {

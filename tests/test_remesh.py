@@ -5,8 +5,8 @@ import pytest
 
 from rftstatic import material, mesh, model
 from rftstatic.mesher import Domain, generate
-from rftstatic.remesh import (NearObstacle, adapt_mesh, critical_damping, explicit_advance, reference_domain,
-                              remesh_relax, remesh_static, transfer_state)
+from rftstatic.remesh import (NearObstacle, adapt_mesh, critical_damping, explicit_advance, refinable_maxima,
+                              reference_domain, remesh_relax, remesh_static, transfer_state)
 from rftstatic.scene import scene_from_dict
 from rftstatic.sizefield import curvature_magnitude, size_field, target_sizes
 from rftstatic.static import StaticOptions, solve_static
@@ -137,6 +137,23 @@ def test_size_field_clipping_and_gradation():
     assert np.abs(np.diff(v, axis=0)).max() <= slope
     assert np.abs(np.diff(v, axis=1)).max() <= slope
     assert np.abs(v[1:, 1:] - v[:-1, :-1]).max() <= np.sqrt(2) * slope
+
+
+def test_refinable_maxima_leave_out_elements_at_the_size_floor():
+    m = mesh.rectangle(0.05, 0.01, 11, 3, origin=(0.0, -0.005))
+    h = m.element_size
+    kappa = np.zeros((m.n_elements, 3))
+    kappa[:, 0] = 1e4                       # wants sqrt(1e-4 / 1e4) = 0.1 mm: far below any floor
+    kappa[0, 0] = 1e5                       # the sharpest element
+    full = (1e5 * h[0], 1e5 * h[0] ** 2)
+    # floor at the present size: nothing can be refined, nothing counts
+    assert refinable_maxima(m, kappa, const=1e-4, h_lower=h.max()) == (0.0, 0.0)
+    # floor well below the present size: every element can still shrink, all count
+    kh, kh2 = refinable_maxima(m, kappa, const=1e-4, h_lower=h.min() / 2)
+    assert np.isclose(kh, full[0]) and np.isclose(kh2, full[1])
+    # a gentle curvature (target above the floor) always counts, whatever the floor
+    kappa[:, 0] = 1.0
+    assert np.isclose(refinable_maxima(m, kappa, const=1e-4, h_lower=h.max())[0], h.max())
 
 
 def test_bad_size_parameters_name_the_parameter():
