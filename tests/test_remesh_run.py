@@ -168,3 +168,20 @@ def test_remeshed_square_pedestal_comes_to_rest(tmp_path):
     assert s["converged"] and s["t"] < 0.8 * s["t_end"] and s["residual_relative"] <= 5e-3
     assert s["drape"]["fold_count"] == 4 and abs(s["drape"]["drape_coefficient"] - 0.502) < 0.04
     assert 1.0 < s["alpha_final"] < 5.0
+
+
+def test_bench_scene_in_a_fresh_process_and_its_report(tmp_path):
+    # the remesh bench runs each scene in its own interpreter (wall time, CPU, peak memory)
+    from rftstatic.bench_remesh import bench_scene, write_report
+
+    r = bench_scene("remesh-pedestal-square-20", TINY)
+    assert r["nodes"] > 0 and r["remeshes"] >= 1 and r["peak_rss_mb"] > 50
+    assert r["process_s"] >= r["wall_time_s"] > 0 and r["cpu_time_s"] > 0 and r["within_target"]
+    mesher = [{"case": "square uniform", "nodes": 2000, "triangles": 3800, "wall_s": 0.3, "triangles_per_s": 12000,
+               "peak_rss_mb": 80.0, "min_angle": 31.0, "mean_min_angle": 52.0, "band_share": 0.98}]
+    write_report({"mesher": mesher, "scenes": [r], "machine": {"cpus": 2, "python": "3", "rftstatic": "0",
+                                                               "date": "today", "load_before": [1.0, 1.0, 1.0]}},
+                 tmp_path)
+    text = (tmp_path / "bench_remesh.md").read_text()
+    assert "| square uniform | 2000 | 3800 |" in text and "remesh-pedestal-square-20" in text
+    assert json.loads((tmp_path / "bench_remesh.json").read_text())["scenes"][0]["nodes"] == r["nodes"]
