@@ -34,6 +34,14 @@ RFT6, C/B scaled; validation/stability.md): 0.02 % at 5e3, 0.5 % at 2e4, 2.1 % a
 8 % at 8e5; the warning starts below the level (2e4) where the strip leaves its 0.5 % tolerance."""
 
 
+_LOCKING_WARNED = False
+
+
+def _note_locking_warned() -> None:
+    global _LOCKING_WARNED
+    _LOCKING_WARNED = True
+
+
 def locking_number(mesh: TriMesh, material: Material) -> float:
     """``max_i (D^m_ii / D^b_ii) h^2`` [-], membrane over bending rigidity times the mean element size squared.
 
@@ -138,7 +146,9 @@ class Model:
                         f"little at 2e4, 3.3 % at 8e4, 8 % at 8e5). Refine to a mean element size below {h_ok:.3g} m or use "
                         f'element = "RFT3"')
                 self.warnings.append(text)
-                log.warning(text)
+                # once per process at warning level: a remeshed run builds a model per remesh
+                log.log(logging.DEBUG if _LOCKING_WARNED else logging.WARNING, text)
+                _note_locking_warned()
 
     # --- constant structures, built on first use ------------------------------------------------
     @cached_property

@@ -63,6 +63,9 @@ def test_rft6_warns_of_membrane_locking_where_the_strip_stiffens(caplog):
 
     from rftstatic.model import LOCKING_WARN, locking_number
 
+    import rftstatic.model
+
+    rftstatic.model._LOCKING_WARNED = False  # logged at warning level once per process
     with caplog.at_level(logging.WARNING, logger="rftstatic.model"):
         coarse = st._strip(21, 5, element="RFT6", ratio=1e6)
     assert locking_number(coarse.mesh, coarse.material) > LOCKING_WARN
