@@ -9,4 +9,13 @@ are imported lazily by the modules that need them, so a scene pays only for
 what it uses.
 """
 
+import os as _os
+
+# One BLAS thread (numpy's OpenBLAS and CHOLMOD's): the package's dense products are small, and an
+# idle OpenBLAS thread busy-waits. Measured, pedestal 61 x 61: 19.7 s wall / 19.9 s CPU with one thread
+# against 20.8 s / 38.1 s with two: the second core was burnt for nothing (and on a shared machine taken
+# from other jobs). Effective when rftstatic is imported before numpy (the CLI); an explicit user
+# setting wins.
+_os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 __version__ = "0.1.0"
