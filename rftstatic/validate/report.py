@@ -186,7 +186,8 @@ def write_report(result: BenchmarkResult, out: Path, *, quick: bool) -> Path:
         for s in result.studies:
             d = s.summary()
             tol = fmt_err(s.tolerance) if s.tolerance is not None else "reported only"
-            lines.append(f"| {s.case} | {s.element} | {fmt_err(d['finest_error'])} | {d['observed_rate']:.2f} | "
+            case = s.case.replace("|", "\\|")  # a pipe in the case would split the table cell
+            lines.append(f"| {case} | {s.element} | {fmt_err(d['finest_error'])} | {d['observed_rate']:.2f} | "
                          f"{fmt_time(d['time_to_1pct'])} | {fmt_time(d['time_to_0p1pct'])} | {tol} | "
                          f"{'yes' if s.passed else 'NO'} |")
         lines.append("")
