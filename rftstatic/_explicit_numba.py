@@ -9,6 +9,8 @@ Imported only when the numba back end is chosen.
 import numba as nb
 import numpy as np
 
+from ._membrane_numba import strain_and_stress
+
 
 @nb.njit(cache=True, nogil=True)
 def internal_force(indptr, indices, data, nodes, G, area, Dm, U, f, with_membrane, energy):
@@ -35,32 +37,7 @@ def internal_force(indptr, indices, data, nodes, G, area, Dm, U, f, with_membran
     E, Q, A = G.shape[0], G.shape[1], G.shape[2]
     H = np.empty((Q, 2, 3))
     for e in range(E):
-        for q in range(Q):
-            for J in range(2):
-                for i in range(3):
-                    H[q, J, i] = 0.0
-            for a in range(A):
-                n = nodes[e, a]
-                gx = G[e, q, a, 0]
-                gy = G[e, q, a, 1]
-                for i in range(3):
-                    u = U[n, i]
-                    H[q, 0, i] += gx * u
-                    H[q, 1, i] += gy * u
-        exx = 0.0
-        eyy = 0.0
-        gxy = 0.0
-        for q in range(Q):
-            exx += H[q, 0, 0] + 0.5 * (H[q, 0, 0] ** 2 + H[q, 0, 1] ** 2 + H[q, 0, 2] ** 2)
-            eyy += H[q, 1, 1] + 0.5 * (H[q, 1, 0] ** 2 + H[q, 1, 1] ** 2 + H[q, 1, 2] ** 2)
-            gxy += (H[q, 0, 1] + H[q, 1, 0]
-                    + H[q, 0, 0] * H[q, 1, 0] + H[q, 0, 1] * H[q, 1, 1] + H[q, 0, 2] * H[q, 1, 2])
-        exx /= Q
-        eyy /= Q
-        gxy /= Q
-        Sxx = Dm[0, 0] * exx + Dm[0, 1] * eyy + Dm[0, 2] * gxy
-        Syy = Dm[1, 0] * exx + Dm[1, 1] * eyy + Dm[1, 2] * gxy
-        Sxy = Dm[2, 0] * exx + Dm[2, 1] * eyy + Dm[2, 2] * gxy
+        exx, eyy, gxy, Sxx, Syy, Sxy = strain_and_stress(e, nodes, G, Dm, U, H)
         if energy:
             W += 0.5 * area[e] * (exx * Sxx + eyy * Syy + gxy * Sxy)
         w = area[e] / Q

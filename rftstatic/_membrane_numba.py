@@ -37,39 +37,49 @@ def _positive_part(sxx, syy, sxy):
 
 
 @nb.njit(cache=True, nogil=True)
+def strain_and_stress(e, nodes, G, Dm, U, H):
+    """Element ``e``: fill ``H (Q, 2, 3)`` with the strain-point displacement gradients
+    ``H[q, J, i] = sum_a G[e, q, a, J] U[n(e, a), i]`` and return the averaged Green strain (Eq. 14)
+    ``(e_xx, e_yy, 2 e_xy)`` [-] and the stress resultant ``S = D^m eps`` (Eq. 15) [N/m]."""
+    Q, A = G.shape[1], G.shape[2]
+    for q in range(Q):
+        for J in range(2):
+            for i in range(3):
+                H[q, J, i] = 0.0
+        for a in range(A):
+            n = nodes[e, a]
+            gx = G[e, q, a, 0]
+            gy = G[e, q, a, 1]
+            for i in range(3):
+                u = U[n, i]
+                H[q, 0, i] += gx * u
+                H[q, 1, i] += gy * u
+    exx = 0.0
+    eyy = 0.0
+    gxy = 0.0
+    for q in range(Q):
+        exx += H[q, 0, 0] + 0.5 * (H[q, 0, 0] ** 2 + H[q, 0, 1] ** 2 + H[q, 0, 2] ** 2)
+        eyy += H[q, 1, 1] + 0.5 * (H[q, 1, 0] ** 2 + H[q, 1, 1] ** 2 + H[q, 1, 2] ** 2)
+        gxy += (H[q, 0, 1] + H[q, 1, 0]
+                + H[q, 0, 0] * H[q, 1, 0] + H[q, 0, 1] * H[q, 1, 1] + H[q, 0, 2] * H[q, 1, 2])
+    exx /= Q
+    eyy /= Q
+    gxy /= Q
+    Sxx = Dm[0, 0] * exx + Dm[0, 1] * eyy + Dm[0, 2] * gxy
+    Syy = Dm[1, 0] * exx + Dm[1, 1] * eyy + Dm[1, 2] * gxy
+    Sxy = Dm[2, 0] * exx + Dm[2, 1] * eyy + Dm[2, 2] * gxy
+    return exx, eyy, gxy, Sxx, Syy, Sxy
+
+
+@nb.njit(cache=True, nogil=True)
 def element_tangents(nodes, G, area, Dm, U, psd, f, K):
     """Fill ``f (E, A, 3)`` [N] and ``K (E, A, 3, A, 3)`` [N/m] at displacements ``U (N, 3)`` [m]."""
     E, Q, A = G.shape[0], G.shape[1], G.shape[2]
-    H = np.empty((Q, 3, 2))
+    H = np.empty((Q, 2, 3))
     B = np.empty((3, A, 3))  # Bbar[k, a, i]
     DB = np.empty((3, A, 3))
     for e in range(E):
-        for q in range(Q):
-            for i in range(3):
-                H[q, i, 0] = 0.0
-                H[q, i, 1] = 0.0
-            for a in range(A):
-                n = nodes[e, a]
-                gx = G[e, q, a, 0]
-                gy = G[e, q, a, 1]
-                for i in range(3):
-                    u = U[n, i]
-                    H[q, i, 0] += u * gx
-                    H[q, i, 1] += u * gy
-        exx = 0.0
-        eyy = 0.0
-        gxy = 0.0
-        for q in range(Q):
-            exx += H[q, 0, 0] + 0.5 * (H[q, 0, 0] ** 2 + H[q, 1, 0] ** 2 + H[q, 2, 0] ** 2)
-            eyy += H[q, 1, 1] + 0.5 * (H[q, 0, 1] ** 2 + H[q, 1, 1] ** 2 + H[q, 2, 1] ** 2)
-            gxy += (H[q, 0, 1] + H[q, 1, 0]
-                    + H[q, 0, 0] * H[q, 0, 1] + H[q, 1, 0] * H[q, 1, 1] + H[q, 2, 0] * H[q, 2, 1])
-        exx /= Q
-        eyy /= Q
-        gxy /= Q
-        Sxx = Dm[0, 0] * exx + Dm[0, 1] * eyy + Dm[0, 2] * gxy
-        Syy = Dm[1, 0] * exx + Dm[1, 1] * eyy + Dm[1, 2] * gxy
-        Sxy = Dm[2, 0] * exx + Dm[2, 1] * eyy + Dm[2, 2] * gxy
+        exx, eyy, gxy, Sxx, Syy, Sxy = strain_and_stress(e, nodes, G, Dm, U, H)
         # Bbar: d eps_k / d x_ai averaged over the strain points, F = I + H
         for a in range(A):
             for i in range(3):
@@ -77,8 +87,8 @@ def element_tangents(nodes, G, area, Dm, U, psd, f, K):
                 b1 = 0.0
                 b2 = 0.0
                 for q in range(Q):
-                    fx = H[q, i, 0]
-                    fy = H[q, i, 1]
+                    fx = H[q, 0, i]
+                    fy = H[q, 1, i]
                     if i == 0:
                         fx += 1.0
                     elif i == 1:

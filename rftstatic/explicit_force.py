@@ -28,15 +28,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .compiled import numba_available
+
 BACKENDS = ("auto", "numpy", "numba")
 
-
-def _numba_available() -> bool:
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 class ForceKernel:
@@ -57,7 +52,7 @@ class ForceKernel:
         if backend not in BACKENDS:
             raise ValueError(f'force backend must be one of {", ".join(BACKENDS)}, got "{backend}"')
         if backend == "auto":
-            backend = "numba" if _numba_available() else "numpy"
+            backend = "numba" if numba_available() else "numpy"
         self.backend = backend
         self.model = model
         self.Kb = model.Kb.tocsr()

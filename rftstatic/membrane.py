@@ -19,6 +19,7 @@ from functools import cached_property
 
 import numpy as np
 
+from .compiled import numba_available
 from .mesh import TriMesh
 from .patch import Patches
 
@@ -123,7 +124,7 @@ class MembraneOperator:
         ``"numpy"`` (batched matrix products), ``"auto"``: numba when installed.
         """
         if backend == "auto":
-            backend = "numba" if _numba_available() else "numpy"
+            backend = "numba" if numba_available() else "numpy"
         if backend == "numba":
             from ._membrane_numba import element_tangents
 
@@ -151,13 +152,6 @@ class MembraneOperator:
         Km *= area[:, None, None, None, None]
         return f, Km
 
-
-def _numba_available() -> bool:
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 def _green_voigt(H: np.ndarray) -> np.ndarray:

@@ -34,12 +34,7 @@ RFT6, C/B scaled; validation/stability.md): 0.02 % at 5e3, 0.5 % at 2e4, 2.1 % a
 8 % at 8e5; the warning starts below the level (2e4) where the strip leaves its 0.5 % tolerance."""
 
 
-_LOCKING_WARNED = False
-
-
-def _note_locking_warned() -> None:
-    global _LOCKING_WARNED
-    _LOCKING_WARNED = True
+_LOCKING_WARNED = False  # the warning is logged at warning level once per process
 
 
 def locking_number(mesh: TriMesh, material: Material) -> float:
@@ -53,7 +48,7 @@ def locking_number(mesh: TriMesh, material: Material) -> float:
     sphere, 100 cm hanging sheet), 1.2e5 (the 371-node unstructured mesh of Fig. 1 and 9).
     """
     Dm, Db = np.asarray(material.Dm, float), np.asarray(material.Db, float)
-    ratio = max(Dm[i, i] / Db[i, i] for i in (0, 1) if Db[i, i] > 0) if np.any(np.diag(Db)[:2] > 0) else 0.0
+    ratio = max((Dm[i, i] / Db[i, i] for i in (0, 1) if Db[i, i] > 0), default=0.0)
     h = float(mesh.element_size.mean())
     return float(ratio * h * h)
 
@@ -147,8 +142,9 @@ class Model:
                         f'element = "RFT3"')
                 self.warnings.append(text)
                 # once per process at warning level: a remeshed run builds a model per remesh
+                global _LOCKING_WARNED
                 log.log(logging.DEBUG if _LOCKING_WARNED else logging.WARNING, text)
-                _note_locking_warned()
+                _LOCKING_WARNED = True
 
     # --- constant structures, built on first use ------------------------------------------------
     @cached_property
