@@ -20,15 +20,21 @@ Two back ends compute the same sums: ``"numpy"`` (the sparse products above) and
 compiled pass over the CSR rows of K_b and over the elements, imported lazily). The numba pass is
 about 3-5x faster on the 41 x 41 and 51 x 51 sheets (``python -m rftstatic.bench_explicit``), because
 scipy's CSR-times-dense products cost several ns per stored entry; ``"auto"`` uses numba when it
-imports. Both are tested against :meth:`Model.internal_force`.
+imports. Both are tested against :meth:`Model.internal_force`. On large meshes the numba pass runs on
+all cores: blocks of elements write their nodal forces into a private array, and each node then
+gathers its bending row and its element slots (no two threads write one entry; same sums). A
+:class:`rftstatic.compiled.ThreadTuner` checks now and then that the threads pay (not on a machine
+whose other core is busy) and falls back to one thread where they do not.
 """
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import scipy.sparse as sp
 
-from .compiled import numba_available
+from .compiled import ThreadTuner, fixed_threads, force_threads, numba_available
 
 BACKENDS = ("auto", "numpy", "numba")
 
@@ -40,6 +46,10 @@ class ForceKernel:
     Parameters
     ----------
     model : :class:`rftstatic.model.Model`
+    backend : ``"auto"``, ``"numpy"`` or ``"numba"``
+    threads : numba back end: element blocks computed in parallel (``None``:
+        :func:`rftstatic.compiled.force_threads`, all cores for large meshes); the result does not
+        depend on it
 
     Attributes
     ----------
@@ -48,7 +58,7 @@ class ForceKernel:
     weight : (E,) element area over the number of strain points, A / Q [m^2]
     """
 
-    def __init__(self, model, *, backend: str = "auto"):
+    def __init__(self, model, *, backend: str = "auto", threads: int | None = None):
         if backend not in BACKENDS:
             raise ValueError(f'force backend must be one of {", ".join(BACKENDS)}, got "{backend}"')
         if backend == "auto":
@@ -77,10 +87,27 @@ class ForceKernel:
         self.area = mem.area
         self.nodes = np.ascontiguousarray(mem.nodes, dtype=np.int64)
         self.G = np.ascontiguousarray(mem.G)
+        self.threads = 1
         if backend == "numba":
-            from ._explicit_numba import internal_force
+            from ._explicit_numba import internal_force, internal_force_parallel
 
             self._nb = internal_force
+            self.threads = force_threads(E) if threads is None else max(1, int(threads))
+            if self.threads > 1:
+                import numba
+
+                # as many element blocks as threads asked for; numba runs them on what it has, and
+                # unless told how many (argument, RFTSTATIC_THREADS) checks that they pay
+                self._run_threads = min(self.threads, int(numba.config.NUMBA_NUM_THREADS))
+                tune = threads is None and fixed_threads() is None and self._run_threads > 1
+                self._tuner = ThreadTuner(self._run_threads) if tune else None
+                # node -> element-slot map of the force gather: slots[slot_ptr[n]:slot_ptr[n + 1]] are
+                # the flat indices e * A + a with nodes[e, a] == n (a node repeated in a patch: each slot)
+                flat = self.nodes.ravel()
+                self._slots = np.argsort(flat, kind="stable").astype(np.int64)
+                self._slot_ptr = np.concatenate([[0], np.cumsum(np.bincount(flat, minlength=N))]).astype(np.int64)
+                self._fe = np.empty((flat.size, 3))
+                self._nb_parallel = internal_force_parallel
 
     def __call__(self, U: np.ndarray, *, energy: bool = False):
         """Internal force ``(N, 3)`` [N]; with ``energy=True`` also the stored energy [J].
@@ -91,8 +118,21 @@ class ForceKernel:
             U = np.ascontiguousarray(U, dtype=float)
             f = np.empty_like(U)
             Kb = self.Kb
-            W = self._nb(Kb.indptr, Kb.indices, Kb.data, self.nodes, self.G, self.area, self.Dm, U, f,
-                         self.with_membrane, energy)
+            if self.threads > 1:
+                import numba
+
+                tuner = self._tuner
+                run = tuner.before() if tuner is not None else self._run_threads
+                numba.set_num_threads(run)
+                t0 = time.perf_counter()
+                W = self._nb_parallel(Kb.indptr, Kb.indices, Kb.data, self.nodes, self.G, self.area, self.Dm, U,
+                                      f, self._fe, self._slot_ptr, self._slots, self.with_membrane, energy,
+                                      self.threads)
+                if tuner is not None:
+                    tuner.after(run, time.perf_counter() - t0)
+            else:
+                W = self._nb(Kb.indptr, Kb.indices, Kb.data, self.nodes, self.G, self.area, self.Dm, U, f,
+                             self.with_membrane, energy)
         else:
             f = self.Kb @ U
             W = 0.5 * float(np.einsum("ni,ni->", U, f)) if energy else 0.0

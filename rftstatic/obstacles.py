@@ -79,19 +79,20 @@ def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
     return v
 
 
-def _rounded_box(q: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _rounded_box(q: np.ndarray, r: float, hessian: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Signed distance of a rounded box in terms of the shifted coordinates ``q``.
 
     Parameters
     ----------
     q : (N, d) ``|p| - (b - r)`` per axis [m]
     r : edge radius [m]
+    hessian : also return ``G`` (else ``None``: the explicit loop needs only ``phi`` and ``g``)
 
     Returns
     -------
     phi : (N,) signed distance [m]
     g : (N, d) derivative of ``phi`` with respect to ``q`` (unit vector)
-    G : (N, d, d) second derivative of ``phi`` with respect to ``q`` [1/m]
+    G : (N, d, d) second derivative of ``phi`` with respect to ``q`` [1/m], or ``None``
 
     Notes
     -----
@@ -112,6 +113,8 @@ def _rounded_box(q: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray, np.nd
     g_in = np.zeros((n, d))
     g_in[np.arange(n), k] = 1.0
     g = np.where(outside[:, None], g, g_in)
+    if not hessian:
+        return phi, g, None
 
     pos = (q > 0.0).astype(float)
     G = (np.einsum("ni,ij->nij", pos, np.eye(d)) - np.einsum("ni,nj->nij", g, g)) * inv[:, None, None]
@@ -370,7 +373,7 @@ class SquarePedestal(Obstacle):
 
     def signed_distance(self, x):
         q, sign = self._q(x)
-        phi, g, _ = _rounded_box(q, self.edge_radius)
+        phi, g, _ = _rounded_box(q, self.edge_radius, hessian=False)
         return phi, g * sign
 
     def normal_gradient(self, x):
@@ -430,7 +433,7 @@ class RoundPedestal(Obstacle):
             )
         self.height = _check_height(height, self.edge_radius, "round pedestal")
 
-    def _parts(self, x):
+    def _parts(self, x, hessian=True):
         x = _as_points(x)
         r = self.edge_radius
         p = x[:, :2] - self.centre_xy
@@ -444,11 +447,11 @@ class RoundPedestal(Obstacle):
         J = np.zeros((x.shape[0], 2, 3))
         J[:, 0, :] = e
         J[:, 1, 2] = sz
-        phi, g, G = _rounded_box(q, r)
+        phi, g, G = _rounded_box(q, r, hessian)
         return phi, g, G, J, e, rho, on_axis
 
     def signed_distance(self, x):
-        phi, g, _, J, *_ = self._parts(x)
+        phi, g, _, J, *_ = self._parts(x, hessian=False)
         return phi, np.einsum("na,nai->ni", g, J)
 
     def normal_gradient(self, x):

@@ -88,6 +88,7 @@ SCHEMA = {
         "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
         "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
+        "perturbation_folds": (int, "0: random modes; n: an n-fold lift about the sheet's centre"),
         "start": (str, "load-steps or relax (dynamic relaxation, then Newton)"),
         "relax_fallback": (bool, "try dynamic relaxation + Newton when the load steps fail"),
         "membrane": (bool, "false: linear Kirchhoff plate (bending only)"),

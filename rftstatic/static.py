@@ -71,6 +71,8 @@ class StaticOptions:
         this many times, instead of cutting back
     perturbation : amplitude of a seeded random out-of-plane start, in element sizes [-]
     seed : seed of that perturbation
+    perturbation_folds : 0 for random low Fourier modes; n > 0 for an n-fold lift around the sheet's
+        centre (:func:`fold_perturbation`), to look for the drape branch with n folds
     """
 
     initial_increment: float = 0.1
@@ -92,6 +94,7 @@ class StaticOptions:
     relax_fallback: bool = True
     perturbation: float = 0.0
     seed: int = 0
+    perturbation_folds: int = 0
     progress: bool = True
 
     def __post_init__(self):
@@ -103,6 +106,9 @@ class StaticOptions:
             raise ValueError(
                 "need 0 < min_increment <= initial_increment <= max_increment <= 1, got "
                 f"{self.min_increment}, {self.initial_increment}, {self.max_increment}")
+        if self.perturbation_folds < 0:
+            raise ValueError(f"solver.perturbation_folds must be 0 (random modes) or a fold count, "
+                             f"got {self.perturbation_folds}")
         if self.rtol <= 0 or self.max_iterations < 1:
             raise ValueError(f"need rtol > 0 and max_iterations >= 1, got {self.rtol}, {self.max_iterations}")
 
@@ -206,6 +212,12 @@ RELAX_NEWTON_ITERATIONS = 10
 """Newton's ``max_iterations`` (doubled at full load: 20 iterations) from a relaxed state before the
 relaxation resumes; the final handover uses the solver's own budget."""
 
+RELAX_BASIN_NEWTON_ITERATIONS = 40
+"""Newton's ``max_iterations`` (80 at full load) from a relaxed state whose exact tangent is positive
+definite: in the basin of a stable minimum, Newton's line-searched descent gets there even on a flat
+energy (the 80 cm sheet at 81 x 81 needs 44 iterations, 31 s; relaxing on and retrying with 20
+iterations took four tries and 8,700 explicit steps more)."""
+
 
 def _relax_then_newton(model, opts, callback, *, first):
     """Dynamic relaxation at full load to near rest, then Newton to the full tolerance.
@@ -215,8 +227,8 @@ def _relax_then_newton(model, opts, callback, *, first):
     converges from there in a few iterations, and the slow tail of the relaxation (half of its steps
     on a 33 x 33 drape) is skipped. Newton gets a short budget (:data:`RELAX_NEWTON_ITERATIONS`). When
     it fails, the relaxation resumes (same displacements and velocities) in chunks of a few damping
-    times; after each chunk the tangent is factorised, and Newton tries again only when it is positive
-    definite (the state is in the basin of a stable minimum: from an indefinite tangent, Newton walks
+    times; after each chunk the tangent is factorised, and Newton tries again, with a longer budget
+    (:data:`RELAX_BASIN_NEWTON_ITERATIONS`), only when it is positive definite (the state is in the basin of a stable minimum: from an indefinite tangent, Newton walks
     downhill for hundreds of iterations on the PSD tangent, to a point that need not be a minimum —
     the 80 cm sheet did). The relaxation ends at rest at half the solver's ``rtol`` or at its time
     limit; Newton then finishes with the solver's own budget.
@@ -243,10 +255,11 @@ def _relax_then_newton(model, opts, callback, *, first):
     if opts.perturbation:  # the same seeded lift as the load steps' start picks the fold branch
         seed = opts.seed
         U = np.zeros((model.mesh.n_nodes, 3))
-        U[:, 2] = smooth_perturbation(model.mesh, seed, opts.perturbation) * model.free[:, 2]
+        U[:, 2] = start_perturbation(model.mesh, opts) * model.free[:, 2]
     polish = replace(opts, start="load-steps", relax_fallback=False, initial_increment=1.0, max_increment=1.0,
                      increment_displacement=1e30)
     short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS)
+    basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
     info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": 0.0, "steps": 0, "handovers": [],
             "after_failure": None if first is None else str(first)}
     t_used, peak = 0.0, 0.0
@@ -277,7 +290,8 @@ def _relax_then_newton(model, opts, callback, *, first):
         handover = {"time_s": t_used, "steps": info["steps"], "at_rest": rel.converged}
         info["handovers"].append(handover)
         try:
-            res = _solve_load_steps(model, U0=U, options=polish if final else short, callback=callback)
+            res = _solve_load_steps(model, U0=U, options=polish if final else basin if tol_force < 1.0 else short,
+                                    callback=callback)
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
             if final:
@@ -323,7 +337,7 @@ def _solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, c
     seed = None
     if opts.perturbation and U0 is None:
         seed = opts.seed
-        U[:, 2] += smooth_perturbation(model.mesh, seed, opts.perturbation) * model.free[:, 2]
+        U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
     solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
     max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
@@ -399,6 +413,30 @@ def _solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, c
         result.wall_time = time.perf_counter() - t0
         result.energies = model.energies(result.U, result.lam)
     return result
+
+
+def start_perturbation(mesh, opts: StaticOptions) -> np.ndarray:
+    """The out-of-plane start ``(N,)`` [m] that ``opts`` asks for (random modes or an n-fold lift)."""
+    if opts.perturbation_folds:
+        return fold_perturbation(mesh, opts.perturbation_folds, opts.seed, opts.perturbation)
+    return smooth_perturbation(mesh, opts.seed, opts.perturbation)
+
+
+def fold_perturbation(mesh, folds: int, seed: int, amplitude: float) -> np.ndarray:
+    """An n-fold out-of-plane start ``(N,)`` [m]: ``a (r/R)^2 (1 + cos(n theta + phi)) / 2``.
+
+    ``theta`` and ``r`` are polar coordinates about the sheet's centroid, ``R`` the largest ``r``,
+    ``a`` is ``amplitude`` mean element sizes and the phase ``phi`` is drawn from ``seed``. A lift
+    only, like :func:`smooth_perturbation`; it grows outwards, where the skirt buckles, so that a
+    symmetric drape leaves its bifurcation towards the branch with ``folds`` folds (§6.2: drapes
+    have several equilibria). Whether that branch is a stable equilibrium is for the solve to say.
+    """
+    rng = np.random.default_rng(seed)
+    X = mesh.X - mesh.X.mean(axis=0)
+    r = np.hypot(X[:, 0], X[:, 1])
+    theta = np.arctan2(X[:, 1], X[:, 0])
+    w = (r / r.max()) ** 2 * 0.5 * (1.0 + np.cos(folds * theta + rng.uniform(0, 2 * np.pi)))
+    return amplitude * float(mesh.element_size.mean()) * w
 
 
 def smooth_perturbation(mesh, seed: int, amplitude: float) -> np.ndarray:

@@ -216,6 +216,7 @@ def test_candidate_list_is_exact_along_a_motion(name):
         state = listed.evaluate(x)
         assert state.energy == pytest.approx(full.energy, rel=1e-13, abs=1e-300)
         np.testing.assert_allclose(state.force, full.force, rtol=1e-13, atol=0)
+        np.testing.assert_allclose(listed.force(x), full.force, rtol=1e-13, atol=0)  # the force-only path
         np.testing.assert_allclose(state.tangent_blocks, full.tangent_blocks, rtol=1e-13, atol=0)
         np.testing.assert_array_equal(state.active, full.active)
         near = full.gap < listed.margin / 2

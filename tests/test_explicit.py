@@ -47,6 +47,21 @@ def test_force_kernel_equals_model_internal_force(element, backend):
     assert W == pytest.approx(e["bending"] + e["membrane"], rel=1e-12)
 
 
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+def test_threaded_force_kernel_is_the_serial_one(element):
+    """The threaded numba force (element blocks, then a per-node gather) equals the serial pass, on
+    a small mesh forced onto it."""
+    pytest.importorskip("numba")
+    mesh = rectangle(0.04, 0.03, 9, 7, pattern="union-jack")
+    model = Model(mesh, preset("wool-kang-yu", warp_angle_deg=30.0), element=element)
+    U = 2e-3 * np.random.default_rng(2).standard_normal((mesh.n_nodes, 3))
+    f1, W1 = ForceKernel(model, backend="numba", threads=1)(U, energy=True)
+    for threads in (2, 3):  # more element blocks than numba has threads run in turn
+        f, W = ForceKernel(model, backend="numba", threads=threads)(U, energy=True)
+        assert np.abs(f - f1).max() <= 1e-13 * np.abs(f1).max()
+        assert W == pytest.approx(W1, rel=1e-13)
+
+
 def test_lumped_mass_is_total_mass_and_scaled():
     model = strip()
     m = lumped_mass(model, 100.0)
@@ -196,3 +211,38 @@ def test_numpy_and_numba_runs_agree():
     a = run_explicit(model, t_end=0.01, backend="numpy", progress=False)
     b = run_explicit(model, t_end=0.01, backend="numba", progress=False)
     assert np.abs(a.U - b.U).max() <= 1e-12 * np.abs(a.U).max()
+
+
+def test_thread_tuner_keeps_the_faster_setting():
+    """Every hold + 2 probe calls the tuner times both settings and keeps the faster one."""
+    from rftstatic.compiled import ThreadTuner
+
+    tuner = ThreadTuner(most=2)
+    cost = {1: 3.6e-3, 2: 6.5e-3}  # the other core busy: one thread is faster
+
+    def run(calls):
+        used = []
+        for _ in range(calls):
+            t = tuner.before()
+            tuner.after(t, cost[t])
+            used.append(t)
+        return used
+
+    period = 2 * tuner.probe + tuner.hold
+    used = run(period)
+    assert used[:tuner.probe] == [1] * tuner.probe and used[tuner.probe:2 * tuner.probe] == [2] * tuner.probe
+    assert set(used[2 * tuner.probe:]) == {1}
+    cost = {1: 3.6e-3, 2: 2.4e-3}  # the machine is idle again: back to two threads after the next check
+    assert set(run(period)[2 * tuner.probe:]) == {2}
+
+
+def test_threads_from_the_environment(monkeypatch):
+    from rftstatic.compiled import force_threads
+
+    monkeypatch.setenv("RFTSTATIC_THREADS", "3")
+    assert force_threads(10) == 3
+    monkeypatch.setenv("RFTSTATIC_THREADS", "many")
+    with pytest.raises(ValueError, match="RFTSTATIC_THREADS"):
+        force_threads(10)
+    monkeypatch.delenv("RFTSTATIC_THREADS")
+    assert force_threads(10) == 1  # a small mesh: one thread

@@ -126,3 +126,26 @@ def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
     b = static.solve_static(mod, options=static.StaticOptions(progress=False, start="relax"))
     assert a.route == "load-steps" and b.route == "relax+newton" and b.relax["at_rest"]
     assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
+
+
+def test_fold_perturbation_has_n_fold_symmetry():
+    """The n-fold start lifts by 0 .. amplitude element sizes and repeats every 2 pi / n about the centre."""
+    from rftstatic.mesh import rectangle
+
+    mesh = rectangle(0.5, 0.5, 41, 41, origin=(-0.25, -0.25))
+    opts = static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=3)
+    w = static.start_perturbation(mesh, opts)
+    h = float(mesh.element_size.mean())
+    # the edge (r / R >= 1 / sqrt 2) passes every angle, so some node lifts by at least half the amplitude
+    assert w.min() >= 0.0 and w.max() <= 2.0 * h * (1 + 1e-12) and w.max() > 0.5 * 2.0 * h
+    # a quarter turn maps the square grid onto itself and must map the 4-fold lift onto itself
+    X = mesh.X - mesh.X.mean(axis=0)
+    turned = np.column_stack([-X[:, 1], X[:, 0]])
+    index = {tuple(np.round(p, 9)): i for i, p in enumerate(X)}
+    partner = np.array([index[tuple(np.round(p, 9))] for p in turned])
+    np.testing.assert_allclose(w[partner], w, atol=1e-12 * h)
+    # a different seed turns the pattern (another phase), the random start is something else again
+    assert not np.allclose(static.start_perturbation(mesh, opts), static.start_perturbation(
+        mesh, static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=4)))
+    with pytest.raises(ValueError, match="perturbation_folds"):
+        static.StaticOptions(perturbation_folds=-1)
