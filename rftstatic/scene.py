@@ -89,6 +89,8 @@ SCHEMA = {
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
         "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
         "perturbation_folds": (int, "0: random modes; n: an n-fold lift about the sheet's centre"),
+        "guide_folds": (int, "relax route: n-fold modulation of the weight in the first stage (0: none)"),
+        "guide_weight": (NUM, "relative amplitude of that modulation, in [0, 1)"),
         "start": (str, "load-steps or relax (dynamic relaxation, then Newton)"),
         "relax_fallback": (bool, "try dynamic relaxation + Newton when the load steps fail"),
         "membrane": (bool, "false: linear Kirchhoff plate (bending only)"),

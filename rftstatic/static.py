@@ -73,6 +73,11 @@ class StaticOptions:
     seed : seed of that perturbation
     perturbation_folds : 0 for random low Fourier modes; n > 0 for an n-fold lift around the sheet's
         centre (:func:`fold_perturbation`), to look for the drape branch with n folds
+    guide_folds, guide_weight : ``start = "relax"`` only: during the first stage of the relaxation
+        (:data:`GUIDE_DAMPING_TIMES` damping times) the weight is modulated by
+        ``1 + guide_weight (r/R)^2 cos(n theta + phi)`` with n = ``guide_folds`` (:func:`fold_pattern`),
+        then restored, so that the sheet falls into n folds and the rest of the relaxation tells
+        whether that drape is a stable equilibrium; 0 = no guide
     """
 
     initial_increment: float = 0.1
@@ -95,6 +100,8 @@ class StaticOptions:
     perturbation: float = 0.0
     seed: int = 0
     perturbation_folds: int = 0
+    guide_folds: int = 0
+    guide_weight: float = 0.0
     progress: bool = True
 
     def __post_init__(self):
@@ -109,6 +116,11 @@ class StaticOptions:
         if self.perturbation_folds < 0:
             raise ValueError(f"solver.perturbation_folds must be 0 (random modes) or a fold count, "
                              f"got {self.perturbation_folds}")
+        if self.guide_folds < 0 or not (0.0 <= self.guide_weight < 1.0):
+            raise ValueError(f"solver.guide_folds must be >= 0 and solver.guide_weight in [0, 1) (a weight "
+                             f"modulation that keeps the weight downward), got {self.guide_folds}, {self.guide_weight}")
+        if self.guide_folds and self.guide_weight and self.start != "relax":
+            raise ValueError('solver.guide_folds guides the dynamic relaxation: it needs solver.start = "relax"')
         if self.rtol <= 0 or self.max_iterations < 1:
             raise ValueError(f"need rtol > 0 and max_iterations >= 1, got {self.rtol}, {self.max_iterations}")
 
@@ -258,7 +270,7 @@ def _relax_then_newton(model, opts, callback, *, first):
         U = np.zeros((model.mesh.n_nodes, 3))
         U[:, 2] = start_perturbation(model.mesh, opts) * model.free[:, 2]
     polish = replace(opts, start="load-steps", relax_fallback=False, initial_increment=1.0, max_increment=1.0,
-                     increment_displacement=1e30)
+                     increment_displacement=1e30, guide_folds=0)
     short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS)
     basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
     info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": 0.0, "steps": 0, "handovers": [],
@@ -274,6 +286,12 @@ def _relax_then_newton(model, opts, callback, *, first):
             text = f"{first}; {text}"
         return ConvergenceError(text, result if result is not None else (first.result if first else None))
 
+    if opts.guide_folds and opts.guide_weight:
+        rel = _guided_relaxation(model, opts, mass_scale=mass_scale, alpha=alpha, U0=U, fail=fail)
+        U, V, peak, t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
+        seed = opts.seed
+        info.update(time_s=t_used, steps=rel.steps, guide={"folds": opts.guide_folds, "weight": opts.guide_weight,
+                                                          "time_s": rel.t, "steps": rel.steps})
     while True:
         try:
             rel = relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=tol_force,
@@ -319,6 +337,29 @@ def _relax_then_newton(model, opts, callback, *, first):
         res.cutbacks += first.result.cutbacks
         res.iterations += first.result.iterations
     return res
+
+
+GUIDE_DAMPING_TIMES = 30.0  # length of the guided stage of the relaxation [damping times 1/alpha]
+
+
+def _guided_relaxation(model, opts: StaticOptions, *, mass_scale, alpha, U0, fail):
+    """The guided first stage of :func:`_relax_then_newton`: relax under an n-fold modulated weight.
+
+    The weight of every node is scaled by ``1 + guide_weight * fold_pattern(...)`` (so the total
+    stays about the same and the load stays downward) for :data:`GUIDE_DAMPING_TIMES` damping
+    times; the model's load is restored afterwards, whatever happens.
+    """
+    from .explicit import InstabilityError, relax
+
+    load = model.load
+    model.load = load * (1.0 + opts.guide_weight * fold_pattern(model.mesh, opts.guide_folds, opts.seed))[:, None]
+    try:
+        return relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=1.0,
+                     max_time=GUIDE_DAMPING_TIMES / alpha, U0=U0, progress=opts.progress)
+    except InstabilityError as exc:
+        raise fail(f"the guided dynamic relaxation became unstable ({exc})") from None
+    finally:
+        model.load = load
 
 
 def _positive_definite(model, U, solver, lam=1.0) -> bool:
@@ -428,6 +469,19 @@ def start_perturbation(mesh, opts: StaticOptions) -> np.ndarray:
     return smooth_perturbation(mesh, opts.seed, opts.perturbation)
 
 
+def fold_pattern(mesh, folds: int, seed: int) -> np.ndarray:
+    """``(r/R)^2 cos(n theta + phi)`` at the nodes ``(N,)`` [-]: an n-fold pattern about the sheet's centroid.
+
+    ``r``, ``theta`` are polar coordinates about the centroid, ``R`` the largest ``r``, and the phase
+    ``phi`` is drawn from ``seed``. Zero at the centre, growing outwards where the skirt buckles.
+    """
+    rng = np.random.default_rng(seed)
+    X = mesh.X - mesh.X.mean(axis=0)
+    r = np.hypot(X[:, 0], X[:, 1])
+    theta = np.arctan2(X[:, 1], X[:, 0])
+    return (r / r.max()) ** 2 * np.cos(folds * theta + rng.uniform(0, 2 * np.pi))
+
+
 def fold_perturbation(mesh, folds: int, seed: int, amplitude: float) -> np.ndarray:
     """An n-fold out-of-plane start ``(N,)`` [m]: ``a (r/R)^2 (1 + cos(n theta + phi)) / 2``.
 
@@ -437,11 +491,9 @@ def fold_perturbation(mesh, folds: int, seed: int, amplitude: float) -> np.ndarr
     symmetric drape leaves its bifurcation towards the branch with ``folds`` folds (§6.2: drapes
     have several equilibria). Whether that branch is a stable equilibrium is for the solve to say.
     """
-    rng = np.random.default_rng(seed)
     X = mesh.X - mesh.X.mean(axis=0)
-    r = np.hypot(X[:, 0], X[:, 1])
-    theta = np.arctan2(X[:, 1], X[:, 0])
-    w = (r / r.max()) ** 2 * 0.5 * (1.0 + np.cos(folds * theta + rng.uniform(0, 2 * np.pi)))
+    r2 = (np.hypot(X[:, 0], X[:, 1]) / np.hypot(X[:, 0], X[:, 1]).max()) ** 2
+    w = 0.5 * (r2 + fold_pattern(mesh, folds, seed))
     return amplitude * float(mesh.element_size.mean()) * w
 
 

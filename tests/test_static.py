@@ -149,3 +149,32 @@ def test_fold_perturbation_has_n_fold_symmetry():
         mesh, static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=4)))
     with pytest.raises(ValueError, match="perturbation_folds"):
         static.StaticOptions(perturbation_folds=-1)
+
+
+def test_guided_relaxation_restores_the_weight_and_reaches_the_same_equilibrium():
+    """The n-fold weight modulation of the relaxation's first stage is undone before the sheet comes
+    to rest: the strip (one equilibrium) ends where the unguided routes end, the model's load intact."""
+    mod = clamped_strip(11, 3)
+    load = mod.load.copy()
+    a = static.solve_static(mod, options=static.StaticOptions(progress=False))
+    b = static.solve_static(mod, options=static.StaticOptions(progress=False, start="relax", guide_folds=3,
+                                                               guide_weight=0.5, seed=2))
+    assert b.converged and b.relax["guide"]["folds"] == 3 and b.relax["guide"]["steps"] > 0
+    np.testing.assert_array_equal(mod.load, load)
+    assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
+
+
+def test_fold_pattern_and_guide_options():
+    from rftstatic.mesh import rectangle
+
+    mesh = rectangle(0.5, 0.5, 21, 21, origin=(-0.25, -0.25))
+    p = static.fold_pattern(mesh, 12, seed=1)
+    assert np.abs(p).max() <= 1.0 + 1e-12 and p.max() > 0.6 and p.min() < -0.6
+    X = mesh.X - mesh.X.mean(axis=0)
+    assert np.abs(p[np.hypot(X[:, 0], X[:, 1]) < 1e-12]).max() < 1e-20  # zero at the centre
+    for bad in ({"guide_weight": 1.0, "guide_folds": 12, "start": "relax"},
+                {"guide_weight": -0.1, "start": "relax"}, {"guide_folds": -2}):
+        with pytest.raises(ValueError, match="guide"):
+            static.StaticOptions(**bad)
+    with pytest.raises(ValueError, match='start = "relax"'):
+        static.StaticOptions(guide_folds=12, guide_weight=0.3)

@@ -95,7 +95,8 @@ def rebuild_index(out=None) -> Path:
         studies = [Study(s["case"], s["element"], s["h"], s["nodes"], s["error"], s["wall_time"], s["tolerance"])
                    for s in d["studies"]]
         results.append(SimpleNamespace(name=d["name"], citation=d.get("citation", ""), reference=d["reference"],
-                                       studies=studies, passed=d.get("passed", True), title=d.get("title", "")))
+                                       studies=studies, passed=d.get("passed", True), title=d.get("title", ""),
+                                       discrepancy=d.get("discrepancy", "")))
     index = out / "README.md"
     if index.exists():
         index.unlink()
@@ -116,6 +117,8 @@ def write_index(results, out: Path, *, quick: bool) -> Path:
         rows[key] = []
         if not res.studies:  # a benchmark of cells or tables: one row with its verdict
             verdict = "pass" if res.passed else "**FAIL**"
+            if getattr(res, "discrepancy", ""):
+                verdict += "; **differs from the paper** (see report)"
             rows[key].append(f"| {key} | {res.citation or res.reference.split('. ')[0]} | "
                              f"{getattr(res, 'title', '')} | - | - | - | - | see report | {verdict} |")
         for s in res.studies:

@@ -85,6 +85,7 @@ class BenchmarkResult:
     time_to_1pct: float | None = None
     time_to_0p1pct: float | None = None
     passed: bool = True
+    discrepancy: str = ""  # where the result differs from the paper's without failing the tolerance
     figures: list = field(default_factory=list)
     notes: list = field(default_factory=list)
     studies: list = field(default_factory=list)
@@ -177,6 +178,8 @@ def write_report(result: BenchmarkResult, out: Path, *, quick: bool) -> Path:
              f"**Result: {'PASS' if result.passed else 'FAIL'}.** Governing study: finest error "
              f"{fmt_err(result.finest_error)}, observed rate {result.observed_rate:.2f} (error ~ h^p), "
              f"time to 1 %: {fmt_time(result.time_to_1pct)}, to 0.1 %: {fmt_time(result.time_to_0p1pct)}.", ""]
+    if result.discrepancy:
+        lines += [f"**Differs from the paper.** {result.discrepancy}", ""]
     if result.studies:
         lines += ["## Convergence studies", "",
                   "Rate p: least-squares slope of log(error) on log(h). Times are model construction + solve "
