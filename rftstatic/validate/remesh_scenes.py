@@ -8,9 +8,13 @@ solution on the dense structured mesh of §4 (33 x 33 / 21 x 160 / 61 x 61), and
 solution on a structured mesh with about the adaptive node count (:data:`COARSE`: the accuracy
 per node that adaptivity buys). Compared: drape coefficient,
 fold count, the deformed boundary curve (its largest distance from the structured one: the
-symmetric Hausdorff distance of the two top-view outlines [cm]), node count and wall time. The
-"error" of the study is the boundary distance divided by the sheet's half side; it is reported,
-not checked (the paper itself finds another branch for the round pedestal: 8 folds vs 12).
+symmetric Hausdorff distance of the two top-view outlines [cm]), node count and wall time.
+
+Tolerance (full run): the drape coefficient of each adaptive route (relaxation and static remesh)
+within :data:`DC_TOL` of the dense structured solution -- the measure a drape tester reads, and
+about its repeatability. The boundary distance divided by the sheet's half side is reported, not
+checked: it measures the fold branch as much as the mesh (the paper itself finds another branch
+for the round pedestal: 8 folds vs 12).
 """
 
 from __future__ import annotations
@@ -26,6 +30,8 @@ SCENES = {  # remeshed scene -> (static reference scene, its overrides, half sid
     "remesh-pedestal-round-50": ("pedestal-round-50", [], 25.0),
     "remesh-sphere-30": ("sphere-30", [], 15.0),
 }
+
+DC_TOL = 0.03  # |DC_adaptive - DC_structured| [-]
 
 # a structured mesh of the reference scene with about as many nodes as the adaptive runs end with
 # (measured: 470-510, 1850-2050, 670-710 nodes): the accuracy per node of adaptivity
@@ -111,7 +117,10 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
         citation="Sze & Zhou (2016) §6",
         reference="Sze & Zhou (2016) §4.2-4.5 (static, Figs. 5-11) and §6 (dynamic relaxation with adaptive "
                   "remeshing, Figs. 14-16); the round pedestal: 8 folds adaptive vs 12 on 21 x 160 nodes.",
-        tolerance="reported, not checked (different routes may find different fold branches)")
+        tolerance="reported only (quick run)" if quick else
+                  f"drape coefficient of each adaptive route (relax, static remesh) within {DC_TOL:g} of the dense "
+                  "structured static solution; the boundary distance is reported, not checked (different routes may "
+                  "find different fold branches)")
     rows, curves = [], {}
     for name, (ref_name, ref_over, half) in SCENES.items():
         quick_over = ["mesh.nodes=[17,17]"] if quick and ref_name != "pedestal-round-50" else (
@@ -143,10 +152,20 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
             curves[name][label] = c
             rows.append(_row(name, label, s, wall, curve_distance(c, ref_curve), half))
     result.rows = rows
-    for r in rows:  # one study per route: its boundary error against the structured reference
-        if r["route"] != "structured static" and r["nodes"]:
-            result.studies.append(Study(f"{r['case']}: {r['route']}", "RFT6", [r["half_side"] / np.sqrt(r["nodes"])],
-                                        [r["nodes"]], [r["error"]], [r["wall_time_s"]], None))
+    dc_ref = {r["case"]: r["drape_coefficient"] for r in rows if r["route"] == "structured static"}
+    for r in rows:  # per route: its boundary error and drape coefficient against the structured reference
+        if r["route"] == "structured static":
+            continue
+        h = [r["half_side"] / np.sqrt(max(r["nodes"], 1))]
+        if r["nodes"]:
+            result.studies.append(Study(f"{r['case']}: {r['route']}", "RFT6", h, [r["nodes"]], [r["error"]],
+                                        [r["wall_time_s"]], None))
+        dc, ref = r["drape_coefficient"], dc_ref[r["case"]]
+        # a route that did not converge has no drape coefficient: NaN, which fails a checked study
+        err = abs(dc - ref) if r["converged"] and dc is not None and ref is not None else float("nan")
+        adaptive = not r["route"].startswith("structured")
+        result.studies.append(Study(f"{r['case']}: {r['route']}, drape coefficient", "RFT6", h, [r["nodes"]],
+                                    [err], [r["wall_time_s"]], DC_TOL if adaptive and not quick else None))
     result.sections.append(("Adaptive vs structured", _table(rows)))
     result.sections.append(("RFT3 vs RFT6 on the coarse unstructured mesh (Figs. 1 and 9)", _rft3_rft6(result)))
     result.notes += _notes(rows)
