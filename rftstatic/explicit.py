@@ -122,7 +122,8 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
                  obstacles=(), U0=None, V0=None, start: str = "consistent", frame_times=(), probes=None,
                  sample_every: int | None = None, callback=None, checkpoint=None, progress: bool = True,
                  energy_check: bool = True, energy_tol: float = 0.25, rest_tol: float = 1e-6,
-                 safety: float = 0.9, backend: str = "auto", _restart: dict | None = None) -> ExplicitResult:
+                 safety: float = 0.9, backend: str = "auto", load=None,
+                 _restart: dict | None = None) -> ExplicitResult:
     """Integrate the motion of ``model`` from t = 0 to ``t_end`` (module docstring).
 
     Parameters
@@ -133,6 +134,7 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
         A step above that estimate runs with a logged warning.
     alpha : mass damping factor [1/s] (§4.6 uses 5)
     mass_scale : mass-scaling factor s [-] (§6 uses 100); the load is not scaled
+    load : (N, 3) external nodal load [N] to use instead of ``model.load`` (e.g. a guided stage)
     obstacles : obstacles acting kinematically after every step (any type, §6.3)
     U0, V0 : (N, 3) initial displacements [m] and velocities [m/s] (default zero)
     start : ``"consistent"`` (v_(-1/2) = V0 - a_0 dt/2) or ``"given"`` (v_(-1/2) = V0)
@@ -165,7 +167,7 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
     obstacles = tuple(obstacles) if not hasattr(obstacles, "signed_distance") else (obstacles,)
     mass = lumped_mass(model, mass_scale)
     kernel = ForceKernel(model, backend=backend)
-    P = np.array(model.load, dtype=float)
+    P = np.array(model.load if load is None else load, dtype=float)
     probes = np.zeros(0, dtype=np.int64) if probes is None else np.atleast_1d(np.asarray(probes, dtype=np.int64))
     if probes.size and (probes.min() < 0 or probes.max() >= N):
         raise ValueError(f"probe nodes must lie in 0..{N - 1}, got min {probes.min()}, max {probes.max()}")
@@ -376,7 +378,7 @@ class RelaxResult:
 
 def relax(model, *, mass_scale: float = 100.0, alpha: float, tol_kinetic: float = 1e-8, tol_force: float = 1e-4,
           max_time: float, dt: float | None = None, U0=None, V0=None, obstacles=(), sample_every: int = 20,
-          peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto") -> RelaxResult:
+          peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto", load=None) -> RelaxResult:
     """Dynamic relaxation (§6): damped explicit motion until the sheet is at rest.
 
     At rest means, at a sample, kinetic energy / peak kinetic energy < ``tol_kinetic`` *and* the
@@ -392,8 +394,10 @@ def relax(model, *, mass_scale: float = 100.0, alpha: float, tol_kinetic: float 
     U0, V0 : start [m] and half-step velocity v_(-1/2) [m/s] (default zero), e.g. to resume a
         relaxation from its :class:`RelaxResult` (``U``, ``V``)
     peak_kinetic : peak kinetic energy [J] of the motion so far, when resuming (``RelaxResult.peak_kinetic``)
+    load : (N, 3) external nodal load [N] instead of ``model.load`` (the resting state then balances it)
     """
-    P_norm = float(np.linalg.norm(np.where(model.free, model.load, 0.0)))
+    P = model.load if load is None else load
+    P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
 
     def at_rest(state, rec):
         peak = max(at_rest.peak, rec["kinetic"])
@@ -403,7 +407,7 @@ def relax(model, *, mass_scale: float = 100.0, alpha: float, tol_kinetic: float 
     at_rest.peak = float(peak_kinetic)
     run = run_explicit(model, t_end=max_time, dt=dt, alpha=alpha, mass_scale=mass_scale, obstacles=obstacles,
                        U0=U0, V0=V0, start="consistent" if V0 is None else "given", sample_every=sample_every,
-                       callback=at_rest, progress=progress, backend=backend)
+                       callback=at_rest, progress=progress, backend=backend, load=load)
     if not run.stopped:
         log.warning("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
                     run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])

@@ -347,19 +347,16 @@ def _guided_relaxation(model, opts: StaticOptions, *, mass_scale, alpha, U0, fai
 
     The weight of every node is scaled by ``1 + guide_weight * fold_pattern(...)`` (so the total
     stays about the same and the load stays downward) for :data:`GUIDE_DAMPING_TIMES` damping
-    times; the model's load is restored afterwards, whatever happens.
+    times; the model itself keeps its true load.
     """
     from .explicit import InstabilityError, relax
 
-    load = model.load
-    model.load = load * (1.0 + opts.guide_weight * fold_pattern(model.mesh, opts.guide_folds, opts.seed))[:, None]
+    guided = model.load * (1.0 + opts.guide_weight * fold_pattern(model.mesh, opts.guide_folds, opts.seed))[:, None]
     try:
         return relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=1.0,
-                     max_time=GUIDE_DAMPING_TIMES / alpha, U0=U0, progress=opts.progress)
+                     max_time=GUIDE_DAMPING_TIMES / alpha, U0=U0, progress=opts.progress, load=guided)
     except InstabilityError as exc:
         raise fail(f"the guided dynamic relaxation became unstable ({exc})") from None
-    finally:
-        model.load = load
 
 
 def _positive_definite(model, U, solver, lam=1.0) -> bool:
@@ -475,11 +472,16 @@ def fold_pattern(mesh, folds: int, seed: int) -> np.ndarray:
     ``r``, ``theta`` are polar coordinates about the centroid, ``R`` the largest ``r``, and the phase
     ``phi`` is drawn from ``seed``. Zero at the centre, growing outwards where the skirt buckles.
     """
-    rng = np.random.default_rng(seed)
+    rho, theta = _polar(mesh)
+    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi)
+    return rho ** 2 * np.cos(folds * theta + phase)
+
+
+def _polar(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """``(r / R, theta)`` of the nodes about the sheet's centroid, ``R`` the largest ``r``."""
     X = mesh.X - mesh.X.mean(axis=0)
     r = np.hypot(X[:, 0], X[:, 1])
-    theta = np.arctan2(X[:, 1], X[:, 0])
-    return (r / r.max()) ** 2 * np.cos(folds * theta + rng.uniform(0, 2 * np.pi))
+    return r / r.max(), np.arctan2(X[:, 1], X[:, 0])
 
 
 def fold_perturbation(mesh, folds: int, seed: int, amplitude: float) -> np.ndarray:
@@ -491,9 +493,7 @@ def fold_perturbation(mesh, folds: int, seed: int, amplitude: float) -> np.ndarr
     symmetric drape leaves its bifurcation towards the branch with ``folds`` folds (§6.2: drapes
     have several equilibria). Whether that branch is a stable equilibrium is for the solve to say.
     """
-    X = mesh.X - mesh.X.mean(axis=0)
-    r2 = (np.hypot(X[:, 0], X[:, 1]) / np.hypot(X[:, 0], X[:, 1]).max()) ** 2
-    w = 0.5 * (r2 + fold_pattern(mesh, folds, seed))
+    w = 0.5 * (_polar(mesh)[0] ** 2 + fold_pattern(mesh, folds, seed))
     return amplitude * float(mesh.element_size.mean()) * w
 
 
