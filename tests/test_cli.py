@@ -74,3 +74,15 @@ def test_preset_with_an_override_changes_only_that_rigidity():
     mod = build_material(load_scene("strip", ["material.C_warp=111.82"]))  # gf/cm, a tenth of the wool's
     assert mod.Dm[0, 0] == pytest.approx(0.1 * base.Dm[0, 0])
     assert mod.Dm[1, 1] == pytest.approx(base.Dm[1, 1]) and mod.Db[0, 0] == pytest.approx(base.Db[0, 0])
+
+
+def test_bad_guide_options_name_the_scene_file_and_the_solver_key():
+    from rftstatic.run import static_options
+
+    scene = load_scene("pedestal-round-50", ["solver.guide_folds=12", "solver.guide_weight=1.5"])
+    with pytest.raises(SceneError, match=r"pedestal-round-50\.toml: solver: .*guide_weight in \[0, 1\).*1\.5"):
+        static_options(scene)
+    scene = load_scene("pedestal-square-20", ["solver.start=load-steps", "solver.guide_folds=4",
+                                              "solver.guide_weight=0.2"])
+    with pytest.raises(SceneError, match=r'solver: .*needs solver.start = "relax"'):
+        static_options(scene)
