@@ -36,24 +36,24 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
-    from .scene import SceneError
-    from .static import ConvergenceError
+    from rftstatic.scenes.schema import SceneError
+    from rftstatic.solvers.static import ConvergenceError
 
     try:
         if args.command == "list":
-            from .scene import list_scenes
+            from rftstatic.scenes.schema import list_scenes
 
             for name, title in list_scenes():
                 print(f"{name:32s} {title}")
             return 0
         if args.command == "case":
-            from .run import run_scene
-            from .scene import load_scene
+            from rftstatic.app.static import run_scene
+            from rftstatic.scenes.schema import load_scene
 
             scene = load_scene(args.name, args.set)
             out = Path(args.out) if args.out else Path("out") / scene.name
             if args.resume:
-                from .dynamic_run import resume_scene
+                from rftstatic.app.dynamic import resume_scene
 
                 summary = resume_scene(scene, out, progress=True, figures=not args.no_figures)
             else:
@@ -68,11 +68,11 @@ def main(argv=None) -> int:
             print(f"outputs written to {out}/")
             return 0
         if args.command == "bench":
-            from .bench import main as bench_main
+            from rftstatic.bench.main import main as bench_main
 
             return bench_main(args.names)
         if args.command == "validate":
-            from .validate import main as validate_main
+            from rftstatic.validate import main as validate_main
 
             return validate_main(args.names, quick=args.quick, out=args.out)
     except SceneError as exc:

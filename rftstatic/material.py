@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .units import STANDARD_GRAVITY, UnitSystem
+from rftstatic.units import STANDARD_GRAVITY, UnitSystem
 
 
 def voigt_rotation(angle: float) -> np.ndarray:
@@ -164,7 +164,7 @@ def fabric_from_units(values: dict, units: UnitSystem, *, warp_angle_deg=0.0, na
 
 def preset(name: str, *, warp_angle_deg: float = 0.0, **overrides) -> Material:
     """A named fabric preset (``"wool-kang-yu"``), optionally rotated and with overrides in its units."""
-    from .units import unit_system
+    from rftstatic.units import unit_system
 
     if name not in PRESETS:
         raise ValueError(f'unknown material preset "{name}"; known: {", ".join(PRESETS)}')

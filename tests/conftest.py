@@ -1,7 +1,9 @@
 import numpy as np
 import pytest
 
-from rftstatic import material, mesh, model
+from rftstatic import material
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
 
 
 @pytest.fixture

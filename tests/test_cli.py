@@ -5,7 +5,7 @@ import json
 import pytest
 
 from rftstatic.cli import main
-from rftstatic.scene import SceneError, load_scene
+from rftstatic.scenes.schema import SceneError, load_scene
 
 
 def test_list_shows_the_strip(capsys):
@@ -62,13 +62,13 @@ def test_unknown_scene_lists_known_ones():
 
 def test_support_box_without_nodes_is_an_error(tmp_path):
     with pytest.raises(SceneError, match=r"supports.0.box.*contains no node"):
-        from rftstatic.build import build_model
+        from rftstatic.scenes.build import build_model
 
         build_model(load_scene("strip", ["supports.0.box=[9.0, 9.0, 9.0, 9.0]"]))
 
 
 def test_preset_with_an_override_changes_only_that_rigidity():
-    from rftstatic.build import build_material
+    from rftstatic.scenes.build import build_material
 
     base = build_material(load_scene("strip"))
     mod = build_material(load_scene("strip", ["material.C_warp=111.82"]))  # gf/cm, a tenth of the wool's
@@ -77,7 +77,7 @@ def test_preset_with_an_override_changes_only_that_rigidity():
 
 
 def test_bad_guide_options_name_the_scene_file_and_the_solver_key():
-    from rftstatic.run import static_options
+    from rftstatic.app.static import static_options
 
     scene = load_scene("pedestal-round-50", ["solver.guide_folds=12", "solver.guide_weight=1.5"])
     with pytest.raises(SceneError, match=r"pedestal-round-50\.toml: solver: .*guide_weight in \[0, 1\).*1\.5"):

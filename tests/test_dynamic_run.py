@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from rftstatic.cli import main
-from rftstatic.dynamic_run import resume_scene, run_dynamic_scene
-from rftstatic.scene import SceneError, load_scene
+from rftstatic.app.dynamic import resume_scene, run_dynamic_scene
+from rftstatic.scenes.schema import SceneError, load_scene
 
 TINY = ["mesh.nodes=[9,9]", "dynamics.t_end=0.05", "dynamics.checkpoint_every=0.01", "dynamics.samples=5",
         "dynamics.frames=[0,0.02,0.05]"]
@@ -24,7 +24,7 @@ def _tiny_scene(extra=()):
 
 
 def _run(scene, out, **kw):
-    from rftstatic.build import build_model
+    from rftstatic.scenes.build import build_model
 
     model, extras = build_model(scene)
     return run_dynamic_scene(scene, model, extras, out, progress=False, figures=False, **kw)

@@ -4,7 +4,10 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from rftstatic import material, mesh, model, patch
+from rftstatic import material
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
+from rftstatic.element import patch
 
 ELEMENTS = ["RFT3", "RFT6"]
 

@@ -5,14 +5,14 @@ import logging
 import numpy as np
 import pytest
 
-from rftstatic.checkpoint import Checkpointer, CheckpointError, load_checkpoint, resume
-from rftstatic.explicit import InstabilityError, compare_with_static, relax, run_explicit
-from rftstatic.explicit_force import ForceKernel
+from rftstatic.solvers.checkpoint import Checkpointer, CheckpointError, load_checkpoint, resume
+from rftstatic.solvers.explicit import InstabilityError, compare_with_static, relax, run_explicit
+from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.material import fabric, preset
-from rftstatic.mesh import rectangle
-from rftstatic.model import Model, Supports, gravity_load
-from rftstatic.obstacles import Floor, RoundPedestal, Sphere, SquarePedestal
-from rftstatic.timestep import element_bound, lanczos_omega, lumped_mass, stable_time_step
+from rftstatic.mesh.trimesh import rectangle
+from rftstatic.model.model import Model, Supports, gravity_load
+from rftstatic.contact.obstacles import Floor, RoundPedestal, Sphere, SquarePedestal
+from rftstatic.solvers.timestep import element_bound, lanczos_omega, lumped_mass, stable_time_step
 
 G = 9.80665
 WOOL = preset("wool-kang-yu")
@@ -149,7 +149,7 @@ def test_automatic_step_is_close_to_the_observed_limit(caplog):
 def test_too_large_step_warns_and_raises_with_suggestion(caplog):
     model = strip()
     est = stable_time_step(model)
-    with caplog.at_level(logging.WARNING, logger="rftstatic.explicit"):
+    with caplog.at_level(logging.WARNING, logger="rftstatic.solvers.explicit"):
         with pytest.raises(InstabilityError, match=r"use dt <= ") as err:
             run_explicit(model, t_end=0.05, dt=2 * est.dt, progress=False)
     assert "exceeds the stable estimate" in caplog.text

@@ -3,8 +3,11 @@
 import numpy as np
 import pytest
 
-from rftstatic import material, mesh, model, static
-from rftstatic.loads import LeverMoment
+from rftstatic import material
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
+from rftstatic.solvers import static
+from rftstatic.model.loads import LeverMoment
 
 
 def _rolled_strip(nx=25, ny=3, element="RFT6"):

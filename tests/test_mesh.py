@@ -4,7 +4,7 @@ import meshio
 import numpy as np
 import pytest
 
-from rftstatic import mesh
+from rftstatic.mesh import trimesh as mesh
 
 
 @pytest.mark.parametrize("pattern", mesh.PATTERNS)
@@ -72,7 +72,8 @@ def test_patches_and_bending_of_a_large_mesh_build_vectorised():
     # 2 x 10^5 triangles: construction stays well under a second per 10^5 elements (benchmark: 10^6 in 17 s)
     import time
 
-    from rftstatic import material, patch
+    from rftstatic import material
+    from rftstatic.element import patch
 
     m = mesh.rectangle(1.0, 1.0, 318, 318)
     t = time.perf_counter()

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from rftstatic.mesher import BackgroundGrid, Domain, MeshingError, MeshQuality, generate
-from rftstatic.mesher.improve import flip_edges, signed_area
-from rftstatic.mesher.quality import unique_edges
-from rftstatic.mesher.sizefield import limit_gradation
+from rftstatic.mesh.mesher import BackgroundGrid, Domain, MeshingError, MeshQuality, generate
+from rftstatic.mesh.mesher.improve import flip_edges, signed_area
+from rftstatic.mesh.mesher.quality import unique_edges
+from rftstatic.mesh.mesher.sizefield import limit_gradation
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -289,7 +289,7 @@ def test_errors_are_value_errors_with_fixes():
 
 
 def test_bench_main_runs_small(capsys):
-    from rftstatic.mesher import bench
+    from rftstatic.bench import mesher as bench
 
     bench.main(["--nodes", "300"])
     out = capsys.readouterr().out

@@ -9,7 +9,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from rftstatic import output, plots
+from rftstatic.io import files as output, plots
 
 
 def rectangle(nx=5, ny=5, lx=4.0, ly=2.0):
@@ -40,7 +40,7 @@ def no_temp_files(directory):
 
 
 def test_import_is_light():
-    code = ("import sys, rftstatic.output, rftstatic.plots; "
+    code = ("import sys, rftstatic.io.files, rftstatic.io.plots; "
             "print('matplotlib' in sys.modules, 'meshio' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]

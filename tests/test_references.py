@@ -7,9 +7,7 @@ import pytest
 from scipy.integrate import simpson
 from scipy.special import zeta
 
-from rftstatic.references import (
-    END_MOMENT, END_SHEAR, SLIT_ANNULAR, SZE2004_NAMES, load_sze2004,
-)
+from rftstatic.references import END_MOMENT, END_SHEAR, SLIT_ANNULAR, SZE2004_NAMES, load_sze2004
 from rftstatic.references.elastica import alpha_of, heavy_elastica
 from rftstatic.references.plates import TABLE, centre_deflection, navier_coefficient
 

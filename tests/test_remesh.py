@@ -3,14 +3,15 @@
 import numpy as np
 import pytest
 
-from rftstatic import material, mesh, model
-from rftstatic.mesher import Domain, generate
-from rftstatic.remesh import (NearObstacle, adapt_mesh, critical_damping, explicit_advance, refinable_maxima,
-                              reference_domain, remesh_relax, remesh_static, transfer_state)
-from rftstatic.scene import scene_from_dict
-from rftstatic.sizefield import curvature_magnitude, size_field, target_sizes
-from rftstatic.static import StaticOptions, solve_static
-from rftstatic.transfer import interpolate, locate, transfer_fields
+from rftstatic import material
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
+from rftstatic.mesh.mesher import Domain, generate
+from rftstatic.remesh.adapt import (NearObstacle, adapt_mesh, critical_damping, explicit_advance, refinable_maxima, reference_domain, remesh_relax, remesh_static, transfer_state)
+from rftstatic.scenes.schema import scene_from_dict
+from rftstatic.remesh.sizefield import curvature_magnitude, size_field, target_sizes
+from rftstatic.solvers.static import StaticOptions, solve_static
+from rftstatic.remesh.transfer import interpolate, locate, transfer_fields
 
 # tip (x, z) of the 5 x 1 cm wool strip on the structured 81 x 17 RFT6 mesh [m]
 # (21 x 5 gives (-32.291, -43.508) mm: the reference is converged to ~0.05 mm)
@@ -224,8 +225,8 @@ def test_critical_damping_is_that_of_a_hanging_chain():
 
 
 def test_near_obstacle_gives_the_same_kinematic_contact():
-    from rftstatic.contact import kinematic_contact
-    from rftstatic.obstacles import from_spec
+    from rftstatic.contact.penalty import kinematic_contact
+    from rftstatic.contact.obstacles import from_spec
 
     rng = np.random.default_rng(3)
     for spec in ({"type": "round-pedestal", "centre": [0, 0], "radius": 0.1, "top": 0.0, "edge_radius": 0.005},
@@ -254,7 +255,7 @@ def _strip_scene():
 
 
 def test_remesh_static_strip_reaches_structured_tip():
-    from rftstatic.build import probe_positions
+    from rftstatic.scenes.build import probe_positions
 
     out = remesh_static(_strip_scene(), const=4e-4, h_lower=1e-3, h_upper=4e-3, max_cycles=4, tol=0.05,
                         kappa_h_max=0.3)

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from rftstatic import static
-from rftstatic.explicit import InstabilityError, run_explicit
-from rftstatic.patch import PatchError
-from rftstatic.timestep import stable_time_step
+from rftstatic.solvers import static
+from rftstatic.solvers.explicit import InstabilityError, run_explicit
+from rftstatic.element.patch import PatchError
+from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.validate import stability as st
 
 
@@ -61,12 +61,12 @@ def test_rft6_warns_of_membrane_locking_where_the_strip_stiffens(caplog):
     out-of-tolerance answer on a warned model as a limitation, not as a silent wrong answer."""
     import logging
 
-    from rftstatic.model import LOCKING_WARN, locking_number
+    from rftstatic.model.model import LOCKING_WARN, locking_number
 
-    import rftstatic.model
+    import rftstatic.model.model
 
-    rftstatic.model._LOCKING_WARNED = False  # logged at warning level once per process
-    with caplog.at_level(logging.WARNING, logger="rftstatic.model"):
+    rftstatic.model.model._LOCKING_WARNED = False  # logged at warning level once per process
+    with caplog.at_level(logging.WARNING, logger="rftstatic.model.model"):
         coarse = st._strip(21, 5, element="RFT6", ratio=1e6)
     assert locking_number(coarse.mesh, coarse.material) > LOCKING_WARN
     assert coarse.warnings and "RFT3" in coarse.warnings[0] and "Refine" in coarse.warnings[0]

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from conftest import clamped_strip
-from rftstatic import static
+from rftstatic.solvers import static
 from rftstatic.references import plates
 from rftstatic.references.elastica import heavy_elastica
 from rftstatic.validate.plates import plate_coefficient
@@ -130,7 +130,7 @@ def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
 
 def test_fold_perturbation_has_n_fold_symmetry():
     """The n-fold start lifts by 0 .. amplitude element sizes and repeats every 2 pi / n about the centre."""
-    from rftstatic.mesh import rectangle
+    from rftstatic.mesh.trimesh import rectangle
 
     mesh = rectangle(0.5, 0.5, 41, 41, origin=(-0.25, -0.25))
     opts = static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=3)
@@ -165,7 +165,7 @@ def test_guided_relaxation_restores_the_weight_and_reaches_the_same_equilibrium(
 
 
 def test_fold_pattern_and_guide_options():
-    from rftstatic.mesh import rectangle
+    from rftstatic.mesh.trimesh import rectangle
 
     mesh = rectangle(0.5, 0.5, 21, 21, origin=(-0.25, -0.25))
     p = static.fold_pattern(mesh, 12, seed=1)

@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from rftstatic import bench
+from rftstatic.bench import main as bench
 from rftstatic.cli import main as cli_main
 from rftstatic.validate.report import observed_rate, time_to_error
 

@@ -23,7 +23,7 @@ import re
 import time
 from pathlib import Path
 
-from .report import BenchmarkResult, fmt_err, fmt_time, write_report
+from rftstatic.validate.report import BenchmarkResult, fmt_err, fmt_time, write_report
 
 __all__ = ["BENCHMARKS", "BenchmarkResult", "main", "run_benchmark", "default_out"]
 
@@ -84,7 +84,7 @@ def rebuild_index(out=None) -> Path:
     import json
     from types import SimpleNamespace
 
-    from .report import Study
+    from rftstatic.validate.report import Study
 
     out = Path(out) if out else default_out()
     results = []

@@ -13,7 +13,7 @@ import os
 import shutil
 from pathlib import Path
 
-from ..bench_drape import run_cached
+from rftstatic.bench.drape import run_cached
 
 
 def cache_root() -> Path:
@@ -33,7 +33,7 @@ def drape_run(scene: str, nodes, element: str, *, figures: bool = True) -> dict:
     """
     overrides = [f"mesh.nodes=[{nodes[0]},{nodes[1]}]", f"element={element}"]
     if os.environ.get("RFTSTATIC_DRAPE_CACHED_ONLY") == "1":
-        from ..bench_drape import run_key
+        from rftstatic.bench.drape import run_key
 
         d = cache_root() / run_key(scene, overrides)
         if not ((d / "record.json").exists() and (d / "state.npz").exists()):
@@ -79,7 +79,7 @@ def status(rec: dict) -> str:
 
 def run_cached_only(scene: str, nodes, element: str) -> dict | None:
     """The cached record of a run, or None when it has not been run (nothing is solved)."""
-    from ..bench_drape import run_key
+    from rftstatic.bench.drape import run_key
 
     overrides = [f"mesh.nodes=[{nodes[0]},{nodes[1]}]", f"element={element}"]
     d = cache_root() / run_key(scene, overrides)
@@ -97,9 +97,9 @@ def free_indicators(rec: dict, scene: str, *, reach: float = 2.0) -> dict:
     """
     import numpy as np
 
-    from ..measures import dihedral_angles
-    from ..obstacles import from_spec
-    from ..scene import load_scene
+    from rftstatic.post.measures import dihedral_angles
+    from rftstatic.contact.obstacles import from_spec
+    from rftstatic.scenes.schema import load_scene
 
     sc = load_scene(scene, rec["overrides"])
     u = sc.units.length

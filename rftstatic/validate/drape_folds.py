@@ -27,8 +27,8 @@ import os
 
 import numpy as np
 
-from .drape_common import cache_root, copy_views, drape_run, mesh_label, run_cached_only, solve_row, status
-from .report import BenchmarkResult
+from rftstatic.validate.drape_common import (cache_root, copy_views, drape_run, mesh_label, run_cached_only, solve_row, status)
+from rftstatic.validate.report import BenchmarkResult
 
 SCENE = "pedestal-round-50"
 PAPER_FOLDS = 12
@@ -176,7 +176,7 @@ def _energy(rec: dict) -> float:
 
 def _branches(quick: bool, result) -> list:
     """Run (or, quick, look up) the other starts on :data:`BRANCH_MESH`; add their table."""
-    from ..bench_drape import run_cached, run_key
+    from rftstatic.bench.drape import run_cached, run_key
 
     default = run_cached_only(SCENE, BRANCH_MESH, "RFT6")
     runs = [] if default is None else [(default, "random modes, seed 1 (default)", "RFT6", [])]
@@ -261,7 +261,7 @@ def _profiles(out, recs, *, name="drape_folds_profiles.png",
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..measures import boundary_loop, fold_count
+    from rftstatic.post.measures import boundary_loop, fold_count
 
     fig, ax = plt.subplots(figsize=(7.5, 4.2))
     for k, (nodes, rec) in enumerate(recs.items()):

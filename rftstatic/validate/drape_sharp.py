@@ -19,8 +19,8 @@ Quick: the §4.2 sheet on 17 x 17 nodes only.
 
 from __future__ import annotations
 
-from .drape_common import drape_run, free_indicators, mesh_label, solve_row, status
-from .report import BenchmarkResult
+from rftstatic.validate.drape_common import drape_run, free_indicators, mesh_label, solve_row, status
+from rftstatic.validate.report import BenchmarkResult
 
 FULL = [("sphere-30", (17, 17), "§4.5 sphere, 17x17"), ("pedestal-square-80", (81, 81), "§4.3 80 cm sheet, 81x81"),
         ("pedestal-square-80", (41, 41), "§4.3 80 cm sheet, 41x41"),
@@ -91,9 +91,9 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
 
 def _figures(out, cases, recs) -> list[str]:
     """Side by side RFT3 | RFT6, top and isometric views, coloured by |kappa| h on a common scale."""
-    from ..drape_figures import obstacle_drawers, plot_side_by_side
-    from ..build import build_model
-    from ..scene import load_scene
+    from rftstatic.io.drape_figures import obstacle_drawers, plot_side_by_side
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.schema import load_scene
 
     names = []
     for scene, nodes, label in cases:

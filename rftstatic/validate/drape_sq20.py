@@ -23,9 +23,9 @@ resolves) and drape coefficient within :data:`DC_TOL`; the quick run is reported
 
 from __future__ import annotations
 
-from ..drape_figures import boundary_distance, boundary_xy
-from .drape_common import copy_views, drape_run, mesh_label, solve_row, status
-from .report import BenchmarkResult, Study, convergence_figures, fmt_err
+from rftstatic.io.drape_figures import boundary_distance, boundary_xy
+from rftstatic.validate.drape_common import copy_views, drape_run, mesh_label, solve_row, status
+from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures, fmt_err
 
 SCENE = "pedestal-square-20"
 HALF = 10.0  # half side [cm]
@@ -114,7 +114,7 @@ def _folds(rec) -> str:
 
 def _overlay(out, cfg, ref, ref_curve) -> str:
     """Fig. 6a: deformed boundaries from the top, the pedestal filled grey."""
-    from ..plots import outline_square, plot_boundary_overlay
+    from rftstatic.io.plots import outline_square, plot_boundary_overlay
 
     nref = cfg["reference"]
     n1, n2 = (33, 61) if cfg is FULL else tuple(cfg["meshes"]["RFT6"][-2:])

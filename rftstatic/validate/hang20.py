@@ -26,9 +26,9 @@ import time
 
 import numpy as np
 
-from ..build import build_model
-from ..scene import load_scene
-from .report import BenchmarkResult, Study, convergence_figures, fmt_err
+from rftstatic.scenes.build import build_model
+from rftstatic.scenes.schema import load_scene
+from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures, fmt_err
 
 L = 0.20  # side [m]
 TIMES = (0.16, 0.32)
@@ -38,8 +38,8 @@ TOLERANCE = 0.01  # corner within 1 % of the side on the finest mesh
 def _corner_positions(n, *, dt_factor=None, clamp=None):
     """Free-corner positions [m] at TIMES for an n x n mesh; dt = dt_factor x critical (None: auto);
     ``clamp``: edge [cm] of the square pinned at each held corner (None: the scene's single nodes)."""
-    from ..explicit import run_explicit
-    from ..timestep import stable_time_step
+    from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.timestep import stable_time_step
 
     scene = load_scene("hang-20", [f"mesh.nodes=[{n}, {n}]"])
     if clamp is not None:  # pinned c x c squares at (0, -10) and (0, 10) cm

@@ -39,10 +39,11 @@ from functools import lru_cache
 
 import numpy as np
 
-from .. import mesh, model
-from ..references import plates as plate_refs
-from . import plates
-from .report import BenchmarkResult, Study, fmt_err, fmt_time, observed_rate, time_to_error
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
+from rftstatic.references import plates as plate_refs
+from rftstatic.validate import plates
+from rftstatic.validate.report import BenchmarkResult, Study, fmt_err, fmt_time, observed_rate, time_to_error
 
 PEER = "scikit-fem"
 PEER_ELEMENTS = ("Morley", "Argyris")
@@ -132,7 +133,7 @@ def peer_plate(n: int, element: str, edges: str, load: str) -> dict:
     """
     import skfem
 
-    from ..linsolve import make_solver
+    from rftstatic.solvers.linear import make_solver
 
     bending, unit_load = _forms()
     t0 = time.perf_counter()
@@ -272,8 +273,8 @@ def _cost_table(result) -> str:
 
 
 def _sze_section(result) -> str:
-    from ..references import load_sze2004
-    from . import sze2004
+    from rftstatic.references import load_sze2004
+    from rftstatic.validate import sze2004
 
     lines = ["S4R: 6 dofs per node (3 translations, 3 rotations); RF triangles: 3 translations per node. Error "
              "measure of sze2004.py: largest deviation over the tabulated load fractions / largest reference "
@@ -383,7 +384,7 @@ def _sze2004_measured() -> str:
     """The finest-mesh RFT6 errors of validation/sze2004.json (our large-deflection report), as text."""
     import json
 
-    from . import default_out
+    from rftstatic.validate import default_out
 
     path = default_out() / "sze2004.json"
     try:
@@ -400,7 +401,7 @@ def _figures(result, out) -> list[str]:
     """Error against wall time and against unknowns: one panel per plate case, every element in each."""
     from matplotlib.ticker import NullFormatter, NullLocator
 
-    from ..plots import _figure, _save
+    from rftstatic.io.plots import _figure, _save
 
     names = []
     styles = {"RFT3=RFT6": ("C0", "o"), f"Morley ({PEER})": ("C1", "s"), f"Argyris ({PEER})": ("C2", "d")}

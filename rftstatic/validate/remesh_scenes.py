@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from .report import BenchmarkResult, Study
+from rftstatic.validate.report import BenchmarkResult, Study
 
 SCENES = {  # remeshed scene -> (static reference scene, its overrides, half side [cm])
     "remesh-pedestal-square-20": ("pedestal-square-20", [], 10.0),
@@ -54,7 +54,7 @@ STATIC_REMESH = ["analysis=static", "contact.penalty=auto", "solver.rtol=1e-5", 
 
 def boundary_curve(summary_x, tri):
     """(B, 2) top-view outline [scene length] of the deformed sheet (ordered boundary loop)."""
-    from ..measures import boundary_loop
+    from rftstatic.post.measures import boundary_loop
 
     loop = boundary_loop(tri, summary_x)
     return summary_x[loop][:, :2]
@@ -79,24 +79,24 @@ def curve_distance(a, b, *, step=None) -> float:
 
 def _solve(name, overrides):
     """Run a scene (any route) and return (summary, (N, 3) deformed x [scene length], tri, wall [s])."""
-    from ..build import build_model
-    from ..remesh_run import remesh_options
-    from ..run import static_options
-    from ..scene import load_scene
-    from ..static import solve_static
+    from rftstatic.scenes.build import build_model
+    from rftstatic.app.remeshed import remesh_options
+    from rftstatic.app.static import static_options
+    from rftstatic.scenes.schema import load_scene
+    from rftstatic.solvers.static import solve_static
 
     scene = load_scene(name, overrides)
     u = scene.units.length
     t0 = time.perf_counter()
     if scene.get("remesh") is not None:
-        from ..remesh_run import solve_remesh_scene, summarize
+        from rftstatic.app.remeshed import solve_remesh_scene, summarize
 
         run = solve_remesh_scene(scene)
         model, U = run["model"], run["U"]
         s = summarize(scene, remesh_options(scene), run)
     else:
-        from ..run import static_summary
-        from ..static import ConvergenceError
+        from rftstatic.app.static import static_summary
+        from rftstatic.solvers.static import ConvergenceError
 
         model, extras = build_model(scene)
         try:
@@ -135,7 +135,7 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
         for label, over in routes:
             target = ref_name if label.startswith("structured") else name
             over = (ref_over + over) if label.startswith("structured") else over
-            from ..static import ConvergenceError
+            from rftstatic.solvers.static import ConvergenceError
 
             t0 = time.perf_counter()
             try:
@@ -254,7 +254,7 @@ def _f(v) -> str:
 
 
 def _overlays(curves, out) -> list:
-    from ..plots import plot_boundary_overlay
+    from rftstatic.io.plots import plot_boundary_overlay
 
     files = []
     for name, c in curves.items():

@@ -148,7 +148,7 @@ def fmt_err(e: float) -> str:
 
 def convergence_figures(result: BenchmarkResult, out: Path, *, studies=None, stem=None, title=None) -> list[str]:
     """Error against node count and against wall time, every element of every case on one plot each."""
-    from ..plots import plot_convergence
+    from rftstatic.io.plots import plot_convergence
 
     studies = result.studies if studies is None else studies
     stem = stem or result.name
@@ -168,7 +168,7 @@ def convergence_figures(result: BenchmarkResult, out: Path, *, studies=None, ste
 
 def write_report(result: BenchmarkResult, out: Path, *, quick: bool) -> Path:
     """Write ``NAME.md`` and ``NAME.json`` into ``out`` (figures are already there)."""
-    from ..output import write_json
+    from rftstatic.io.files import write_json
 
     lines = [f"# {result.title}", "",
              f"Benchmark `{result.name}`{' (quick: coarse meshes only)' if quick else ''}; regenerate with "

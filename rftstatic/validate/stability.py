@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .report import BenchmarkResult, fmt_err
+from rftstatic.validate.report import BenchmarkResult, fmt_err
 
 L, WIDTH = 0.05, 0.01  # strip [m]
 CM2 = 1e4  # 1/cm^2 in 1/m^2
@@ -64,7 +64,9 @@ class Cell:
 # ---------------------------------------------------------------- models
 
 def _strip(nx, ny, *, element="RFT6", ratio=None, alpha=None, pattern="right", mesh_=None, membrane=True):
-    from .. import material, mesh, model
+    from rftstatic import material
+    from rftstatic.mesh import trimesh as mesh
+    from rftstatic.model import model
 
     m = mesh_ if mesh_ is not None else mesh.rectangle(L, WIDTH, nx, ny, origin=(0.0, -WIDTH / 2), pattern=pattern)
     mat = material.preset("wool-kang-yu")
@@ -84,7 +86,7 @@ def _static_summary(res) -> dict:
 
 
 def _solve(mod, opts=None):
-    from .. import static
+    from rftstatic.solvers import static
 
     return static.solve_static(mod, options=opts or static.StaticOptions(progress=False))
 
@@ -92,8 +94,8 @@ def _solve(mod, opts=None):
 def strip_cell(nx=21, ny=5, *, element="RFT6", ratio=None, alpha=None, one_step=False, mesh_kind=None,
                h=None, jitter=None, seed=0, degenerate=None) -> dict:
     """The wool strip against the extensible heavy elastica (see module docstring)."""
-    from .. import static
-    from ..references.elastica import heavy_elastica
+    from rftstatic.solvers import static
+    from rftstatic.references.elastica import heavy_elastica
 
     m = _strip_mesh(nx, ny, mesh_kind=mesh_kind, h=h, jitter=jitter, seed=seed, degenerate=degenerate)
     mod = _strip(nx, ny, element=element, ratio=ratio, alpha=alpha, mesh_=m)
@@ -117,10 +119,10 @@ def strip_cell(nx=21, ny=5, *, element="RFT6", ratio=None, alpha=None, one_step=
 
 
 def _strip_mesh(nx, ny, *, mesh_kind=None, h=None, jitter=None, seed=0, degenerate=None):
-    from .. import mesh
+    from rftstatic.mesh import trimesh as mesh
 
     if mesh_kind == "unstructured":
-        from ..mesher import BackgroundGrid, Domain, generate
+        from rftstatic.mesh.mesher import BackgroundGrid, Domain, generate
 
         domain = Domain.rectangle(0.0, -WIDTH / 2, L, WIDTH)
         r = generate(domain, BackgroundGrid.uniform(h, domain))
@@ -145,7 +147,10 @@ def _strip_mesh(nx, ny, *, mesh_kind=None, h=None, jitter=None, seed=0, degenera
 
 def pedestal_cell(n=17, *, ratio=None, one_step=False) -> dict:
     """pedestal-square-20 at n x n nodes; ``ratio`` C/B [1/cm^2] via a full material table."""
-    from .. import build, material, run, scene, static
+    from rftstatic.scenes import build, schema as scene
+    from rftstatic import material
+    from rftstatic.app import static as run
+    from rftstatic.solvers import static
 
     overrides = [f"mesh.nodes=[{n},{n}]"]
     s = scene.load_scene("pedestal-square-20", overrides)
@@ -169,7 +174,7 @@ def pedestal_cell(n=17, *, ratio=None, one_step=False) -> dict:
 
 def scene_override_cell() -> dict:
     """The scene path: ``[material] preset = ...`` with an override (``material.C_warp=...``)."""
-    from .. import build, scene
+    from rftstatic.scenes import build, schema as scene
 
     s = scene.load_scene("pedestal-square-20", ["mesh.nodes=[9,9]", "material.C_warp=111.82"])
     mat = build.build_material(s)
@@ -180,7 +185,7 @@ def scene_override_cell() -> dict:
 
 def plate_cell(n=21, *, one_step=True) -> dict:
     """Clamped unit plate, uniform load, bending only: centre coefficient against Timoshenko."""
-    from .plates import plate_coefficient
+    from rftstatic.validate.plates import plate_coefficient
 
     r = plate_coefficient(n, "clamped", "uniform")
     return {"converged": r["converged"], "value": r["value"], "reference": r["reference"], "error": r["error"],
@@ -189,12 +194,12 @@ def plate_cell(n=21, *, one_step=True) -> dict:
 
 def end_moment_cell(nx=25, ny=3, *, element="RFT6", steps_per_table=4) -> dict:
     """The full roll-up of Sze et al. (2004) (sze2004.end_moment) against the exact circle."""
-    from ..references import load_sze2004
-    from .sze2004 import end_moment
+    from rftstatic.references import load_sze2004
+    from rftstatic.validate.sze2004 import end_moment
 
     r = end_moment(nx, ny, element, load_sze2004("end_moment"), steps_per_table=steps_per_table)
     if not r["converged"]:
-        from ..static import ConvergenceError
+        from rftstatic.solvers.static import ConvergenceError
 
         raise ConvergenceError(r["message"])
     return {"converged": True, "value": r["value"], "reference": r["reference"], "error": r["error"],
@@ -203,7 +208,7 @@ def end_moment_cell(nx=25, ny=3, *, element="RFT6", steps_per_table=4) -> dict:
 
 
 def _hang(n):
-    from .. import build, scene
+    from rftstatic.scenes import build, schema as scene
 
     s = scene.load_scene("hang-20", [f"mesh.nodes=[{n},{n}]"])
     mod, extras = build.build_model(s)
@@ -217,8 +222,8 @@ def explicit_dt_cell(n=11, *, factor=1.0, steps=1500, alpha=5.0) -> dict:
     Reference: the same time at half the automatic step (free-corner displacement). Above the
     critical step an :class:`InstabilityError` is the right behaviour, if the step it suggests runs.
     """
-    from ..explicit import InstabilityError, run_explicit
-    from ..timestep import stable_time_step
+    from rftstatic.solvers.explicit import InstabilityError, run_explicit
+    from rftstatic.solvers.timestep import stable_time_step
 
     mod, corner = _hang(n)
     est = stable_time_step(mod, alpha=alpha)
@@ -248,14 +253,14 @@ def explicit_dt_cell(n=11, *, factor=1.0, steps=1500, alpha=5.0) -> dict:
 
 def mass_scale_cell(n=11, *, scale=1.0, steps=300) -> dict:
     """Stable step with mass scaling s against sqrt(s) x the unscaled one; a short run at that step."""
-    from ..explicit import run_explicit
-    from ..timestep import stable_time_step
+    from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.timestep import stable_time_step
 
     mod, corner = _hang(n)
     base = stable_time_step(mod, alpha=5.0)
     est = stable_time_step(mod, alpha=5.0, mass_scale=scale)
     # with damping dt_crit = (sqrt(a^2 + 4 w^2) - a) / w^2, w = w1 / sqrt(s): exact sqrt(s) only at a = 0
-    from ..timestep import critical_step
+    from rftstatic.solvers.timestep import critical_step
 
     expect = 0.9 * critical_step(base.omega_max / math.sqrt(scale), 5.0)
     res = run_explicit(mod, t_end=steps * est.dt, mass_scale=scale, alpha=5.0, progress=False)

@@ -15,9 +15,12 @@ import time
 
 import numpy as np
 
-from .. import material, mesh, model, static
-from ..references.elastica import heavy_elastica
-from .report import BenchmarkResult, Study, convergence_figures, fmt_err
+from rftstatic import material
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
+from rftstatic.solvers import static
+from rftstatic.references.elastica import heavy_elastica
+from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures, fmt_err
 
 L, WIDTH = 0.05, 0.01  # [m]
 TOLERANCE = 0.005  # tip error / L on the finest mesh
@@ -125,7 +128,7 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
 
 def _profile_figure(out, side_mesh) -> str:
     """Side profiles (mid-width line) of the strip for the three patterns against the elastica."""
-    from ..plots import plot_side_profiles
+    from rftstatic.io.plots import plot_side_profiles
 
     nx, ny = side_mesh
     curves = {}

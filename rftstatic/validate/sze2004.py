@@ -27,9 +27,12 @@ import time
 
 import numpy as np
 
-from .. import material, mesh, model, static
-from ..references import END_MOMENT, END_SHEAR, SLIT_ANNULAR, load_sze2004
-from .report import BenchmarkResult, Study, convergence_figures, fmt_err
+from rftstatic import material
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
+from rftstatic.solvers import static
+from rftstatic.references import END_MOMENT, END_SHEAR, SLIT_ANNULAR, load_sze2004
+from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures, fmt_err
 
 TOLERANCE = 0.03
 
@@ -98,7 +101,7 @@ def end_moment(nx, ny, element, table, *, plane=True, steps_per_table=4):
     stiffness. ``plane=True`` holds u_y = 0 (the benchmark is a plane roll-up): free in y, RFT6 leaves
     the x-z plane at a bifurcation near closure (M/M_max ~ 0.95; reported in the notes).
     """
-    from ..loads import LeverMoment
+    from rftstatic.model.loads import LeverMoment
 
     c = END_MOMENT
     t0 = time.perf_counter()
@@ -270,7 +273,7 @@ def _table(result, case, table) -> str:
 
 
 def _curve_figures(result, out, tables) -> list[str]:
-    from ..plots import plot_load_deflection
+    from rftstatic.io.plots import plot_load_deflection
 
     names = []
     spec = {"end shear": ("end_shear", ("minus_u", "w"), ("minus_u_tip", "w_tip"), ("-U", "W"), END_SHEAR.load_max),

@@ -1,0 +1,343 @@
+"""Run a dynamic scene (``analysis = "dynamic"`` or ``"relax"``) and write what users look at.
+
+``dynamic``: the explicit central-difference motion of Sze & Zhou (2016) §2.4 (Eq. 16-22) with the
+mass damping ``alpha M v`` of Eq. 27 (sign as in method.md), as in their §4.6 (Figs. 12-13: sheets
+hung at two adjacent corners, alpha = 5/s, falling from flat at t = 0). ``relax``: the same motion
+with mass scaling (§6, default s = 100), stopped when the sheet is at rest (kinetic energy below
+``rest_tolerance`` of its peak and out-of-balance force below ``force_tolerance`` of the load); with
+``compare_static = true`` the resting state is compared with the static Newton solution.
+
+Obstacles act kinematically (§6.3): the penalty contact (and, for true dynamics, the in-plane holds) that
+:func:`rftstatic.build.build_model` adds for the static solver are dropped for these runs.
+
+Outputs in the run folder, every number in the scene's units:
+
+* ``frame_t<time>_{iso,side}.png`` at the scene's ``frames`` times;
+* ``series/state_<k>.vtu`` (the frames and ``samples`` regular states) indexed by ``series.pvd``;
+* ``animation.gif`` (the sampled states, isometric view), ``energy.png`` (kinetic and potential
+  energy against time);
+* ``summary.json``: counts, step and its estimate, steps, wall time, element-steps per second,
+  probe trajectories (t, x, y, z), time at rest, energies, flags;
+* ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
+  continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.checkpoint`).
+
+All files are written atomically (:mod:`rftstatic.output`), so an interrupted run leaves no partial file.
+"""
+
+from __future__ import annotations
+
+import logging
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+from rftstatic import __version__
+
+log = logging.getLogger(__name__)
+
+CHECKPOINT = "checkpoint.npz"
+DEFAULTS = {
+    "dynamic": {"alpha": 0.0, "mass_scale": 1.0, "rest_tolerance": 1e-3},
+    "relax": {"alpha": 5.0, "mass_scale": 100.0, "rest_tolerance": 1e-8},
+}
+
+
+def dynamics_options(scene) -> dict:
+    """The scene's ``[dynamics]`` table checked and converted to SI, with the defaults filled in."""
+    analysis = scene.get("analysis", "static")
+    d = dict(scene.get("dynamics", {}))
+    u = scene.units
+    if "t_end" not in d:
+        raise scene.error("dynamics.t_end", f"an analysis = \"{analysis}\" scene needs its end time "
+                          "(dynamics.t_end, the longest simulated time for relax)")
+    opts = {**DEFAULTS[analysis], "force_tolerance": 1e-4, "samples": 30, "compare_static": False,
+            "checkpoint_every": 0.2 / u.time, "frames": []}
+    opts.update(d)
+
+    def positive(key, strict=True):
+        v = opts[key]
+        if not (isinstance(v, (int, float)) and (v > 0 if strict else v >= 0)):
+            raise scene.error(f"dynamics.{key}", f"must be {'> 0' if strict else '>= 0'}, got {v!r}")
+
+    for key in ("t_end", "mass_scale", "rest_tolerance", "force_tolerance", "checkpoint_every"):
+        positive(key)
+    positive("alpha", strict=False)
+    if opts.get("dt") is not None:
+        positive("dt")
+    if opts["samples"] < 0:
+        raise scene.error("dynamics.samples", f"must be >= 0, got {opts['samples']}")
+    frames = opts["frames"]
+    if not all(isinstance(f, (int, float)) and 0 <= f <= opts["t_end"] for f in frames):
+        raise scene.error("dynamics.frames", f"expected times in [0, t_end = {opts['t_end']}], got {frames!r}")
+    t = u.time
+    return {"t_end": opts["t_end"] * t, "dt": None if opts.get("dt") is None else opts["dt"] * t,
+            "alpha": opts["alpha"] / t, "mass_scale": float(opts["mass_scale"]),
+            "frames": np.array(sorted(set(float(f) * t for f in frames))),
+            "checkpoint_every": opts["checkpoint_every"] * t, "rest_tolerance": float(opts["rest_tolerance"]),
+            "force_tolerance": float(opts["force_tolerance"]), "samples": int(opts["samples"]),
+            "compare_static": bool(opts["compare_static"])}
+
+
+def dynamic_model(scene, model, extras):
+    """The model without the static solver's penalty contact (obstacles act kinematically).
+
+    A true dynamic run also drops the in-plane holds of a sheet on a frictionless support; dynamic
+    relaxation (``analysis = "relax"``) seeks the static drape and keeps them (unless
+    ``contact.hold_inplane = false``), or a slightly asymmetric sheet creeps and spins on the support
+    and never comes to rest.
+    """
+    if model.contact is None:
+        return model
+    from rftstatic.scenes.build import build_supports, hold_inplane_rigid_modes
+    from rftstatic.model.model import Model
+
+    supports = build_supports(scene, model.mesh)
+    if scene.get("analysis") == "relax" and scene.get("contact.hold_inplane", True):
+        hold_inplane_rigid_modes(model.mesh, supports)
+    return Model(model.mesh, model.material, element=model.element, supports=supports,
+                 load=model.load, contact=None, membrane=model.with_membrane)
+
+
+def probe_interpolation(model, probes: dict):
+    """Probe names, (P, 3) nodes and (P, 3) barycentric weights of the scene's reference points."""
+    names = list(probes)
+    if not names:
+        return [], np.zeros((0, 3), np.int64), np.zeros((0, 3))
+    pts = np.array([probes[n] for n in names], float)
+    elem, bary = model.mesh.locate(pts)
+    nodes = np.empty((len(names), 3), np.int64)
+    w = np.zeros((len(names), 3))
+    inside = elem >= 0
+    nodes[inside] = model.mesh.tri[elem[inside]]
+    w[inside] = bary[inside]
+    if (~inside).any():  # on the boundary the trifinder may miss: the nearest node
+        nodes[~inside] = model.mesh.nearest_node(pts[~inside])[:, None]
+        w[~inside] = [1.0, 0.0, 0.0]
+    return names, nodes, w
+
+
+def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
+    """Continue the dynamic run of ``scene`` from ``out_dir/checkpoint.npz`` (``case NAME --resume``)."""
+    from rftstatic.scenes.build import build_model
+
+    if scene.get("analysis", "static") == "static":
+        raise scene.error("analysis", "--resume continues a dynamic or relax run; this scene is static")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    model, extras = build_model(scene)
+    return run_dynamic_scene(scene, model, extras, out, progress=progress, figures=figures, resume=True)
+
+
+def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True, resume=False,
+                      callback=None, backend="auto") -> dict:
+    """Run a ``dynamic`` or ``relax`` scene and write its outputs into ``out`` (module docstring).
+
+    Parameters
+    ----------
+    scene : validated :class:`rftstatic.scene.Scene`
+    model, extras : from :func:`rftstatic.build.build_model` (extras: obstacles, probes [m])
+    out : output folder
+    resume : continue from ``out/checkpoint.npz`` (a fresh run, logged, when there is none)
+    callback : extra ``callback(state, sample)`` at every history sample; returning True stops the run
+    backend : force back end of :func:`rftstatic.explicit.run_explicit`
+
+    Returns
+    -------
+    The summary as written to ``summary.json`` (plain Python types, scene units).
+    """
+    from rftstatic.solvers.checkpoint import CheckpointError, Checkpointer, load_checkpoint
+    from rftstatic.solvers.checkpoint import resume as resume_run
+    from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.timestep import stable_time_step
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    analysis = scene.get("analysis", "dynamic")
+    o = dynamics_options(scene)
+    static_model = model
+    model = dynamic_model(scene, model, extras)
+    obstacles = tuple(extras.get("obstacles", ()))
+    names, pnodes, pw = probe_interpolation(model, extras.get("probes", {}))
+    t_end = o["t_end"]
+    regular = np.linspace(0.0, t_end, o["samples"] + 1) if o["samples"] else np.zeros(0)
+    save_times = np.unique(np.concatenate([o["frames"], regular]))
+
+    free_load = float(np.linalg.norm(np.where(model.free, model.load, 0.0)))
+    peak = {"kinetic": 0.0}
+
+    def watch(state, rec):
+        peak["kinetic"] = max(peak["kinetic"], rec["kinetic"])
+        stop = callback(state, rec) if callback is not None else False
+        if analysis == "relax":
+            stop = stop or bool(peak["kinetic"] > 0 and rec["kinetic"] < o["rest_tolerance"] * peak["kinetic"]
+                                and rec["residual"] < o["force_tolerance"] * free_load)
+        return stop
+
+    ckpt_path = out / CHECKPOINT
+    wall0 = time.perf_counter()
+    resumed_from = None
+    if resume and ckpt_path.exists():
+        data = load_checkpoint(ckpt_path)
+        saved = data["options"]
+        for key, want in (("t_end", t_end), ("alpha", o["alpha"]), ("mass_scale", o["mass_scale"])):
+            if not np.isclose(float(saved[key]), want, rtol=1e-12, atol=0.0):
+                raise scene.error(f"dynamics.{key}", f"the checkpoint {ckpt_path} was written with {key} = "
+                                  f"{float(saved[key]):g} (SI), the scene asks {want:g}; run without --resume")
+        if not np.array_equal(np.asarray(saved["frame_times"], float), save_times):
+            raise scene.error("dynamics.frames", f"the checkpoint {ckpt_path} saved other frame times; run "
+                              "without --resume")
+        hist_k = np.asarray(data["history"]["kinetic"], float)
+        peak["kinetic"] = float(hist_k.max()) if hist_k.size else 0.0
+        dt = data["dt"]
+        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o["checkpoint_every"] / dt))))
+        resumed_from = data["t"]
+        try:
+            run = resume_run(ckpt_path, model, obstacles=obstacles, callback=watch, checkpoint=ckpt,
+                             progress=progress)
+        except CheckpointError as exc:
+            raise scene.error("--resume", f"{exc}") from None
+        estimate = run.estimate
+    else:
+        if resume:
+            log.warning("no checkpoint %s: starting the run from t = 0", ckpt_path)
+        estimate = stable_time_step(model, mass_scale=o["mass_scale"], alpha=o["alpha"])
+        dt = o["dt"] if o["dt"] is not None else estimate.dt
+        if dt > estimate.dt * (1 + 1e-3):
+            log.warning("dynamics.dt = %.4g s exceeds the stable estimate %.4g s", dt, estimate.dt)
+        n_steps = max(1, int(np.ceil(t_end / dt - 1e-9)))
+        dt = t_end / n_steps
+        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o["checkpoint_every"] / dt))))
+        run = run_explicit(model, t_end=t_end, dt=dt, alpha=o["alpha"], mass_scale=o["mass_scale"],
+                           obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(), callback=watch,
+                           checkpoint=ckpt, progress=progress, rest_tol=o["rest_tolerance"], backend=backend)
+        run.estimate = run.estimate or estimate
+    wall = time.perf_counter() - wall0
+
+    summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)
+    if analysis == "relax":
+        summary["converged"] = summary["at_rest"] = bool(run.stopped)
+        if o["compare_static"]:
+            summary["static_comparison"] = _compare_static(scene, static_model, run.U)
+    _write(scene, model, out, run, summary, o, save_times, figures=figures)
+    from rftstatic.io.files import to_jsonable
+
+    return to_jsonable(summary)
+
+
+def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from) -> dict:
+    u = scene.units
+    h = run.history
+    est = run.estimate
+    X3 = model.X3
+    # probe trajectories: barycentric interpolation of the recorded node displacements
+    rec = run.probes.reshape(len(h["time"]), len(names), 3, 3)  # (S, P, a, i)
+    ref = np.einsum("pa,pai->pi", pw, X3[pnodes]) if names else np.zeros((0, 3))
+    traj = ref[None] + np.einsum("pa,spai->spi", pw, rec)
+    t_scene = h["time"] / u.time
+    probes = {name: {"reference": ref[k] / u.length, "time": t_scene, "x": traj[:, k, 0] / u.length,
+                     "y": traj[:, k, 1] / u.length, "z": traj[:, k, 2] / u.length,
+                     "final": traj[-1, k] / u.length} for k, name in enumerate(names)}
+    energy = lambda v: float(v) / u.energy  # noqa: E731
+    final = {k: energy(h[k][-1]) for k in ("kinetic", "potential", "strain", "external_work", "dissipated",
+                                           "contact_loss", "total")}
+    t_rest = run.time_at_rest
+    summary = {
+        "scene": scene.name, "title": scene.get("title", ""), "figure": scene.get("figure", ""),
+        "units": u.name, "overrides": {k: v for k, v in scene.overrides.items() if k != "resume"},
+        "element": model.element, "analysis": analysis,
+        "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements, "mesh": model.mesh.summary(),
+        "t_end": o["t_end"] / u.time, "t": run.t / u.time,
+        "alpha": o["alpha"] * u.time, "mass_scale": o["mass_scale"],
+        "dt": run.dt / u.time,
+        "dt_estimate": None if est is None else {"dt": est.dt / u.time, "dt_crit": est.dt_crit / u.time,
+                                                 "omega_max": est.omega_max * u.time, "method": est.method,
+                                                 "safety": est.safety},
+        "steps": run.steps,
+        "wall_time_s": wall,
+        "element_steps_per_second": model.mesh.n_elements * run.steps / max(wall, 1e-12),
+        "loop_element_steps_per_second": run.element_steps_per_second,
+        "resumed_from_t": None if resumed_from is None else resumed_from / u.time,
+        "time_at_rest": None if t_rest is None else t_rest / u.time,
+        "rest_tolerance": o["rest_tolerance"],
+        "at_rest": t_rest is not None,
+        "converged": bool(run.steps > 0 and np.isfinite(h["total"]).all()),
+        "stopped_early": bool(run.stopped),
+        "energies": {"final": final, "peak_kinetic": energy(h["kinetic"].max()),
+                     "energy_drift": energy(h["total"][-1] - h["total"][0])},
+        "residual": float(h["residual"][-1]) / u.force,
+        "probes": probes,
+        "software": {"rftstatic": __version__, "python": platform.python_version()},
+        "warnings": list(model.warnings),
+    }
+    if run.contact_nodes:
+        summary["contact_nodes"] = run.contact_nodes
+    return summary
+
+
+def _compare_static(scene, model, U) -> dict:
+    from rftstatic.solvers.explicit import compare_with_static
+    from rftstatic.app.static import static_options
+    from rftstatic.solvers.static import solve_static
+
+    res = solve_static(model, options=static_options(scene, progress=False))
+    cmp = compare_with_static(model, U, res.U)
+    u = scene.units.length
+    return {"max_difference": cmp["max_difference"] / u, "max_displacement": cmp["max_displacement"] / u,
+            "relative": cmp["relative"], "static_converged": bool(res.converged)}
+
+
+def _tag(t: float) -> str:
+    return f"{t:.4f}".rstrip("0").rstrip(".") if t else "0"
+
+
+def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True) -> None:
+    from rftstatic.io.files import write_json, write_pvd, write_vtu
+
+    u = scene.units
+    tri = model.mesh.tri
+    X3 = model.X3
+    frames = run.frames  # (t [s], U [m]) at save_times (up to where the run stopped)
+    series = []
+    if scene.get("output.vtu", True):
+        (out / "series").mkdir(exist_ok=True)
+        for k, (t, U) in enumerate(frames):
+            name = f"series/state_{k:04d}.vtu"
+            cell = {"relative_curvature": model.relative_curvature(U), "membrane_strain": model.membrane_strain(U)}
+            write_vtu(out / name, X3, U, tri, length_unit_scale=u.length, cell_data=cell)
+            series.append((t / u.time, name))
+        write_pvd(out / "series.pvd", series)
+        summary["vtu_series"] = {"pvd": "series.pvd", "states": len(series)}
+    requested = o["frames"]
+    idx = np.searchsorted(save_times, requested)
+    summary["frames"] = [{"time": float(tr / u.time), "state_time": float(frames[i][0] / u.time)}
+                         for tr, i in zip(requested, idx) if i < len(frames)]
+    write_json(out / "summary.json", summary)
+    if not figures:
+        return
+    from rftstatic.io.plots import animate, plot_history, plot_views
+
+    lu = {"cm-gf-s": "cm", "mm-N-s": "mm", "SI": "m"}.get(u.name, "")
+    short = f"{scene.name} ({model.element}, {model.mesh.n_nodes} nodes)"
+    views = [v for v in scene.get("output.views", ["iso", "side"]) if v in ("iso", "side", "top")]
+    for entry, i in zip(summary["frames"], idx):
+        t, U = frames[i]
+        files = plot_views(str(out / f"frame_t{_tag(entry['time'])}"), (X3 + U) / u.length, tri, views=views,
+                           title=f"{short}: t = {entry['time']:g} s", length_unit=lu)
+        entry["files"] = {v: p.name for v, p in files.items()}
+    reg = np.linspace(0.0, o["t_end"], o["samples"] + 1) if o["samples"] else save_times
+    pick = sorted(set(np.searchsorted(save_times, reg).tolist()) & set(range(len(frames))))
+    if pick:
+        animate(out / "animation.gif", [(X3 + frames[i][1]) / u.length for i in pick], tri,
+                times=[frames[i][0] / u.time for i in pick], view="iso", fps=12, title=scene.name,
+                length_unit=lu)
+        summary["animation"] = {"file": "animation.gif", "frames": len(pick)}
+    h = run.history
+    plot_history(out / "energy.png", h["time"] / u.time,
+                 {"kinetic": h["kinetic"] / u.energy, "potential (stored - P.D)": h["potential"] / u.energy,
+                  "dissipated (damping)": h["dissipated"] / u.energy},
+                 xlabel="time [s]", ylabel=f"energy [{u.name.split('-')[1] if '-' in u.name else 'J'}"
+                 f"{' ' + lu if lu else ''}]", title=f"{scene.name}: energies (alpha = {o['alpha'] * u.time:g} /s)")
+    summary["energy_plot"] = "energy.png"
+    write_json(out / "summary.json", summary)

@@ -1,0 +1,409 @@
+"""Contact of the sheet's nodes with rigid obstacles: penalty (statics) and kinematic (explicit dynamics).
+
+Penalty contact (Sze & Zhou 2016, §4.5; Liu & Sze 2009). Every node ``n`` with nodal area ``A_n`` and
+every obstacle with signed distance ``phi`` (``phi < 0`` inside) contribute
+
+    E = sum_n sum_obstacles 1/2 k A_n min(phi(x_n), 0)^2                      [J]
+
+to the total potential energy. Its gradient ``f_n = k A_n min(phi, 0) n`` (``n = grad phi``) is what
+:meth:`PenaltyContact.force` returns, i.e. an internal-force term of the residual
+``R = f_int + f_contact - P``; the force the obstacle exerts on the sheet is ``-f_n = k A_n |phi| n``
+(outward). Its derivative is node-diagonal,
+
+    K_n = d f_n / d x_n = k A_n (n n^T + phi H)     for phi < 0,  0 otherwise,
+
+with ``H`` the Hessian of ``phi`` (:meth:`rftstatic.obstacles.Obstacle.normal_gradient`); the global
+tangent only needs these ``(N, 3, 3)`` diagonal blocks. The ``phi H`` term is negative semi-definite on a
+convex obstacle (it softens the tangential directions on a sphere or a rounded edge) and is tiny next to
+``n n^T`` because ``|phi| << 1 / |H|``.
+
+A node pressed with a contact pressure ``p`` [Pa] penetrates ``p / k`` (:func:`estimate_penetration`);
+:func:`auto_penalty` chooses ``k`` from the fabric and the element size so that this stays a small
+fraction of the element size.
+
+Kinematic contact (§6.3): after an explicit time step a penetrated node is moved to its closest surface
+point and the inward normal component of its velocity is removed (:func:`kinematic_contact`).
+
+Nothing here depends on the obstacles' types: only ``signed_distance`` and ``normal_gradient`` are used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from rftstatic.contact.obstacles import Obstacle
+
+__all__ = [
+    "PenaltyContact",
+    "ContactState",
+    "auto_penalty",
+    "estimate_penetration",
+    "kinematic_contact",
+]
+
+
+def _as_list(obstacles: Obstacle | Iterable[Obstacle]) -> list[Obstacle]:
+    """Obstacles as a list; a single obstacle is accepted. Raise naming a bad entry."""
+    items = [obstacles] if hasattr(obstacles, "signed_distance") else list(obstacles)
+    for i, ob in enumerate(items):
+        if not (hasattr(ob, "signed_distance") and hasattr(ob, "normal_gradient")):
+            raise ValueError(
+                f"obstacles[{i}] = {ob!r} is not an obstacle (needs signed_distance and normal_gradient)"
+            )
+    return items
+
+
+def _as_points(x, n_nodes: int | None = None, name: str = "x") -> np.ndarray:
+    arr = np.asarray(x, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 3 or (n_nodes is not None and arr.shape[0] != n_nodes):
+        want = "(N, 3)" if n_nodes is None else f"({n_nodes}, 3)"
+        raise ValueError(f"{name} must have shape {want}, got shape {arr.shape}")
+    return arr
+
+
+def _positive(name: str, value, *, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        raise ValueError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """Penalty contact evaluated at one configuration.
+
+    Attributes
+    ----------
+    energy : contact energy [J]
+    force : (N, 3) gradient of the energy, ``dE/dx`` [N]
+    tangent_blocks : (N, 3, 3) node-diagonal blocks of ``d force / dx`` [N/m]
+    gap : (N,) smallest signed distance over the obstacles [m]
+    active : (N,) node penetrates at least one obstacle
+    """
+
+    energy: float
+    force: np.ndarray
+    tangent_blocks: np.ndarray
+    gap: np.ndarray
+    active: np.ndarray
+
+    @property
+    def max_penetration(self) -> float:
+        """Largest penetration depth ``max(0, -min gap)`` [m]."""
+        return float(max(0.0, -self.gap.min())) if self.gap.size else 0.0
+
+    @property
+    def n_active(self) -> int:
+        """Number of penetrating nodes."""
+        return int(np.count_nonzero(self.active))
+
+
+class PenaltyContact:
+    """Node-to-obstacle penalty contact, ``E = sum 1/2 k A_n min(phi, 0)^2``.
+
+    Parameters
+    ----------
+    obstacles : an obstacle or a sequence of them (anything with ``signed_distance`` and
+        ``normal_gradient``)
+    node_area : (N,) area attributed to each node, e.g. a third of its triangles' areas [m^2]
+    stiffness : penalty stiffness ``k`` (pressure per penetration depth) [N/m^3]; see :func:`auto_penalty`
+    smoothing : width ``eps`` [m] of a C^2 onset of the penalty (0: the plain quadratic penalty).
+        With ``eps > 0`` the energy density per node is ``k (eps - phi)^3 / (6 eps)`` for
+        ``0 <= phi < eps`` and ``k (eps^2/6 - eps phi/2 + phi^2/2)`` for ``phi < 0``: value, slope and
+        curvature are continuous, so the Hessian does not jump when a node touches or leaves the
+        obstacle and Newton keeps its quadratic convergence while the contact set settles. A node
+        resting under a pressure ``p`` sits at ``phi = eps/2 - p/k``.
+
+    Notes
+    -----
+    The four methods :meth:`energy`, :meth:`force`, :meth:`tangent_blocks` and :meth:`gaps` each
+    evaluate the signed distances once; :meth:`evaluate` returns all of them from one evaluation and is
+    what a Newton iteration should call.
+
+    Candidate list: :meth:`evaluate` computes distances only for the nodes that were within
+    ``margin`` of an obstacle when the list was last refreshed, and refreshes it (one evaluation of
+    every node) once some node has moved more than ``margin / 2`` since. A signed distance changes
+    no faster than the point moves, so a node left out is still more than ``margin / 2 > eps`` away
+    and has no contact energy: the result is exact, and an explicit step (which moves nodes a small
+    fraction of an element) pays for the few nodes near the obstacle instead of all of them.
+    """
+
+    def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float,
+                 smoothing: float = 0.0):
+        self.obstacles = _as_list(obstacles)
+        self.smoothing = _positive("smoothing", smoothing, allow_zero=True)
+        area = np.asarray(node_area, dtype=float)
+        if area.ndim != 1:
+            raise ValueError(f"node_area must have shape (N,), got shape {area.shape}")
+        bad = ~np.isfinite(area) | (area < 0)
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"node_area must be finite and >= 0, got node_area[{i}] = {area[i]!r}")
+        self.node_area = area
+        self.stiffness = _positive("stiffness", stiffness)
+        # list margin [m]: a few onset widths, and half a node spacing so explicit runs refresh seldom
+        spacing = float(np.sqrt(np.mean(area))) if area.size and np.mean(area) > 0 else 0.0
+        self.margin = max(4.0 * self.smoothing, 0.5 * spacing)
+        self._candidates = None  # (indices, positions at refresh, lower bound of the gap at refresh)
+        self.refreshes = 0
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of nodes ``N``."""
+        return self.node_area.shape[0]
+
+    def _distances(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Signed distances ``(M, N)`` [m] and normals ``(M, N, 3)`` for the ``M`` obstacles."""
+        return self._distances_of(_as_points(x, self.n_nodes))
+
+    def _distances_of(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`_distances` for any number of points ``(P, 3)`` [m]."""
+        if not self.obstacles:
+            return np.full((0, x.shape[0]), np.inf), np.zeros((0, x.shape[0], 3))
+        phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
+        return np.stack(phis), np.stack(normals)
+
+    def evaluate(self, x: np.ndarray, *, tangent: bool = True) -> ContactState:
+        """Energy, force, tangent blocks and gaps at positions ``x``.
+
+        Parameters
+        ----------
+        x : (N, 3) current nodal positions [m]
+        tangent : also compute the tangent blocks (else they are zeros)
+
+        Returns
+        -------
+        ContactState
+        """
+        x = _as_points(x, self.n_nodes)
+        n = x.shape[0]
+        cand, gap = self._near(x)
+        xc = x[cand]
+        phi, normal = self._distances_of(xc)
+        e, d1, d2 = self._density(phi)  # energy density, d/dphi, d2/dphi2 per unit k A  (M, C)
+        ka = self.stiffness * self.node_area[cand]  # (C,) [N/m]
+        energy = float(np.sum(ka * np.sum(e, axis=0)))
+        force = np.zeros((n, 3))
+        force[cand] = np.einsum("n,mn,mni->ni", ka, d1, normal)
+        blocks = np.zeros((n, 3, 3))
+        if tangent:
+            for m, ob in enumerate(self.obstacles):
+                # touching nodes (phi = 0) get the one-sided Hessian too: a sheet laid on a support
+                # then starts with the support's stiffness instead of a singular tangent
+                act = phi[m] <= self.smoothing
+                if not np.any(act):
+                    continue
+                H = ob.normal_gradient(xc[act])
+                nn = np.einsum("ni,nj->nij", normal[m, act], normal[m, act])
+                blocks[cand[act]] += ka[act, None, None] * (d2[m, act, None, None] * nn + d1[m, act, None, None] * H)
+        active = np.zeros(n, dtype=bool)
+        if phi.shape[0]:
+            gap[cand] = phi.min(axis=0)
+            active[cand] = np.any(phi < 0.0, axis=0)
+        return ContactState(energy, force, blocks, gap, active)
+
+    def _near(self, x):
+        """Indices of the candidate nodes and an ``(N,)`` gap array: exact values are filled in by
+        the caller for the candidates; the others hold a lower bound (> margin / 2) [m]."""
+        n = x.shape[0]
+        if not self.obstacles:
+            return np.arange(0), np.full(n, np.inf)
+        c = self._candidates
+        if c is not None:
+            idx, x_ref, bound = c
+            moved = np.sqrt(np.max(np.einsum("ni,ni->n", x - x_ref, x - x_ref)))
+            if moved <= 0.5 * self.margin:
+                return idx, bound - moved
+        phi, _ = self._distances_of(x)
+        gap = phi.min(axis=0)
+        idx = np.flatnonzero(gap < self.margin)
+        self._candidates = (idx, x.copy(), gap)
+        self.refreshes += 1
+        return idx, gap.copy()
+
+    def _density(self, phi):
+        eps = self.smoothing
+        inside = phi < 0.0
+        if eps == 0.0:
+            pen = np.where(inside, phi, 0.0)
+            return 0.5 * pen**2, pen, np.where(phi <= 0.0, 1.0, 0.0)
+        onset = (phi >= 0.0) & (phi < eps)
+        a = np.where(onset, eps - phi, 0.0)
+        p = np.where(inside, phi, 0.0)
+        e = np.where(onset, a**3 / (6 * eps), 0.0) + np.where(inside, eps**2 / 6 - eps * p / 2 + p**2 / 2, 0.0)
+        d1 = np.where(onset, -(a**2) / (2 * eps), 0.0) + np.where(inside, p - eps / 2, 0.0)
+        d2 = np.where(onset, a / eps, 0.0) + np.where(inside, 1.0, 0.0)
+        return e, d1, d2
+
+    def _slope(self, phi):
+        """``d1`` of :meth:`_density` alone (the force needs no energy or curvature)."""
+        eps = self.smoothing
+        if eps == 0.0:
+            return np.minimum(phi, 0.0)
+        d1 = np.where(phi < 0.0, phi - 0.5 * eps, 0.0)
+        onset = (phi >= 0.0) & (phi < eps)
+        if np.any(onset):
+            a = eps - phi[onset]
+            d1[onset] = -(a * a) / (2 * eps)
+        return d1
+
+    def energy(self, x: np.ndarray) -> float:
+        """Contact energy ``sum 1/2 k A_n min(phi, 0)^2`` [J] at ``x (N, 3)`` [m]."""
+        return self.evaluate(x, tangent=False).energy
+
+    def force(self, x: np.ndarray) -> np.ndarray:
+        """Gradient of the contact energy, ``(N, 3)`` [N], at ``x (N, 3)`` [m].
+
+        ``k A_n min(phi, 0) n`` summed over the obstacles; it points into the obstacle, so it is the
+        contact term of the residual (the obstacle pushes the sheet with its negative). The explicit
+        loop calls this once per step: only the candidates' distances and the slope of the energy
+        density are computed (no energy, gaps or tangent blocks).
+        """
+        x = _as_points(x, self.n_nodes)
+        cand, _ = self._near(x)
+        force = np.zeros((x.shape[0], 3))
+        if cand.size:
+            phi, normal = self._distances_of(x[cand])
+            d1 = self._slope(phi)
+            force[cand] = np.einsum("n,mn,mni->ni", self.stiffness * self.node_area[cand], d1, normal)
+        return force
+
+    def tangent_blocks(self, x: np.ndarray) -> np.ndarray:
+        """Node-diagonal blocks ``(N, 3, 3)`` [N/m] of ``d force / dx`` at ``x (N, 3)`` [m].
+
+        ``k A_n (n n^T + phi H)`` for each obstacle the node penetrates; symmetric.
+        """
+        return self.evaluate(x).tangent_blocks
+
+    def gaps(self, x: np.ndarray) -> np.ndarray:
+        """Smallest signed distance of each node over the obstacles, ``(N,)`` [m] (``inf`` if none)."""
+        x = _as_points(x, self.n_nodes)
+        phi, _ = self._distances(x)
+        return phi.min(axis=0) if phi.shape[0] else np.full(x.shape[0], np.inf)
+
+    def max_penetration(self, x: np.ndarray) -> float:
+        """Largest penetration depth ``max(0, -min gap)`` [m] at ``x (N, 3)`` [m]."""
+        gap = self.gaps(x)
+        return float(max(0.0, -gap.min())) if gap.size else 0.0
+
+    def active(self, x: np.ndarray) -> np.ndarray:
+        """``(N,)`` bool: node penetrates at least one obstacle at ``x (N, 3)`` [m]."""
+        return self.gaps(x) < 0.0
+
+
+def auto_penalty(
+    *,
+    membrane_rigidity: float,
+    bending_rigidity: float,
+    weight: float,
+    h: float,
+    factor: float = 1.0,
+    target: float = 1e-3,
+    pressure_factor: float = 10.0,
+) -> float:
+    """Penalty stiffness from the fabric and the element size.
+
+    Parameters
+    ----------
+    membrane_rigidity : tensile rigidity ``C`` (largest of warp/weft) [N/m]
+    bending_rigidity : bending rigidity ``B`` [N m]
+    weight : weight per unit area ``w`` [N/m^2]
+    h : element size (edge length) near the contact [m]
+    factor : multiplier on the result (``> 1`` stiffer, less penetration, worse conditioning)
+    target : admissible penetration as a fraction of ``h`` under the design pressure
+    pressure_factor : design contact pressure in units of ``w``
+
+    Returns
+    -------
+    k : penalty stiffness [N/m^3]
+
+    Notes
+    -----
+    A node carries area ``~h^2``, so its penalty spring is ``k h^2`` [N/m] and a contact pressure
+    ``p`` makes it penetrate ``d = p / k``. Three conditions are combined,
+
+        k = factor * max(C / h^2,  B / h^4,  pressure_factor * w / (target * h)).
+
+    * ``C / h^2``: the node's penalty spring equals the membrane stiffness of its elements (``~C``), so
+      the contact does not dominate the tangent's conditioning, yet is as stiff as the sheet in-plane;
+    * ``B / h^4``: the same with the bending stiffness ``B / h^2`` of a node (never the largest for
+      fabrics, kept for stiff plates);
+    * ``pressure_factor * w / (target * h)``: under the design pressure ``p = pressure_factor * w`` the
+      penetration is at most ``target * h``. The default ``p = 10 w`` covers the line load at a pedestal's
+      edge: a hanging length ``L`` pulls with tension ``~w L`` spread over one element, ``p ~ w L / h``.
+
+    For the wool of §4 (``C = 1096.6 N/m``, ``B = 8.14e-6 N m``, ``w = 1.863 N/m^2``) at ``h = 5 mm``:
+    ``C / h^2 = 4.4e7``, ``B / h^4 = 1.3e4``, ``10 w / (1e-3 h) = 3.7e6`` so ``k = 4.4e7 N/m^3`` and
+    ``10 w`` penetrates ``4.2e-7 m = 8.5e-5 h``.
+    """
+    c = _positive("membrane_rigidity", membrane_rigidity, allow_zero=True)
+    b = _positive("bending_rigidity", bending_rigidity, allow_zero=True)
+    w = _positive("weight", weight, allow_zero=True)
+    h = _positive("h", h)
+    factor = _positive("factor", factor)
+    target = _positive("target", target)
+    pressure_factor = _positive("pressure_factor", pressure_factor, allow_zero=True)
+    k = factor * max(c / h**2, b / h**4, pressure_factor * w / (target * h))
+    if not k > 0:
+        raise ValueError(
+            "membrane_rigidity, bending_rigidity and weight (with pressure_factor) are all zero; "
+            "give at least one of them > 0"
+        )
+    return k
+
+
+def estimate_penetration(pressure, k: float):
+    """Penetration ``pressure / k`` [m] of a node pressed with ``pressure`` [Pa] on a penalty ``k`` [N/m^3].
+
+    ``pressure`` may be a number or an array; ``k > 0``.
+    """
+    k = _positive("k", k)
+    p = np.asarray(pressure, dtype=float)
+    if np.any(p < 0) or not np.all(np.isfinite(p)):
+        raise ValueError(f"pressure must be finite and >= 0, got {pressure!r}")
+    out = p / k
+    return float(out) if out.ndim == 0 else out
+
+
+def kinematic_contact(
+    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Kinematic contact correction after an explicit step (§6.3).
+
+    Each penetrated node (``phi < 0``) is moved to its closest surface point ``x - phi n`` and the inward
+    part of its normal velocity is removed (``v <- v - min(v.n, 0) n``); tangential and outward
+    velocities are kept (frictionless, no rebound). Obstacles are treated one after the other.
+
+    Parameters
+    ----------
+    obstacles : an obstacle or a sequence of them
+    x : (N, 3) nodal positions at the end of the step [m]
+    v : (N, 3) nodal velocities [m/s]
+
+    Returns
+    -------
+    x_new : (N, 3) corrected positions [m]
+    v_new : (N, 3) corrected velocities [m/s]
+    n_active : number of nodes that were corrected
+    """
+    items = _as_list(obstacles)
+    x_new = _as_points(x).copy()
+    v_new = _as_points(v, x_new.shape[0], name="v").copy()
+    touched = np.zeros(x_new.shape[0], dtype=bool)
+    for ob in items:
+        phi, normal = ob.signed_distance(x_new)
+        act = phi < 0.0
+        if not np.any(act):
+            continue
+        n = normal[act]
+        x_new[act] -= phi[act, None] * n
+        vn = np.einsum("ni,ni->n", v_new[act], n)
+        v_new[act] -= np.minimum(vn, 0.0)[:, None] * n
+        touched |= act
+    return x_new, v_new, int(np.count_nonzero(touched))

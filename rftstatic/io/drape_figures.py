@@ -1,0 +1,195 @@
+"""Figures of draped sheets in the style of the paper (Sze & Zhou 2016, Figs. 6-11).
+
+- :func:`obstacle_drawers`: the obstacles of a scene as ``draw(ax, view)`` callables for
+  :func:`rftstatic.plots.plot_views` (pedestal top outlines through ``plots.outline_drawer``, the
+  sphere as its silhouette), in the scene's length unit;
+- :func:`boundary_xy`: the projected outer boundary of a drape (Fig. 6a);
+- :func:`boundary_distance`: the largest distance between two projected boundary curves
+  (symmetric Hausdorff distance of the closed polylines);
+- :func:`plot_side_by_side`: two drapes (RFT3 and RFT6) in one figure, top and isometric views,
+  coloured by the relative curvature |kappa| h on a common scale (Fig. 8).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["obstacle_drawers", "obstacle_outline", "boundary_xy", "boundary_distance", "plot_side_by_side"]
+
+
+def obstacle_outline(d: dict, length_scale: float = 1.0) -> tuple[np.ndarray | None, float | None]:
+    """Top outline (K, 2) and top height of an obstacle given by ``Obstacle.as_dict()`` [m].
+
+    Lengths are divided by ``length_scale`` (the scene's length unit in metres). Returns
+    ``(None, None)`` for obstacles without a top outline (floor).
+    """
+    from rftstatic.io.plots import outline_circle, outline_square
+
+    s = float(length_scale)
+    t = d.get("type", "")
+    if t == "square-pedestal":
+        hw = np.broadcast_to(np.asarray(d["half_width"], float), (2,)) / s
+        c = np.asarray(d["centre"], float)[:2] / s
+        out = outline_square(c[0], c[1], float(hw[0]), corner_radius=float(d.get("edge_radius", 0.0)) / s)
+        if hw[0] != hw[1]:
+            out = (out - c) * [1.0, hw[1] / hw[0]] + c
+        return out, float(d["top"]) / s
+    if t == "round-pedestal":
+        c = np.asarray(d["centre"], float)[:2] / s
+        return outline_circle(c[0], c[1], float(d["radius"]) / s), float(d["top"]) / s
+    if t == "sphere":
+        c = np.asarray(d["centre"], float) / s
+        return outline_circle(c[0], c[1], float(d["radius"]) / s), float(c[2] + float(d["radius"]) / s)
+    return None, None
+
+
+def _sphere_drawer(centre, radius, color="0.55"):
+    """``draw(ax, view)`` for a sphere: filled disc in the top and side views, three great circles in 3-D."""
+    a = np.linspace(0.0, 2.0 * np.pi, 129)
+    cx, cy, cz = centre
+
+    def draw(ax, view: str) -> None:
+        if view == "top":
+            ax.fill(cx + radius * np.cos(a), cy + radius * np.sin(a), color=color, alpha=0.6, zorder=1)
+        elif view == "side":
+            ax.fill(cx + radius * np.cos(a), cz + radius * np.sin(a), color=color, alpha=0.6, zorder=1)
+        elif view == "iso":
+            c, s = radius * np.cos(a), radius * np.sin(a)
+            for xs, ys, zs in ((cx + c, cy + s, np.full_like(a, cz)), (cx + c, np.full_like(a, cy), cz + s),
+                               (np.full_like(a, cx), cy + c, cz + s)):
+                ax.plot(xs, ys, zs, color=color, lw=1.0)
+
+    return draw
+
+
+def obstacle_drawers(obstacles, length_scale: float = 1.0) -> list:
+    """``draw(ax, view)`` callables for ``plots.plot_views(obstacles_draw=...)``, in scene units.
+
+    Parameters
+    ----------
+    obstacles : sequence of :class:`rftstatic.obstacles.Obstacle` (their ``as_dict()`` is read, [m])
+    length_scale : the scene's length unit [m] (0.01 for cm)
+    """
+    from rftstatic.io.plots import outline_drawer
+
+    draws = []
+    for ob in obstacles:
+        d = ob.as_dict()
+        if d.get("type") == "sphere":
+            draws.append(_sphere_drawer(np.asarray(d["centre"], float) / length_scale,
+                                        float(d["radius"]) / length_scale))
+            continue
+        outline, top = obstacle_outline(d, length_scale)
+        if outline is not None:
+            draws.append(outline_drawer(outline, z=top))
+    return draws
+
+
+def boundary_xy(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(B, 2) projected outer boundary of a draped sheet, in the order of the loop.
+
+    Parameters
+    ----------
+    x : (N, 3) node positions [any length unit]
+    tri : (E, 3) triangles
+    """
+    from rftstatic.post.measures import boundary_loop
+
+    loop = boundary_loop(tri, x)
+    return np.asarray(x, float)[loop, :2]
+
+
+def _densify(c: np.ndarray, step: float) -> np.ndarray:
+    """Points along the closed polyline ``c`` (M, 2) no farther apart than ``step``."""
+    a, b = c, np.roll(c, -1, axis=0)
+    seg = np.linalg.norm(b - a, axis=1)
+    k = np.maximum(1, np.ceil(seg / step).astype(int))
+    idx = np.repeat(np.arange(len(c)), k)
+    frac = (np.arange(k.sum()) - np.repeat(np.cumsum(k) - k, k)) / np.repeat(k, k)
+    return a[idx] + frac[:, None] * (b[idx] - a[idx])
+
+
+def boundary_distance(c1: np.ndarray, c2: np.ndarray, *, step: float | None = None) -> float:
+    """Largest distance between two closed curves (symmetric Hausdorff distance) [their unit].
+
+    Both curves are sampled at ``step`` (default 1/2000 of the larger extent); the distance is
+    exact to within ``step / 2``.
+    """
+    from scipy.spatial import cKDTree
+
+    c1, c2 = np.asarray(c1, float), np.asarray(c2, float)
+    if step is None:
+        step = max(np.ptp(c1, axis=0).max(), np.ptp(c2, axis=0).max()) / 2000.0
+    p1, p2 = _densify(c1, step), _densify(c2, step)
+    d12 = cKDTree(p2).query(p1)[0].max()
+    d21 = cKDTree(p1).query(p2)[0].max()
+    return float(max(d12, d21))
+
+
+def plot_side_by_side(path, drapes: dict, *, title: str, obstacles_draw=None, length_unit: str = "cm",
+                      clim=None, views=("top", "iso")):
+    """One row per view, one column per drape; shaded and coloured by |kappa| h on a common scale.
+
+    Parameters
+    ----------
+    drapes : label -> (x (N, 3) [length_unit], tri (E, 3), color (E,) relative curvature [-])
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib import cm, colors
+    from matplotlib.collections import PolyCollection
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    labels = list(drapes)
+    if clim is None:
+        clim = (0.0, max(float(np.max(c)) for _, _, c in drapes.values()))
+    norm = colors.Normalize(*clim)
+    cmap = matplotlib.colormaps["viridis"]
+    fig = plt.figure(figsize=(5.0 * len(labels), 4.6 * len(views)))
+    lo = np.min([d[0].min(axis=0) for d in drapes.values()], axis=0)
+    hi = np.max([d[0].max(axis=0) for d in drapes.values()], axis=0)
+    for r, view in enumerate(views):
+        for k, lb in enumerate(labels):
+            x, tri, col = drapes[lb]
+            p = x[tri]
+            nrm = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+            nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+            rgba = cmap(norm(col))
+            idx = r * len(labels) + k + 1
+            if view == "iso":
+                light = np.array([-0.4, -0.6, 0.7]) / np.linalg.norm([-0.4, -0.6, 0.7])
+                shade = 0.45 + 0.55 * np.abs(nrm @ light)
+                rgba[:, :3] *= shade[:, None]
+                ax = fig.add_subplot(len(views), len(labels), idx, projection="3d")
+                for draw in obstacles_draw or ():
+                    draw(ax, view)
+                ax.add_collection3d(Poly3DCollection(p, facecolors=rgba, edgecolors=rgba, linewidths=0.1))
+                span = (hi - lo).max() / 2
+                mid = (hi + lo) / 2
+                ax.set_xlim(mid[0] - span, mid[0] + span)
+                ax.set_ylim(mid[1] - span, mid[1] + span)
+                ax.set_zlim(mid[2] - span, mid[2] + span)
+                ax.view_init(elev=30, azim=-60)
+                ax.set_box_aspect((1, 1, 1))
+            else:
+                order = np.argsort(p[:, :, 2].mean(axis=1))  # painter's order: highest drawn last
+                shade = 0.45 + 0.55 * np.abs(nrm[:, 2])
+                rgba[:, :3] *= shade[:, None]
+                ax = fig.add_subplot(len(views), len(labels), idx)
+                for draw in obstacles_draw or ():
+                    draw(ax, view)
+                ax.add_collection(PolyCollection(p[order][:, :, :2], facecolors=rgba[order], edgecolors="k",
+                                                 linewidths=0.05, zorder=2))
+                ax.set_xlim(lo[0], hi[0])
+                ax.set_ylim(lo[1], hi[1])
+                ax.set_aspect("equal")
+                ax.set_xlabel(f"x [{length_unit}]")
+                ax.set_ylabel(f"y [{length_unit}]")
+            ax.set_title(f"{lb} ({view})", fontsize="small")
+    fig.suptitle(title)
+    fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=fig.axes, shrink=0.6, label="|kappa| h")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,423 @@
+"""Triangle meshes of the flat reference configuration, and their generators.
+
+A :class:`TriMesh` holds the flat reference coordinates ``X (N, 2)`` [m], counter-clockwise
+triangles ``tri (E, 3)`` and the height ``z0`` [m] of the reference plane. The fabric's reference
+configuration is flat (§2.1), so every mesh -- structured, polar or read from a file -- lives in
+the plane z = z0. Edge topology (which triangle lies across which edge) is computed once, with
+vectorised numpy, and cached.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+PATTERNS = ("right", "left", "alternate", "union-jack")
+
+
+class MeshError(ValueError):
+    """Invalid mesh input; the message names the problem and what to do."""
+
+
+@dataclass(frozen=True, eq=False)
+class EdgeTopology:
+    """Half-edge adjacency of a triangle mesh.
+
+    Local edge k of element e is the edge opposite its vertex k, i.e. nodes
+    ``tri[e, (k+1)%3], tri[e, (k+2)%3]``.
+
+    Attributes
+    ----------
+    neighbour : (E, 3) int, element across local edge k, or -1 on the boundary
+    neighbour_vertex : (E, 3) int, local vertex of the neighbour opposite the shared edge, or -1
+    edges : (M, 2) int, unique edges (sorted node pairs)
+    edge_of : (E, 3) int, index into ``edges`` of local edge k
+    """
+
+    neighbour: np.ndarray
+    neighbour_vertex: np.ndarray
+    edges: np.ndarray
+    edge_of: np.ndarray
+
+    @property
+    def is_boundary(self) -> np.ndarray:
+        """(E, 3) bool, local edge k has no neighbour."""
+        return self.neighbour < 0
+
+
+def _edge_topology(tri: np.ndarray, n_nodes: int) -> EdgeTopology:
+    E = len(tri)
+    a = tri[:, [1, 2, 0]]
+    b = tri[:, [2, 0, 1]]
+    lo, hi = np.minimum(a, b).ravel(), np.maximum(a, b).ravel()
+    key = lo.astype(np.int64) * n_nodes + hi
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    new = np.r_[True, ks[1:] != ks[:-1]]
+    edge_id_sorted = np.cumsum(new) - 1
+    edge_of = np.empty(3 * E, dtype=np.int64)
+    edge_of[order] = edge_id_sorted
+    counts = np.bincount(edge_id_sorted)
+    if counts.max(initial=0) > 2:
+        bad = np.flatnonzero(counts > 2)[0]
+        first = order[np.searchsorted(edge_id_sorted, bad)]
+        n0, n1 = lo[first], hi[first]
+        raise MeshError(
+            f"edge ({n0}, {n1}) is shared by {counts[bad]} triangles; the mesh must be a manifold "
+            "surface (each edge in at most two triangles)"
+        )
+    unique_first = order[new]
+    edges = np.stack([lo[unique_first], hi[unique_first]], axis=1)
+    # pair the two half-edges of every interior edge: consecutive in sorted order
+    neighbour = np.full(3 * E, -1, dtype=np.int64)
+    pair = np.flatnonzero(~new)  # position j pairs with j-1
+    h1, h0 = order[pair], order[pair - 1]
+    neighbour[h0] = h1
+    neighbour[h1] = h0
+    nb_elem = np.where(neighbour >= 0, neighbour // 3, -1).reshape(E, 3)
+    nb_vert = np.where(neighbour >= 0, neighbour % 3, -1).reshape(E, 3)
+    return EdgeTopology(nb_elem, nb_vert, edges, edge_of.reshape(E, 3))
+
+
+@dataclass(frozen=True, eq=False)
+class TriMesh:
+    """A triangle mesh of the flat reference configuration.
+
+    Parameters
+    ----------
+    X : (N, 2) reference coordinates [m]
+    tri : (E, 3) node indices; reoriented to counter-clockwise if needed
+    z0 : height of the reference plane [m]
+    name : label for summaries
+    """
+
+    X: np.ndarray
+    tri: np.ndarray
+    z0: float = 0.0
+    name: str = "mesh"
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        X = np.ascontiguousarray(self.X, dtype=float)
+        tri = np.ascontiguousarray(self.tri, dtype=np.int64)
+        if X.ndim != 2 or X.shape[1] != 2:
+            raise MeshError(f"X must have shape (N, 2), got {X.shape}")
+        if tri.ndim != 2 or tri.shape[1] != 3 or len(tri) == 0:
+            raise MeshError(f"tri must have shape (E, 3) with E > 0, got {tri.shape}")
+        if tri.min() < 0 or tri.max() >= len(X):
+            raise MeshError(f"tri refers to nodes outside 0..{len(X) - 1} (min {tri.min()}, max {tri.max()})")
+        if not np.isfinite(X).all():
+            raise MeshError("X contains non-finite coordinates")
+        area2 = _signed_area2(X, tri)
+        flip = area2 < 0
+        if flip.any():
+            tri = tri.copy()
+            tri[flip] = tri[flip][:, [0, 2, 1]]
+            area2 = np.abs(area2)
+        scale = np.ptp(X, axis=0).max() ** 2
+        tiny = area2 <= 1e-14 * scale
+        if tiny.any():
+            e = int(np.flatnonzero(tiny)[0])
+            c = X[tri[e]].mean(axis=0)
+            raise MeshError(
+                f"{tiny.sum()} degenerate (zero-area) triangle(s), first: element {e} at "
+                f"({c[0]:.6g}, {c[1]:.6g}); remove or re-mesh them"
+            )
+        unused = np.setdiff1d(np.arange(len(X)), tri.ravel())
+        if len(unused):
+            raise MeshError(f"{len(unused)} node(s) belong to no triangle (first: node {unused[0]}); remove them")
+        object.__setattr__(self, "X", X)
+        object.__setattr__(self, "tri", tri)
+        self.topology  # noqa: B018 -- validates the edge structure now (non-manifold edges)
+
+    # --- sizes ------------------------------------------------------------------------------
+    @property
+    def n_nodes(self) -> int:
+        return len(self.X)
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.tri)
+
+    @cached_property
+    def area(self) -> np.ndarray:
+        """(E,) reference triangle areas [m^2]."""
+        return 0.5 * _signed_area2(self.X, self.tri)
+
+    @cached_property
+    def node_area(self) -> np.ndarray:
+        """(N,) lumped nodal areas, a third of each adjacent triangle [m^2]."""
+        return np.bincount(self.tri.ravel(), np.repeat(self.area / 3.0, 3), minlength=self.n_nodes)
+
+    @cached_property
+    def element_size(self) -> np.ndarray:
+        """(E,) average side length h of each triangle [m] (the h of Eq. 28)."""
+        P = self.X[self.tri]
+        d = P[:, [1, 2, 0]] - P[:, [2, 0, 1]]
+        return np.linalg.norm(d, axis=2).mean(axis=1)
+
+    @property
+    def X3(self) -> np.ndarray:
+        """(N, 3) reference positions in space [m]."""
+        return np.column_stack([self.X, np.full(self.n_nodes, self.z0)])
+
+    @cached_property
+    def topology(self) -> EdgeTopology:
+        return _edge_topology(self.tri, self.n_nodes)
+
+    @cached_property
+    def boundary_nodes(self) -> np.ndarray:
+        """Sorted indices of nodes on the boundary."""
+        t = self.topology
+        e, k = np.nonzero(t.is_boundary)
+        return np.unique(np.r_[self.tri[e, (k + 1) % 3], self.tri[e, (k + 2) % 3]])
+
+    @cached_property
+    def boundary_edges(self) -> np.ndarray:
+        """(B, 2) boundary edges, oriented counter-clockwise around the domain."""
+        e, k = np.nonzero(self.topology.is_boundary)
+        return np.stack([self.tri[e, (k + 1) % 3], self.tri[e, (k + 2) % 3]], axis=1)
+
+    def nodes_in_box(self, xmin, xmax, ymin, ymax, tol=None) -> np.ndarray:
+        """Indices of nodes with reference coordinates in the box (inclusive, with tolerance) [m]."""
+        if tol is None:
+            tol = 1e-6 * float(np.ptp(self.X, axis=0).max())
+        x, y = self.X[:, 0], self.X[:, 1]
+        m = (x >= xmin - tol) & (x <= xmax + tol) & (y >= ymin - tol) & (y <= ymax + tol)
+        return np.flatnonzero(m)
+
+    def nearest_node(self, points) -> np.ndarray:
+        """Index of the node nearest to each reference point ``points (P, 2)`` [m]."""
+        from scipy.spatial import cKDTree
+
+        return cKDTree(self.X).query(np.atleast_2d(points))[1]
+
+    def locate(self, points):
+        """Element containing each reference point and its barycentric coordinates.
+
+        Returns ``(elem (P,), bary (P, 3))``; elem is -1 for points outside the mesh.
+        """
+        from matplotlib.tri import Triangulation
+
+        pts = np.atleast_2d(np.asarray(points, float))
+        finder = Triangulation(self.X[:, 0], self.X[:, 1], self.tri).get_trifinder()
+        elem = np.asarray(finder(pts[:, 0], pts[:, 1]), dtype=np.int64)
+        P = self.X[self.tri[np.maximum(elem, 0)]]
+        T = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=2)
+        l12 = np.linalg.solve(T, (pts - P[:, 0])[..., None])[..., 0]
+        bary = np.column_stack([1 - l12.sum(axis=1), l12])
+        return elem, bary
+
+    def summary(self) -> dict:
+        return {
+            "name": self.name,
+            "nodes": self.n_nodes,
+            "elements": self.n_elements,
+            "h_mean_m": float(self.element_size.mean()),
+            **self.info,
+        }
+
+
+def _signed_area2(X, tri):
+    P = X[tri]
+    d1, d2 = P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
+    return d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+
+
+# --- generators ------------------------------------------------------------------------------
+
+
+def rectangle(lx, ly, nx, ny, *, origin=(0.0, 0.0), pattern="right", z0=0.0) -> TriMesh:
+    """Structured triangulation of a ``lx`` x ``ly`` rectangle with ``nx`` x ``ny`` nodes.
+
+    Parameters
+    ----------
+    lx, ly : side lengths [m]
+    nx, ny : nodes along x and y (>= 2)
+    origin : lower-left corner [m]
+    pattern : diagonal pattern of each grid cell: ``"right"`` (all /), ``"left"`` (all \\),
+        ``"alternate"`` (/ and \\ in a checkerboard) or ``"union-jack"`` (mirrored about the centre
+        lines, so the mesh has the rectangle's symmetries).
+    """
+    nx, ny = int(nx), int(ny)
+    if nx < 2 or ny < 2:
+        raise MeshError(f"a rectangle needs at least 2 x 2 nodes, got {nx} x {ny}")
+    if lx <= 0 or ly <= 0:
+        raise MeshError(f"rectangle sides must be positive, got {lx} x {ly}")
+    if pattern not in PATTERNS:
+        raise MeshError(f'unknown diagonal pattern "{pattern}"; use one of {", ".join(PATTERNS)}')
+    xs = origin[0] + np.linspace(0.0, lx, nx)
+    ys = origin[1] + np.linspace(0.0, ly, ny)
+    X = np.stack(np.meshgrid(xs, ys, indexing="xy"), axis=-1).reshape(-1, 2)
+    i, j = np.meshgrid(np.arange(nx - 1), np.arange(ny - 1), indexing="xy")
+    i, j = i.ravel(), j.ravel()
+    n00 = j * nx + i
+    n10, n01, n11 = n00 + 1, n00 + nx, n00 + nx + 1
+    if pattern == "right":
+        slash = np.ones_like(i, dtype=bool)
+    elif pattern == "left":
+        slash = np.zeros_like(i, dtype=bool)
+    elif pattern == "alternate":
+        slash = (i + j) % 2 == 0
+    else:  # union-jack: diagonals point away from the centre
+        ci, cj = (nx - 1) / 2.0, (ny - 1) / 2.0
+        slash = ((i + 0.5 - ci) * (j + 0.5 - cj)) > 0
+    t_slash = np.stack([np.stack([n00, n10, n11], 1), np.stack([n00, n11, n01], 1)], 1)
+    t_back = np.stack([np.stack([n00, n10, n01], 1), np.stack([n10, n11, n01], 1)], 1)
+    tri = np.where(slash[:, None, None], t_slash, t_back).reshape(-1, 3)
+    info = {"generator": "rectangle", "size": [lx, ly], "nodes_xy": [nx, ny], "pattern": pattern}
+    return TriMesh(X, tri, z0=z0, name=f"rectangle {nx}x{ny}", info=info)
+
+
+def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern="alternate",
+          square=False, z0=0.0) -> TriMesh:
+    """Polar mesh of a disc or annulus, or of a square by mapping the rings onto squares.
+
+    Parameters
+    ----------
+    r_outer : outer radius (or half side when ``square``) [m]
+    n_radial : nodes along a radius, including the inner ring (and the centre for a disc)
+    n_circ : nodes around each ring
+    r_inner : inner radius [m]; 0 gives a disc with a centre node (fan of triangles around it)
+    square : map every ring onto the square of the same "radius" (Chebyshev norm) so that a
+        square sheet is meshed with ``n_radial`` x ``n_circ`` nodes -- how we read the paper's
+        21 x 160 and 31 x 240 meshes of the 50 x 50 cm sheet of §4.4.
+    pattern : diagonal of each quadrilateral: ``"right"``, ``"left"`` or ``"alternate"``.
+    """
+    n_radial, n_circ = int(n_radial), int(n_circ)
+    if n_radial < 2 or n_circ < 3:
+        raise MeshError(f"a polar mesh needs n_radial >= 2 and n_circ >= 3, got {n_radial}, {n_circ}")
+    if not (0 <= r_inner < r_outer):
+        raise MeshError(f"need 0 <= r_inner < r_outer, got r_inner={r_inner}, r_outer={r_outer}")
+    if pattern not in ("right", "left", "alternate"):
+        raise MeshError(f'unknown diagonal pattern "{pattern}" for a polar mesh; use right, left or alternate')
+    theta = 2 * np.pi * np.arange(n_circ) / n_circ
+    direction = np.column_stack([np.cos(theta), np.sin(theta)])
+    if square:
+        direction = direction / np.abs(direction).max(axis=1, keepdims=True)
+    disc = r_inner == 0.0
+    rings = np.linspace(r_inner, r_outer, n_radial)
+    first = 1 if disc else 0
+    X_rings = (rings[first:, None, None] * direction[None]).reshape(-1, 2)
+    X = np.vstack([np.zeros((1, 2)), X_rings]) if disc else X_rings
+    X = X + np.asarray(centre, float)
+    offset = 1 if disc else 0
+    nr = n_radial - first  # number of rings with n_circ nodes
+    r, c = np.meshgrid(np.arange(nr - 1), np.arange(n_circ), indexing="ij")
+    r, c = r.ravel(), c.ravel()
+    a = offset + r * n_circ + c
+    b = offset + r * n_circ + (c + 1) % n_circ
+    a2, b2 = a + n_circ, b + n_circ
+    if pattern == "right":
+        diag = np.ones_like(r, dtype=bool)
+    elif pattern == "left":
+        diag = np.zeros_like(r, dtype=bool)
+    else:
+        diag = (r + c) % 2 == 0
+    t1 = np.where(diag[:, None], np.stack([a, b, b2], 1), np.stack([a, b, a2], 1))
+    t2 = np.where(diag[:, None], np.stack([a, b2, a2], 1), np.stack([b, b2, a2], 1))
+    tri = np.vstack([t1, t2])
+    if disc:
+        c = np.arange(n_circ)
+        fan = np.stack([np.zeros(n_circ, int), 1 + c, 1 + (c + 1) % n_circ], 1)
+        tri = np.vstack([fan, tri])
+    kind = "square-polar" if square else ("disc" if disc else "annulus")
+    info = {"generator": kind, "r_outer": r_outer, "r_inner": r_inner, "nodes_radial_circ": [n_radial, n_circ]}
+    return TriMesh(X, tri, z0=z0, name=f"{kind} {n_radial}x{n_circ}", info=info)
+
+
+def square_polar(half_side, n_radial, n_circ, *, centre=(0.0, 0.0), core_radius=None, pattern="right",
+                 z0=0.0) -> TriMesh:
+    """A square sheet meshed by rings that blend from a circle to the square's edge, around a core.
+
+    This is how we read the paper's "21 x 160" and "31 x 240" node meshes of the 50 x 50 cm sheet
+    on the round pedestal (§4.4, Fig. 10): ``n_radial`` rings of ``n_circ`` nodes; ring 0 is a circle
+    of radius ``core_radius``, the last ring is the square's edge, ring t in between is
+    ``rho(t) [(1 - t) c(theta) + t c(theta) / |c(theta)|_inf]`` with ``rho`` linear in t. A polar fan
+    down to the centre would put slivers, and patches whose six points lie on a line pair (singular,
+    method.md), at the centre; the disc inside ring 0 is instead meshed by our advancing-front mesher
+    with ring 0's nodes as its boundary. The default ``core_radius`` makes the quadrilaterals next to
+    the core square (circumferential spacing = radial spacing).
+
+    Parameters
+    ----------
+    half_side : half the side of the square sheet [m]
+    n_radial, n_circ : rings and nodes per ring
+    core_radius : radius of the unstructured core [m]
+    """
+    from rftstatic.mesh.mesher import Domain, generate
+
+    n_radial, n_circ = int(n_radial), int(n_circ)
+    if n_radial < 2 or n_circ < 8:
+        raise MeshError(f"square_polar needs n_radial >= 2 and n_circ >= 8, got {n_radial}, {n_circ}")
+    R = float(half_side)
+    if core_radius is None:
+        a = 2 * np.pi / n_circ * (n_radial - 1)
+        core_radius = R / (1.0 + a)
+    if not (0 < core_radius < R):
+        raise MeshError(f"core_radius must lie in (0, half_side = {R}), got {core_radius}")
+    theta = 2 * np.pi * np.arange(n_circ) / n_circ
+    c = np.column_stack([np.cos(theta), np.sin(theta)])
+    q = c / np.abs(c).max(axis=1, keepdims=True)
+    t = np.linspace(0.0, 1.0, n_radial)[:, None, None]
+    rho = core_radius + t * (R - core_radius)
+    rings = (rho * ((1 - t) * c + t * q)).reshape(-1, 2)
+    r, k = np.meshgrid(np.arange(n_radial - 1), np.arange(n_circ), indexing="ij")
+    r, k = r.ravel(), k.ravel()
+    a_, b_ = r * n_circ + k, r * n_circ + (k + 1) % n_circ
+    a2, b2 = a_ + n_circ, b_ + n_circ
+    diag = np.ones_like(r, bool) if pattern == "right" else ((r + k) % 2 == 0 if pattern == "alternate" else np.zeros_like(r, bool))
+    t1 = np.where(diag[:, None], np.stack([a_, b_, b2], 1), np.stack([a_, b_, a2], 1))
+    t2 = np.where(diag[:, None], np.stack([a_, b2, a2], 1), np.stack([b_, b2, a2], 1))
+    core = generate(Domain.polygon(rings[:n_circ]), 2 * np.pi * core_radius / n_circ)
+    # core nodes on ring 0 are ring 0's own nodes: match them, append the interior ones
+    from scipy.spatial import cKDTree
+
+    dist, idx = cKDTree(rings[:n_circ]).query(core.points)
+    on_ring = dist < 1e-6 * core_radius
+    remap = np.empty(len(core.points), dtype=np.int64)
+    remap[on_ring] = idx[on_ring]
+    interior = np.flatnonzero(~on_ring)
+    remap[interior] = len(rings) + np.arange(len(interior))
+    X = np.vstack([rings, core.points[interior]]) + np.asarray(centre, float)
+    tri = np.vstack([t1, t2, remap[core.triangles]])
+    info = {"generator": "square-polar", "half_side": R, "nodes_radial_circ": [n_radial, n_circ],
+            "core_radius": core_radius, "core_nodes": int(len(interior))}
+    return TriMesh(X, tri, z0=z0, name=f"square-polar {n_radial}x{n_circ}", info=info)
+
+
+def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
+    """Read a flat triangle mesh with meshio (any format it reads).
+
+    Parameters
+    ----------
+    path : file name
+    length_scale : SI value of the file's length unit [m]
+    z0 : height of the reference plane [m]; default: the file's (constant) z
+    """
+    import meshio
+
+    try:
+        m = meshio.read(path)
+    except Exception as exc:  # meshio raises many types; re-raise with the file name
+        raise MeshError(f"{path}: meshio could not read it ({exc})") from exc
+    tris = [c.data for c in m.cells if c.type == "triangle"]
+    if not tris:
+        kinds = sorted({c.type for c in m.cells})
+        raise MeshError(f"{path}: no triangle cells (found {kinds}); export the mesh as triangles")
+    tri = np.vstack(tris)
+    P = np.asarray(m.points, float) * length_scale
+    z = P[:, 2] if P.shape[1] == 3 else np.zeros(len(P))
+    span = max(np.ptp(P[:, :2], axis=0).max(), 1e-300)
+    if np.ptp(z) > 1e-9 * span:
+        raise MeshError(
+            f"{path}: the mesh is not flat in a plane z = const (z spans {np.ptp(z):.3g}); the reference "
+            "configuration of a fabric is flat: export it in the x-y plane"
+        )
+    used = np.unique(tri)
+    remap = np.full(len(P), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    mesh_z0 = float(z[used].mean()) if z0 is None else z0
+    return TriMesh(P[used, :2], remap[tri], z0=mesh_z0, name=str(path), info={"generator": "file", "path": str(path)})

@@ -1,0 +1,253 @@
+"""The RF model: everything that is built once per mesh, and the total potential energy.
+
+``Model`` owns the mesh, its patches and image-node rules, the material, the constant bending
+stiffness K_b (Eq. 13), the membrane operator of RFT3 or RFT6, supports, the external load and the
+contact term. Its methods evaluate, for a displacement field ``U (N, 3)`` [m] and a load factor
+``lam``, the total potential energy (method.md)
+
+    Pi(U) = E_b + E_m + E_c - lam P . U,
+
+its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
+The state is only ``U``; solvers are functions of (model, U).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from rftstatic.model.assembly import AssemblyPlan, scatter_forces, scatter_matrices
+from rftstatic.material import Material
+from rftstatic.element.membrane import ELEMENTS, membrane_operator
+from rftstatic.mesh.trimesh import TriMesh
+from rftstatic.element.patch import bending_stiffness, build_patches, curvature
+
+log = logging.getLogger(__name__)
+
+LOCKING_WARN = 1e4
+"""Locking number ``(C/B) h^2`` [-] above which an RFT6 model warns of membrane locking (see
+:func:`locking_number`). Measured on the wool strip of §4.1 (tip error against the heavy elastica,
+RFT6, C/B scaled; validation/stability.md): 0.02 % at 5e3, 0.5 % at 2e4, 2.1 % at 5e4, 3.3 % at 8e4,
+8 % at 8e5; the warning starts below the level (2e4) where the strip leaves its 0.5 % tolerance."""
+
+
+_LOCKING_WARNED = False  # the warning is logged at warning level once per process
+
+
+def locking_number(mesh: TriMesh, material: Material) -> float:
+    """``max_i (D^m_ii / D^b_ii) h^2`` [-], membrane over bending rigidity times the mean element size squared.
+
+    RFT6 averages the strains of the six-node quadratic interpolation (§3); under pure bending
+    (nodes on a cylinder) those strains are about twice the CST's, (kappa h)^2 / 12 against
+    (kappa h)^2 / 24, and unlike the CST's they cannot all be relieved by moving the nodes: the
+    parasitic membrane energy, relative to the bending energy, grows with this number. Wool on the
+    paper's meshes: 3e3-8e3 (pedestals, 61 x 61 sphere), 1.7e4 (80 cm sheet at 81 x 81), 6e4 (17 x 17
+    sphere, 100 cm hanging sheet), 1.2e5 (the 371-node unstructured mesh of Fig. 1 and 9).
+    """
+    Dm, Db = np.asarray(material.Dm, float), np.asarray(material.Db, float)
+    ratio = max((Dm[i, i] / Db[i, i] for i in (0, 1) if Db[i, i] > 0), default=0.0)
+    h = float(mesh.element_size.mean())
+    return float(ratio * h * h)
+
+
+@dataclass
+class Supports:
+    """Prescribed (zero) displacements.
+
+    Attributes
+    ----------
+    clamped : node indices held fixed with zero slope across clamped edges (image rule U_img = U_c)
+    pinned : node indices held fixed, free to rotate
+    fixed : (N, 3) bool, further single components held fixed (e.g. in-plane rigid modes)
+    """
+
+    clamped: np.ndarray
+    pinned: np.ndarray
+    fixed: np.ndarray
+
+    @classmethod
+    def none(cls, n_nodes):
+        empty = np.zeros(0, dtype=np.int64)
+        return cls(empty, empty.copy(), np.zeros((n_nodes, 3), dtype=bool))
+
+    def fixed_mask(self) -> np.ndarray:
+        m = self.fixed.copy()
+        m[self.clamped] = True
+        m[self.pinned] = True
+        return m
+
+
+def gravity_load(mesh: TriMesh, weight: float, direction=(0.0, 0.0, -1.0)) -> np.ndarray:
+    """Nodal weight ``(N, 3)`` [N] of a sheet of areal weight ``weight`` [N/m^2] (a third per vertex)."""
+    return np.outer(mesh.node_area * weight, np.asarray(direction, float))
+
+
+def edge_load(mesh: TriMesh, edges: np.ndarray, force_per_length) -> np.ndarray:
+    """Nodal forces ``(N, 3)`` [N] of a uniform line load [N/m] on ``edges (B, 2)`` (half per end)."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    length = np.linalg.norm(mesh.X[edges[:, 1]] - mesh.X[edges[:, 0]], axis=1)
+    w = np.repeat(0.5 * length, 2)
+    P = np.zeros((mesh.n_nodes, 3))
+    share = np.bincount(edges.ravel(), w, minlength=mesh.n_nodes)
+    return P + np.outer(share, np.asarray(force_per_length, float))
+
+
+class Model:
+    """An RF triangle model of a flat fabric sheet (see module docstring).
+
+    Parameters
+    ----------
+    mesh : reference mesh [m]
+    material : rigidities and weight (SI)
+    element : ``"RFT3"`` or ``"RFT6"``
+    supports : prescribed displacements (default: none)
+    load : (N, 3) external nodal load at load factor 1 [N] (default: zero)
+    contact : an object with ``energy(x)``, ``force(x)``, ``tangent_blocks(x)`` (penalty contact)
+    membrane : include the membrane energy (``False`` gives the linear Kirchhoff plate)
+    load_terms : loads with a potential scaled by the load factor, e.g.
+        :class:`rftstatic.loads.LeverMoment` (methods ``potential``, ``force``, ``tangent_blocks``,
+        ``commit``)
+    """
+
+    def __init__(self, mesh: TriMesh, material: Material, *, element="RFT6", supports=None, load=None,
+                 contact=None, membrane=True, load_terms=()):
+        if element not in ELEMENTS:
+            raise ValueError(f'unknown element "{element}"; use one of {", ".join(ELEMENTS)}')
+        self.mesh = mesh
+        self.material = material
+        self.element = element
+        self.supports = supports if supports is not None else Supports.none(mesh.n_nodes)
+        self.load = np.zeros((mesh.n_nodes, 3)) if load is None else np.asarray(load, float)
+        if self.load.shape != (mesh.n_nodes, 3):
+            raise ValueError(f"load must have shape ({mesh.n_nodes}, 3), got {self.load.shape}")
+        self.contact = contact
+        self.load_terms = list(load_terms)
+        self.with_membrane = bool(membrane)
+        self.fixed = self.supports.fixed_mask()
+        self.free = ~self.fixed
+        self.patches = build_patches(mesh, clamped_nodes=self.supports.clamped)
+        self.Kb = bending_stiffness(mesh, self.patches, material.Db)
+        self.membrane = membrane_operator(element, mesh, self.patches)
+        self.warnings: list[str] = []
+        if element == "RFT6" and self.with_membrane:
+            lock = locking_number(mesh, material)
+            if lock > LOCKING_WARN:
+                h_ok = float(mesh.element_size.mean()) * np.sqrt(LOCKING_WARN / lock)
+                text = (f"RFT6 membrane locking: (C/B) h^2 = {lock:.3g} > {LOCKING_WARN:.0e}; the averaged "
+                        f"mid-side strains stiffen bending on this mesh (the wool strip of §4.1 bends 0.5 % too "
+                        f"little at 2e4, 3.3 % at 8e4, 8 % at 8e5). Refine to a mean element size below {h_ok:.3g} m or use "
+                        f'element = "RFT3"')
+                self.warnings.append(text)
+                # once per process at warning level: a remeshed run builds a model per remesh
+                global _LOCKING_WARNED
+                log.log(logging.DEBUG if _LOCKING_WARNED else logging.WARNING, text)
+                _LOCKING_WARNED = True
+
+    # --- constant structures, built on first use ------------------------------------------------
+    @cached_property
+    def plan(self) -> AssemblyPlan:
+        return AssemblyPlan(self.patches.nodes, self.mesh.n_nodes, self.free)
+
+    @cached_property
+    def _bending_data(self) -> np.ndarray:
+        return self.plan.scalar_kron_data(self.Kb)
+
+    @cached_property
+    def _membrane_map(self) -> np.ndarray:
+        return self.plan.element_map(self.membrane.nodes)
+
+    @property
+    def X3(self) -> np.ndarray:
+        """(N, 3) reference positions [m]."""
+        return self.mesh.X3
+
+    def positions(self, U) -> np.ndarray:
+        return self.X3 + U
+
+    # --- energy and its derivatives -------------------------------------------------------------
+    def energies(self, U, lam=1.0) -> dict:
+        """Parts of the total potential [J]: bending, membrane, contact, external work, total."""
+        Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
+        Em = self.membrane.energy(U, self.material.Dm) if self.with_membrane else 0.0
+        Ec = self.contact.energy(self.positions(U)) if self.contact is not None else 0.0
+        W = lam * float(np.einsum("ni,ni->", self.load, U))
+        if self.load_terms:
+            x = self.positions(U)
+            W -= lam * sum(t.potential(x) for t in self.load_terms)
+        return {"bending": Eb, "membrane": Em, "contact": Ec, "external_work": W,
+                "total": Eb + Em + Ec - W}
+
+    def potential(self, U, lam=1.0) -> float:
+        """Total potential energy Pi(U) [J]."""
+        return self.energies(U, lam)["total"]
+
+    def internal_force(self, U) -> np.ndarray:
+        """Internal (bending + membrane + contact) force ``(N, 3)`` [N], the gradient of the stored energy."""
+        f = self.Kb @ U
+        if self.with_membrane:
+            fe = self.membrane.element_forces(U, self.material.Dm)
+            f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
+        if self.contact is not None:
+            f += self.contact.force(self.positions(U))
+        return f
+
+    def residual(self, U, lam=1.0) -> np.ndarray:
+        """Out-of-balance force ``dPi/dU (N, 3)`` [N]; zero at equilibrium on the free dofs."""
+        r = self.internal_force(U) - lam * self.load
+        for term in self.load_terms:
+            r += lam * term.force(self.positions(U))
+        return r
+
+    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0):
+        """Internal force ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m] at load factor ``lam``.
+
+        ``psd=True`` drops compressive stress from the geometric stiffness (positive semi-definite
+        membrane tangent); ``shift`` adds ``shift * I`` (Levenberg-Marquardt).
+        """
+        plan = self.plan
+        data = self._bending_data.copy()
+        f = self.Kb @ U
+        x = self.positions(U)
+        if self.with_membrane:
+            fe, ke = self.membrane.element_tangents(U, self.material.Dm, psd=psd)
+            f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
+            data += scatter_matrices(self._membrane_map, ke, plan.nnz)
+        if self.contact is not None:
+            state = self.contact.evaluate(x)
+            f += state.force
+            data += scatter_matrices(plan.diag_positions, state.tangent_blocks, plan.nnz)
+        for term in self.load_terms:  # load stiffness of potential loads (not part of f)
+            rows, cols, blocks = term.tangent_blocks(x)
+            data += scatter_matrices(plan.positions(rows, cols), lam * blocks, plan.nnz)
+        if shift:
+            data += scatter_matrices(plan.diag_positions, shift * np.broadcast_to(np.eye(3), (self.mesh.n_nodes, 3, 3)), plan.nnz)
+        return f, plan.free_matrix(data)
+
+    # --- post-processing ------------------------------------------------------------------------
+    def curvature(self, U) -> np.ndarray:
+        """(E, 3) element curvature (k_xx, k_yy, 2 k_xy) [1/m], Eq. 7."""
+        return curvature(self.patches, U, self.positions(U))
+
+    def membrane_strain(self, U) -> np.ndarray:
+        """(E, 3) averaged Green membrane strain (e_xx, e_yy, 2 e_xy) [-]."""
+        return self.membrane.strain(U)
+
+    def relative_curvature(self, U) -> np.ndarray:
+        """(E,) |kappa| h, the relative curvature of §2.2 and §5.1 [-]."""
+        k = self.curvature(U)
+        mag = np.sqrt(k[:, 0] ** 2 + k[:, 1] ** 2 + 0.5 * k[:, 2] ** 2)
+        return mag * self.mesh.element_size
+
+    def summary(self) -> dict:
+        return {
+            "element": self.element,
+            "nodes": self.mesh.n_nodes,
+            "elements": self.mesh.n_elements,
+            "free_dofs": int(self.free.sum()),
+            "clamped_nodes": int(len(self.supports.clamped)),
+            "pinned_nodes": int(len(self.supports.pinned)),
+            "membrane": self.with_membrane,
+        }

@@ -1,0 +1,5 @@
+"""Layer ``post``: measures of a deformed sheet (drape coefficient, boundary, folds, sharp-fold
+indicators) and probe interpolation.
+
+Imports from ``remesh`` and below.
+"""

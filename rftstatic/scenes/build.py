@@ -1,0 +1,285 @@
+"""From a validated scene (scene units) to a :class:`~rftstatic.model.Model` (SI units).
+
+Everything a scene names in reference coordinates -- supports, loads, probes, obstacles -- is
+located on the mesh here, so that it carries over to any other mesh of the same sheet.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rftstatic import material as mat
+from rftstatic.mesh import trimesh as meshmod
+from rftstatic.model.model import Model, Supports, edge_load, gravity_load
+from rftstatic.scenes.schema import Scene
+from rftstatic.units import unit_system
+
+
+def build_mesh(scene: Scene) -> meshmod.TriMesh:
+    u = scene.units.length
+    m = scene.get("mesh", {})
+    kind = m.get("kind", "rectangle")
+    z0 = m.get("z", 0.0) * u
+    try:
+        if kind == "rectangle":
+            lx, ly = _pair(scene, "mesh.size", m.get("size", [1.0, 1.0]))
+            nx, ny = _pair(scene, "mesh.nodes", m.get("nodes", [11, 11]), int)
+            ox, oy = _pair(scene, "mesh.origin", m.get("origin", [-lx / 2, -ly / 2]))
+            return meshmod.rectangle(lx * u, ly * u, nx, ny, origin=(ox * u, oy * u),
+                                     pattern=m.get("pattern", "right"), z0=z0)
+        if kind == "square-polar":
+            nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", [21, 160]), int)
+            cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
+            if "radius" not in m:
+                raise scene.error("mesh.radius", "a square-polar mesh needs its half side as radius")
+            core = m.get("inner_radius")
+            return meshmod.square_polar(m["radius"] * u, nr, nc, centre=(cx * u, cy * u),
+                                        core_radius=None if core is None else core * u,
+                                        pattern=m.get("pattern", "right"), z0=z0)
+        if kind == "polar":
+            nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", [11, 40]), int)
+            cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
+            if "radius" not in m:
+                raise scene.error("mesh.radius", f"a {kind} mesh needs its radius")
+            return meshmod.polar(m["radius"] * u, nr, nc, r_inner=m.get("inner_radius", 0.0) * u,
+                                 centre=(cx * u, cy * u), pattern=m.get("pattern", "alternate"),
+                                 square=(kind == "square-polar"), z0=z0)
+        if kind == "file":
+            if "path" not in m:
+                raise scene.error("mesh.path", "a file mesh needs the path of the mesh file")
+            path = m["path"]
+            if scene.path is not None and not __import__("os").path.isabs(path):
+                path = str(scene.path.parent / path)
+            return meshmod.read(path, length_scale=u, z0=z0 if "z" in m else None)
+        if kind == "unstructured":
+            return _unstructured(scene, m, u, z0)
+    except meshmod.MeshError as exc:
+        raise scene.error("mesh", str(exc)) from None
+    raise scene.error("mesh.kind", f'"{kind}" is not a mesh kind; use rectangle, polar, square-polar, file or unstructured')
+
+
+def _unstructured(scene, m, u, z0):
+    from rftstatic.mesh.mesher import BackgroundGrid, Domain, generate
+
+    if "h" not in m:
+        raise scene.error("mesh.h", "an unstructured mesh needs its target element size h")
+    h = m["h"] * u
+    if "radius" in m:
+        cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
+        domain = Domain.disc(cx * u, cy * u, m["radius"] * u)
+    else:
+        lx, ly = _pair(scene, "mesh.size", m.get("size", [1.0, 1.0]))
+        ox, oy = _pair(scene, "mesh.origin", m.get("origin", [-lx / 2, -ly / 2]))
+        domain = Domain.rectangle(ox * u, oy * u, lx * u, ly * u)
+    res = generate(domain, BackgroundGrid.uniform(h, domain))
+    return meshmod.TriMesh(res.points, res.triangles, z0=z0, name=f"unstructured h={m['h']}",
+                           info={"generator": "advancing-front", "quality": res.quality.as_dict()})
+
+
+def _pair(scene, key, value, kind=float):
+    if not (isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value)):
+        raise scene.error(key, f"expected two numbers [a, b], got {value!r}")
+    return kind(value[0]), kind(value[1])
+
+
+def build_material(scene: Scene) -> mat.Material:
+    m = dict(scene.get("material", {"preset": "wool-kang-yu"}))
+    units = scene.units
+    angle = m.pop("warp_angle", 0.0)
+    try:
+        if "preset" in m:
+            name = m.pop("preset")
+            m.pop("kind", None)
+            # preset values are in the preset's own units; overrides in the scene's units
+            base = mat.preset(name, warp_angle_deg=angle)
+            if not m:
+                return base
+            _, values = mat.PRESETS[name]
+            pu = unit_system(mat.PRESETS[name][0])
+            merged = {k: v * pu.to_si(1.0, mat._FABRIC_KINDS[k]) / units.to_si(1.0, mat._FABRIC_KINDS[k])
+                      for k, v in values.items()}
+            merged.update(m)
+            return mat.fabric_from_units(merged, units, warp_angle_deg=angle, name=name + " (modified)")
+        kind = m.pop("kind", "fabric")
+        if kind == "isotropic":
+            for key in ("E", "nu", "thickness"):
+                if key not in m:
+                    raise scene.error(f"material.{key}", "an isotropic shell needs E, nu and thickness")
+            extra = set(m) - {"E", "nu", "thickness", "weight"}
+            if extra:
+                raise scene.error("material", f"keys {sorted(extra)} do not apply to an isotropic shell")
+            return mat.isotropic_shell(E=units.to_si(m["E"], "pressure"), nu=m["nu"],
+                                       thickness=units.to_si(m["thickness"], "length"),
+                                       weight=units.to_si(m.get("weight", 0.0), "pressure"))
+        if kind != "fabric":
+            raise scene.error("material.kind", f'"{kind}" is not a material kind; use fabric or isotropic')
+        needed = {"C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "B_twist", "weight"}
+        missing = needed - set(m)
+        if missing:
+            raise scene.error("material", f"a fabric needs {sorted(missing)} (or preset = \"wool-kang-yu\")")
+        bad = set(m) - set(mat._FABRIC_KINDS)
+        if bad:
+            raise scene.error("material", f"keys {sorted(bad)} do not apply to a fabric")
+        return mat.fabric_from_units(m, units, warp_angle_deg=angle)
+    except ValueError as exc:
+        if isinstance(exc, type(scene.error("", ""))):
+            raise
+        raise scene.error("material", str(exc)) from None
+
+
+def select_nodes(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
+    """Nodes named by a ``box`` or ``at`` entry of a scene table (reference coordinates)."""
+    u = scene.units.length
+    if "box" in spec:
+        box = spec["box"]
+        if not (isinstance(box, list) and len(box) == 4):
+            raise scene.error(f"{key}.box", f"expected [xmin, xmax, ymin, ymax], got {box!r}")
+        nodes = mesh.nodes_in_box(*(b * u for b in box))
+    elif "at" in spec:
+        pts = np.atleast_2d(np.asarray(spec["at"], float))
+        if pts.shape[1] != 2:
+            raise scene.error(f"{key}.at", f"expected [[x, y], ...], got {spec['at']!r}")
+        nodes = np.unique(mesh.nearest_node(pts * u))
+    else:
+        raise scene.error(key, "needs a box = [xmin, xmax, ymin, ymax] or at = [[x, y], ...]")
+    if len(nodes) == 0:
+        raise scene.error(f"{key}.box", f"{spec['box']} contains no node of the mesh; check the coordinates "
+                          f"(scene units, reference configuration)")
+    return nodes
+
+
+def build_supports(scene: Scene, mesh) -> Supports:
+    clamped, pinned = [], []
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    for i, spec in enumerate(scene.get("supports", [])):
+        key = f"supports.{i}"
+        nodes = select_nodes(scene, mesh, spec, key)
+        kind = spec.get("kind", "pinned")
+        if kind == "clamped":
+            clamped.append(nodes)
+        elif kind == "pinned":
+            pinned.append(nodes)
+        elif kind == "fixed":
+            comps = spec.get("components", "xyz")
+            if not comps or set(comps) - set("xyz"):
+                raise scene.error(f"{key}.components", f'"{comps}" must be letters of "xyz"')
+            for c in comps:
+                fixed[nodes, "xyz".index(c)] = True
+        else:
+            raise scene.error(f"{key}.kind", f'"{kind}" is not a support kind; use clamped, pinned or fixed')
+    cat = lambda a: np.unique(np.concatenate(a)) if a else np.zeros(0, dtype=np.int64)  # noqa: E731
+    return Supports(cat(clamped), cat(pinned), fixed)
+
+
+def build_load(scene: Scene, mesh, material) -> np.ndarray:
+    units = scene.units
+    loads = scene.get("loads", {"gravity": True})
+    P = np.zeros((mesh.n_nodes, 3))
+    if loads.get("gravity", False):
+        P += gravity_load(mesh, material.weight)
+    if "pressure" in loads:
+        P += gravity_load(mesh, units.to_si(loads["pressure"], "pressure"))
+    for i, spec in enumerate(loads.get("point", [])):
+        f = np.asarray(spec.get("force", [0, 0, 0]), float)
+        if f.shape != (3,):
+            raise scene.error(f"loads.point.{i}.force", f"expected [fx, fy, fz], got {spec.get('force')!r}")
+        nodes = select_nodes(scene, mesh, spec, f"loads.point.{i}")
+        P[nodes] += units.to_si(f, "force") / len(nodes)
+    for i, spec in enumerate(loads.get("edge", [])):
+        q = np.asarray(spec.get("force_per_length", [0, 0, 0]), float)
+        if q.shape != (3,):
+            raise scene.error(f"loads.edge.{i}.force_per_length", f"expected [fx, fy, fz], got {q!r}")
+        nodes = select_nodes(scene, mesh, spec, f"loads.edge.{i}")
+        inside = np.zeros(mesh.n_nodes, bool)
+        inside[nodes] = True
+        edges = mesh.boundary_edges[inside[mesh.boundary_edges].all(axis=1)]
+        if len(edges) == 0:
+            raise scene.error(f"loads.edge.{i}.box", "contains no boundary edge")
+        P += edge_load(mesh, edges, units.to_si(q, "line_force"))
+    return P
+
+
+def build_contact(scene: Scene, mesh, material, supports: Supports):
+    """Obstacles and penalty contact (None without obstacles); may add in-plane holds to ``supports``."""
+    specs = scene.get("obstacles", [])
+    if not specs:
+        return None, []
+    from rftstatic.contact.penalty import PenaltyContact, auto_penalty
+    from rftstatic.contact.obstacles import from_spec
+
+    obstacles = []
+    for i, spec in enumerate(specs):
+        try:
+            obstacles.append(from_spec(spec, scene.units.length))
+        except ValueError as exc:
+            raise scene.error(f"obstacles.{i}", str(exc)) from None
+    c = scene.get("contact", {})
+    h = float(mesh.element_size.mean())
+    penalty = c.get("penalty", "auto")
+    if penalty == "auto":
+        k = auto_penalty(membrane_rigidity=material.membrane_scale, bending_rigidity=material.bending_scale,
+                         weight=max(material.weight, 1e-300), h=h, factor=c.get("factor", 1.0))
+    elif isinstance(penalty, (int, float)) and penalty > 0:
+        k = scene.units.to_si(float(penalty), "stiffness_volumetric")
+    else:
+        raise scene.error("contact.penalty", f'expected "auto" or a positive number, got {penalty!r}')
+    if c.get("hold_inplane", True):
+        hold_inplane_rigid_modes(mesh, supports)
+    smoothing = c.get("smoothing", 0.05) * h
+    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=smoothing), obstacles
+
+
+def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
+    """Remove the in-plane rigid modes of a sheet on a frictionless support (method.md).
+
+    The node nearest the sheet's centre is held in x and y (translations) and the node nearest
+    the point one quarter of the sheet's width along +x from it is held in y (spin about z).
+    Nothing is added when the supports already hold the sheet in its plane.
+    """
+    if supports.fixed_mask()[:, :2].any():
+        return
+    centre = 0.5 * (mesh.X.min(axis=0) + mesh.X.max(axis=0))
+    c = int(mesh.nearest_node([centre])[0])
+    reach = 0.25 * float(np.ptp(mesh.X[:, 0]))
+    a = int(mesh.nearest_node([centre + [reach, 0.0]])[0])
+    supports.fixed[c, 0] = supports.fixed[c, 1] = True
+    supports.fixed[a, 1] = True
+
+
+def build_model(scene: Scene, mesh=None) -> tuple[Model, dict]:
+    """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras."""
+    mesh = build_mesh(scene) if mesh is None else mesh
+    material = build_material(scene)
+    supports = build_supports(scene, mesh)
+    load = build_load(scene, mesh, material)
+    contact, obstacles = build_contact(scene, mesh, material, supports)
+    membrane = scene.get("solver.membrane", True)
+    model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
+                  contact=contact, membrane=membrane)
+    probes = {}
+    u = scene.units.length
+    for i, spec in enumerate(scene.get("probes", [])):
+        if "name" not in spec or "at" not in spec:
+            raise scene.error(f"probes.{i}", "a probe needs a name and at = [x, y]")
+        probes[spec["name"]] = np.asarray(spec["at"], float) * u
+    return model, {"obstacles": obstacles, "probes": probes}
+
+
+def probe_positions(model: Model, probes: dict, U: np.ndarray) -> dict:
+    """Reference and deformed positions [m] of named reference points (barycentric interpolation)."""
+    if not probes:
+        return {}
+    names = list(probes)
+    pts = np.array([probes[n] for n in names])
+    elem, bary = model.mesh.locate(pts)
+    out = {}
+    for k, name in enumerate(names):
+        if elem[k] < 0:  # on the boundary, the trifinder may miss: take the nearest node
+            node = model.mesh.nearest_node(pts[k:k + 1])[0]
+            ref, disp = model.X3[node], U[node]
+        else:
+            nodes = model.mesh.tri[elem[k]]
+            ref = bary[k] @ model.X3[nodes]
+            disp = bary[k] @ U[nodes]
+        out[name] = {"reference": ref, "deformed": ref + disp}
+    return out

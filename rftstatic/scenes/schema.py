@@ -1,0 +1,272 @@
+"""Scene files: TOML data that say which paper figure they reproduce, in the units they state.
+
+A scene is parsed into plain dictionaries, validated against :data:`SCHEMA` (an unknown key or a
+value of the wrong type is a :class:`SceneError` naming the file, the key and the value), and
+``--set key=value`` overrides are applied before validation. :func:`build_model` turns a scene
+into a :class:`rftstatic.model.Model` in SI units; the schema is documented in the README.
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
+
+CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
+
+NUM = (int, float)
+LIST = (list,)
+
+# key -> (allowed python types, help). Nested tables are dicts; arrays of tables are [dict].
+SCHEMA = {
+    "title": (str, "one line saying what the scene is"),
+    "figure": (str, "the paper figure or section it reproduces"),
+    "units": (str, "unit system: " + ", ".join(UNIT_SYSTEMS)),
+    "element": (str, "RFT3 or RFT6"),
+    "analysis": (str, "static (Newton), dynamic (explicit) or relax (dynamic relaxation)"),
+    "mesh": ({
+        "kind": (str, "rectangle, polar, square-polar, file or unstructured"),
+        "size": (LIST, "[lx, ly] of a rectangle"),
+        "nodes": (LIST, "[nx, ny] (rectangle) or [n_radial, n_circ] (polar)"),
+        "origin": (LIST, "lower-left corner of a rectangle"),
+        "centre": (LIST, "centre of a polar mesh"),
+        "pattern": (str, "diagonal pattern: right, left, alternate, union-jack"),
+        "radius": (NUM, "outer radius (polar) or half side (square-polar)"),
+        "inner_radius": (NUM, "inner radius of an annulus"),
+        "path": (str, "mesh file read with meshio (relative to the scene file)"),
+        "h": (NUM, "target element size of an unstructured mesh"),
+        "z": (NUM, "height of the flat reference plane"),
+    }, "the flat reference mesh"),
+    "material": ({
+        "preset": (str, "named fabric, e.g. wool-kang-yu"),
+        "kind": (str, "fabric (rigidities) or isotropic (E, nu, thickness)"),
+        "warp_angle": (NUM, "angle of the warp from the x axis [deg]"),
+        **{k: (NUM, "fabric rigidity in scene units") for k in
+           ("C_warp", "C_weft", "C_shear", "C12", "B_warp", "B_weft", "B_twist", "B12")},
+        "weight": (NUM, "areal weight [force/area]"),
+        "E": (NUM, "Young's modulus [force/area]"),
+        "nu": (NUM, "Poisson ratio"),
+        "thickness": (NUM, "shell thickness [length]"),
+    }, "fabric or shell rigidities"),
+    "supports": ([{
+        "kind": (str, "clamped, pinned or fixed"),
+        "box": (LIST, "[xmin, xmax, ymin, ymax] in reference coordinates"),
+        "at": (LIST, "[[x, y], ...] reference points (nearest nodes)"),
+        "components": (str, "for kind = fixed: which of x, y, z are held, e.g. 'xy'"),
+    }], "prescribed (zero) displacements"),
+    "loads": ({
+        "gravity": (bool, "the material's weight, along -z"),
+        "pressure": (NUM, "uniform transverse load along -z [force/area]"),
+        "point": ([{"at": (LIST, "[x, y]"), "force": (LIST, "[fx, fy, fz]")}], "nodal forces"),
+        "edge": ([{"box": (LIST, "[xmin, xmax, ymin, ymax]"),
+                   "force_per_length": (LIST, "[fx, fy, fz] per unit length")}], "boundary line loads"),
+    }, "external loads at load factor 1"),
+    "obstacles": ([{
+        "type": (str, "floor, sphere, square-pedestal or round-pedestal"),
+        "centre": (LIST, "centre"), "radius": (NUM, "radius"), "half_width": (NUM, "half side"),
+        "size": (LIST, "sides"), "top": (NUM, "height of the top face"), "edge_radius": (NUM, "rounding"),
+        "height": (NUM, "height of a pedestal"),
+    }], "rigid obstacles"),
+    "contact": ({
+        "penalty": ((str, *NUM), '"auto" or a penalty stiffness [force/length^3]'),
+        "factor": (NUM, "multiplier of the automatic penalty"),
+        "hold_inplane": (bool, "hold the in-plane rigid modes of a sheet on a frictionless support"),
+        "smoothing": (NUM, "width of the C2 penalty onset, in mean element sizes (default 0.05)"),
+    }, "penalty contact"),
+    "solver": ({
+        "initial_increment": (NUM, ""), "min_increment": (NUM, ""), "max_increment": (NUM, ""),
+        "max_iterations": (int, ""), "rtol": (NUM, ""), "intermediate_rtol": (NUM, ""), "etol": (NUM, ""),
+        "max_step": (NUM, "cap on the largest nodal increment per iteration [length]"),
+        "increment_displacement": (NUM, "target nodal displacement per increment [length]"),
+        "line_search": (bool, ""), "tangent": (str, "auto, exact or psd"),
+        "max_continuations": (int, "snap-through continuations per increment"),
+        "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
+        "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
+        "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
+        "perturbation_folds": (int, "0: random modes; n: an n-fold lift about the sheet's centre"),
+        "guide_folds": (int, "relax route: n-fold modulation of the weight in the first stage (0: none)"),
+        "guide_weight": (NUM, "relative amplitude of that modulation, in [0, 1)"),
+        "start": (str, "load-steps or relax (dynamic relaxation, then Newton)"),
+        "relax_fallback": (bool, "try dynamic relaxation + Newton when the load steps fail"),
+        "membrane": (bool, "false: linear Kirchhoff plate (bending only)"),
+    }, "static solver options (rftstatic.static.StaticOptions)"),
+    "dynamics": ({
+        "t_end": (NUM, "end time [time]"), "dt": (NUM, "time step (default: automatic)"),
+        "alpha": (NUM, "mass damping [1/time]"), "mass_scale": (NUM, "mass scaling factor"),
+        "frames": (LIST, "times of the saved frames"), "checkpoint_every": (NUM, "[time]"),
+        "rest_tolerance": (NUM, "kinetic-energy ratio at which the sheet is at rest"),
+        "samples": (int, "regular states saved for the VTU series and the GIF"),
+        "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
+        "compare_static": (bool, "relax: report the difference from the static Newton solution"),
+    }, "explicit dynamics options"),
+    "remesh": ({
+        "const": (NUM, "const of Eq. 29, |kappa| h^2 = const [length]"),
+        "h_lower": (NUM, "smallest element size [length]"), "h_upper": (NUM, "largest element size [length]"),
+        "gradation": (NUM, "largest size ratio between neighbours one element apart"),
+        "max_cycles": (int, "static route: most remeshing cycles"),
+        "tol": (NUM, "stop when the node count changes by less than this fraction"),
+        "kappa_h_max": (NUM, "static route: largest |kappa| h accepted without remeshing"),
+        "kappa_h2_max": (NUM, "relax route: remesh when max |kappa| h^2 exceeds this [length]"),
+        "every": (int, "relax route: remesh every this many steps"),
+        "transfer": (str, "mesh (interpolation on the old mesh), patch (its RF patch quadratics) or grid "
+                          "(background grid, as the paper)"),
+        "damping": (str, "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's slowest "
+                         "swing, at most dynamics.alpha)"),
+    }, "global adaptive remeshing (§5)"),
+    "probes": ([{"name": (str, "probe name"), "at": (LIST, "[x, y] reference point")}], "tracked points"),
+    "output": ({
+        "views": (LIST, "PNG views: side, top, iso"),
+        "vtu": (bool, "write the deformed mesh as VTU"),
+    }, "what a run writes"),
+}
+
+
+class SceneError(ValueError):
+    """Invalid scene; the message names the file, the key and the value, and what to do."""
+
+
+@dataclass
+class Scene:
+    """A validated scene: its data (scene units), file and unit system."""
+
+    data: dict
+    path: Path | None = None
+    name: str = "scene"
+    overrides: dict = field(default_factory=dict)
+
+    @property
+    def units(self) -> UnitSystem:
+        return unit_system(self.data.get("units", "cm-gf-s"))
+
+    def get(self, dotted: str, default=None):
+        node = self.data
+        for part in dotted.split("."):
+            if not isinstance(node, dict) or part not in node:
+                return default
+            node = node[part]
+        return node
+
+    def error(self, key: str, message: str) -> SceneError:
+        where = str(self.path) if self.path else self.name
+        return SceneError(f"{where}: {key}: {message}")
+
+
+def find_scene(name: str) -> Path:
+    """``name`` as a path to a .toml file, or a scene in ``cases/``."""
+    p = Path(name)
+    if p.suffix == ".toml":
+        if not p.exists():
+            raise SceneError(f"{p}: no such scene file")
+        return p
+    candidate = CASES_DIR / f"{name}.toml"
+    if candidate.exists():
+        return candidate
+    known = ", ".join(sorted(q.stem for q in CASES_DIR.glob("*.toml")))
+    raise SceneError(f'no scene "{name}" in {CASES_DIR}; known scenes: {known}')
+
+
+def list_scenes() -> list[tuple[str, str]]:
+    """(name, title) of every scene in ``cases/``."""
+    out = []
+    for p in sorted(CASES_DIR.glob("*.toml")):
+        with open(p, "rb") as fh:
+            data = tomllib.load(fh)
+        out.append((p.stem, data.get("title", "") + (f"  [{data['figure']}]" if "figure" in data else "")))
+    return out
+
+
+def parse_override(text: str) -> tuple[str, object]:
+    """``key=value`` with a TOML value (``3``, ``[21, 101]``, ``"RFT3"``); bare words are strings."""
+    if "=" not in text:
+        raise SceneError(f'--set "{text}": expected key=value, e.g. --set element=RFT3')
+    key, raw = text.split("=", 1)
+    key, raw = key.strip(), raw.strip()
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return key, value
+
+
+def apply_override(data: dict, key: str, value, source="--set") -> None:
+    parts = key.split(".")
+    node = data
+    for i, part in enumerate(parts[:-1]):
+        if isinstance(node, list):
+            try:
+                node = node[int(part)]
+            except (ValueError, IndexError):
+                raise SceneError(f'{source} {key}: "{part}" is not an index of the array {".".join(parts[:i])}') from None
+            continue
+        node = node.setdefault(part, {})
+    last = parts[-1]
+    if isinstance(node, list):
+        try:
+            node[int(last)] = value
+        except (ValueError, IndexError):
+            raise SceneError(f'{source} {key}: "{last}" is not an index of the array') from None
+    else:
+        node[last] = value
+
+
+def load_scene(name_or_path: str, overrides=()) -> Scene:
+    """Read, override and validate a scene (``overrides``: ``["key=value", ...]``)."""
+    path = find_scene(name_or_path)
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML ({exc})") from None
+    applied = {}
+    for text in overrides:
+        key, value = parse_override(text)
+        apply_override(data, key, value)
+        applied[key] = value
+    scene = Scene(data, path, path.stem, applied)
+    validate(scene)
+    return scene
+
+
+def scene_from_dict(data: dict, name="scene") -> Scene:
+    scene = Scene(copy.deepcopy(data), None, name)
+    validate(scene)
+    return scene
+
+
+def validate(scene: Scene) -> None:
+    _check_table(scene, scene.data, SCHEMA, "")
+    if scene.data.get("units", "cm-gf-s") not in UNIT_SYSTEMS:
+        raise scene.error("units", f'unknown unit system "{scene.data["units"]}"; use one of {", ".join(UNIT_SYSTEMS)}')
+    if scene.data.get("element", "RFT6") not in ("RFT3", "RFT6"):
+        raise scene.error("element", f'"{scene.data["element"]}" is not an element; use RFT3 or RFT6')
+    if scene.data.get("analysis", "static") not in ("static", "dynamic", "relax"):
+        raise scene.error("analysis", f'"{scene.data["analysis"]}" is not an analysis; use static, dynamic or relax')
+
+
+def _check_table(scene, table, schema, prefix):
+    if not isinstance(table, dict):
+        raise scene.error(prefix.rstrip("."), f"expected a table, got {table!r}")
+    for key, value in table.items():
+        full = prefix + key
+        if key not in schema:
+            close = ", ".join(sorted(schema))
+            raise scene.error(full, f"unknown key (value {value!r}); known keys here: {close}")
+        spec, _ = schema[key]
+        if isinstance(spec, dict):
+            _check_table(scene, value, spec, full + ".")
+        elif isinstance(spec, list):
+            if not isinstance(value, list):
+                raise scene.error(full, f"expected an array of tables ([[{full}]]), got {value!r}")
+            for i, item in enumerate(value):
+                _check_table(scene, item, spec[0], f"{full}.{i}.")
+        else:
+            types = spec if isinstance(spec, tuple) else (spec,)
+            ok = isinstance(value, types) and not (isinstance(value, bool) and bool not in types)
+            if not ok:
+                names = "/".join(t.__name__ for t in types)
+                raise scene.error(full, f"expected {names}, got {value!r} ({type(value).__name__})")
