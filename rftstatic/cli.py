@@ -36,8 +36,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
-    from rftstatic.scenes.schema import SceneError
-    from rftstatic.solvers.static import ConvergenceError
+    from rftstatic.errors import ConvergenceError, SceneError
 
     try:
         if args.command == "list":

@@ -5,7 +5,8 @@ import json
 import pytest
 
 from rftstatic.cli import main
-from rftstatic.scenes.schema import SceneError, load_scene
+from rftstatic.errors import SceneError
+from rftstatic.scenes.schema import load_scene
 
 
 def test_list_shows_the_strip(capsys):

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from rftstatic.contact.obstacles import RoundPedestal, Sphere, SquarePedestal
 from rftstatic.io.drape_figures import boundary_distance, boundary_xy, obstacle_drawers, obstacle_outline
 from rftstatic.mesh.trimesh import rectangle
-from rftstatic.contact.obstacles import RoundPedestal, Sphere, SquarePedestal
 
 
 def _circle(r, n=400, c=(0.0, 0.0)):

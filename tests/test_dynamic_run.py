@@ -6,9 +6,10 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from rftstatic.cli import main
 from rftstatic.app.dynamic import resume_scene, run_dynamic_scene
-from rftstatic.scenes.schema import SceneError, load_scene
+from rftstatic.cli import main
+from rftstatic.errors import SceneError
+from rftstatic.scenes.schema import load_scene
 
 TINY = ["mesh.nodes=[9,9]", "dynamics.t_end=0.05", "dynamics.checkpoint_every=0.01", "dynamics.samples=5",
         "dynamics.frames=[0,0.02,0.05]"]

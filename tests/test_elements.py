@@ -5,9 +5,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from rftstatic import material
+from rftstatic.element import patch
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
-from rftstatic.element import patch
 
 ELEMENTS = ["RFT3", "RFT6"]
 

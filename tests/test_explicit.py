@@ -5,13 +5,14 @@ import logging
 import numpy as np
 import pytest
 
-from rftstatic.solvers.checkpoint import Checkpointer, CheckpointError, load_checkpoint, resume
-from rftstatic.solvers.explicit import InstabilityError, compare_with_static, relax, run_explicit
+from rftstatic.contact.obstacles import Floor, RoundPedestal, Sphere, SquarePedestal
 from rftstatic.element.explicit_force import ForceKernel
+from rftstatic.errors import CheckpointError, InstabilityError
 from rftstatic.material import fabric, preset
 from rftstatic.mesh.trimesh import rectangle
 from rftstatic.model.model import Model, Supports, gravity_load
-from rftstatic.contact.obstacles import Floor, RoundPedestal, Sphere, SquarePedestal
+from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint, resume
+from rftstatic.solvers.explicit import compare_with_static, relax, run_explicit
 from rftstatic.solvers.timestep import element_bound, lanczos_omega, lumped_mass, stable_time_step
 
 G = 9.80665

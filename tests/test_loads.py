@@ -6,8 +6,8 @@ import pytest
 from rftstatic import material
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
-from rftstatic.solvers import static
 from rftstatic.model.loads import LeverMoment
+from rftstatic.solvers import static
 
 
 def _rolled_strip(nx=25, ny=3, element="RFT6"):

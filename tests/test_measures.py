@@ -5,7 +5,16 @@ import json
 import numpy as np
 import pytest
 
-from rftstatic.post.measures import (boundary_loop, curvature_norm, dihedral_angles, drape_coefficient, drape_measures, fold_count, shadow_area, sharp_fold_indicator)
+from rftstatic.post.measures import (
+    boundary_loop,
+    curvature_norm,
+    dihedral_angles,
+    drape_coefficient,
+    drape_measures,
+    fold_count,
+    shadow_area,
+    sharp_fold_indicator,
+)
 
 
 def square_grid(n, side=1.0):

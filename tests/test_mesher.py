@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from rftstatic.mesh.mesher import BackgroundGrid, Domain, MeshingError, MeshQuality, generate
+from rftstatic.errors import MeshingError
+from rftstatic.mesh.mesher import BackgroundGrid, Domain, MeshQuality, generate
 from rftstatic.mesh.mesher.improve import flip_edges, signed_area
 from rftstatic.mesh.mesher.quality import unique_edges
 from rftstatic.mesh.mesher.sizefield import limit_gradation

@@ -3,7 +3,15 @@
 import numpy as np
 import pytest
 
-from rftstatic.contact.obstacles import (Floor, Obstacle, RoundPedestal, Sphere, SquarePedestal, from_spec, obstacle_types)
+from rftstatic.contact.obstacles import (
+    Floor,
+    Obstacle,
+    RoundPedestal,
+    Sphere,
+    SquarePedestal,
+    from_spec,
+    obstacle_types,
+)
 
 STEP = 1e-6  # [m], central differences on geometry of size ~1-10 cm
 

@@ -9,7 +9,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from rftstatic.io import files as output, plots
+from rftstatic.io import files as output
+from rftstatic.io import plots
 
 
 def rectangle(nx=5, ny=5, lx=4.0, ly=2.0):

@@ -5,13 +5,23 @@ import pytest
 
 from rftstatic import material
 from rftstatic.mesh import trimesh as mesh
-from rftstatic.model import model
 from rftstatic.mesh.mesher import Domain, generate
-from rftstatic.remesh.adapt import (NearObstacle, adapt_mesh, critical_damping, explicit_advance, refinable_maxima, reference_domain, remesh_relax, remesh_static, transfer_state)
-from rftstatic.scenes.schema import scene_from_dict
+from rftstatic.model import model
+from rftstatic.remesh.adapt import (
+    NearObstacle,
+    adapt_mesh,
+    critical_damping,
+    explicit_advance,
+    reference_domain,
+    refinable_maxima,
+    remesh_relax,
+    remesh_static,
+    transfer_state,
+)
 from rftstatic.remesh.sizefield import curvature_magnitude, size_field, target_sizes
-from rftstatic.solvers.static import StaticOptions, solve_static
 from rftstatic.remesh.transfer import interpolate, locate, transfer_fields
+from rftstatic.scenes.schema import scene_from_dict
+from rftstatic.solvers.static import StaticOptions, solve_static
 
 # tip (x, z) of the 5 x 1 cm wool strip on the structured 81 x 17 RFT6 mesh [m]
 # (21 x 5 gives (-32.291, -43.508) mm: the reference is converged to ~0.05 mm)
@@ -225,8 +235,8 @@ def test_critical_damping_is_that_of_a_hanging_chain():
 
 
 def test_near_obstacle_gives_the_same_kinematic_contact():
-    from rftstatic.contact.penalty import kinematic_contact
     from rftstatic.contact.obstacles import from_spec
+    from rftstatic.contact.penalty import kinematic_contact
 
     rng = np.random.default_rng(3)
     for spec in ({"type": "round-pedestal", "centre": [0, 0], "radius": 0.1, "top": 0.0, "edge_radius": 0.005},
@@ -255,9 +265,9 @@ def _strip_scene():
 
 
 def test_remesh_static_strip_reaches_structured_tip():
-    from rftstatic.scenes.build import probe_positions
+    from rftstatic.scenes.build import model_factory, probe_positions
 
-    out = remesh_static(_strip_scene(), const=4e-4, h_lower=1e-3, h_upper=4e-3, max_cycles=4, tol=0.05,
+    out = remesh_static(model_factory(_strip_scene()), const=4e-4, h_lower=1e-3, h_upper=4e-3, max_cycles=4, tol=0.05,
                         kappa_h_max=0.3)
     assert out.converged and out.result.converged
     recs = out.records
@@ -299,7 +309,7 @@ def test_driver_input_errors():
         remesh_relax(_strip, const=1e-4, h_lower=1e-3, h_upper=2e-3)
     with pytest.raises(ValueError, match="kappa_h2_max"):
         remesh_relax(_strip, const=1e-4, h_lower=1e-3, h_upper=2e-3, alpha=3.0, kappa_h2_max=-1.0)
-    with pytest.raises(TypeError, match="Scene or a callable"):
+    with pytest.raises(TypeError, match="callable mesh -> model"):
         remesh_static(42, const=1e-4, h_lower=1e-3, h_upper=2e-3)
     with pytest.raises(ValueError, match="transfer method"):
         transfer_fields(mesh.rectangle(1, 1, 3, 3), np.zeros((1, 2)), [np.zeros((9, 3))], method="rbf")

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from rftstatic.app.remeshed import remesh_options, run_remesh_scene
-from rftstatic.scenes.schema import SceneError, load_scene
+from rftstatic.errors import SceneError
+from rftstatic.scenes.schema import load_scene
 
 # a 20 x 20 cm sheet on the 10 cm pedestal, coarse enough to run in a few seconds
 TINY = ["mesh.h=4.0", "remesh.const=2.0", "remesh.h_lower=2.5", "remesh.h_upper=5.0", "remesh.every=200",
@@ -64,9 +65,9 @@ def test_remesh_options_scene_units_and_errors():
 def test_kinematic_contact_reaction_balances_weight_on_the_pedestal():
     # a flat sheet lying on the pedestal's top: the top face carries the weight of the nodes on it,
     # so the residual with the contact reaction is zero there and only the overhang is unbalanced
-    from rftstatic.scenes.build import build_model
     from rftstatic.app.dynamic import dynamic_model
     from rftstatic.app.remeshed import _with_contact_reaction
+    from rftstatic.scenes.build import build_model
 
     scene = load_scene("remesh-pedestal-square-20", TINY)
     model, extras = build_model(scene)
@@ -86,8 +87,8 @@ def test_kinematic_contact_reaction_balances_weight_on_the_pedestal():
 def _sphere_with_hold_off_the_top():
     """The tiny sphere scene shifted 0.8 cm in x: the node held in x and y (the in-plane hold
     nearest the sheet's centre) sits on the sphere where its normal is inclined."""
-    from rftstatic.scenes.build import build_model
     from rftstatic.app.dynamic import dynamic_model
+    from rftstatic.scenes.build import build_model
 
     scene = load_scene("remesh-sphere-30", ["mesh.h=3.0", "obstacles.0.centre=[0.8, 0.3, -5.0]"])
     model, extras = build_model(scene)
@@ -95,8 +96,8 @@ def _sphere_with_hold_off_the_top():
 
 
 def test_contact_reaction_at_a_node_held_in_plane_on_a_sphere():
-    from rftstatic.contact.obstacles import from_spec
     from rftstatic.app.remeshed import _with_contact_reaction
+    from rftstatic.contact.obstacles import from_spec
 
     _, plain, _ = _sphere_with_hold_off_the_top()
     i = np.flatnonzero(~plain.free[:, 0] & plain.free[:, 2])[0]  # held in x, y, free in z

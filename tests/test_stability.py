@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from rftstatic.errors import InstabilityError, PatchError
 from rftstatic.solvers import static
-from rftstatic.solvers.explicit import InstabilityError, run_explicit
-from rftstatic.element.patch import PatchError
+from rftstatic.solvers.explicit import run_explicit
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.validate import stability as st
 
@@ -61,9 +61,8 @@ def test_rft6_warns_of_membrane_locking_where_the_strip_stiffens(caplog):
     out-of-tolerance answer on a warned model as a limitation, not as a silent wrong answer."""
     import logging
 
-    from rftstatic.model.model import LOCKING_WARN, locking_number
-
     import rftstatic.model.model
+    from rftstatic.model.model import LOCKING_WARN, locking_number
 
     rftstatic.model.model._LOCKING_WARNED = False  # logged at warning level once per process
     with caplog.at_level(logging.WARNING, logger="rftstatic.model.model"):

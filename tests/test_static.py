@@ -3,11 +3,12 @@
 import numpy as np
 import pytest
 
-from conftest import clamped_strip
-from rftstatic.solvers import static
 from rftstatic.references import plates
 from rftstatic.references.elastica import heavy_elastica
+from rftstatic.solvers import static
 from rftstatic.validate.plates import plate_coefficient
+
+from conftest import clamped_strip
 
 
 def plate_centre_coefficient(n, edges, load, *, pattern="right"):

@@ -90,8 +90,8 @@ def dynamic_model(scene, model, extras):
     """
     if model.contact is None:
         return model
-    from rftstatic.scenes.build import build_supports, hold_inplane_rigid_modes
     from rftstatic.model.model import Model
+    from rftstatic.scenes.build import build_supports, hold_inplane_rigid_modes
 
     supports = build_supports(scene, model.mesh)
     if scene.get("analysis") == "relax" and scene.get("contact.hold_inplane", True):
@@ -147,7 +147,8 @@ def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True,
     -------
     The summary as written to ``summary.json`` (plain Python types, scene units).
     """
-    from rftstatic.solvers.checkpoint import CheckpointError, Checkpointer, load_checkpoint
+    from rftstatic.errors import CheckpointError
+    from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
     from rftstatic.solvers.checkpoint import resume as resume_run
     from rftstatic.solvers.explicit import run_explicit
     from rftstatic.solvers.timestep import stable_time_step
@@ -277,8 +278,8 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
 
 
 def _compare_static(scene, model, U) -> dict:
-    from rftstatic.solvers.explicit import compare_with_static
     from rftstatic.app.static import static_options
+    from rftstatic.solvers.explicit import compare_with_static
     from rftstatic.solvers.static import solve_static
 
     res = solve_static(model, options=static_options(scene, progress=False))

@@ -134,8 +134,8 @@ def solve_remesh_scene(scene, opts=None) -> dict:
 
 
 def _static(scene, opts) -> dict:
-    from rftstatic.scenes.build import build_model
     from rftstatic.remesh.adapt import remesh_static
+    from rftstatic.scenes.build import build_model
 
     meshes = []
 
@@ -160,9 +160,15 @@ def _static_opts(scene):
 
 
 def _relax(scene, opts) -> dict:
-    from rftstatic.scenes.build import build_model
     from rftstatic.app.dynamic import dynamic_model, dynamics_options
-    from rftstatic.remesh.adapt import (RemeshRecord, _curvature_figures, explicit_advance, refinable_maxima, remesh_relax)
+    from rftstatic.remesh.adapt import (
+        RemeshRecord,
+        _curvature_figures,
+        explicit_advance,
+        refinable_maxima,
+        remesh_relax,
+    )
+    from rftstatic.scenes.build import build_model
 
     d = dynamics_options(scene)
 
@@ -249,8 +255,8 @@ def _with_contact_reaction(model, obstacles):
 
 def summarize(scene, opts, run) -> dict:
     """The summary (scene units) of a :func:`solve_remesh_scene` run."""
-    from rftstatic.scenes.build import probe_positions
     from rftstatic.app.static import drape_summary
+    from rftstatic.scenes.build import probe_positions
 
     u = scene.units
     model, U = run["model"], run["U"]
@@ -292,8 +298,8 @@ def summarize(scene, opts, run) -> dict:
 
 
 def _write(scene, run, out: Path, summary: dict, *, figures=True) -> None:
-    from rftstatic.io.files import write_json
     from rftstatic.app.static import write_outputs
+    from rftstatic.io.files import write_json
 
     write_outputs(scene, run["model"], run["extras"], run["U"], out, summary, figures=figures)
     if not figures:

@@ -14,9 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from rftstatic import __version__
+from rftstatic.errors import ConvergenceError
 from rftstatic.scenes.build import build_model, probe_positions
 from rftstatic.scenes.schema import Scene
-from rftstatic.solvers.static import ConvergenceError, StaticOptions, solve_static
+from rftstatic.solvers.static import StaticOptions, solve_static
 
 log = logging.getLogger(__name__)
 

@@ -64,10 +64,11 @@ def _child(name: str, out: str, overrides: list[str], figures: bool) -> None:
     """Run one static scene in this process, save ``state.npz`` and print one JSON line of measures."""
     import resource
 
-    from rftstatic.scenes.build import build_model
     from rftstatic.app.static import static_options, static_summary, write_outputs
+    from rftstatic.errors import ConvergenceError
+    from rftstatic.scenes.build import build_model
     from rftstatic.scenes.schema import load_scene
-    from rftstatic.solvers.static import ConvergenceError, solve_static
+    from rftstatic.solvers.static import solve_static
 
     out_dir = Path(out)
     out_dir.mkdir(parents=True, exist_ok=True)

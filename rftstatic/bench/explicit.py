@@ -10,20 +10,8 @@ from __future__ import annotations
 import argparse
 import time
 
-import numpy as np
 
-
-def sheet_model(side: float, n: int, element: str = "RFT6"):
-    """The §4.6 sheet: ``side`` [m], n x n nodes, wool, two adjacent corners pinned, own weight."""
-    from rftstatic.material import preset
-    from rftstatic.mesh.trimesh import rectangle
-    from rftstatic.model.model import Model, Supports, gravity_load
-
-    mesh = rectangle(side, side, n, n)
-    mat = preset("wool-kang-yu")
-    corners = mesh.nearest_node([[0.0, side], [side, side]])
-    sup = Supports(np.zeros(0, dtype=np.int64), corners, np.zeros((mesh.n_nodes, 3), bool))
-    return Model(mesh, mat, element=element, supports=sup, load=gravity_load(mesh, mat.weight))
+from rftstatic.bench.problems import sheet_model
 
 
 def measure(model, *, steps: int, backend: str) -> dict:

@@ -38,8 +38,8 @@ def _line(name, seconds, target=None, extra=""):
 
 def bench_strip(nx=51, ny=11, element="RFT6") -> dict:
     """Full static solve of the clamped wool strip with ``nx`` x ``ny`` nodes."""
+    from rftstatic.bench.problems import strip_model
     from rftstatic.solvers import static
-    from rftstatic.validate.strip import strip_model
 
     t0 = time.perf_counter()
     mod = strip_model(nx, ny, element=element)
@@ -52,8 +52,8 @@ def bench_strip(nx=51, ny=11, element="RFT6") -> dict:
 
 def bench_newton(n=81, side=0.2, element="RFT6") -> dict:
     """One Newton iteration on an n x n-node wool sheet: assembly, factorisation, solve [s]."""
+    from rftstatic.bench.problems import sheet_model
     from rftstatic.solvers import linear as linsolve
-    from rftstatic.bench.explicit import sheet_model
 
     mod = sheet_model(side, n, element)
     rng = np.random.default_rng(0)
@@ -94,9 +94,9 @@ def bench_newton(n=81, side=0.2, element="RFT6") -> dict:
 
 def bench_construction(n=708) -> dict:
     """Patch topology/curvature operator and bending stiffness of an n x n-node rectangle [s]."""
+    from rftstatic.element.patch import bending_stiffness, build_patches
     from rftstatic.material import preset
     from rftstatic.mesh.trimesh import rectangle
-    from rftstatic.element.patch import bending_stiffness, build_patches
 
     mesh = rectangle(1.0, 1.0, n, n)
     mesh.topology  # edge topology is part of the mesh, built before the timing

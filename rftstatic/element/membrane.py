@@ -20,8 +20,8 @@ from functools import cached_property
 import numpy as np
 
 from rftstatic.compiled import numba_available
-from rftstatic.mesh.trimesh import TriMesh
 from rftstatic.element.patch import Patches
+from rftstatic.mesh.trimesh import TriMesh
 
 ELEMENTS = ("RFT3", "RFT6")
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from rftstatic.errors import PatchError
 from rftstatic.mesh.trimesh import TriMesh
 
 log = logging.getLogger(__name__)
@@ -34,9 +35,6 @@ COND_ERROR = 1e10
 COND_WARN = 1e6
 """Condition number above which a patch is reported as badly conditioned (a warning)."""
 
-
-class PatchError(ValueError):
-    """A singular patch: its six points lie (nearly) on one conic (method.md)."""
 
 
 def quadratic_basis(x, y):

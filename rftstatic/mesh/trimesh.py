@@ -14,11 +14,10 @@ from functools import cached_property
 
 import numpy as np
 
+from rftstatic.errors import MeshError
+
 PATTERNS = ("right", "left", "alternate", "union-jack")
 
-
-class MeshError(ValueError):
-    """Invalid mesh input; the message names the problem and what to do."""
 
 
 @dataclass(frozen=True, eq=False)

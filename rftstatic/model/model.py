@@ -19,11 +19,11 @@ from functools import cached_property
 
 import numpy as np
 
-from rftstatic.model.assembly import AssemblyPlan, scatter_forces, scatter_matrices
-from rftstatic.material import Material
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
-from rftstatic.mesh.trimesh import TriMesh
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
+from rftstatic.material import Material
+from rftstatic.mesh.trimesh import TriMesh
+from rftstatic.model.assembly import AssemblyPlan, scatter_forces, scatter_matrices
 
 log = logging.getLogger(__name__)
 

@@ -106,8 +106,8 @@ def adapt_mesh(mesh, kappa, *, const, h_lower, h_upper, gradation=1.3, domain=No
     new_mesh : :class:`rftstatic.mesh.TriMesh` in the same plane z0, ``info["quality"]`` the mesher's figures
     result : :class:`rftstatic.mesher.MeshResult`
     """
-    from rftstatic.mesh.trimesh import TriMesh
     from rftstatic.mesh.mesher import generate
+    from rftstatic.mesh.trimesh import TriMesh
 
     if domain is None:
         domain = reference_domain(mesh)
@@ -174,15 +174,10 @@ class RemeshRecord:
 
 
 def _factory(problem):
-    """``mesh -> (model, extras)`` from a Scene or a callable (``mesh=None``: the initial mesh)."""
-    from rftstatic.scenes.schema import Scene
-
-    if isinstance(problem, Scene):
-        from rftstatic.scenes.build import build_model
-
-        return lambda mesh=None: build_model(problem, mesh=mesh)
+    """``mesh -> (model, extras)`` from a callable ``factory(mesh)`` (``mesh=None``: the initial mesh)."""
     if not callable(problem):
-        raise TypeError(f"problem must be a Scene or a callable mesh -> model, got {type(problem).__name__}")
+        raise TypeError(f"problem must be a callable mesh -> model (e.g. a scene's model factory, "
+                        f"rftstatic.scenes.build.model_factory), got {type(problem).__name__}")
 
     def make(mesh=None):
         out = problem(mesh)
@@ -275,9 +270,8 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
 
     Parameters
     ----------
-    problem : :class:`rftstatic.scene.Scene` (rebuilt with ``build_model(scene, mesh=...)``), or a
-        callable ``factory(mesh) -> Model`` or ``-> (Model, extras)``; ``factory(None)`` gives the
-        initial mesh's model
+    problem : a callable ``factory(mesh) -> Model`` or ``-> (Model, extras)``; ``factory(None)`` gives
+        the initial mesh's model (for a scene: :func:`rftstatic.scenes.build.model_factory`)
     const, h_lower, h_upper : Eq. 29 [m]: h_new = sqrt(const / |kappa|) clipped to [h_lower, h_upper]
     max_cycles : at most this many remeshes after the initial solve
     tol : stop when the next mesh's node count differs by less than this fraction [-] ...
@@ -288,8 +282,8 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         scenes: const / h_lower = 1, measured max |kappa| h 0.86-1.5 on settled meshes)
     gradation : gradation limit of the size field (ratio >= 1)
     transfer : ``"mesh"`` or ``"grid"`` (:mod:`rftstatic.transfer`)
-    options : :class:`rftstatic.static.StaticOptions` of the first solve (default: scene's
-        ``[solver]`` table, or the defaults); later solves start from the transferred state at
+    options : :class:`rftstatic.solvers.newton.StaticOptions` of the first solve (default: the
+        defaults, without a progress bar); later solves start from the transferred state at
         full load (one load step) and fall back to the full load ramp from flat if that fails
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
 
@@ -304,8 +298,8 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
     rftstatic.static.ConvergenceError
         when a solve fails even from flat (its ``.result`` is the last equilibrium)
     """
-    from rftstatic.scenes.schema import Scene
-    from rftstatic.solvers.static import ConvergenceError, StaticOptions, solve_static
+    from rftstatic.errors import ConvergenceError
+    from rftstatic.solvers.static import StaticOptions, solve_static
 
     if kappa_h_max is not None and not kappa_h_max > 0:
         raise ValueError(f"kappa_h_max = {kappa_h_max!r} must be a positive relative curvature or None")
@@ -315,12 +309,7 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         raise ValueError(f'transfer = "{transfer}" is unknown; use one of {", ".join(METHODS)}')
     make = _factory(problem)
     if options is None:
-        if isinstance(problem, Scene):
-            from rftstatic.app.static import static_options
-
-            options = static_options(problem, progress=False)
-        else:
-            options = StaticOptions(progress=False)
+        options = StaticOptions(progress=False)
     t0 = time.perf_counter()
     model, extras = make(None)
     _check_common(model.mesh, const, h_lower, h_upper, tol)
@@ -550,7 +539,7 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
 
     Parameters
     ----------
-    problem : Scene or ``factory(mesh) -> Model | (Model, extras)`` (as in :func:`remesh_static`)
+    problem : ``factory(mesh) -> Model | (Model, extras)`` (as in :func:`remesh_static`)
     const, h_lower, h_upper : Eq. 29 [m]
     advance : ``advance(model, U, V, n_steps) -> (U, V, t_advanced)``; default
         :func:`explicit_advance` with ``alpha``, ``mass_scale`` and the scene's obstacles

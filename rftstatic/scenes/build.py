@@ -204,8 +204,8 @@ def build_contact(scene: Scene, mesh, material, supports: Supports):
     specs = scene.get("obstacles", [])
     if not specs:
         return None, []
-    from rftstatic.contact.penalty import PenaltyContact, auto_penalty
     from rftstatic.contact.obstacles import from_spec
+    from rftstatic.contact.penalty import PenaltyContact, auto_penalty
 
     obstacles = []
     for i, spec in enumerate(specs):
@@ -263,6 +263,12 @@ def build_model(scene: Scene, mesh=None) -> tuple[Model, dict]:
             raise scene.error(f"probes.{i}", "a probe needs a name and at = [x, y]")
         probes[spec["name"]] = np.asarray(spec["at"], float) * u
     return model, {"obstacles": obstacles, "probes": probes}
+
+
+def model_factory(scene: Scene):
+    """``factory(mesh=None) -> (Model, extras)``: the scene's model on ``mesh`` (None: its own mesh),
+    for the remeshing drivers (:mod:`rftstatic.remesh`), which rebuild the model on every new mesh."""
+    return lambda mesh=None: build_model(scene, mesh=mesh)
 
 
 def probe_positions(model: Model, probes: dict, U: np.ndarray) -> dict:

@@ -13,8 +13,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 
+from rftstatic.errors import SceneError
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
@@ -125,9 +125,6 @@ SCHEMA = {
     }, "what a run writes"),
 }
 
-
-class SceneError(ValueError):
-    """Invalid scene; the message names the file, the key and the value, and what to do."""
 
 
 @dataclass

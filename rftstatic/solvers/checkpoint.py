@@ -21,13 +21,12 @@ from pathlib import Path
 
 import numpy as np
 
+from rftstatic.errors import CheckpointError
+
 log = logging.getLogger(__name__)
 
 FORMAT = 1
 
-
-class CheckpointError(ValueError):
-    """A checkpoint that cannot be used (wrong model, unknown format, missing file)."""
 
 
 def model_fingerprint(model) -> str:

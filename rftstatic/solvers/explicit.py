@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.element.explicit_force import ForceKernel
+from rftstatic.errors import InstabilityError
 from rftstatic.progress import Progress
 from rftstatic.solvers.timestep import StepEstimate, lumped_mass, stable_time_step
 
@@ -50,13 +51,6 @@ log = logging.getLogger(__name__)
 HISTORY_KEYS = ("time", "kinetic", "potential", "strain", "external_work", "dissipated", "contact_loss", "total",
                 "residual")
 
-
-class InstabilityError(RuntimeError):
-    """The explicit run became unstable; attributes ``t``, ``step``, ``dt`` and ``suggested_dt`` [s]."""
-
-    def __init__(self, message, *, t, step, dt, suggested_dt):
-        super().__init__(message)
-        self.t, self.step, self.dt, self.suggested_dt = t, step, dt, suggested_dt
 
 
 @dataclass

@@ -25,19 +25,13 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
+from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
+from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
 from rftstatic.units import STANDARD_GRAVITY
 
 log = logging.getLogger(__name__)
 
-
-class ConvergenceError(RuntimeError):
-    """The static solve failed; ``result`` holds the last equilibrium reached (not converged)."""
-
-    def __init__(self, message, result=None):
-        super().__init__(message)
-        self.result = result
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -246,7 +240,8 @@ def _relax_then_newton(model, opts, callback, *, first):
     the 80 cm sheet did). The relaxation ends at rest at half the solver's ``rtol`` or at its time
     limit; Newton then finishes with the solver's own budget.
     """
-    from rftstatic.solvers.explicit import InstabilityError, relax
+    from rftstatic.errors import InstabilityError
+    from rftstatic.solvers.explicit import relax
     from rftstatic.solvers.timestep import stable_time_step
 
     t0 = time.perf_counter()
@@ -349,7 +344,8 @@ def _guided_relaxation(model, opts: StaticOptions, *, mass_scale, alpha, U0, fai
     stays about the same and the load stays downward) for :data:`GUIDE_DAMPING_TIMES` damping
     times; the model itself keeps its true load.
     """
-    from rftstatic.solvers.explicit import InstabilityError, relax
+    from rftstatic.errors import InstabilityError
+    from rftstatic.solvers.explicit import relax
 
     guided = model.load * (1.0 + opts.guide_weight * fold_pattern(model.mesh, opts.guide_folds, opts.seed))[:, None]
     try:

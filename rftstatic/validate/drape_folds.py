@@ -27,7 +27,15 @@ import os
 
 import numpy as np
 
-from rftstatic.validate.drape_common import (cache_root, copy_views, drape_run, mesh_label, run_cached_only, solve_row, status)
+from rftstatic.validate.drape_common import (
+    cache_root,
+    copy_views,
+    drape_run,
+    mesh_label,
+    run_cached_only,
+    solve_row,
+    status,
+)
 from rftstatic.validate.report import BenchmarkResult
 
 SCENE = "pedestal-round-50"

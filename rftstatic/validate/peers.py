@@ -40,7 +40,6 @@ from functools import lru_cache
 import numpy as np
 
 from rftstatic.mesh import trimesh as mesh
-from rftstatic.model import model
 from rftstatic.references import plates as plate_refs
 from rftstatic.validate import plates
 from rftstatic.validate.report import BenchmarkResult, Study, fmt_err, fmt_time, observed_rate, time_to_error

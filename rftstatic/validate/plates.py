@@ -18,9 +18,9 @@ import numpy as np
 from rftstatic import material
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
-from rftstatic.solvers import static
 from rftstatic.references import plates
-from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures, fmt_err
+from rftstatic.solvers import static
+from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures
 
 SHELL = material.isotropic_shell(E=1.0e4, nu=0.3, thickness=0.01)
 LINEAR = static.StaticOptions(initial_increment=1.0, increment_displacement=1e9, progress=False)

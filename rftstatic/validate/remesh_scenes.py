@@ -79,9 +79,9 @@ def curve_distance(a, b, *, step=None) -> float:
 
 def _solve(name, overrides):
     """Run a scene (any route) and return (summary, (N, 3) deformed x [scene length], tri, wall [s])."""
-    from rftstatic.scenes.build import build_model
     from rftstatic.app.remeshed import remesh_options
     from rftstatic.app.static import static_options
+    from rftstatic.scenes.build import build_model
     from rftstatic.scenes.schema import load_scene
     from rftstatic.solvers.static import solve_static
 
@@ -96,7 +96,7 @@ def _solve(name, overrides):
         s = summarize(scene, remesh_options(scene), run)
     else:
         from rftstatic.app.static import static_summary
-        from rftstatic.solvers.static import ConvergenceError
+        from rftstatic.errors import ConvergenceError
 
         model, extras = build_model(scene)
         try:
@@ -135,7 +135,7 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
         for label, over in routes:
             target = ref_name if label.startswith("structured") else name
             over = (ref_over + over) if label.startswith("structured") else over
-            from rftstatic.solvers.static import ConvergenceError
+            from rftstatic.errors import ConvergenceError
 
             t0 = time.perf_counter()
             try:

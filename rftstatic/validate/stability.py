@@ -94,8 +94,8 @@ def _solve(mod, opts=None):
 def strip_cell(nx=21, ny=5, *, element="RFT6", ratio=None, alpha=None, one_step=False, mesh_kind=None,
                h=None, jitter=None, seed=0, degenerate=None) -> dict:
     """The wool strip against the extensible heavy elastica (see module docstring)."""
-    from rftstatic.solvers import static
     from rftstatic.references.elastica import heavy_elastica
+    from rftstatic.solvers import static
 
     m = _strip_mesh(nx, ny, mesh_kind=mesh_kind, h=h, jitter=jitter, seed=seed, degenerate=degenerate)
     mod = _strip(nx, ny, element=element, ratio=ratio, alpha=alpha, mesh_=m)
@@ -147,9 +147,10 @@ def _strip_mesh(nx, ny, *, mesh_kind=None, h=None, jitter=None, seed=0, degenera
 
 def pedestal_cell(n=17, *, ratio=None, one_step=False) -> dict:
     """pedestal-square-20 at n x n nodes; ``ratio`` C/B [1/cm^2] via a full material table."""
-    from rftstatic.scenes import build, schema as scene
     from rftstatic import material
     from rftstatic.app import static as run
+    from rftstatic.scenes import build
+    from rftstatic.scenes import schema as scene
     from rftstatic.solvers import static
 
     overrides = [f"mesh.nodes=[{n},{n}]"]
@@ -174,7 +175,8 @@ def pedestal_cell(n=17, *, ratio=None, one_step=False) -> dict:
 
 def scene_override_cell() -> dict:
     """The scene path: ``[material] preset = ...`` with an override (``material.C_warp=...``)."""
-    from rftstatic.scenes import build, schema as scene
+    from rftstatic.scenes import build
+    from rftstatic.scenes import schema as scene
 
     s = scene.load_scene("pedestal-square-20", ["mesh.nodes=[9,9]", "material.C_warp=111.82"])
     mat = build.build_material(s)
@@ -199,7 +201,7 @@ def end_moment_cell(nx=25, ny=3, *, element="RFT6", steps_per_table=4) -> dict:
 
     r = end_moment(nx, ny, element, load_sze2004("end_moment"), steps_per_table=steps_per_table)
     if not r["converged"]:
-        from rftstatic.solvers.static import ConvergenceError
+        from rftstatic.errors import ConvergenceError
 
         raise ConvergenceError(r["message"])
     return {"converged": True, "value": r["value"], "reference": r["reference"], "error": r["error"],
@@ -208,7 +210,8 @@ def end_moment_cell(nx=25, ny=3, *, element="RFT6", steps_per_table=4) -> dict:
 
 
 def _hang(n):
-    from rftstatic.scenes import build, schema as scene
+    from rftstatic.scenes import build
+    from rftstatic.scenes import schema as scene
 
     s = scene.load_scene("hang-20", [f"mesh.nodes=[{n},{n}]"])
     mod, extras = build.build_model(s)
@@ -222,7 +225,8 @@ def explicit_dt_cell(n=11, *, factor=1.0, steps=1500, alpha=5.0) -> dict:
     Reference: the same time at half the automatic step (free-corner displacement). Above the
     critical step an :class:`InstabilityError` is the right behaviour, if the step it suggests runs.
     """
-    from rftstatic.solvers.explicit import InstabilityError, run_explicit
+    from rftstatic.errors import InstabilityError
+    from rftstatic.solvers.explicit import run_explicit
     from rftstatic.solvers.timestep import stable_time_step
 
     mod, corner = _hang(n)

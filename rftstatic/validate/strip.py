@@ -10,31 +10,18 @@ across it, ``warp_angle = 90 deg``). Studies: RFT3 and RFT6 on meshes (nx, ny) =
 
 from __future__ import annotations
 
-import dataclasses
 import time
 
 import numpy as np
 
-from rftstatic import material
-from rftstatic.mesh import trimesh as mesh
-from rftstatic.model import model
-from rftstatic.solvers import static
+from rftstatic.bench.problems import STRIP_LENGTH, STRIP_WIDTH, strip_model
 from rftstatic.references.elastica import heavy_elastica
+from rftstatic.solvers import static
 from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures, fmt_err
 
-L, WIDTH = 0.05, 0.01  # [m]
+L, WIDTH = STRIP_LENGTH, STRIP_WIDTH  # [m]
 TOLERANCE = 0.005  # tip error / L on the finest mesh
 PATTERN_REPORT_LIMIT = 0.01
-
-
-def strip_model(nx, ny, *, element="RFT6", pattern="right", warp_angle_deg=0.0, alpha=None):
-    """The §4.1 strip clamped at x = 0 under its weight; ``alpha`` rescales the weight to w = alpha B / L^3."""
-    m = mesh.rectangle(L, WIDTH, nx, ny, origin=(0.0, -WIDTH / 2), pattern=pattern)
-    mat = material.preset("wool-kang-yu", warp_angle_deg=warp_angle_deg)
-    if alpha is not None:
-        mat = dataclasses.replace(mat, weight=alpha * mat.Db[0, 0] / L**3)
-    sup = model.Supports(m.nodes_in_box(0, 0, -1, 1), np.zeros(0, np.int64), np.zeros((m.n_nodes, 3), bool))
-    return model.Model(m, mat, element=element, supports=sup, load=model.gravity_load(m, mat.weight))
 
 
 def solve_strip(nx, ny, **kw) -> dict:

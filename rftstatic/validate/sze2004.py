@@ -30,8 +30,8 @@ import numpy as np
 from rftstatic import material
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
-from rftstatic.solvers import static
 from rftstatic.references import END_MOMENT, END_SHEAR, SLIT_ANNULAR, load_sze2004
+from rftstatic.solvers import static
 from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures, fmt_err
 
 TOLERANCE = 0.03

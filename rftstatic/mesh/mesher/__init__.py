@@ -31,8 +31,8 @@ constrained Laplacian smoothing, local optimisation of the worst nodes
 ``python -m rftstatic.mesher.bench`` times meshes of 2k, 20k and 200k nodes.
 """
 
+from rftstatic.errors import MeshingError
 from rftstatic.mesh.mesher.domain import Domain, Loop
-from rftstatic.mesh.mesher.errors import MeshingError
 from rftstatic.mesh.mesher.generate import MeshResult, generate
 from rftstatic.mesh.mesher.quality import MeshQuality, measure_quality
 from rftstatic.mesh.mesher.sizefield import BackgroundGrid

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rftstatic.mesh.mesher.errors import MeshingError
+from rftstatic.errors import MeshingError
 
 __all__ = ["Loop", "Domain"]
 

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from rftstatic.mesh.mesher.errors import MeshingError
+from rftstatic.errors import MeshingError
 
 __all__ = ["advance_front"]
 

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rftstatic.errors import MeshingError
 from rftstatic.mesh.mesher.domain import Domain
-from rftstatic.mesh.mesher.errors import MeshingError
 from rftstatic.mesh.mesher.front import advance_front
 from rftstatic.mesh.mesher.improve import improve
 from rftstatic.mesh.mesher.quality import MeshQuality, measure_quality

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rftstatic.mesh.mesher.errors import MeshingError
+from rftstatic.errors import MeshingError
 
 __all__ = ["BackgroundGrid", "limit_gradation"]
 
