@@ -18,4 +18,6 @@ import os as _os
 # setting wins.
 _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-__version__ = "0.1.0"
+from rftstatic.provenance import __version__  # noqa: E402
+
+__all__ = ["__version__"]

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic import __version__
+from rftstatic.provenance import __version__
 
 log = logging.getLogger(__name__)
 

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic import __version__
+from rftstatic.provenance import __version__
 from rftstatic.remesh.adapt import DAMPING
 from rftstatic.remesh.transfer import METHODS
 

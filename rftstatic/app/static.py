@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic import __version__
+from rftstatic.provenance import __version__
 from rftstatic.errors import ConvergenceError
 from rftstatic.scenes.build import build_model, probe_positions
 from rftstatic.scenes.schema import Scene

@@ -113,7 +113,7 @@ def _machine() -> dict:
     import os
     import platform
 
-    from rftstatic import __version__
+    from rftstatic.provenance import __version__
 
     return {"cpus": os.cpu_count(), "python": platform.python_version(), "rftstatic": __version__,
             "date": time.strftime("%Y-%m-%d %H:%M"), "load_before": _load()}
