@@ -12,8 +12,6 @@ import ast
 import configparser
 from pathlib import Path
 
-import pytest
-
 import rftstatic
 
 PACKAGE = Path(rftstatic.__file__).resolve().parent
