@@ -12,7 +12,9 @@ from rftstatic.material import fabric, preset
 from rftstatic.mesh.trimesh import rectangle
 from rftstatic.model.model import Model, Supports, gravity_load
 from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint, resume
-from rftstatic.solvers.explicit import compare_with_static, relax, run_explicit
+from rftstatic.solvers.explicit import run_explicit
+from rftstatic.solvers.relaxation import relax
+from rftstatic.solvers.static import compare_with_static
 from rftstatic.solvers.timestep import element_bound, lanczos_omega, lumped_mass, stable_time_step
 
 G = 9.80665

@@ -5,7 +5,7 @@ import pytest
 
 from rftstatic.references import plates
 from rftstatic.references.elastica import heavy_elastica
-from rftstatic.solvers import static
+from rftstatic.solvers import perturbation, static
 from rftstatic.validate.plates import plate_coefficient
 
 from conftest import clamped_strip
@@ -135,7 +135,7 @@ def test_fold_perturbation_has_n_fold_symmetry():
 
     mesh = rectangle(0.5, 0.5, 41, 41, origin=(-0.25, -0.25))
     opts = static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=3)
-    w = static.start_perturbation(mesh, opts)
+    w = perturbation.start_perturbation(mesh, opts)
     h = float(mesh.element_size.mean())
     # the edge (r / R >= 1 / sqrt 2) passes every angle, so some node lifts by at least half the amplitude
     assert w.min() >= 0.0 and w.max() <= 2.0 * h * (1 + 1e-12) and w.max() > 0.5 * 2.0 * h
@@ -146,7 +146,7 @@ def test_fold_perturbation_has_n_fold_symmetry():
     partner = np.array([index[tuple(np.round(p, 9))] for p in turned])
     np.testing.assert_allclose(w[partner], w, atol=1e-12 * h)
     # a different seed turns the pattern (another phase), the random start is something else again
-    assert not np.allclose(static.start_perturbation(mesh, opts), static.start_perturbation(
+    assert not np.allclose(perturbation.start_perturbation(mesh, opts), perturbation.start_perturbation(
         mesh, static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=4)))
     with pytest.raises(ValueError, match="perturbation_folds"):
         static.StaticOptions(perturbation_folds=-1)
@@ -169,7 +169,7 @@ def test_fold_pattern_and_guide_options():
     from rftstatic.mesh.trimesh import rectangle
 
     mesh = rectangle(0.5, 0.5, 21, 21, origin=(-0.25, -0.25))
-    p = static.fold_pattern(mesh, 12, seed=1)
+    p = perturbation.fold_pattern(mesh, 12, seed=1)
     assert np.abs(p).max() <= 1.0 + 1e-12 and p.max() > 0.6 and p.min() < -0.6
     X = mesh.X - mesh.X.mean(axis=0)
     assert np.abs(p[np.hypot(X[:, 0], X[:, 1]) < 1e-12]).max() < 1e-20  # zero at the centre

@@ -279,8 +279,7 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
 
 def _compare_static(scene, model, U) -> dict:
     from rftstatic.app.static import static_options
-    from rftstatic.solvers.explicit import compare_with_static
-    from rftstatic.solvers.static import solve_static
+    from rftstatic.solvers.static import compare_with_static, solve_static
 
     res = solve_static(model, options=static_options(scene, progress=False))
     cmp = compare_with_static(model, U, res.U)

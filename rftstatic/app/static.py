@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic.provenance import __version__
 from rftstatic.errors import ConvergenceError
+from rftstatic.provenance import __version__
 from rftstatic.scenes.build import build_model, probe_positions
 from rftstatic.scenes.schema import Scene
 from rftstatic.solvers.static import StaticOptions, solve_static

@@ -13,7 +13,6 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-
 from rftstatic.errors import SceneError
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 

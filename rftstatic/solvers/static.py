@@ -1,168 +1,31 @@
-"""Static drape: load-scaled Newton iteration on the total potential energy (method.md, §4).
+"""The static route (method.md, §4 and §6): load-scaled Newton, dynamic relaxation, or both.
 
-The gravity/load factor ``lam`` rises from 0 to 1 in adaptive increments. At each increment a
-Newton iteration minimises Pi(U) = E_b + E_m + E_c - lam P.U:
-
-1. tangent: the exact Hessian first; if the Cholesky factorisation finds it indefinite (membrane
-   compression) or the step is not a descent direction, the compressive stress is dropped from the
-   geometric stiffness (positive semi-definite membrane tangent), and if needed a
-   Levenberg-Marquardt shift is added;
-2. the step is scaled so that no node moves more than ``max_step`` (the "simple scaling" of Liu &
-   Sze 2009), which keeps the first steps from a flat start in range;
-3. an Armijo backtracking line search on Pi makes every accepted step lower the energy;
-4. convergence needs both the force residual ``|r| <= rtol |lam P|`` and the energy criterion
-   ``|d . r_new| <= etol max(|d_1 . r_0|, |lam P.U|)`` (work of the residual on the last step).
-An increment that does not converge is cut back (``increment / 4``) from the last equilibrium;
-below ``min_increment`` the solve stops with :class:`ConvergenceError`, which carries the last
-equilibrium, labelled as not converged.
+:func:`solve_static` runs the load-scaled Newton iteration (:mod:`rftstatic.solvers.newton`) from the
+flat start; when it cannot get through (a drape whose many folds snap through one after another), or
+when ``start = "relax"``, dynamic relaxation at full load (:mod:`rftstatic.solvers.relaxation`) brings
+the sheet near rest and Newton polishes the equilibrium to the same tolerance. The result is checked
+to be a stable minimum (one Cholesky factorisation of the exact tangent).
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError
-from rftstatic.progress import Progress
+from rftstatic.errors import ConvergenceError, InstabilityError
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
+from rftstatic.solvers.newton import StaticOptions, StaticResult, solve_load_steps
+from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
+from rftstatic.solvers.relaxation import relax
+from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.units import STANDARD_GRAVITY
 
+__all__ = ["ConvergenceError", "StaticOptions", "StaticResult", "solve_static", "compare_with_static"]
+
 log = logging.getLogger(__name__)
-
-
-
-@dataclass(frozen=True, kw_only=True)
-class StaticOptions:
-    """Options of :func:`solve_static` (scene table ``[solver]``).
-
-    Attributes
-    ----------
-    initial_increment, min_increment, max_increment : load-factor increments [-]
-    max_iterations : Newton iterations per increment
-    rtol : force tolerance, relative to the applied load |lam P| [-], at full load
-    intermediate_rtol : looser force tolerance for the increments on the way to full load [-]
-    etol : energy tolerance on the work of the residual over the last step, relative to the larger
-        of the first step's work and the work of the applied load [-]
-    max_step : cap on the largest nodal increment per Newton iteration [m]; ``None``: 10 % of the
-        sheet's diagonal
-    increment_displacement : target largest nodal displacement per load increment [m], from which
-        the next increment is sized by the secant (first: tangent) rate d|U|/d lam; ``None``: 5 %
-        of the sheet's diagonal. Halved or grown with the Newton iteration count.
-    line_search : Armijo backtracking on Pi
-    tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
-    linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
-    max_load_steps : give up after this many increments
-    start : ``"load-steps"`` (load-scaled Newton from the flat start) or ``"relax"`` (dynamic
-        relaxation at full load, then Newton to polish: for drapes with many folds)
-    relax_fallback : when the load steps fail, try dynamic relaxation + Newton before giving up
-    reuse_factorisation : how many further steps may reuse a factorisation while the residual keeps
-        falling by more than 70 % per step (modified Newton; 0 = full Newton)
-    max_continuations : an increment whose Newton iteration runs out of iterations while the energy
-        is still falling markedly (snap-through into a fold) continues from where it stopped, up to
-        this many times, instead of cutting back
-    perturbation : amplitude of a seeded random out-of-plane start, in element sizes [-]
-    seed : seed of that perturbation
-    perturbation_folds : 0 for random low Fourier modes; n > 0 for an n-fold lift around the sheet's
-        centre (:func:`fold_perturbation`), to look for the drape branch with n folds
-    guide_folds, guide_weight : ``start = "relax"`` only: during the first stage of the relaxation
-        (:data:`GUIDE_DAMPING_TIMES` damping times) the weight is modulated by
-        ``1 + guide_weight (r/R)^2 cos(n theta + phi)`` with n = ``guide_folds`` (:func:`fold_pattern`),
-        then restored, so that the sheet falls into n folds and the rest of the relaxation tells
-        whether that drape is a stable equilibrium; 0 = no guide
-    """
-
-    initial_increment: float = 0.1
-    min_increment: float = 1e-5
-    max_increment: float = 1.0
-    max_iterations: int = 30
-    rtol: float = 1e-6
-    intermediate_rtol: float = 0.1
-    etol: float = 1e-12
-    max_step: float | None = None
-    increment_displacement: float | None = None
-    line_search: bool = True
-    tangent: str = "auto"
-    linear_solver: str = "auto"
-    max_load_steps: int = 2000
-    max_continuations: int = 10
-    reuse_factorisation: int = 2
-    start: str = "load-steps"
-    relax_fallback: bool = True
-    perturbation: float = 0.0
-    seed: int = 0
-    perturbation_folds: int = 0
-    guide_folds: int = 0
-    guide_weight: float = 0.0
-    progress: bool = True
-
-    def __post_init__(self):
-        if self.start not in ("load-steps", "relax"):
-            raise ValueError(f'solver.start must be "load-steps" or "relax", got "{self.start}"')
-        if self.tangent not in ("auto", "exact", "psd"):
-            raise ValueError(f'solver.tangent must be "auto", "exact" or "psd", got "{self.tangent}"')
-        if not (0 < self.min_increment <= self.initial_increment <= self.max_increment <= 1):
-            raise ValueError(
-                "need 0 < min_increment <= initial_increment <= max_increment <= 1, got "
-                f"{self.min_increment}, {self.initial_increment}, {self.max_increment}")
-        if self.perturbation_folds < 0:
-            raise ValueError(f"solver.perturbation_folds must be 0 (random modes) or a fold count, "
-                             f"got {self.perturbation_folds}")
-        if self.guide_folds < 0 or not (0.0 <= self.guide_weight < 1.0):
-            raise ValueError(f"solver.guide_folds must be >= 0 and solver.guide_weight in [0, 1) (a weight "
-                             f"modulation that keeps the weight downward), got {self.guide_folds}, {self.guide_weight}")
-        if self.guide_folds and self.guide_weight and self.start != "relax":
-            raise ValueError('solver.guide_folds guides the dynamic relaxation: it needs solver.start = "relax"')
-        if self.rtol <= 0 or self.max_iterations < 1:
-            raise ValueError(f"need rtol > 0 and max_iterations >= 1, got {self.rtol}, {self.max_iterations}")
-
-
-@dataclass
-class StaticResult:
-    """Outcome of :func:`solve_static`.
-
-    Attributes
-    ----------
-    U : (N, 3) displacements of the last equilibrium [m]
-    lam : load factor reached [-]
-    converged : True only if lam = 1 was reached in equilibrium
-    load_steps : one record per accepted increment (load factor, iterations, residual, tangents)
-    """
-
-    U: np.ndarray
-    lam: float
-    converged: bool
-    load_steps: list = field(default_factory=list)
-    iterations: int = 0
-    cutbacks: int = 0
-    linear_solver: str = ""
-    wall_time: float = 0.0
-    energies: dict = field(default_factory=dict)
-    residual: float = float("nan")
-    stable: bool | None = None
-    message: str = ""
-    tangent_modes: dict = field(default_factory=dict)
-    seed: int | None = None
-    route: str = "load-steps"
-    relax: dict = field(default_factory=dict)
-
-    def summary(self) -> dict:
-        d = {k: v for k, v in asdict(self).items() if k != "U"}
-        d["load_step_count"] = len(self.load_steps)
-        return d
-
-
-@dataclass
-class _Newton:
-    converged: bool
-    U: np.ndarray
-    iterations: int
-    residual: float
-    reason: str = ""
-    stable: bool | None = None
-    descending: bool = False  # the energy still fell markedly over the last iterations
 
 
 def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
@@ -191,7 +54,7 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     if opts.start == "relax":
         return _check_stability(model, _relax_then_newton(model, opts, callback, first=None), opts)
     try:
-        return _check_stability(model, _solve_load_steps(model, U0=U0, options=opts, callback=callback), opts)
+        return _check_stability(model, solve_load_steps(model, U0=U0, options=opts, callback=callback), opts)
     except ConvergenceError as exc:
         if not opts.relax_fallback or model.load_terms or not np.any(model.load):
             raise
@@ -240,10 +103,6 @@ def _relax_then_newton(model, opts, callback, *, first):
     the 80 cm sheet did). The relaxation ends at rest at half the solver's ``rtol`` or at its time
     limit; Newton then finishes with the solver's own budget.
     """
-    from rftstatic.errors import InstabilityError
-    from rftstatic.solvers.explicit import relax
-    from rftstatic.solvers.timestep import stable_time_step
-
     t0 = time.perf_counter()
     size = float(np.ptp(model.mesh.X, axis=0).max())
     omega1 = np.sqrt(STANDARD_GRAVITY / (0.25 * size))  # pendulum estimate of the lowest drape mode
@@ -309,7 +168,7 @@ def _relax_then_newton(model, opts, callback, *, first):
             # start needed 19 of them: 80 iterations each cost it 20 minutes)
             long_try = tol_force < 1.0 and not any(h.get("basin") for h in info["handovers"][:-1])
             handover["basin"] = tol_force < 1.0
-            res = _solve_load_steps(model, U0=U, options=polish if final else basin if long_try else short,
+            res = solve_load_steps(model, U0=U, options=polish if final else basin if long_try else short,
                                     callback=callback)
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
@@ -344,9 +203,6 @@ def _guided_relaxation(model, opts: StaticOptions, *, mass_scale, alpha, U0, fai
     stays about the same and the load stays downward) for :data:`GUIDE_DAMPING_TIMES` damping
     times; the model itself keeps its true load.
     """
-    from rftstatic.errors import InstabilityError
-    from rftstatic.solvers.explicit import relax
-
     guided = model.load * (1.0 + opts.guide_weight * fold_pattern(model.mesh, opts.guide_folds, opts.seed))[:, None]
     try:
         return relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=1.0,
@@ -367,358 +223,13 @@ def _positive_definite(model, U, solver, lam=1.0) -> bool:
     return True
 
 
-def _solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
-    """The load-scaled Newton iteration of :func:`solve_static`."""
-    opts = options or StaticOptions()
-    t0 = time.perf_counter()
-    n = model.mesh.n_nodes
-    free = model.free.ravel()
-    U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
-    seed = None
-    if opts.perturbation and U0 is None:
-        seed = opts.seed
-        U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
-    solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
-    diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
-    max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
-    target = opts.increment_displacement if opts.increment_displacement is not None else 0.05 * diagonal
-    result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
-    modes = {"exact": 0, "psd": 0, "shift": 0}
-    lam = 0.0
-    dlam = _first_increment(model, U, opts, solver, target)
-    U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
-    continuing = None  # Newton state of an increment that is still snapping through
-    continuations = 0
-    bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
-    try:
-        while lam < 1.0:
-            if len(result.load_steps) >= opts.max_load_steps:
-                raise ConvergenceError(
-                    f"load factor {lam:.6g}: {opts.max_load_steps} load increments used without reaching "
-                    "full load; raise solver.max_load_steps or solver.initial_increment")
-            lam_next = min(1.0, lam + dlam)
-            start = U
-            if continuing is not None:
-                start = continuing
-            elif U_prev is not None:  # secant predictor along the equilibrium path
-                start = U + (lam_next - lam) / (lam - lam_prev) * (U - U_prev)
-            nt = _newton(model, start, lam_next, opts, solver, max_step, modes)
-            continuing = None
-            result.iterations += nt.iterations
-            if nt.converged:
-                continuations = 0
-                U_prev, lam_prev = U, lam
-                lam, U = lam_next, nt.U
-                for term in model.load_terms:  # fix the branch of angle-type potentials
-                    term.commit(model.positions(U))
-                result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
-                                          "increment": dlam})
-                result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
-                bar.update(lam, f"it {nt.iterations}")
-                if callback is not None:
-                    callback(lam, U)
-                if nt.iterations <= 4:
-                    target *= 1.5
-                elif nt.iterations >= 10:
-                    target *= 0.5
-                rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
-                grow = 2.0 * (lam - lam_prev)  # never more than double the last increment
-                dlam = float(np.clip(target / max(rate, 1e-300), opts.min_increment, min(opts.max_increment, grow)))
-                continue
-            if nt.descending and continuations < opts.max_continuations:
-                continuations += 1
-                continuing = nt.U
-                log.info("load factor %.6g: still descending after %d iterations (snap-through); continuing "
-                         "(%d/%d)", lam_next, nt.iterations, continuations, opts.max_continuations)
-                continue
-            result.cutbacks += 1
-            log.info("load factor %.6g: %s after %d iterations (|r| = %.3e); cutting back the increment",
-                     lam_next, nt.reason, nt.iterations, nt.residual)
-            dlam /= 4.0
-            target /= 4.0
-            if dlam < opts.min_increment:
-                raise ConvergenceError(
-                    f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
-                    f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
-                    f"min_increment = {opts.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
-        result.converged = True
-        result.message = "converged"
-    except ConvergenceError as exc:
-        result.message = str(exc)
-        exc.result = result
-        raise
-    finally:
-        bar.close()
-        result.tangent_modes = dict(modes)
-        result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam)
-    return result
+def compare_with_static(model, U_relaxed, U_static=None) -> dict:
+    """Difference between a relaxed state and the static Newton solution (``solve_static`` if not given).
 
-
-def start_perturbation(mesh, opts: StaticOptions) -> np.ndarray:
-    """The out-of-plane start ``(N,)`` [m] that ``opts`` asks for (random modes or an n-fold lift)."""
-    if opts.perturbation_folds:
-        return fold_perturbation(mesh, opts.perturbation_folds, opts.seed, opts.perturbation)
-    return smooth_perturbation(mesh, opts.seed, opts.perturbation)
-
-
-def fold_pattern(mesh, folds: int, seed: int) -> np.ndarray:
-    """``(r/R)^2 cos(n theta + phi)`` at the nodes ``(N,)`` [-]: an n-fold pattern about the sheet's centroid.
-
-    ``r``, ``theta`` are polar coordinates about the centroid, ``R`` the largest ``r``, and the phase
-    ``phi`` is drawn from ``seed``. Zero at the centre, growing outwards where the skirt buckles.
+    Returns ``{"max_difference": [m], "max_displacement": [m], "relative": [-]}``.
     """
-    rho, theta = _polar(mesh)
-    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi)
-    return rho ** 2 * np.cos(folds * theta + phase)
-
-
-def _polar(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """``(r / R, theta)`` of the nodes about the sheet's centroid, ``R`` the largest ``r``."""
-    X = mesh.X - mesh.X.mean(axis=0)
-    r = np.hypot(X[:, 0], X[:, 1])
-    return r / r.max(), np.arctan2(X[:, 1], X[:, 0])
-
-
-def fold_perturbation(mesh, folds: int, seed: int, amplitude: float) -> np.ndarray:
-    """An n-fold out-of-plane start ``(N,)`` [m]: ``a (r/R)^2 (1 + cos(n theta + phi)) / 2``.
-
-    ``theta`` and ``r`` are polar coordinates about the sheet's centroid, ``R`` the largest ``r``,
-    ``a`` is ``amplitude`` mean element sizes and the phase ``phi`` is drawn from ``seed``. A lift
-    only, like :func:`smooth_perturbation`; it grows outwards, where the skirt buckles, so that a
-    symmetric drape leaves its bifurcation towards the branch with ``folds`` folds (§6.2: drapes
-    have several equilibria). Whether that branch is a stable equilibrium is for the solve to say.
-    """
-    w = 0.5 * (_polar(mesh)[0] ** 2 + fold_pattern(mesh, folds, seed))
-    return amplitude * float(mesh.element_size.mean()) * w
-
-
-def smooth_perturbation(mesh, seed: int, amplitude: float) -> np.ndarray:
-    """A seeded, smooth out-of-plane start ``(N,)`` [m]: random low Fourier modes of the sheet.
-
-    Six modes with wavelengths between a half and a sixth of the sheet size, shifted and scaled to
-    lie between 0 and ``amplitude`` mean element sizes (upward, never into an obstacle). Smooth, so that it tips a symmetric start
-    off its bifurcation without stretching the membrane; the seed is reported with the result.
-    """
-    rng = np.random.default_rng(seed)
-    X = mesh.X - mesh.X.mean(axis=0)
-    size = float(np.ptp(mesh.X, axis=0).max())
-    w = np.zeros(mesh.n_nodes)
-    for _ in range(6):
-        k = 2 * np.pi * rng.uniform(2.0, 6.0) / size
-        direction = rng.normal(size=2)
-        direction /= np.linalg.norm(direction)
-        w += rng.normal() * np.cos(k * X @ direction + rng.uniform(0, 2 * np.pi))
-    # lift only (0 .. amplitude): a start pushed into an obstacle would meet the full penalty
-    w = (w - w.min()) / max(np.ptp(w), 1e-300)
-    return amplitude * float(mesh.element_size.mean()) * w
-
-
-def _first_increment(model, U, opts, solver, target) -> float:
-    """First load increment: the tangent displacement rate d|U|/d lam at the start, scaled to ``target``."""
-    free = model.free.ravel()
-    P = model.load.ravel()[free]
-    if not np.any(P) or model.load_terms:
-        return opts.initial_increment
-    try:
-        _, K = model.tangent(U, psd=True)
-        du = np.zeros(3 * model.mesh.n_nodes)
-        du[free] = solver.solve(K, P)
-    except (NotPositiveDefinite, LinearSolveError):
-        return opts.initial_increment
-    rate = float(np.linalg.norm(du.reshape(-1, 3), axis=1).max())
-    return float(np.clip(target / max(rate, 1e-300), opts.min_increment, opts.initial_increment))
-
-
-def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
-    """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified)."""
-    rtol = opts.rtol if lam >= 1.0 else max(opts.rtol, opts.intermediate_rtol)
-    # the final increment converges to the tight tolerance and may need longer
-    max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
-    etol = opts.etol if lam >= 1.0 else max(opts.etol, opts.intermediate_rtol**2)
-    free = model.free.ravel()
-    P = model.load
-    if model.load_terms:  # potential loads (end moments) count as applied forces
-        x0 = model.positions(U)
-        P = P - sum(t.force(x0) for t in model.load_terms)
-    # a floor keeps the tolerance above round-off for vanishing loads
-    ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
-    atol = 0.0
-    U = U.copy()
-    Pi = model.potential(U, lam)
-    r = (model.residual(U, lam)).ravel()[free]
-    rnorm = float(np.linalg.norm(r))
-    if not np.isfinite(rnorm):
-        return _Newton(False, U, 0, rnorm, "non-finite residual")
-    work0 = None
-    last_work = np.inf
-    stable = None
-    mu = 0.0  # Levenberg-Marquardt damping, relative to the mean tangent diagonal
-    Pi_history = [Pi]
-    reuse = False  # the last factorisation may serve the next step (modified Newton)
-    age = 0
-    for it in range(1, max_iterations + 1):
-        if rtol * ref < rnorm < 1e4 * rtol * ref:  # close: is the rest round-off?
-            atol = _roundoff_floor(model, U)
-        if rnorm <= rtol * ref + atol and (it > 1 and last_work <= etol * work0):
-            return _Newton(True, U, it - 1, rnorm, stable=stable)
-        d = None
-        fresh = False
-        if reuse and age < opts.reuse_factorisation:
-            try:
-                d = solver.resolve(-r)
-            except LinearSolveError:
-                d = None
-            if d is not None and not (np.all(np.isfinite(d)) and float(r @ d) < 0.0):
-                d = None
-            if d is not None:
-                modes["reused"] = modes.get("reused", 0) + 1
-                age += 1
-        if d is None:
-            try:
-                d, mode = _direction(model, U, lam, r, opts, solver, modes, damping=mu)
-            except LinearSolveError as exc:
-                return _Newton(False, U, it, rnorm, f"linear solve failed ({exc})")
-            stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
-            age = 0
-            fresh = True
-            # curvature of the quadratic model along d: (K + s I) d = -r  =>  d.K.d = -d.r - s d.d
-            dKd = -float(r @ d) - _direction.shift * float(d @ d)
-        dfull = np.zeros(3 * model.mesh.n_nodes)
-        dfull[free] = d
-        step = dfull.reshape(-1, 3)
-        biggest = float(np.linalg.norm(step, axis=1).max())
-        cap = 1.0
-        if biggest > max_step:
-            cap = max_step / biggest
-            step *= cap
-        slope = float(r @ step.ravel()[free])
-        alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts)
-        if alpha is None:
-            return _Newton(False, U, it, rnorm, "line search found no decrease of the energy")
-        U = U + alpha * step
-        Pi = Pi_new
-        Pi_history.append(Pi)
-        # Levenberg-Marquardt damping as a trust region (More's update): the ratio of the actual to
-        # the predicted energy decrease of a fresh Newton step decides; a step the line search had to
-        # shorten (a near-singular or indefinite direction: a sheet balanced on a sphere, a fold
-        # forming) damps the next one, good steps undo it, so the final iterations are pure Newton
-        if fresh:
-            predicted = -(slope + 0.5 * cap * cap * dKd)
-            actual = Pi_history[-2] - Pi_new if len(Pi_history) > 1 else 0.0
-            tiny = 1e-10 * max(abs(Pi), abs(work0 or 0.0))
-            if alpha == 1.0 and abs(predicted) <= tiny:
-                rho = 1.0  # below what the energy resolves: the residual decides convergence
-            else:
-                rho = actual / predicted if (alpha == 1.0 and predicted > 0) else 0.0
-            if alpha < 1.0 or rho < 0.25:
-                mu = max(4.0 * mu, 1e-6)
-            elif rho > 0.75:
-                mu = mu / 3.0 if mu > 1e-9 else 0.0
-        r_new = model.residual(U, lam).ravel()[free]
-        work = abs(float(alpha * step.ravel()[free] @ r_new))
-        if work0 is None:
-            # energy scale: the first step's work or the work of the load so far, whichever is larger
-            # (a good predictor makes the first step tiny; round-off must not stall the criterion)
-            parts = model.energies(U, lam)
-            work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))),
-                        parts["bending"] + parts["membrane"], 1e-300)
-        last_work = work
-        # modified Newton: keep the factorisation while it still cuts the residual fast
-        rnorm_new = float(np.linalg.norm(r_new))
-        reuse = alpha == 1.0 and rnorm_new < 0.3 * rnorm
-        r = r_new
-        rnorm = rnorm_new
-        if not np.isfinite(rnorm):
-            return _Newton(False, U, it, rnorm, "non-finite residual")
-    if rnorm <= rtol * ref + atol and last_work <= etol * work0:
-        return _Newton(True, U, max_iterations, rnorm, stable=stable)
-    # still sliding downhill? compare the energy drop of the last third with the scale of the work
-    k = max(2, len(Pi_history) // 3)
-    drop = Pi_history[-k] - Pi_history[-1]
-    descending = drop > 1e-6 * max(work0 or 0.0, abs(lam * float(np.einsum("ni,ni->", P, U))))
-    return _Newton(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
-                   descending=descending)
-
-
-def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
-    """Newton direction on the free dofs, with the indefinite-tangent safeguard.
-
-    ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt).
-    """
-    sequence = {"auto": ["exact", "psd", "shift"], "exact": ["exact", "shift"], "psd": ["psd", "shift"]}[opts.tangent]
-    last_error = None
-    base = 0.0
-    if damping:
-        base = damping * _diagonal_scale(model, U)
-    for mode in sequence:
-        shifts = [base] if mode != "shift" else None
-        if mode == "shift":
-            _, K = model.tangent(U, psd=True, lam=lam)
-            scale = float(np.abs(K.diagonal()).mean())
-            shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
-        for shift in shifts:
-            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam)
-            try:
-                d = solver.solve(K, -r)
-            except NotPositiveDefinite as exc:
-                last_error = exc
-                continue
-            if not np.all(np.isfinite(d)):
-                last_error = LinearSolveError("non-finite step")
-                continue
-            if float(r @ d) < 0.0 or not np.any(r):
-                modes[mode] += 1
-                _direction.shift = shift
-                return d, mode
-            last_error = LinearSolveError("the step is not a descent direction of the energy")
-    raise LinearSolveError(str(last_error))
-
-
-def _roundoff_floor(model, U) -> float:
-    """Residual [N] below which round-off rules: 100 eps times the summed magnitudes of the element
-    forces. A membrane 10^8 times stiffer than the bending (per unit area) carries element forces
-    that cancel to a residual far below them; no tolerance relative to the load can be met there."""
-    if not model.with_membrane:
-        return 0.0
-    from rftstatic.model.assembly import scatter_forces
-
-    fe = np.abs(model.membrane.element_forces(U, model.material.Dm))
-    fabs = scatter_forces(model.membrane.nodes, fe, model.mesh.n_nodes)
-    return 100 * np.finfo(float).eps * float(np.linalg.norm(fabs.ravel()[model.free.ravel()]))
-
-
-def _diagonal_scale(model, U) -> float:
-    """Mean diagonal of the tangent [N/m], computed once per model (the scale of the LM damping)."""
-    scale = getattr(model, "_lm_scale", None)
-    if scale is None:
-        _, K0 = model.tangent(U, psd=True)
-        scale = float(np.abs(K0.diagonal()).mean())
-        model._lm_scale = scale
-    return scale
-
-
-def _line_search(model, U, step, lam, Pi0, slope, opts, max_trials=12):
-    """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""
-    if not opts.line_search:
-        return 1.0, model.potential(U + step, lam)
-    parts = model.energies(U, lam)
-    scale = abs(parts["bending"]) + abs(parts["membrane"]) + abs(parts["contact"]) + abs(parts["external_work"])
-    if abs(slope) <= 1e-10 * scale:
-        # the predicted decrease is below what the energy can resolve: near the solution the Newton
-        # step is reliable, and the force residual (not the energy) decides convergence
-        return 1.0, model.potential(U + step, lam)
-    roundoff = 1e-13 * scale
-    alpha = 1.0
-    for _ in range(max_trials):
-        Pi = model.potential(U + alpha * step, lam)
-        if np.isfinite(Pi) and Pi <= Pi0 + 1e-4 * alpha * slope + roundoff:
-            return alpha, Pi
-        # minimiser of the quadratic through Pi0, slope and Pi(alpha), safeguarded
-        if np.isfinite(Pi):
-            denom = 2.0 * (Pi - Pi0 - slope * alpha)
-            a_q = -slope * alpha * alpha / denom if denom > 0 else 0.5 * alpha
-            alpha = float(np.clip(a_q, 0.1 * alpha, 0.5 * alpha))
-        else:
-            alpha *= 0.1
-    return None, Pi0
+    if U_static is None:
+        U_static = solve_static(model, options=StaticOptions(progress=False)).U
+    d = float(np.linalg.norm(U_relaxed - U_static, axis=1).max())
+    s = float(np.linalg.norm(U_static, axis=1).max())
+    return {"max_difference": d, "max_displacement": s, "relative": d / max(s, 1e-300)}
