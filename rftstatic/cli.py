@@ -46,13 +46,13 @@ def main(argv=None) -> int:
                 print(f"{name:32s} {title}")
             return 0
         if args.command == "case":
-            from rftstatic.app.static import run_scene
+            from rftstatic.app.registry import run_scene
             from rftstatic.scenes.schema import load_scene
 
             scene = load_scene(args.name, args.set)
             out = Path(args.out) if args.out else Path("out") / scene.name
             if args.resume:
-                from rftstatic.app.dynamic import resume_scene
+                from rftstatic.app.registry import resume_scene
 
                 summary = resume_scene(scene, out, progress=True, figures=not args.no_figures)
             else:

@@ -24,6 +24,15 @@ class MeshingError(ValueError):
     """
 
 
+class ParameterError(ValueError):
+    """A bad option of a library function: ``"key: detail"``. The scene layer maps ``key`` to the scene
+    key (e.g. ``h_lower`` -> ``remesh.h_lower``) and shows ``detail``."""
+
+    def __init__(self, key: str, detail: str):
+        super().__init__(f"{key}: {detail}")
+        self.key, self.detail = key, detail
+
+
 class PatchError(ValueError):
     """A singular patch: its six points lie (nearly) on one conic (method.md)."""
 

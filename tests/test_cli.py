@@ -78,7 +78,7 @@ def test_preset_with_an_override_changes_only_that_rigidity():
 
 
 def test_bad_guide_options_name_the_scene_file_and_the_solver_key():
-    from rftstatic.app.static import static_options
+    from rftstatic.scenes.options import static_options
 
     scene = load_scene("pedestal-round-50", ["solver.guide_folds=12", "solver.guide_weight=1.5"])
     with pytest.raises(SceneError, match=r"pedestal-round-50\.toml: solver: .*guide_weight in \[0, 1\).*1\.5"):

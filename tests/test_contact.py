@@ -3,14 +3,9 @@
 import numpy as np
 import pytest
 
+from rftstatic.contact.kinematic import kinematic_contact
 from rftstatic.contact.obstacles import Floor, RoundPedestal, Sphere, SquarePedestal
-from rftstatic.contact.penalty import (
-    ContactState,
-    PenaltyContact,
-    auto_penalty,
-    estimate_penetration,
-    kinematic_contact,
-)
+from rftstatic.contact.penalty import ContactState, PenaltyContact, auto_penalty, estimate_penetration
 
 # Wool of §4 (Kang & Yu 1995) in SI: 1118.2 gf/cm, 0.083 gf cm, 0.019 gf/cm^2.
 GF = 9.80665e-3  # [N]

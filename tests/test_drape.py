@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from rftstatic import material
-from rftstatic.app.static import static_options
 from rftstatic.cli import main
 from rftstatic.contact.obstacles import Floor
 from rftstatic.contact.penalty import PenaltyContact, auto_penalty
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
 from rftstatic.scenes.build import build_model, hold_inplane_rigid_modes
+from rftstatic.scenes.options import static_options
 from rftstatic.scenes.schema import load_scene
 from rftstatic.solvers import static
 

@@ -6,7 +6,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from rftstatic.app.dynamic import resume_scene, run_dynamic_scene
+from rftstatic.app.dynamic import run_dynamic_scene
+from rftstatic.app.registry import resume_scene
 from rftstatic.cli import main
 from rftstatic.errors import SceneError
 from rftstatic.scenes.schema import load_scene

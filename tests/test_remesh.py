@@ -235,8 +235,8 @@ def test_critical_damping_is_that_of_a_hanging_chain():
 
 
 def test_near_obstacle_gives_the_same_kinematic_contact():
+    from rftstatic.contact.kinematic import kinematic_contact
     from rftstatic.contact.obstacles import from_spec
-    from rftstatic.contact.penalty import kinematic_contact
 
     rng = np.random.default_rng(3)
     for spec in ({"type": "round-pedestal", "centre": [0, 0], "radius": 0.1, "top": 0.0, "edge_radius": 0.005},
@@ -265,7 +265,8 @@ def _strip_scene():
 
 
 def test_remesh_static_strip_reaches_structured_tip():
-    from rftstatic.scenes.build import model_factory, probe_positions
+    from rftstatic.post.probes import probe_positions
+    from rftstatic.scenes.build import model_factory
 
     out = remesh_static(model_factory(_strip_scene()), const=4e-4, h_lower=1e-3, h_upper=4e-3, max_cycles=4, tol=0.05,
                         kappa_h_max=0.3)

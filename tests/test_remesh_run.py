@@ -5,8 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from rftstatic.app.remeshed import remesh_options, run_remesh_scene
+from rftstatic.app.remeshed import run_remesh_scene
 from rftstatic.errors import SceneError
+from rftstatic.scenes.options import remesh_options
 from rftstatic.scenes.schema import load_scene
 
 # a 20 x 20 cm sheet on the 10 cm pedestal, coarse enough to run in a few seconds
@@ -50,14 +51,14 @@ def test_relax_outputs_exist_and_are_well_formed(tiny_run):
 def test_remesh_options_scene_units_and_errors():
     s = load_scene("remesh-pedestal-round-50")
     o = remesh_options(s)
-    assert o["h_lower"] == pytest.approx(0.006) and o["const"] == pytest.approx(0.006)  # cm -> m
-    assert o["gradation"] == 1.3 and o["transfer"] == "mesh"
+    assert o.h_lower == pytest.approx(0.006) and o.const == pytest.approx(0.006)  # cm -> m
+    assert o.gradation == 1.3 and o.transfer == "mesh"
     with pytest.raises(SceneError, match="remesh.h_lower"):
         remesh_options(load_scene("remesh-pedestal-round-50", ["remesh.h_lower=9.0"]))
     with pytest.raises(SceneError, match="remesh.transfer"):
         remesh_options(load_scene("remesh-pedestal-round-50", ["remesh.transfer=spline"]))
-    assert o["damping"] == "critical" and remesh_options(load_scene("strip", ["remesh.const=0.04", "remesh.h_lower=0.1",
-                                                                             "remesh.h_upper=0.4"]))["damping"] == "fixed"
+    assert o.damping == "critical" and remesh_options(load_scene("strip", ["remesh.const=0.04", "remesh.h_lower=0.1",
+                                                                         "remesh.h_upper=0.4"])).damping == "fixed"
     with pytest.raises(SceneError, match="remesh.damping"):
         remesh_options(load_scene("remesh-pedestal-round-50", ["remesh.damping=adaptive"]))
 
@@ -65,18 +66,16 @@ def test_remesh_options_scene_units_and_errors():
 def test_kinematic_contact_reaction_balances_weight_on_the_pedestal():
     # a flat sheet lying on the pedestal's top: the top face carries the weight of the nodes on it,
     # so the residual with the contact reaction is zero there and only the overhang is unbalanced
-    from rftstatic.app.dynamic import dynamic_model
-    from rftstatic.app.remeshed import _with_contact_reaction
+    from rftstatic.contact.kinematic import contact_reaction_residual
     from rftstatic.scenes.build import build_model
 
     scene = load_scene("remesh-pedestal-square-20", TINY)
-    model, extras = build_model(scene)
-    plain = dynamic_model(scene, model, extras)
+    plain, extras = build_model(scene)  # a relax scene: kinematic obstacles, no contact term
+    assert plain.contact is None
     U = np.zeros_like(plain.X3)
     r0 = plain.residual(U).copy()
-    m = _with_contact_reaction(plain, extras["obstacles"])
-    r = m.residual(U)
-    X = m.X3[:, :2]  # [m]: the 10 x 10 cm pedestal top is |x|, |y| <= 0.05 m
+    r = contact_reaction_residual(plain, extras["obstacles"], U)
+    X = plain.X3[:, :2]  # [m]: the 10 x 10 cm pedestal top is |x|, |y| <= 0.05 m
     on_top = np.all(np.abs(X) < 0.05 - 0.002, axis=1)  # clear of the 0.2 cm edge rounding
     off = np.any(np.abs(X) > 0.05, axis=1)
     assert on_top.sum() >= 3 and off.sum() >= 3
@@ -87,16 +86,15 @@ def test_kinematic_contact_reaction_balances_weight_on_the_pedestal():
 def _sphere_with_hold_off_the_top():
     """The tiny sphere scene shifted 0.8 cm in x: the node held in x and y (the in-plane hold
     nearest the sheet's centre) sits on the sphere where its normal is inclined."""
-    from rftstatic.app.dynamic import dynamic_model
     from rftstatic.scenes.build import build_model
 
     scene = load_scene("remesh-sphere-30", ["mesh.h=3.0", "obstacles.0.centre=[0.8, 0.3, -5.0]"])
-    model, extras = build_model(scene)
-    return scene, dynamic_model(scene, model, extras), extras["obstacles"]
+    model, extras = build_model(scene)  # a relax scene: kinematic obstacles, in-plane holds kept
+    return scene, model, extras["obstacles"]
 
 
 def test_contact_reaction_at_a_node_held_in_plane_on_a_sphere():
-    from rftstatic.app.remeshed import _with_contact_reaction
+    from rftstatic.contact.kinematic import contact_reaction_residual
     from rftstatic.contact.obstacles import from_spec
 
     _, plain, _ = _sphere_with_hold_off_the_top()
@@ -107,9 +105,8 @@ def test_contact_reaction_at_a_node_held_in_plane_on_a_sphere():
     centre = xi - R * np.array([np.sin(tilt), 0.0, np.cos(tilt)])
     sphere = from_spec({"type": "sphere", "centre": centre.tolist(), "radius": R})
     assert abs(sphere.signed_distance(xi[None])[0][0]) < 1e-15
-    m = _with_contact_reaction(plain, [sphere])
     U = np.zeros_like(plain.X3)  # flat and unstrained: the residual is minus the weight
-    r = np.where(m.free, m.residual(U), 0.0)
+    r = np.where(plain.free, contact_reaction_residual(plain, [sphere], U), 0.0)
     w = -plain.load[i, 2]
     assert w > 0
     # the normal reaction w / cos(tilt) carries the weight; its in-plane part goes to the support

@@ -27,111 +27,53 @@ All files are written atomically (:mod:`rftstatic.output`), so an interrupted ru
 from __future__ import annotations
 
 import logging
-import platform
 import time
 from pathlib import Path
 
 import numpy as np
 
-from rftstatic.provenance import __version__
+from rftstatic.app.result import RunResult
+from rftstatic.errors import CheckpointError
+from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
+from rftstatic.io.summary import summary_header
+from rftstatic.post.probes import probe_interpolation
+from rftstatic.scenes.build import build_model
+from rftstatic.scenes.options import dynamics_options, static_options
+from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
+from rftstatic.solvers.checkpoint import resume as resume_run
+from rftstatic.solvers.explicit import run_explicit
+from rftstatic.solvers.static import compare_with_static, solve_static
+from rftstatic.solvers.timestep import stable_time_step
 
 log = logging.getLogger(__name__)
 
 CHECKPOINT = "checkpoint.npz"
-DEFAULTS = {
-    "dynamic": {"alpha": 0.0, "mass_scale": 1.0, "rest_tolerance": 1e-3},
-    "relax": {"alpha": 5.0, "mass_scale": 100.0, "rest_tolerance": 1e-8},
-}
 
 
-def dynamics_options(scene) -> dict:
-    """The scene's ``[dynamics]`` table checked and converted to SI, with the defaults filled in."""
-    analysis = scene.get("analysis", "static")
-    d = dict(scene.get("dynamics", {}))
-    u = scene.units
-    if "t_end" not in d:
-        raise scene.error("dynamics.t_end", f"an analysis = \"{analysis}\" scene needs its end time "
-                          "(dynamics.t_end, the longest simulated time for relax)")
-    opts = {**DEFAULTS[analysis], "force_tolerance": 1e-4, "samples": 30, "compare_static": False,
-            "checkpoint_every": 0.2 / u.time, "frames": []}
-    opts.update(d)
-
-    def positive(key, strict=True):
-        v = opts[key]
-        if not (isinstance(v, (int, float)) and (v > 0 if strict else v >= 0)):
-            raise scene.error(f"dynamics.{key}", f"must be {'> 0' if strict else '>= 0'}, got {v!r}")
-
-    for key in ("t_end", "mass_scale", "rest_tolerance", "force_tolerance", "checkpoint_every"):
-        positive(key)
-    positive("alpha", strict=False)
-    if opts.get("dt") is not None:
-        positive("dt")
-    if opts["samples"] < 0:
-        raise scene.error("dynamics.samples", f"must be >= 0, got {opts['samples']}")
-    frames = opts["frames"]
-    if not all(isinstance(f, (int, float)) and 0 <= f <= opts["t_end"] for f in frames):
-        raise scene.error("dynamics.frames", f"expected times in [0, t_end = {opts['t_end']}], got {frames!r}")
-    t = u.time
-    return {"t_end": opts["t_end"] * t, "dt": None if opts.get("dt") is None else opts["dt"] * t,
-            "alpha": opts["alpha"] / t, "mass_scale": float(opts["mass_scale"]),
-            "frames": np.array(sorted(set(float(f) * t for f in frames))),
-            "checkpoint_every": opts["checkpoint_every"] * t, "rest_tolerance": float(opts["rest_tolerance"]),
-            "force_tolerance": float(opts["force_tolerance"]), "samples": int(opts["samples"]),
-            "compare_static": bool(opts["compare_static"])}
-
-
-def dynamic_model(scene, model, extras):
-    """The model without the static solver's penalty contact (obstacles act kinematically).
-
-    A true dynamic run also drops the in-plane holds of a sheet on a frictionless support; dynamic
-    relaxation (``analysis = "relax"``) seeks the static drape and keeps them (unless
-    ``contact.hold_inplane = false``), or a slightly asymmetric sheet creeps and spins on the support
-    and never comes to rest.
-    """
-    if model.contact is None:
-        return model
-    from rftstatic.model.model import Model
-    from rftstatic.scenes.build import build_supports, hold_inplane_rigid_modes
-
-    supports = build_supports(scene, model.mesh)
-    if scene.get("analysis") == "relax" and scene.get("contact.hold_inplane", True):
-        hold_inplane_rigid_modes(model.mesh, supports)
-    return Model(model.mesh, model.material, element=model.element, supports=supports,
-                 load=model.load, contact=None, membrane=model.with_membrane)
-
-
-def probe_interpolation(model, probes: dict):
-    """Probe names, (P, 3) nodes and (P, 3) barycentric weights of the scene's reference points."""
-    names = list(probes)
-    if not names:
-        return [], np.zeros((0, 3), np.int64), np.zeros((0, 3))
-    pts = np.array([probes[n] for n in names], float)
-    elem, bary = model.mesh.locate(pts)
-    nodes = np.empty((len(names), 3), np.int64)
-    w = np.zeros((len(names), 3))
-    inside = elem >= 0
-    nodes[inside] = model.mesh.tri[elem[inside]]
-    w[inside] = bary[inside]
-    if (~inside).any():  # on the boundary the trifinder may miss: the nearest node
-        nodes[~inside] = model.mesh.nearest_node(pts[~inside])[:, None]
-        w[~inside] = [1.0, 0.0, 0.0]
-    return names, nodes, w
+def run(scene, out: Path, *, progress=True, figures=True, resume=False) -> RunResult:
+    """Build ``scene``'s model (obstacles acting kinematically) and run it (:func:`run_dynamic_scene`)."""
+    model, extras = build_model(scene)
+    summary, explicit = _run(scene, model, extras, out, progress=progress, figures=figures, resume=resume)
+    return RunResult(summary, model, explicit.U, extras, out)
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
     """Continue the dynamic run of ``scene`` from ``out_dir/checkpoint.npz`` (``case NAME --resume``)."""
-    from rftstatic.scenes.build import build_model
-
     if scene.get("analysis", "static") == "static":
         raise scene.error("analysis", "--resume continues a dynamic or relax run; this scene is static")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    model, extras = build_model(scene)
-    return run_dynamic_scene(scene, model, extras, out, progress=progress, figures=figures, resume=True)
+    return run(scene, out, progress=progress, figures=figures, resume=True).summary
 
 
 def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True, resume=False,
                       callback=None, backend="auto") -> dict:
+    """:func:`_run`, returning only the summary."""
+    return _run(scene, model, extras, out, progress=progress, figures=figures, resume=resume, callback=callback,
+                backend=backend)[0]
+
+
+def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False, callback=None, backend="auto"):
     """Run a ``dynamic`` or ``relax`` scene and write its outputs into ``out`` (module docstring).
 
     Parameters
@@ -145,25 +87,19 @@ def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True,
 
     Returns
     -------
-    The summary as written to ``summary.json`` (plain Python types, scene units).
+    The summary as written to ``summary.json`` (plain Python types, scene units) and the
+    :class:`~rftstatic.solvers.explicit.ExplicitResult`.
     """
-    from rftstatic.errors import CheckpointError
-    from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
-    from rftstatic.solvers.checkpoint import resume as resume_run
-    from rftstatic.solvers.explicit import run_explicit
-    from rftstatic.solvers.timestep import stable_time_step
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     analysis = scene.get("analysis", "dynamic")
     o = dynamics_options(scene)
-    static_model = model
-    model = dynamic_model(scene, model, extras)
     obstacles = tuple(extras.get("obstacles", ()))
-    names, pnodes, pw = probe_interpolation(model, extras.get("probes", {}))
-    t_end = o["t_end"]
-    regular = np.linspace(0.0, t_end, o["samples"] + 1) if o["samples"] else np.zeros(0)
-    save_times = np.unique(np.concatenate([o["frames"], regular]))
+    names, pnodes, pw = probe_interpolation(model.mesh, extras.get("probes", {}))
+    t_end = o.t_end
+    regular = np.linspace(0.0, t_end, o.samples + 1) if o.samples else np.zeros(0)
+    save_times = np.unique(np.concatenate([o.frames, regular]))
 
     free_load = float(np.linalg.norm(np.where(model.free, model.load, 0.0)))
     peak = {"kinetic": 0.0}
@@ -172,8 +108,8 @@ def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True,
         peak["kinetic"] = max(peak["kinetic"], rec["kinetic"])
         stop = callback(state, rec) if callback is not None else False
         if analysis == "relax":
-            stop = stop or bool(peak["kinetic"] > 0 and rec["kinetic"] < o["rest_tolerance"] * peak["kinetic"]
-                                and rec["residual"] < o["force_tolerance"] * free_load)
+            stop = stop or bool(peak["kinetic"] > 0 and rec["kinetic"] < o.rest_tolerance * peak["kinetic"]
+                                and rec["residual"] < o.force_tolerance * free_load)
         return stop
 
     ckpt_path = out / CHECKPOINT
@@ -182,7 +118,7 @@ def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True,
     if resume and ckpt_path.exists():
         data = load_checkpoint(ckpt_path)
         saved = data["options"]
-        for key, want in (("t_end", t_end), ("alpha", o["alpha"]), ("mass_scale", o["mass_scale"])):
+        for key, want in (("t_end", t_end), ("alpha", o.alpha), ("mass_scale", o.mass_scale)):
             if not np.isclose(float(saved[key]), want, rtol=1e-12, atol=0.0):
                 raise scene.error(f"dynamics.{key}", f"the checkpoint {ckpt_path} was written with {key} = "
                                   f"{float(saved[key]):g} (SI), the scene asks {want:g}; run without --resume")
@@ -192,7 +128,7 @@ def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True,
         hist_k = np.asarray(data["history"]["kinetic"], float)
         peak["kinetic"] = float(hist_k.max()) if hist_k.size else 0.0
         dt = data["dt"]
-        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o["checkpoint_every"] / dt))))
+        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
         resumed_from = data["t"]
         try:
             run = resume_run(ckpt_path, model, obstacles=obstacles, callback=watch, checkpoint=ckpt,
@@ -203,28 +139,26 @@ def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True,
     else:
         if resume:
             log.warning("no checkpoint %s: starting the run from t = 0", ckpt_path)
-        estimate = stable_time_step(model, mass_scale=o["mass_scale"], alpha=o["alpha"])
-        dt = o["dt"] if o["dt"] is not None else estimate.dt
+        estimate = stable_time_step(model, mass_scale=o.mass_scale, alpha=o.alpha)
+        dt = o.dt if o.dt is not None else estimate.dt
         if dt > estimate.dt * (1 + 1e-3):
             log.warning("dynamics.dt = %.4g s exceeds the stable estimate %.4g s", dt, estimate.dt)
         n_steps = max(1, int(np.ceil(t_end / dt - 1e-9)))
         dt = t_end / n_steps
-        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o["checkpoint_every"] / dt))))
-        run = run_explicit(model, t_end=t_end, dt=dt, alpha=o["alpha"], mass_scale=o["mass_scale"],
+        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
+        run = run_explicit(model, t_end=t_end, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
                            obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(), callback=watch,
-                           checkpoint=ckpt, progress=progress, rest_tol=o["rest_tolerance"], backend=backend)
+                           checkpoint=ckpt, progress=progress, rest_tol=o.rest_tolerance, backend=backend)
         run.estimate = run.estimate or estimate
     wall = time.perf_counter() - wall0
 
     summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)
     if analysis == "relax":
         summary["converged"] = summary["at_rest"] = bool(run.stopped)
-        if o["compare_static"]:
-            summary["static_comparison"] = _compare_static(scene, static_model, run.U)
+        if o.compare_static:
+            summary["static_comparison"] = _compare_static(scene, run.U)
     _write(scene, model, out, run, summary, o, save_times, figures=figures)
-    from rftstatic.io.files import to_jsonable
-
-    return to_jsonable(summary)
+    return to_jsonable(summary), run
 
 
 def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from) -> dict:
@@ -244,13 +178,10 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
     final = {k: energy(h[k][-1]) for k in ("kinetic", "potential", "strain", "external_work", "dissipated",
                                            "contact_loss", "total")}
     t_rest = run.time_at_rest
-    summary = {
-        "scene": scene.name, "title": scene.get("title", ""), "figure": scene.get("figure", ""),
-        "units": u.name, "overrides": {k: v for k, v in scene.overrides.items() if k != "resume"},
-        "element": model.element, "analysis": analysis,
-        "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements, "mesh": model.mesh.summary(),
-        "t_end": o["t_end"] / u.time, "t": run.t / u.time,
-        "alpha": o["alpha"] * u.time, "mass_scale": o["mass_scale"],
+    summary = summary_header(scene, model, analysis)
+    summary.update({
+        "t_end": o.t_end / u.time, "t": run.t / u.time,
+        "alpha": o.alpha * u.time, "mass_scale": o.mass_scale,
         "dt": run.dt / u.time,
         "dt_estimate": None if est is None else {"dt": est.dt / u.time, "dt_crit": est.dt_crit / u.time,
                                                  "omega_max": est.omega_max * u.time, "method": est.method,
@@ -261,7 +192,7 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
         "loop_element_steps_per_second": run.element_steps_per_second,
         "resumed_from_t": None if resumed_from is None else resumed_from / u.time,
         "time_at_rest": None if t_rest is None else t_rest / u.time,
-        "rest_tolerance": o["rest_tolerance"],
+        "rest_tolerance": o.rest_tolerance,
         "at_rest": t_rest is not None,
         "converged": bool(run.steps > 0 and np.isfinite(h["total"]).all()),
         "stopped_early": bool(run.stopped),
@@ -269,18 +200,15 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
                      "energy_drift": energy(h["total"][-1] - h["total"][0])},
         "residual": float(h["residual"][-1]) / u.force,
         "probes": probes,
-        "software": {"rftstatic": __version__, "python": platform.python_version()},
-        "warnings": list(model.warnings),
-    }
+    })
     if run.contact_nodes:
         summary["contact_nodes"] = run.contact_nodes
     return summary
 
 
-def _compare_static(scene, model, U) -> dict:
-    from rftstatic.app.static import static_options
-    from rftstatic.solvers.static import compare_with_static, solve_static
-
+def _compare_static(scene, U) -> dict:
+    """The relaxed state ``U`` [m] against the static Newton solution of the scene (penalty contact)."""
+    model, _ = build_model(scene, contact="penalty")
     res = solve_static(model, options=static_options(scene, progress=False))
     cmp = compare_with_static(model, U, res.U)
     u = scene.units.length
@@ -293,7 +221,6 @@ def _tag(t: float) -> str:
 
 
 def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True) -> None:
-    from rftstatic.io.files import write_json, write_pvd, write_vtu
 
     u = scene.units
     tri = model.mesh.tri
@@ -309,7 +236,7 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
             series.append((t / u.time, name))
         write_pvd(out / "series.pvd", series)
         summary["vtu_series"] = {"pvd": "series.pvd", "states": len(series)}
-    requested = o["frames"]
+    requested = o.frames
     idx = np.searchsorted(save_times, requested)
     summary["frames"] = [{"time": float(tr / u.time), "state_time": float(frames[i][0] / u.time)}
                          for tr, i in zip(requested, idx) if i < len(frames)]
@@ -326,7 +253,7 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
         files = plot_views(str(out / f"frame_t{_tag(entry['time'])}"), (X3 + U) / u.length, tri, views=views,
                            title=f"{short}: t = {entry['time']:g} s", length_unit=lu)
         entry["files"] = {v: p.name for v, p in files.items()}
-    reg = np.linspace(0.0, o["t_end"], o["samples"] + 1) if o["samples"] else save_times
+    reg = np.linspace(0.0, o.t_end, o.samples + 1) if o.samples else save_times
     pick = sorted(set(np.searchsorted(save_times, reg).tolist()) & set(range(len(frames))))
     if pick:
         animate(out / "animation.gif", [(X3 + frames[i][1]) / u.length for i in pick], tri,
@@ -338,6 +265,6 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
                  {"kinetic": h["kinetic"] / u.energy, "potential (stored - P.D)": h["potential"] / u.energy,
                   "dissipated (damping)": h["dissipated"] / u.energy},
                  xlabel="time [s]", ylabel=f"energy [{u.name.split('-')[1] if '-' in u.name else 'J'}"
-                 f"{' ' + lu if lu else ''}]", title=f"{scene.name}: energies (alpha = {o['alpha'] * u.time:g} /s)")
+                 f"{' ' + lu if lu else ''}]", title=f"{scene.name}: energies (alpha = {o.alpha * u.time:g} /s)")
     summary["energy_plot"] = "energy.png"
     write_json(out / "summary.json", summary)

@@ -64,9 +64,11 @@ def _child(name: str, out: str, overrides: list[str], figures: bool) -> None:
     """Run one static scene in this process, save ``state.npz`` and print one JSON line of measures."""
     import resource
 
-    from rftstatic.app.static import static_options, static_summary, write_outputs
+    from rftstatic.app.static import static_summary
     from rftstatic.errors import ConvergenceError
+    from rftstatic.io.results import write_outputs
     from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.options import static_options
     from rftstatic.scenes.schema import load_scene
     from rftstatic.solvers.static import solve_static
 

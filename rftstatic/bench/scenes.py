@@ -25,7 +25,7 @@ def _child(name: str, out: str) -> None:
     """Run one scene in this process and print its measures as one JSON line."""
     import resource
 
-    from rftstatic.app.static import run_scene
+    from rftstatic.app.registry import run_scene
     from rftstatic.scenes.schema import load_scene
 
     t0 = time.perf_counter()

@@ -1,4 +1,4 @@
-"""Contact of the sheet's nodes with rigid obstacles: penalty (statics) and kinematic (explicit dynamics).
+"""Penalty contact of the sheet's nodes with rigid obstacles (the static solver's contact law).
 
 Penalty contact (Sze & Zhou 2016, §4.5; Liu & Sze 2009). Every node ``n`` with nodal area ``A_n`` and
 every obstacle with signed distance ``phi`` (``phi < 0`` inside) contribute
@@ -21,8 +21,7 @@ A node pressed with a contact pressure ``p`` [Pa] penetrates ``p / k`` (:func:`e
 :func:`auto_penalty` chooses ``k`` from the fabric and the element size so that this stays a small
 fraction of the element size.
 
-Kinematic contact (§6.3): after an explicit time step a penetrated node is moved to its closest surface
-point and the inward normal component of its velocity is removed (:func:`kinematic_contact`).
+The kinematic contact of the explicit solver is :mod:`rftstatic.contact.kinematic`.
 
 Nothing here depends on the obstacles' types: only ``signed_distance`` and ``normal_gradient`` are used.
 """
@@ -30,10 +29,13 @@ Nothing here depends on the obstacles' types: only ``signed_distance`` and ``nor
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+from typing import Sequence
 
 import numpy as np
 
+from rftstatic.contact.common import as_list as _as_list
+from rftstatic.contact.common import as_points as _as_points
+from rftstatic.contact.common import positive as _positive
 from rftstatic.contact.obstacles import Obstacle
 
 __all__ = [
@@ -41,37 +43,7 @@ __all__ = [
     "ContactState",
     "auto_penalty",
     "estimate_penetration",
-    "kinematic_contact",
 ]
-
-
-def _as_list(obstacles: Obstacle | Iterable[Obstacle]) -> list[Obstacle]:
-    """Obstacles as a list; a single obstacle is accepted. Raise naming a bad entry."""
-    items = [obstacles] if hasattr(obstacles, "signed_distance") else list(obstacles)
-    for i, ob in enumerate(items):
-        if not (hasattr(ob, "signed_distance") and hasattr(ob, "normal_gradient")):
-            raise ValueError(
-                f"obstacles[{i}] = {ob!r} is not an obstacle (needs signed_distance and normal_gradient)"
-            )
-    return items
-
-
-def _as_points(x, n_nodes: int | None = None, name: str = "x") -> np.ndarray:
-    arr = np.asarray(x, dtype=float)
-    if arr.ndim != 2 or arr.shape[1] != 3 or (n_nodes is not None and arr.shape[0] != n_nodes):
-        want = "(N, 3)" if n_nodes is None else f"({n_nodes}, 3)"
-        raise ValueError(f"{name} must have shape {want}, got shape {arr.shape}")
-    return arr
-
-
-def _positive(name: str, value, *, allow_zero: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
-        raise ValueError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value!r}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -369,41 +341,3 @@ def estimate_penetration(pressure, k: float):
         raise ValueError(f"pressure must be finite and >= 0, got {pressure!r}")
     out = p / k
     return float(out) if out.ndim == 0 else out
-
-
-def kinematic_contact(
-    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, int]:
-    """Kinematic contact correction after an explicit step (§6.3).
-
-    Each penetrated node (``phi < 0``) is moved to its closest surface point ``x - phi n`` and the inward
-    part of its normal velocity is removed (``v <- v - min(v.n, 0) n``); tangential and outward
-    velocities are kept (frictionless, no rebound). Obstacles are treated one after the other.
-
-    Parameters
-    ----------
-    obstacles : an obstacle or a sequence of them
-    x : (N, 3) nodal positions at the end of the step [m]
-    v : (N, 3) nodal velocities [m/s]
-
-    Returns
-    -------
-    x_new : (N, 3) corrected positions [m]
-    v_new : (N, 3) corrected velocities [m/s]
-    n_active : number of nodes that were corrected
-    """
-    items = _as_list(obstacles)
-    x_new = _as_points(x).copy()
-    v_new = _as_points(v, x_new.shape[0], name="v").copy()
-    touched = np.zeros(x_new.shape[0], dtype=bool)
-    for ob in items:
-        phi, normal = ob.signed_distance(x_new)
-        act = phi < 0.0
-        if not np.any(act):
-            continue
-        n = normal[act]
-        x_new[act] -= phi[act, None] * n
-        vn = np.einsum("ni,ni->n", v_new[act], n)
-        v_new[act] -= np.minimum(vn, 0.0)[:, None] * n
-        touched |= act
-    return x_new, v_new, int(np.count_nonzero(touched))

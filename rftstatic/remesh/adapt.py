@@ -41,8 +41,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rftstatic.remesh.sizefield import check_size_bounds, curvature_magnitude, size_field
+from rftstatic.errors import ParameterError
+from rftstatic.remesh.sizefield import curvature_magnitude, size_field
 from rftstatic.remesh.transfer import METHODS, transfer_fields
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
+
+DAMPING = ("fixed", "critical")
+"""Damping of the remeshed relaxation: the scene's alpha, or critical for the sheet's slowest swing."""
 
 log = logging.getLogger(__name__)
 
@@ -226,11 +231,50 @@ def refinable_maxima(mesh, kappa, *, const, h_lower):
     return float((mag * h)[keep].max(initial=0.0)), float((mag * h * h)[keep].max(initial=0.0))
 
 
-def _check_common(mesh, const, h_lower, h_upper, tol):
+def check_remesh_parameters(*, const, h_lower, h_upper, gradation=1.3, max_cycles=5, tol=0.05, kappa_h_max=None,
+                            transfer="mesh", every=None, kappa_h2_max=None, damping="fixed") -> None:
+    """Check the options of :func:`remesh_static` and :func:`remesh_relax` (any consistent units).
+
+    Raises :class:`~rftstatic.errors.ParameterError` whose ``key`` names the parameter: const, h_lower,
+    h_upper, gradation, tol must be positive finite numbers (kappa_h_max too unless None), h_lower <=
+    h_upper, gradation >= 1, transfer in :data:`~rftstatic.remesh.transfer.METHODS`, damping in
+    :data:`DAMPING`, every a positive and max_cycles a non-negative integer (every may be None),
+    kappa_h2_max a positive length or None.
+    """
+    values = {"const": const, "h_lower": h_lower, "h_upper": h_upper, "gradation": gradation, "tol": tol,
+              "kappa_h_max": kappa_h_max}
+    for key, v in values.items():
+        if key == "kappa_h_max" and v is None:
+            continue
+        if not (isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(v, bool)
+                and np.isfinite(v) and v > 0):
+            raise ParameterError(key, f"must be a positive number, got {v!r}")
+    if gradation < 1:
+        raise ParameterError("gradation", f"must be >= 1 (a size ratio), got {gradation!r}")
+    if h_lower > h_upper:
+        raise ParameterError("h_lower", f"h_lower = {h_lower} exceeds h_upper = {h_upper}; Eq. 29 clips h_target "
+                             "to [h_lower, h_upper]: swap them")
+    if transfer not in METHODS:
+        raise ParameterError("transfer", f'"{transfer}" is unknown; use one of {", ".join(METHODS)}')
+    if damping not in DAMPING:
+        raise ParameterError("damping", f'"{damping}" is unknown; use one of {", ".join(DAMPING)}')
+    for key, v, low in (("every", every, 1), ("max_cycles", max_cycles, 0)):
+        if v is None and key == "every":
+            continue
+        if not (isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= low):
+            raise ParameterError(key, f"must be a {'positive' if low else 'non-negative'} integer, got {v!r}")
+    if kappa_h2_max is not None and not (isinstance(kappa_h2_max, (int, float)) and kappa_h2_max > 0):
+        raise ParameterError("kappa_h2_max", f"must be a positive length or None (Eq. 28), got {kappa_h2_max!r}")
+
+
+def _check_extent(mesh, h_lower, h_upper):
+    """Element size bounds no larger than the sheet (the smaller side of its bounding box)."""
     lo, hi = mesh.X.min(axis=0), mesh.X.max(axis=0)
-    check_size_bounds(const=const, h_lower=h_lower, h_upper=h_upper, extent=float((hi - lo).min()))
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol = {tol!r} must be a positive relative node-count change (e.g. 0.05)")
+    extent = float((hi - lo).min())
+    for name, v in (("h_lower", h_lower), ("h_upper", h_upper)):
+        if v > extent:
+            raise ParameterError(name, f"{name} = {v!r} m is larger than the sheet (smaller side {extent:.6g} m); "
+                                 f"a flat region would get elements bigger than the domain: use {name} < {extent:.6g}")
 
 
 # --------------------------------------------------------------------------------------------- static
@@ -259,9 +303,7 @@ class RemeshStaticResult:
 def _continuation(options):
     """Options that solve at full load straight from a transferred equilibrium (Newton from it: a
     ``start = "relax"`` of the first solve would throw the transferred state away and relax from flat)."""
-    return dataclasses.replace(options, start="load-steps", initial_increment=1.0, max_increment=1.0,
-                               min_increment=min(options.min_increment, 1.0),
-                               increment_displacement=1e30, perturbation=0.0)
+    return options.from_state()
 
 
 def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, kappa_h_max=None,
@@ -301,18 +343,14 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
     from rftstatic.errors import ConvergenceError
     from rftstatic.solvers.static import StaticOptions, solve_static
 
-    if kappa_h_max is not None and not kappa_h_max > 0:
-        raise ValueError(f"kappa_h_max = {kappa_h_max!r} must be a positive relative curvature or None")
-    if int(max_cycles) != max_cycles or max_cycles < 0:
-        raise ValueError(f"max_cycles = {max_cycles!r} must be a non-negative integer")
-    if transfer not in METHODS:
-        raise ValueError(f'transfer = "{transfer}" is unknown; use one of {", ".join(METHODS)}')
+    check_remesh_parameters(const=const, h_lower=h_lower, h_upper=h_upper, gradation=gradation,
+                            max_cycles=max_cycles, tol=tol, kappa_h_max=kappa_h_max, transfer=transfer)
     make = _factory(problem)
     if options is None:
         options = StaticOptions(progress=False)
     t0 = time.perf_counter()
     model, extras = make(None)
-    _check_common(model.mesh, const, h_lower, h_upper, tol)
+    _check_extent(model.mesh, h_lower, h_upper)
     if domain is None:
         domain = reference_domain(model.mesh)
     result = solve_static(model, options=options)
@@ -364,7 +402,6 @@ def _static_figures(result, *, restarted):
 
 
 # --------------------------------------------------------------------------------------------- relaxation
-DAMPING = ("fixed", "critical")
 CHAIN = 1.2024
 """Fundamental frequency of a hanging chain of length l, in units of sqrt(g / l) (j_01 / 2 = 2.4048 / 2)."""
 
@@ -457,7 +494,7 @@ class NearObstacle:
         return self.obstacle.normal_gradient(x)
 
 
-def explicit_advance(*, alpha, mass_scale=100.0, dt=None, obstacles=(), safety=0.9, backend="auto",
+def explicit_advance(*, alpha, mass_scale=RELAX_MASS_SCALE, dt=None, obstacles=(), safety=0.9, backend="auto",
                      energy_check=False, damping="fixed"):
     """An ``advance(model, U, V, n_steps) -> (U, V, t)`` stepper on :func:`rftstatic.explicit.run_explicit`.
 
@@ -524,10 +561,10 @@ class RemeshRelaxResult:
     skipped: int = 0
 
 
-def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, mass_scale=100.0,
+def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, mass_scale=RELAX_MASS_SCALE,
                  damping="fixed", every=None, kappa_h2_max=None, chunk=200, max_steps=100_000, max_remesh=50,
                  tol=0.05, tol_force=1e-4, tol_kinetic=1e-8, skip_settled=True, gradation=1.3, transfer="mesh",
-                 domain=None, U0=None, V0=None) -> RemeshRelaxResult:
+                 domain=None, U0=None, V0=None, residual=None) -> RemeshRelaxResult:
     """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6).
 
     The motion is advanced ``chunk`` steps at a time. After each chunk (step d) the mesh is
@@ -560,6 +597,9 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         and the transfer restarts the oscillation, as §5 warns); skipping settled meshes, it came
         to rest.
     U0, V0 : (N, 3) start on the initial mesh (default zero)
+    residual : ``residual(model, U) -> (N, 3)`` [N], the out-of-balance force of the rest test (default
+        ``model.residual(U)``; with kinematic obstacles,
+        :func:`rftstatic.contact.kinematic.contact_reaction_residual` takes their reaction off)
 
     Returns
     -------
@@ -570,12 +610,13 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
     make = _factory(problem)
     if int(chunk) < 1:
         raise ValueError(f"chunk = {chunk!r} must be a positive number of steps")
-    if every is not None and int(every) < 1:
-        raise ValueError(f"every = {every!r} must be a positive number of steps or None")
-    if kappa_h2_max is not None and not kappa_h2_max > 0:
-        raise ValueError(f"kappa_h2_max = {kappa_h2_max!r} must be a positive length [m] or None (Eq. 28)")
+    check_remesh_parameters(const=const, h_lower=h_lower, h_upper=h_upper, gradation=gradation, tol=tol,
+                            transfer=transfer, every=every, kappa_h2_max=kappa_h2_max, damping=damping)
+    if residual is None:
+        def residual(model, U):
+            return model.residual(U)
     model, extras = make(None)
-    _check_common(model.mesh, const, h_lower, h_upper, tol)
+    _check_extent(model.mesh, h_lower, h_upper)
     if advance is None:
         if alpha is None:
             raise ValueError("alpha (mass damping [1/s]) is needed by the default explicit stepper; or pass advance=")
@@ -606,7 +647,7 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, V, V))
         peak = max(peak, kinetic)
         P = np.where(model.free, model.load, 0.0)
-        r = float(np.linalg.norm(np.where(model.free, model.residual(U), 0.0)))
+        r = float(np.linalg.norm(np.where(model.free, residual(model, U), 0.0)))
         rest = r <= tol_force * max(float(np.linalg.norm(P)), 1e-300) and (kinetic <= tol_kinetic * peak or kinetic == 0)
         reason = ("rest" if rest else "every" if every is not None and since >= every
                   else "curvature" if kappa_h2_max is not None and rkh2 > kappa_h2_max else None)

@@ -199,20 +199,46 @@ def build_load(scene: Scene, mesh, material) -> np.ndarray:
     return P
 
 
-def build_contact(scene: Scene, mesh, material, supports: Supports):
-    """Obstacles and penalty contact (None without obstacles); may add in-plane holds to ``supports``."""
-    specs = scene.get("obstacles", [])
-    if not specs:
-        return None, []
+CONTACT_LAWS = ("penalty", "kinematic")
+"""How obstacles act: the static solver's penalty (an energy) or the explicit solver's kinematic projection."""
+
+
+def contact_law(scene: Scene) -> str:
+    """The contact law the scene's analysis uses: ``"penalty"`` for static, ``"kinematic"`` for dynamic/relax."""
+    return "penalty" if scene.get("analysis", "static") == "static" else "kinematic"
+
+
+def build_obstacles(scene: Scene) -> list:
+    """The scene's obstacles in SI (:func:`rftstatic.contact.obstacles.from_spec`)."""
     from rftstatic.contact.obstacles import from_spec
-    from rftstatic.contact.penalty import PenaltyContact, auto_penalty
 
     obstacles = []
-    for i, spec in enumerate(specs):
+    for i, spec in enumerate(scene.get("obstacles", [])):
         try:
             obstacles.append(from_spec(spec, scene.units.length))
         except ValueError as exc:
             raise scene.error(f"obstacles.{i}", str(exc)) from None
+    return obstacles
+
+
+def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str = "penalty"):
+    """The obstacles and, for ``law = "penalty"``, the penalty contact (None without obstacles, or for the
+    kinematic law). May add the in-plane holds of a sheet on a frictionless support to ``supports``:
+    the static drape (penalty) and dynamic relaxation (a kinematic run of a ``relax`` scene) seek a rest
+    state and keep them (unless ``contact.hold_inplane = false``), or a slightly asymmetric sheet creeps
+    and spins on the support; a true dynamic run does not."""
+    if law not in CONTACT_LAWS:
+        raise ValueError(f'contact law "{law}" is unknown; use one of {", ".join(CONTACT_LAWS)}')
+    obstacles = build_obstacles(scene)
+    if not obstacles:
+        return None, []
+    hold = scene.get("contact.hold_inplane", True)
+    if law == "kinematic":
+        if hold and scene.get("analysis") == "relax":
+            hold_inplane_rigid_modes(mesh, supports)
+        return None, obstacles
+    from rftstatic.contact.penalty import PenaltyContact, auto_penalty
+
     c = scene.get("contact", {})
     h = float(mesh.element_size.mean())
     penalty = c.get("penalty", "auto")
@@ -223,7 +249,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports):
         k = scene.units.to_si(float(penalty), "stiffness_volumetric")
     else:
         raise scene.error("contact.penalty", f'expected "auto" or a positive number, got {penalty!r}')
-    if c.get("hold_inplane", True):
+    if hold:
         hold_inplane_rigid_modes(mesh, supports)
     smoothing = c.get("smoothing", 0.05) * h
     return PenaltyContact(obstacles, mesh.node_area, k, smoothing=smoothing), obstacles
@@ -246,13 +272,18 @@ def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
     supports.fixed[a, 1] = True
 
 
-def build_model(scene: Scene, mesh=None) -> tuple[Model, dict]:
-    """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras."""
+def build_model(scene: Scene, mesh=None, *, contact: str | None = None) -> tuple[Model, dict]:
+    """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras.
+
+    ``contact``: how the obstacles act, ``"penalty"`` (in the model's energy) or ``"kinematic"`` (by the
+    explicit solver; the model has no contact term); default :func:`contact_law` of the scene's analysis.
+    ``extras``: ``{"obstacles": [...], "probes": {name: (2,) reference point [m]}}``.
+    """
     mesh = build_mesh(scene) if mesh is None else mesh
     material = build_material(scene)
     supports = build_supports(scene, mesh)
     load = build_load(scene, mesh, material)
-    contact, obstacles = build_contact(scene, mesh, material, supports)
+    contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
     membrane = scene.get("solver.membrane", True)
     model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
                   contact=contact, membrane=membrane)
@@ -265,27 +296,7 @@ def build_model(scene: Scene, mesh=None) -> tuple[Model, dict]:
     return model, {"obstacles": obstacles, "probes": probes}
 
 
-def model_factory(scene: Scene):
+def model_factory(scene: Scene, *, contact: str | None = None):
     """``factory(mesh=None) -> (Model, extras)``: the scene's model on ``mesh`` (None: its own mesh),
     for the remeshing drivers (:mod:`rftstatic.remesh`), which rebuild the model on every new mesh."""
-    return lambda mesh=None: build_model(scene, mesh=mesh)
-
-
-def probe_positions(model: Model, probes: dict, U: np.ndarray) -> dict:
-    """Reference and deformed positions [m] of named reference points (barycentric interpolation)."""
-    if not probes:
-        return {}
-    names = list(probes)
-    pts = np.array([probes[n] for n in names])
-    elem, bary = model.mesh.locate(pts)
-    out = {}
-    for k, name in enumerate(names):
-        if elem[k] < 0:  # on the boundary, the trifinder may miss: take the nearest node
-            node = model.mesh.nearest_node(pts[k:k + 1])[0]
-            ref, disp = model.X3[node], U[node]
-        else:
-            nodes = model.mesh.tri[elem[k]]
-            ref = bary[k] @ model.X3[nodes]
-            disp = bary[k] @ U[nodes]
-        out[name] = {"reference": ref, "deformed": ref + disp}
-    return out
+    return lambda mesh=None: build_model(scene, mesh=mesh, contact=contact)

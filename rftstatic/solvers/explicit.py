@@ -328,7 +328,7 @@ def _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, ene
 
 
 def _contact(model, obstacles, U, V, mass, acc) -> int:
-    from rftstatic.contact.penalty import kinematic_contact
+    from rftstatic.contact.kinematic import kinematic_contact
 
     X3 = model.X3
     x_new, v_new, n_active = kinematic_contact(obstacles, X3 + U, V)

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -118,6 +118,18 @@ class StaticOptions:
             raise ValueError('solver.guide_folds guides the dynamic relaxation: it needs solver.start = "relax"')
         if self.rtol <= 0 or self.max_iterations < 1:
             raise ValueError(f"need rtol > 0 and max_iterations >= 1, got {self.rtol}, {self.max_iterations}")
+
+    def single_step(self) -> StaticOptions:
+        """These options with the whole load in one increment (no displacement-sized increments)."""
+        return replace(self, initial_increment=1.0, max_increment=1.0, increment_displacement=1e30)
+
+    def from_state(self, *, relax_fallback: bool | None = None) -> StaticOptions:
+        """Options for Newton at full load straight from a given state (a relaxed or transferred
+        equilibrium): one load step, no relaxation start, no perturbation or fold guide.
+        ``relax_fallback``: override the fallback to relaxation when that Newton fails."""
+        fallback = self.relax_fallback if relax_fallback is None else relax_fallback
+        return replace(self.single_step(), start="load-steps", perturbation=0.0, guide_folds=0,
+                       relax_fallback=fallback)
 
 
 @dataclass

@@ -15,6 +15,9 @@ from rftstatic.solvers.explicit import ExplicitResult, run_explicit
 
 log = logging.getLogger(__name__)
 
+RELAX_MASS_SCALE = 100.0
+"""Mass-scaling factor s of dynamic relaxation (§6 uses 100): the stable step grows by sqrt(s)."""
+
 
 @dataclass
 class RelaxResult:
@@ -31,7 +34,7 @@ class RelaxResult:
     peak_kinetic: float = 0.0
 
 
-def relax(model, *, mass_scale: float = 100.0, alpha: float, tol_kinetic: float = 1e-8, tol_force: float = 1e-4,
+def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kinetic: float = 1e-8, tol_force: float = 1e-4,
           max_time: float, dt: float | None = None, U0=None, V0=None, obstacles=(), sample_every: int = 20,
           peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto", load=None) -> RelaxResult:
     """Dynamic relaxation (§6): damped explicit motion until the sheet is at rest.

@@ -19,7 +19,7 @@ from rftstatic.errors import ConvergenceError, InstabilityError
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
 from rftstatic.solvers.newton import StaticOptions, StaticResult, solve_load_steps
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
-from rftstatic.solvers.relaxation import relax
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, relax
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.units import STANDARD_GRAVITY
 
@@ -106,7 +106,7 @@ def _relax_then_newton(model, opts, callback, *, first):
     t0 = time.perf_counter()
     size = float(np.ptp(model.mesh.X, axis=0).max())
     omega1 = np.sqrt(STANDARD_GRAVITY / (0.25 * size))  # pendulum estimate of the lowest drape mode
-    mass_scale = 100.0
+    mass_scale = RELAX_MASS_SCALE
     alpha = 2.0 * omega1 / np.sqrt(mass_scale)  # about critical for that mode of the scaled system
     max_time = 100.0 / alpha  # the relaxation's expected need: 100 damping times (checked below)
     chunk = 4.0 / alpha  # relaxation between two tangent checks [s]
@@ -123,8 +123,7 @@ def _relax_then_newton(model, opts, callback, *, first):
         seed = opts.seed
         U = np.zeros((model.mesh.n_nodes, 3))
         U[:, 2] = start_perturbation(model.mesh, opts) * model.free[:, 2]
-    polish = replace(opts, start="load-steps", relax_fallback=False, initial_increment=1.0, max_increment=1.0,
-                     increment_displacement=1e30, guide_folds=0)
+    polish = opts.from_state(relax_fallback=False)
     short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS)
     basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
     info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": 0.0, "steps": 0, "handovers": [],

@@ -79,9 +79,8 @@ def curve_distance(a, b, *, step=None) -> float:
 
 def _solve(name, overrides):
     """Run a scene (any route) and return (summary, (N, 3) deformed x [scene length], tri, wall [s])."""
-    from rftstatic.app.remeshed import remesh_options
-    from rftstatic.app.static import static_options
     from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.options import remesh_options, static_options
     from rftstatic.scenes.schema import load_scene
     from rftstatic.solvers.static import solve_static
 

@@ -165,7 +165,7 @@ def pedestal_cell(n=17, *, ratio=None, one_step=False) -> dict:
     mod, extras = build.build_model(s)
     opts = run.static_options(s, progress=False)
     if one_step:
-        opts = dataclasses.replace(opts, initial_increment=1.0, max_increment=1.0, increment_displacement=1e30)
+        opts = opts.single_step()
     res = static.solve_static(mod, options=opts)
     out = _static_summary(res)
     out["nodes"] = mod.mesh.n_nodes

@@ -1,0 +1,89 @@
+"""Kinematic contact of the explicit solver (§6.3) and the reaction it implies at rest.
+
+After an explicit time step a penetrated node is moved to its closest surface point and the inward
+normal component of its velocity is removed (:func:`kinematic_contact`). At rest, the obstacles carry
+the part of the load that presses the touching nodes onto them: :func:`contact_reaction_residual` is
+the out-of-balance force with that frictionless reaction taken off, the residual a rest test needs.
+
+Nothing here depends on the obstacles' types: only ``signed_distance`` is used.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from rftstatic.contact.common import as_list as _as_list
+from rftstatic.contact.common import as_points as _as_points
+from rftstatic.contact.obstacles import Obstacle
+
+
+def kinematic_contact(
+    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Kinematic contact correction after an explicit step (§6.3).
+
+    Each penetrated node (``phi < 0``) is moved to its closest surface point ``x - phi n`` and the inward
+    part of its normal velocity is removed (``v <- v - min(v.n, 0) n``); tangential and outward
+    velocities are kept (frictionless, no rebound). Obstacles are treated one after the other.
+
+    Parameters
+    ----------
+    obstacles : an obstacle or a sequence of them
+    x : (N, 3) nodal positions at the end of the step [m]
+    v : (N, 3) nodal velocities [m/s]
+
+    Returns
+    -------
+    x_new : (N, 3) corrected positions [m]
+    v_new : (N, 3) corrected velocities [m/s]
+    n_active : number of nodes that were corrected
+    """
+    items = _as_list(obstacles)
+    x_new = _as_points(x).copy()
+    v_new = _as_points(v, x_new.shape[0], name="v").copy()
+    touched = np.zeros(x_new.shape[0], dtype=bool)
+    for ob in items:
+        phi, normal = ob.signed_distance(x_new)
+        act = phi < 0.0
+        if not np.any(act):
+            continue
+        n = normal[act]
+        x_new[act] -= phi[act, None] * n
+        vn = np.einsum("ni,ni->n", v_new[act], n)
+        v_new[act] -= np.minimum(vn, 0.0)[:, None] * n
+        touched |= act
+    return x_new, v_new, int(np.count_nonzero(touched))
+
+
+TOUCH_TOLERANCE = 1e-3
+"""A node touches an obstacle when its signed distance is below this fraction of the smallest element size."""
+
+
+def contact_reaction_residual(model, obstacles, U, lam: float = 1.0) -> np.ndarray:
+    """``model.residual(U, lam)`` ``(N, 3)`` [N] with the kinematic contact's reaction taken off.
+
+    ``model.residual(U)`` = F(U) - P knows nothing of the kinematic obstacles: the weight carried by a
+    pedestal stays in it and the sheet never counts as at rest. At a node touching an obstacle (phi below
+    :data:`TOUCH_TOLERANCE` of the smallest element size) a frictionless reaction lam n (n the outward
+    normal, lam >= 0) acts; lam is the one that best balances the node's free dofs,
+    lam = max(0, r_f . n_f / |n_f|^2) with r_f, n_f the residual and the normal on the free components
+    (on a fully free node lam = max(r . n, 0); on a node whose x and y are held, e.g. the in-plane hold
+    on top of a sphere, the support takes the in-plane part of lam n), and r -> r - lam n there.
+    """
+    r = model.residual(U, lam)
+    obstacles = _as_list(obstacles) if obstacles else []
+    if not obstacles:
+        return r
+    tol = TOUCH_TOLERANCE * float(model.mesh.element_size.min())
+    x = model.X3 + U
+    for ob in obstacles:
+        phi, n = ob.signed_distance(x)
+        touch = phi <= tol
+        nf = n[touch] * model.free[touch]
+        nn = np.einsum("ni,ni->n", nf, nf)
+        rn = np.einsum("ni,ni->n", r[touch] * model.free[touch], nf)
+        reaction = np.where(nn > 0, np.maximum(rn, 0.0) / np.where(nn > 0, nn, 1.0), 0.0)
+        r[touch] -= reaction[:, None] * n[touch]
+    return r

@@ -1,0 +1,28 @@
+"""Write a solved state: ``summary.json``, ``deformed.vtu`` (displacement, curvature, relative
+curvature |kappa| h, membrane strain) and the PNG views, all in the scene's units."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rftstatic.io.files import write_json, write_vtu
+
+
+def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=True) -> None:
+    """Write ``summary`` and the deformed state ``U (N, 3)`` [m] of ``model`` into ``out``."""
+    u = scene.units.length
+    write_json(out / "summary.json", summary)
+    cell = {"curvature": model.curvature(U) * u, "relative_curvature": model.relative_curvature(U),
+            "membrane_strain": model.membrane_strain(U)}
+    if scene.get("output.vtu", True):
+        write_vtu(out / "deformed.vtu", model.X3, U, model.mesh.tri, length_unit_scale=u, cell_data=cell)
+    if figures:
+        from rftstatic.io.drape_figures import obstacle_drawers
+        from rftstatic.io.plots import plot_views
+
+        views = tuple(scene.get("output.views", ["side", "top", "iso"]))
+        status = "" if summary.get("converged", True) else " (NOT CONVERGED)"
+        title = f"{scene.get('title', scene.name)} - {model.element}, {model.mesh.n_nodes} nodes{status}"
+        plot_views(str(out / "view"), model.positions(U) / u, model.mesh.tri, views=views, title=title,
+                   color_by=cell["relative_curvature"], color_label="|kappa| h",
+                   obstacles_draw=obstacle_drawers(extras.get("obstacles", ()), u))

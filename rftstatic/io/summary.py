@@ -1,0 +1,72 @@
+"""The parts of ``summary.json`` every analysis shares, in the scene's units.
+
+- :func:`summary_header`: what ran (scene, its resolved data, element, mesh, software with git commit and
+  code fingerprint, warnings, peak memory);
+- :func:`drape_summary`: drape coefficient, fold count and the sharp-fold indicator (method.md);
+- :func:`probe_summary`: reference and deformed positions of the scene's probes.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from rftstatic.post.measures import drape_measures
+from rftstatic.post.probes import probe_positions
+from rftstatic.provenance import peak_memory_mb, software
+
+
+def summary_header(scene, model, analysis: str) -> dict:
+    """Keys every summary starts with: scene, title, figure, units, overrides, element, analysis, nodes,
+    elements, mesh, software, warnings, peak_memory_mb and ``resolved_scene`` (the scene's data after
+    the overrides, scene units)."""
+    return {
+        "scene": scene.name,
+        "title": scene.get("title", ""),
+        "figure": scene.get("figure", ""),
+        "units": scene.units.name,
+        "overrides": {k: v for k, v in scene.overrides.items() if k != "resume"},
+        "element": model.element,
+        "analysis": analysis,
+        "nodes": model.mesh.n_nodes,
+        "elements": model.mesh.n_elements,
+        "mesh": model.mesh.summary(),
+        "software": software(),
+        "warnings": list(model.warnings),
+        "peak_memory_mb": peak_memory_mb(),
+        "resolved_scene": copy.deepcopy(scene.data),
+    }
+
+
+def drape_summary(scene, model, extras, U) -> dict:
+    """Drape coefficient, fold count and sharp-fold indicator (method.md) at ``U (N, 3)`` [m], scene units."""
+    u = scene.units.length
+    x = model.positions(U)
+    obstacles = extras["obstacles"]
+    disc_area, centre = obstacles[0].footprint() if obstacles else (None, np.zeros(2))
+    m = drape_measures(x, model.mesh.tri, sheet_area=float(model.mesh.area.sum()), disc_area=disc_area,
+                       centre=centre, curvature=model.curvature(U), h=model.mesh.element_size)
+    return _scale_lengths(m, u)
+
+
+_LENGTH_KEYS = ("boundary_radius_min", "boundary_radius_mean", "boundary_radius_max", "max_dihedral_at",
+                "max_relative_curvature_at")
+
+
+def _scale_lengths(m: dict, u: float) -> dict:
+    """Drape measures from SI to the scene's length unit ``u`` [m]."""
+    out = dict(m)
+    if "shadow_area" in out:
+        out["shadow_area"] = out["shadow_area"] / u**2
+    for key in _LENGTH_KEYS:
+        if key in out and out[key] is not None:
+            out[key] = (np.asarray(out[key], float) / u).tolist()
+    return out
+
+
+def probe_summary(scene, model, probes: dict, U) -> dict:
+    """``{name: {"reference": [x, y, z], "deformed": [x, y, z]}}`` in scene length units."""
+    u = scene.units.length
+    return {name: {"reference": (p["reference"] / u).tolist(), "deformed": (p["deformed"] / u).tolist()}
+            for name, p in probe_positions(model, probes, U).items()}

@@ -1,0 +1,176 @@
+"""The one step that turns a scene's ``[solver]``, ``[dynamics]`` and ``[remesh]`` tables into SI options.
+
+Every default is written once: the static solver's in :class:`~rftstatic.solvers.newton.StaticOptions`,
+the explicit and relaxation runs' in :data:`DYNAMICS_DEFAULTS` (per analysis type), the remeshing
+drivers' in :class:`RemeshOptions`. A bad value raises :class:`~rftstatic.errors.SceneError` naming the
+file, the key and the value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import MISSING, dataclass, fields
+
+import numpy as np
+
+from rftstatic.errors import ParameterError, SceneError
+from rftstatic.remesh.adapt import check_remesh_parameters
+from rftstatic.solvers.newton import StaticOptions
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
+
+_STATIC_KEYS = {f.name for f in fields(StaticOptions)} - {"progress"}
+_STATIC_LENGTH_KEYS = ("max_step", "increment_displacement")
+
+
+def static_options(scene, *, progress=True) -> StaticOptions:
+    """The scene's ``[solver]`` table as :class:`StaticOptions` (lengths in SI [m]).
+
+    ``solver.membrane`` is a model switch (:func:`rftstatic.scenes.build.build_model`), not a solver
+    option, and is left out here.
+    """
+    s = dict(scene.get("solver", {}))
+    s.pop("membrane", None)
+    u = scene.units.length
+    for key in _STATIC_LENGTH_KEYS:
+        if key in s:
+            s[key] = s[key] * u
+    unknown = set(s) - _STATIC_KEYS
+    if unknown:
+        raise scene.error("solver", f"unknown option(s) {sorted(unknown)}")
+    try:
+        return StaticOptions(**s, progress=progress)
+    except (TypeError, ValueError) as exc:
+        raise scene.error("solver", str(exc)) from None
+
+
+DYNAMICS_DEFAULTS = {
+    # true dynamics (§4.6): the real mass, no damping unless the scene asks, rest at 1e-3 of the peak
+    "dynamic": {"alpha": 0.0, "mass_scale": 1.0, "rest_tolerance": 1e-3},
+    # dynamic relaxation (§6): alpha = 5/s with mass scaling s = 100, rest at 1e-8 of the peak
+    "relax": {"alpha": 5.0, "mass_scale": RELAX_MASS_SCALE, "rest_tolerance": 1e-8},
+}
+"""Defaults of ``[dynamics]`` that depend on the analysis type (scene units); the others are in
+:class:`DynamicsOptions`."""
+
+
+@dataclass(frozen=True)
+class DynamicsOptions:
+    """``[dynamics]`` of a ``dynamic`` or ``relax`` scene, in SI.
+
+    Attributes
+    ----------
+    t_end : end time (for relax: the longest simulated time) [s]
+    dt : time step [s]; None: 0.9 x the Lanczos stable step
+    alpha : mass damping [1/s]
+    mass_scale : mass-scaling factor s [-]
+    frames : (F,) sorted times of the PNG frames [s]
+    checkpoint_every : simulated time between checkpoints [s] (scene default 0.2 s)
+    rest_tolerance : kinetic / peak kinetic energy at rest [-]
+    force_tolerance : relax: out-of-balance force / load at rest [-]
+    samples : regular states saved for the VTU series and the GIF
+    compare_static : relax: report the difference from the static Newton solution
+    """
+
+    t_end: float
+    dt: float | None
+    alpha: float
+    mass_scale: float
+    frames: np.ndarray
+    checkpoint_every: float
+    rest_tolerance: float
+    force_tolerance: float = 1e-4
+    samples: int = 30
+    compare_static: bool = False
+
+
+CHECKPOINT_EVERY_S = 0.2
+"""Default simulated time between checkpoints [s]."""
+
+
+def dynamics_options(scene) -> DynamicsOptions:
+    """The scene's ``[dynamics]`` table checked and converted to SI, with the defaults filled in."""
+    analysis = scene.get("analysis", "static")
+    if analysis not in DYNAMICS_DEFAULTS:
+        raise scene.error("analysis", f'"{analysis}" has no [dynamics]; use "dynamic" or "relax"')
+    d = dict(scene.get("dynamics", {}))
+    u = scene.units
+    if "t_end" not in d:
+        raise scene.error("dynamics.t_end", f"an analysis = \"{analysis}\" scene needs its end time "
+                          "(dynamics.t_end, the longest simulated time for relax)")
+    defaults = {f.name: f.default for f in fields(DynamicsOptions) if f.default is not MISSING}
+    opts = {**defaults, **DYNAMICS_DEFAULTS[analysis], "checkpoint_every": CHECKPOINT_EVERY_S / u.time, "frames": []}
+    opts.update(d)
+
+    def positive(key, strict=True):
+        v = opts[key]
+        if not (isinstance(v, (int, float)) and (v > 0 if strict else v >= 0)):
+            raise scene.error(f"dynamics.{key}", f"must be {'> 0' if strict else '>= 0'}, got {v!r}")
+
+    for key in ("t_end", "mass_scale", "rest_tolerance", "force_tolerance", "checkpoint_every"):
+        positive(key)
+    positive("alpha", strict=False)
+    if opts.get("dt") is not None:
+        positive("dt")
+    if opts["samples"] < 0:
+        raise scene.error("dynamics.samples", f"must be >= 0, got {opts['samples']}")
+    frames = opts["frames"]
+    if not all(isinstance(f, (int, float)) and 0 <= f <= opts["t_end"] for f in frames):
+        raise scene.error("dynamics.frames", f"expected times in [0, t_end = {opts['t_end']}], got {frames!r}")
+    t = u.time
+    return DynamicsOptions(
+        t_end=opts["t_end"] * t, dt=None if opts.get("dt") is None else opts["dt"] * t, alpha=opts["alpha"] / t,
+        mass_scale=float(opts["mass_scale"]), frames=np.array(sorted(set(float(f) * t for f in frames))),
+        checkpoint_every=opts["checkpoint_every"] * t, rest_tolerance=float(opts["rest_tolerance"]),
+        force_tolerance=float(opts["force_tolerance"]), samples=int(opts["samples"]),
+        compare_static=bool(opts["compare_static"]))
+
+
+@dataclass(frozen=True)
+class RemeshOptions:
+    """``[remesh]`` of a scene, in SI (Eq. 29: h_new = sqrt(const / |kappa|) in [h_lower, h_upper]).
+
+    Attributes
+    ----------
+    const : [m]; h_lower, h_upper : element size bounds [m]
+    gradation : largest size ratio between neighbours one element apart [-]
+    max_cycles : static route: most remeshing cycles
+    tol : stop when the node count changes by less than this fraction [-]
+    kappa_h_max : static route: largest |kappa| h accepted without remeshing [-] (None: node count alone)
+    transfer : "mesh", "patch" or "grid" (:mod:`rftstatic.remesh.transfer`)
+    every : relax route: remesh every this many steps (None: on the curvature trigger)
+    kappa_h2_max : relax route: remesh when max |kappa| h^2 exceeds this [m]
+    damping : relax route: "fixed" (dynamics.alpha) or "critical"
+    """
+
+    const: float
+    h_lower: float
+    h_upper: float
+    gradation: float = 1.3
+    max_cycles: int = 5
+    tol: float = 0.05
+    kappa_h_max: float | None = None
+    transfer: str = "mesh"
+    every: int | None = None
+    kappa_h2_max: float | None = None
+    damping: str = "fixed"
+
+
+REMESH_LENGTH_KEYS = ("const", "h_lower", "h_upper", "kappa_h2_max")
+"""``[remesh]`` keys that are lengths (scene units in the file, SI in :class:`RemeshOptions`)."""
+
+
+def remesh_options(scene) -> RemeshOptions:
+    """The scene's ``[remesh]`` table with defaults, checked (:func:`check_remesh_parameters`), in SI."""
+    r = dict(scene.get("remesh", {}))
+    for key in ("const", "h_lower", "h_upper"):
+        if key not in r:
+            raise scene.error(f"remesh.{key}", f"a [remesh] table needs {key} (Eq. 29, scene length units)")
+    try:
+        check_remesh_parameters(**r)
+    except ParameterError as exc:
+        raise scene.error(f"remesh.{exc.key}", exc.detail) from None
+    u = scene.units.length
+    return RemeshOptions(**{k: (v * u if k in REMESH_LENGTH_KEYS and v is not None else v) for k, v in r.items()})
+
+
+__all__ = ["static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
+           "DYNAMICS_DEFAULTS", "SceneError"]
