@@ -7,18 +7,10 @@ from rftstatic import material
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.mesh.mesher import Domain, generate
 from rftstatic.model import model
-from rftstatic.remesh.adapt import (
-    NearObstacle,
-    adapt_mesh,
-    critical_damping,
-    explicit_advance,
-    reference_domain,
-    refinable_maxima,
-    remesh_relax,
-    remesh_static,
-    transfer_state,
-)
+from rftstatic.remesh.adapt import adapt_mesh, reference_domain, refinable_maxima, transfer_state
+from rftstatic.remesh.relax_driver import NearObstacle, critical_damping, explicit_advance, remesh_relax
 from rftstatic.remesh.sizefield import curvature_magnitude, size_field, target_sizes
+from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.remesh.transfer import interpolate, locate, transfer_fields
 from rftstatic.scenes.schema import scene_from_dict
 from rftstatic.solvers.static import StaticOptions, solve_static
@@ -249,7 +241,7 @@ def test_near_obstacle_gives_the_same_kinematic_contact():
             x = x + rng.normal(scale=3e-4, size=x.shape)
             a, b = kinematic_contact(ob, x, v), kinematic_contact(near, x, v)
             assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and a[2] == b[2]
-        assert 1 < near.refreshes < 100 and len(near._list[0]) < len(x) / 2
+        assert 1 < near.refreshes < 100 and len(near.candidates) < len(x) / 2
 
 
 # ------------------------------------------------------------------------------------------ drivers

@@ -117,7 +117,7 @@ def test_contact_reaction_at_a_node_held_in_plane_on_a_sphere():
 
 
 def test_explicit_contact_never_moves_a_held_dof():
-    from rftstatic.remesh.adapt import explicit_advance
+    from rftstatic.remesh.relax_driver import explicit_advance
 
     scene, plain, obstacles = _sphere_with_hold_off_the_top()
     held = ~plain.free

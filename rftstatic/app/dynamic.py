@@ -42,6 +42,7 @@ from rftstatic.scenes.options import dynamics_options, static_options
 from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
 from rftstatic.solvers.checkpoint import resume as resume_run
 from rftstatic.solvers.explicit import run_explicit
+from rftstatic.solvers.relaxation import AtRest
 from rftstatic.solvers.static import compare_with_static, solve_static
 from rftstatic.solvers.timestep import stable_time_step
 
@@ -102,15 +103,12 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     save_times = np.unique(np.concatenate([o.frames, regular]))
 
     free_load = float(np.linalg.norm(np.where(model.free, model.load, 0.0)))
-    peak = {"kinetic": 0.0}
+    rest = AtRest(tol_kinetic=o.rest_tolerance, tol_force=o.force_tolerance, load_norm=free_load)
 
     def watch(state, rec):
-        peak["kinetic"] = max(peak["kinetic"], rec["kinetic"])
+        at_rest = rest(state, rec)  # tracks the peak kinetic energy at every sample
         stop = callback(state, rec) if callback is not None else False
-        if analysis == "relax":
-            stop = stop or bool(peak["kinetic"] > 0 and rec["kinetic"] < o.rest_tolerance * peak["kinetic"]
-                                and rec["residual"] < o.force_tolerance * free_load)
-        return stop
+        return bool(stop or (analysis == "relax" and at_rest))
 
     ckpt_path = out / CHECKPOINT
     wall0 = time.perf_counter()
@@ -126,7 +124,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
             raise scene.error("dynamics.frames", f"the checkpoint {ckpt_path} saved other frame times; run "
                               "without --resume")
         hist_k = np.asarray(data["history"]["kinetic"], float)
-        peak["kinetic"] = float(hist_k.max()) if hist_k.size else 0.0
+        rest.peak_kinetic = float(hist_k.max()) if hist_k.size else 0.0
         dt = data["dt"]
         ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
         resumed_from = data["t"]

@@ -39,14 +39,9 @@ from rftstatic.contact.kinematic import contact_reaction_residual
 from rftstatic.io.files import to_jsonable, write_json
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import drape_summary, probe_summary, summary_header
-from rftstatic.remesh.adapt import (
-    RemeshRecord,
-    _curvature_figures,
-    explicit_advance,
-    refinable_maxima,
-    remesh_relax,
-    remesh_static,
-)
+from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
+from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
+from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import REMESH_LENGTH_KEYS, dynamics_options, remesh_options, static_options
 
@@ -118,7 +113,7 @@ def _static(scene, opts) -> dict:
     meshes = []
 
     def factory(mesh=None):
-        model, extras = build_model(scene, mesh=mesh)
+        model, extras = build_model(scene, mesh=mesh, quiet=mesh is not None)
         meshes.append({"model": model, "U": None, "t": 0.0, "step": 0})
         return model, extras
 
@@ -136,7 +131,8 @@ def _relax(scene, opts) -> dict:
     d = dynamics_options(scene)
 
     def factory(mesh=None):
-        return build_model(scene, mesh=mesh)  # a relax scene: the obstacles act kinematically
+        # a relax scene: the obstacles act kinematically; the first mesh's model warns, the others are quiet
+        return build_model(scene, mesh=mesh, quiet=mesh is not None)
 
     model0, extras0 = factory(None)
     obstacles = tuple(extras0.get("obstacles", ()))

@@ -33,6 +33,7 @@ from typing import Sequence
 
 import numpy as np
 
+from rftstatic.contact.candidates import CandidateList
 from rftstatic.contact.common import as_list as _as_list
 from rftstatic.contact.common import as_points as _as_points
 from rftstatic.contact.common import positive as _positive
@@ -98,12 +99,14 @@ class PenaltyContact:
     evaluate the signed distances once; :meth:`evaluate` returns all of them from one evaluation and is
     what a Newton iteration should call.
 
-    Candidate list: :meth:`evaluate` computes distances only for the nodes that were within
-    ``margin`` of an obstacle when the list was last refreshed, and refreshes it (one evaluation of
-    every node) once some node has moved more than ``margin / 2`` since. A signed distance changes
-    no faster than the point moves, so a node left out is still more than ``margin / 2 > eps`` away
-    and has no contact energy: the result is exact, and an explicit step (which moves nodes a small
-    fraction of an element) pays for the few nodes near the obstacle instead of all of them.
+    Candidate list: given a :class:`~rftstatic.contact.candidates.CandidateList` (made by
+    :meth:`new_candidates`, kept by the solver in its State), :meth:`evaluate` and :meth:`force`
+    compute distances only for the nodes that were within ``margin`` of an obstacle when the list was
+    last refreshed, and refresh it (one evaluation of every node) once some node has moved more than
+    ``margin / 2`` since. A node left out is still more than ``margin / 2 > eps`` away and has no
+    contact energy: the result is exact, and an explicit step (which moves nodes a small fraction of
+    an element) pays for the few nodes near the obstacle instead of all of them. Without a list every
+    node is evaluated; the contact itself holds no state.
     """
 
     def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float,
@@ -122,8 +125,10 @@ class PenaltyContact:
         # list margin [m]: a few onset widths, and half a node spacing so explicit runs refresh seldom
         spacing = float(np.sqrt(np.mean(area))) if area.size and np.mean(area) > 0 else 0.0
         self.margin = max(4.0 * self.smoothing, 0.5 * spacing)
-        self._candidates = None  # (indices, positions at refresh, lower bound of the gap at refresh)
-        self.refreshes = 0
+
+    def new_candidates(self) -> CandidateList:
+        """An empty candidate list with this contact's margin (for a solver's State)."""
+        return CandidateList(self.margin)
 
     @property
     def n_nodes(self) -> int:
@@ -141,13 +146,15 @@ class PenaltyContact:
         phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
         return np.stack(phis), np.stack(normals)
 
-    def evaluate(self, x: np.ndarray, *, tangent: bool = True) -> ContactState:
+    def evaluate(self, x: np.ndarray, *, tangent: bool = True, candidates: CandidateList | None = None
+                 ) -> ContactState:
         """Energy, force, tangent blocks and gaps at positions ``x``.
 
         Parameters
         ----------
         x : (N, 3) current nodal positions [m]
         tangent : also compute the tangent blocks (else they are zeros)
+        candidates : the solve's candidate list (refreshed here when needed); None: every node
 
         Returns
         -------
@@ -155,7 +162,7 @@ class PenaltyContact:
         """
         x = _as_points(x, self.n_nodes)
         n = x.shape[0]
-        cand, gap = self._near(x)
+        cand, gap = self._near(x, candidates)
         xc = x[cand]
         phi, normal = self._distances_of(xc)
         e, d1, d2 = self._density(phi)  # energy density, d/dphi, d2/dphi2 per unit k A  (M, C)
@@ -180,24 +187,20 @@ class PenaltyContact:
             active[cand] = np.any(phi < 0.0, axis=0)
         return ContactState(energy, force, blocks, gap, active)
 
-    def _near(self, x):
+    def _near(self, x, candidates):
         """Indices of the candidate nodes and an ``(N,)`` gap array: exact values are filled in by
         the caller for the candidates; the others hold a lower bound (> margin / 2) [m]."""
         n = x.shape[0]
         if not self.obstacles:
             return np.arange(0), np.full(n, np.inf)
-        c = self._candidates
-        if c is not None:
-            idx, x_ref, bound = c
-            moved = np.sqrt(np.max(np.einsum("ni,ni->n", x - x_ref, x - x_ref)))
-            if moved <= 0.5 * self.margin:
-                return idx, bound - moved
+        if candidates is None:
+            return np.arange(n), np.full(n, np.inf)
+        hit = candidates.lookup(x)
+        if hit is not None:
+            return hit
         phi, _ = self._distances_of(x)
         gap = phi.min(axis=0)
-        idx = np.flatnonzero(gap < self.margin)
-        self._candidates = (idx, x.copy(), gap)
-        self.refreshes += 1
-        return idx, gap.copy()
+        return candidates.refresh(x, gap), gap.copy()
 
     def _density(self, phi):
         eps = self.smoothing
@@ -225,11 +228,11 @@ class PenaltyContact:
             d1[onset] = -(a * a) / (2 * eps)
         return d1
 
-    def energy(self, x: np.ndarray) -> float:
+    def energy(self, x: np.ndarray, *, candidates: CandidateList | None = None) -> float:
         """Contact energy ``sum 1/2 k A_n min(phi, 0)^2`` [J] at ``x (N, 3)`` [m]."""
-        return self.evaluate(x, tangent=False).energy
+        return self.evaluate(x, tangent=False, candidates=candidates).energy
 
-    def force(self, x: np.ndarray) -> np.ndarray:
+    def force(self, x: np.ndarray, *, candidates: CandidateList | None = None) -> np.ndarray:
         """Gradient of the contact energy, ``(N, 3)`` [N], at ``x (N, 3)`` [m].
 
         ``k A_n min(phi, 0) n`` summed over the obstacles; it points into the obstacle, so it is the
@@ -238,7 +241,7 @@ class PenaltyContact:
         density are computed (no energy, gaps or tangent blocks).
         """
         x = _as_points(x, self.n_nodes)
-        cand, _ = self._near(x)
+        cand, _ = self._near(x, candidates)
         force = np.zeros((x.shape[0], 3))
         if cand.size:
             phi, normal = self._distances_of(x[cand])
@@ -246,12 +249,12 @@ class PenaltyContact:
             force[cand] = np.einsum("n,mn,mni->ni", self.stiffness * self.node_area[cand], d1, normal)
         return force
 
-    def tangent_blocks(self, x: np.ndarray) -> np.ndarray:
+    def tangent_blocks(self, x: np.ndarray, *, candidates: CandidateList | None = None) -> np.ndarray:
         """Node-diagonal blocks ``(N, 3, 3)`` [N/m] of ``d force / dx`` at ``x (N, 3)`` [m].
 
         ``k A_n (n n^T + phi H)`` for each obstacle the node penetrates; symmetric.
         """
-        return self.evaluate(x).tangent_blocks
+        return self.evaluate(x, candidates=candidates).tangent_blocks
 
     def gaps(self, x: np.ndarray) -> np.ndarray:
         """Smallest signed distance of each node over the obstacles, ``(N,)`` [m] (``inf`` if none)."""

@@ -109,10 +109,11 @@ class ForceKernel:
                 self._fe = np.empty((flat.size, 3))
                 self._nb_parallel = internal_force_parallel
 
-    def __call__(self, U: np.ndarray, *, energy: bool = False):
+    def __call__(self, U: np.ndarray, *, energy: bool = False, candidates=None):
         """Internal force ``(N, 3)`` [N]; with ``energy=True`` also the stored energy [J].
 
-        The stored energy is bending + membrane + penalty contact (:meth:`Model.energies`).
+        The stored energy is bending + membrane + penalty contact (:meth:`Model.energies`);
+        ``candidates`` is the solve's contact candidate list (a cache; None: every node).
         """
         if self.backend == "numba":
             U = np.ascontiguousarray(U, dtype=float)
@@ -142,9 +143,9 @@ class ForceKernel:
                 W += Wm
         if self.contact is not None:
             x = self.X3 + U
-            f += self.contact.force(x)
+            f += self.contact.force(x, candidates=candidates)
             if energy:
-                W += self.contact.energy(x)
+                W += self.contact.energy(x, candidates=candidates)
         return (f, W) if energy else f
 
     def _membrane(self, U, energy):

@@ -34,9 +34,6 @@ RFT6, C/B scaled; validation/stability.md): 0.02 % at 5e3, 0.5 % at 2e4, 2.1 % a
 8 % at 8e5; the warning starts below the level (2e4) where the strip leaves its 0.5 % tolerance."""
 
 
-_LOCKING_WARNED = False  # the warning is logged at warning level once per process
-
-
 def locking_number(mesh: TriMesh, material: Material) -> float:
     """``max_i (D^m_ii / D^b_ii) h^2`` [-], membrane over bending rigidity times the mean element size squared.
 
@@ -110,10 +107,12 @@ class Model:
     load_terms : loads with a potential scaled by the load factor, e.g.
         :class:`rftstatic.loads.LeverMoment` (methods ``potential``, ``force``, ``tangent_blocks``,
         ``commit``)
+    quiet : log the model's warnings (``warnings``: membrane locking) at debug level, not warning
+        level (a remeshed run builds one model per mesh and warns once)
     """
 
     def __init__(self, mesh: TriMesh, material: Material, *, element="RFT6", supports=None, load=None,
-                 contact=None, membrane=True, load_terms=()):
+                 contact=None, membrane=True, load_terms=(), quiet=False):
         if element not in ELEMENTS:
             raise ValueError(f'unknown element "{element}"; use one of {", ".join(ELEMENTS)}')
         self.mesh = mesh
@@ -141,10 +140,8 @@ class Model:
                         f"little at 2e4, 3.3 % at 8e4, 8 % at 8e5). Refine to a mean element size below {h_ok:.3g} m or use "
                         f'element = "RFT3"')
                 self.warnings.append(text)
-                # once per process at warning level: a remeshed run builds a model per remesh
-                global _LOCKING_WARNED
-                log.log(logging.DEBUG if _LOCKING_WARNED else logging.WARNING, text)
-                _LOCKING_WARNED = True
+                # quiet: the caller has said it already (a remeshed run builds a model per remesh)
+                log.log(logging.DEBUG if quiet else logging.WARNING, text)
 
     # --- constant structures, built on first use ------------------------------------------------
     @cached_property
@@ -168,11 +165,13 @@ class Model:
         return self.X3 + U
 
     # --- energy and its derivatives -------------------------------------------------------------
-    def energies(self, U, lam=1.0) -> dict:
+    # ``candidates``: the solve's contact candidate list (a cache held in its State; results do not
+    # depend on it), or None to evaluate the contact at every node.
+    def energies(self, U, lam=1.0, *, candidates=None) -> dict:
         """Parts of the total potential [J]: bending, membrane, contact, external work, total."""
         Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
         Em = self.membrane.energy(U, self.material.Dm) if self.with_membrane else 0.0
-        Ec = self.contact.energy(self.positions(U)) if self.contact is not None else 0.0
+        Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
         W = lam * float(np.einsum("ni,ni->", self.load, U))
         if self.load_terms:
             x = self.positions(U)
@@ -180,28 +179,28 @@ class Model:
         return {"bending": Eb, "membrane": Em, "contact": Ec, "external_work": W,
                 "total": Eb + Em + Ec - W}
 
-    def potential(self, U, lam=1.0) -> float:
+    def potential(self, U, lam=1.0, *, candidates=None) -> float:
         """Total potential energy Pi(U) [J]."""
-        return self.energies(U, lam)["total"]
+        return self.energies(U, lam, candidates=candidates)["total"]
 
-    def internal_force(self, U) -> np.ndarray:
+    def internal_force(self, U, *, candidates=None) -> np.ndarray:
         """Internal (bending + membrane + contact) force ``(N, 3)`` [N], the gradient of the stored energy."""
         f = self.Kb @ U
         if self.with_membrane:
             fe = self.membrane.element_forces(U, self.material.Dm)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
-            f += self.contact.force(self.positions(U))
+            f += self.contact.force(self.positions(U), candidates=candidates)
         return f
 
-    def residual(self, U, lam=1.0) -> np.ndarray:
+    def residual(self, U, lam=1.0, *, candidates=None) -> np.ndarray:
         """Out-of-balance force ``dPi/dU (N, 3)`` [N]; zero at equilibrium on the free dofs."""
-        r = self.internal_force(U) - lam * self.load
+        r = self.internal_force(U, candidates=candidates) - lam * self.load
         for term in self.load_terms:
             r += lam * term.force(self.positions(U))
         return r
 
-    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0):
+    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None):
         """Internal force ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m] at load factor ``lam``.
 
         ``psd=True`` drops compressive stress from the geometric stiffness (positive semi-definite
@@ -216,9 +215,9 @@ class Model:
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
             data += scatter_matrices(self._membrane_map, ke, plan.nnz)
         if self.contact is not None:
-            state = self.contact.evaluate(x)
-            f += state.force
-            data += scatter_matrices(plan.diag_positions, state.tangent_blocks, plan.nnz)
+            cs = self.contact.evaluate(x, candidates=candidates)
+            f += cs.force
+            data += scatter_matrices(plan.diag_positions, cs.tangent_blocks, plan.nnz)
         for term in self.load_terms:  # load stiffness of potential loads (not part of f)
             rows, cols, blocks = term.tangent_blocks(x)
             data += scatter_matrices(plan.positions(rows, cols), lam * blocks, plan.nnz)

@@ -272,11 +272,12 @@ def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
     supports.fixed[a, 1] = True
 
 
-def build_model(scene: Scene, mesh=None, *, contact: str | None = None) -> tuple[Model, dict]:
+def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: bool = False) -> tuple[Model, dict]:
     """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras.
 
     ``contact``: how the obstacles act, ``"penalty"`` (in the model's energy) or ``"kinematic"`` (by the
     explicit solver; the model has no contact term); default :func:`contact_law` of the scene's analysis.
+    ``quiet``: the model's warnings at debug level (a remeshed run warns for its first mesh only).
     ``extras``: ``{"obstacles": [...], "probes": {name: (2,) reference point [m]}}``.
     """
     mesh = build_mesh(scene) if mesh is None else mesh
@@ -286,7 +287,7 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None) -> tuple
     contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
     membrane = scene.get("solver.membrane", True)
     model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
-                  contact=contact, membrane=membrane)
+                  contact=contact, membrane=membrane, quiet=quiet)
     probes = {}
     u = scene.units.length
     for i, spec in enumerate(scene.get("probes", [])):
@@ -299,4 +300,4 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None) -> tuple
 def model_factory(scene: Scene, *, contact: str | None = None):
     """``factory(mesh=None) -> (Model, extras)``: the scene's model on ``mesh`` (None: its own mesh),
     for the remeshing drivers (:mod:`rftstatic.remesh`), which rebuild the model on every new mesh."""
-    return lambda mesh=None: build_model(scene, mesh=mesh, contact=contact)
+    return lambda mesh=None: build_model(scene, mesh=mesh, contact=contact, quiet=mesh is not None)

@@ -43,6 +43,7 @@ import numpy as np
 
 from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.errors import InstabilityError
+from rftstatic.model.state import State
 from rftstatic.progress import Progress
 from rftstatic.solvers.timestep import StepEstimate, lumped_mass, stable_time_step
 
@@ -50,24 +51,6 @@ log = logging.getLogger(__name__)
 
 HISTORY_KEYS = ("time", "kinetic", "potential", "strain", "external_work", "dissipated", "contact_loss", "total",
                 "residual")
-
-
-@dataclass
-class State:
-    """What changes from step to step.
-
-    Attributes
-    ----------
-    t : time of ``U`` [s]
-    U : (N, 3) displacements D_n [m]
-    V_half : (N, 3) velocities v_(n-1/2) [m/s]
-    step : step number n
-    """
-
-    t: float
-    U: np.ndarray
-    V_half: np.ndarray
-    step: int
 
 
 @dataclass
@@ -87,6 +70,7 @@ class ExplicitResult:
     time_at_rest : first sample time after which kinetic/peak kinetic stays below ``rest_tol``, or None
     stopped : True if a callback stopped the run before ``t_end``
     wall_time : [s]; element_steps_per_second : E * steps / wall time
+    state : the final :class:`~rftstatic.model.state.State` (U, V, t, step, contact candidates)
     """
 
     U: np.ndarray
@@ -103,6 +87,7 @@ class ExplicitResult:
     contact_nodes: int = 0
     wall_time: float = 0.0
     element_steps_per_second: float = 0.0
+    state: State | None = None
 
     def summary(self) -> dict:
         return {"t": self.t, "steps": self.steps, "dt": self.dt, "time_at_rest": self.time_at_rest,
@@ -156,127 +141,160 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
         raise ValueError(f'start must be "consistent" or "given", got "{start}"')
     wall0 = time.perf_counter()
     N = model.mesh.n_nodes
-    free = model.free
     obstacles = tuple(obstacles) if not hasattr(obstacles, "signed_distance") else (obstacles,)
-    mass = lumped_mass(model, mass_scale)
-    kernel = ForceKernel(model, backend=backend)
-    P = np.array(model.load if load is None else load, dtype=float)
     probes = np.zeros(0, dtype=np.int64) if probes is None else np.atleast_1d(np.asarray(probes, dtype=np.int64))
     if probes.size and (probes.min() < 0 or probes.max() >= N):
         raise ValueError(f"probe nodes must lie in 0..{N - 1}, got min {probes.min()}, max {probes.max()}")
-    frame_times = np.sort(np.asarray(frame_times, dtype=float).ravel())
-
+    loop = _Loop(model, obstacles, mass_scale=mass_scale, alpha=alpha, load=load, backend=backend, probes=probes,
+                 frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()))
     if _restart is None:
-        U = np.zeros((N, 3)) if U0 is None else np.array(U0, dtype=float)
-        V = np.zeros((N, 3)) if V0 is None else np.array(V0, dtype=float)
-        for name, arr in (("U0", U), ("V0", V)):
-            if arr.shape != (N, 3):
-                raise ValueError(f"{name} must have shape ({N}, 3), got {arr.shape}")
-        V *= free
-        estimate, dt = _choose_step(model, U, dt, alpha=alpha, mass_scale=mass_scale, safety=safety,
+        state = State.initial(model, U0, V0)
+        state.V *= model.free
+        estimate, dt = _choose_step(model, state.U, dt, alpha=alpha, mass_scale=mass_scale, safety=safety,
                                     needed=energy_check or dt is None)
         n_steps = max(1, int(np.ceil(t_end / dt - 1e-9)))
         dt = t_end / n_steps
-        step = 0
-        acc = {"damping": 0.0, "contact": 0.0, "total0": None, "scale": 0.0, "peak_kinetic": 0.0,
-               "frame_index": 0}
-        hist = {k: [] for k in HISTORY_KEYS}
-        probe_hist, frames = [], []
-        if start == "consistent":
-            a0 = (P - kernel(U)) / mass[:, None] - alpha * V
-            V = V - 0.5 * dt * a0 * free
+        loop.begin(dt, start_consistent=start == "consistent", state=state)
     else:
         r = _restart
-        U, V, step, dt, n_steps = r["U"], r["V_half"], r["step"], r["dt"], r["n_steps"]
-        estimate, acc = r["estimate"], r["acc"]
-        hist = {k: list(r["history"][k]) for k in HISTORY_KEYS}
-        probe_hist = list(r["probes"])
-        frames = list(r["frames"])
+        state = State.initial(model, r["U"], r["V_half"], t=r["step"] * r["dt"], step=r["step"])
+        dt, n_steps, estimate = r["dt"], r["n_steps"], r["estimate"]
+        loop.resume(dt, r)
     if sample_every is None:
         sample_every = max(1, n_steps // 2000)
-    sample_every = int(sample_every)
-    check_every = min(sample_every, 50)
-    Ufix = U.copy()
-    fixed_any = bool((~free).any())
-    minv = free / mass[:, None]  # (N, 3) inverse mass, zero on supported dofs
-    damp = 1.0 - alpha * dt
-    Vnew = np.empty_like(V)
-    opts = {"t_end": t_end, "alpha": alpha, "mass_scale": mass_scale, "sample_every": sample_every,
+    opts = {"t_end": t_end, "alpha": alpha, "mass_scale": mass_scale, "sample_every": int(sample_every),
             "energy_check": energy_check, "energy_tol": energy_tol, "rest_tol": rest_tol, "safety": safety,
-            "frame_times": frame_times, "probe_nodes": probes, "backend": kernel.backend}
+            "frame_times": loop.frame_times, "probe_nodes": probes, "backend": loop.kernel.backend}
+    check = _EnergyCheck(model, estimate, mass_scale=mass_scale, alpha=alpha, safety=safety, tol=energy_tol,
+                         enabled=energy_check)
     bar = Progress(t_end, "explicit", unit=" s", enabled=progress)
-    stopped = False
-    n_contact = 0
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            while step < n_steps:
-                t = step * dt
-                sample = step % sample_every == 0
-                check = sample or step % check_every == 0
-                if check:
-                    f, W = kernel(U, energy=True)
-                else:
-                    f = kernel(U)
-                while acc["frame_index"] < len(frame_times) and t >= frame_times[acc["frame_index"]] - 1e-9 * dt:
-                    frames.append((t, U.copy()))
-                    acc["frame_index"] += 1
-                # Eq. 20-21, with the damping force lagged half a step
-                np.subtract(P, f, out=f)
-                f *= minv
-                np.multiply(V, damp, out=Vnew)
-                f *= dt
-                Vnew += f
-                if alpha:
-                    acc["damping"] += alpha * dt * float(np.einsum("n,ni,ni->", mass, V, Vnew))
-                if check:
-                    rec = _sample(t, U, V, Vnew, W, P, f, dt, mass, minv, free, acc)
-                    if energy_check:
-                        _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, energy_tol, acc)
-                    if sample:
-                        for k in HISTORY_KEYS:
-                            hist[k].append(rec[k])
-                        probe_hist.append(U[probes].copy())
-                        bar.update(t, f"KE {rec['kinetic']:.3g} J")
-                        if callback is not None and callback(State(t, U, V, step), rec):
-                            stopped = True
-                V, Vnew = Vnew, V
-                # Eq. 22
-                U += dt * V
-                if obstacles:
-                    n_contact = _contact(model, obstacles, U, V, mass, acc)
-                    if fixed_any:
-                        np.copyto(U, Ufix, where=~free)
-                step += 1
-                if stopped:
-                    break
-                if checkpoint is not None and checkpoint.due(step) and step < n_steps:
-                    checkpoint.save(model, obstacles, State(step * dt, U, V, step), dt=dt, n_steps=n_steps,
-                                    estimate=estimate, acc=acc, history=hist, probes=probe_hist,
-                                    frames=frames, options=opts)
-            t = step * dt
-            # final sample at the end state
-            f, W = kernel(U, energy=True)
-            while acc["frame_index"] < len(frame_times) and t >= frame_times[acc["frame_index"]] - 1e-9 * dt:
-                frames.append((t, U.copy()))
-                acc["frame_index"] += 1
-            g = (P - f) * minv * dt
-            Vend = V * damp + g
-            rec = _sample(t, U, V, Vend, W, P, g, dt, mass, minv, free, acc)
-            if energy_check:
-                _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, energy_tol, acc)
-            if not hist["time"] or hist["time"][-1] != t:
-                for k in HISTORY_KEYS:
-                    hist[k].append(rec[k])
-                probe_hist.append(U[probes].copy())
+            stopped = loop.advance(state, n_steps, int(sample_every), check, bar, callback=callback,
+                                   checkpoint=checkpoint, checkpoint_info={"estimate": estimate, "options": opts})
+            loop.final_sample(state, check)
     finally:
         bar.close()
-    history = {k: np.asarray(v, dtype=float) for k, v in hist.items()}
+    history = {k: np.asarray(v, dtype=float) for k, v in loop.hist.items()}
     wall = time.perf_counter() - wall0
     return ExplicitResult(
-        U=U, V=V, t=t, steps=step, dt=dt, estimate=estimate, history=history,
-        probes=np.asarray(probe_hist, dtype=float).reshape(len(probe_hist), len(probes), 3), frames=frames,
-        time_at_rest=_time_at_rest(history, rest_tol), stopped=stopped, contact_nodes=n_contact,
-        wall_time=wall, element_steps_per_second=model.mesh.n_elements * step / max(wall, 1e-12))
+        U=state.U, V=state.V, t=state.t, steps=state.step, dt=dt, estimate=estimate, history=history,
+        probes=np.asarray(loop.probe_hist, dtype=float).reshape(len(loop.probe_hist), len(probes), 3),
+        frames=loop.frames, time_at_rest=_time_at_rest(history, rest_tol), stopped=stopped,
+        contact_nodes=loop.n_contact, wall_time=wall,
+        element_steps_per_second=model.mesh.n_elements * state.step / max(wall, 1e-12), state=state)
+
+
+class _Loop:
+    """The central-difference loop of :func:`run_explicit` (Eq. 20-22) and its bookkeeping: energy
+    accumulators, history samples, probe records and frames. The solve's state is a :class:`State`."""
+
+    def __init__(self, model, obstacles, *, mass_scale, alpha, load, backend, probes, frame_times):
+        self.model, self.obstacles, self.alpha = model, obstacles, alpha
+        self.free = model.free
+        self.mass = lumped_mass(model, mass_scale)
+        self.kernel = ForceKernel(model, backend=backend)
+        self.P = np.array(model.load if load is None else load, dtype=float)
+        self.probes, self.frame_times = probes, frame_times
+        self.minv = self.free / self.mass[:, None]  # (N, 3) inverse mass, zero on supported dofs
+        self.n_contact = 0
+
+    def begin(self, dt, *, start_consistent, state):
+        """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
+        self.dt = dt
+        self.acc = {"damping": 0.0, "contact": 0.0, "total0": None, "scale": 0.0, "peak_kinetic": 0.0,
+                    "frame_index": 0}
+        self.hist = {k: [] for k in HISTORY_KEYS}
+        self.probe_hist, self.frames = [], []
+        if start_consistent:
+            f = self.kernel(state.U, candidates=state.candidates)
+            a0 = (self.P - f) / self.mass[:, None] - self.alpha * state.V
+            state.V = state.V - 0.5 * dt * a0 * self.free
+
+    def resume(self, dt, r):
+        """Continue the records of a checkpoint ``r`` (:func:`rftstatic.solvers.checkpoint.load_checkpoint`)."""
+        self.dt = dt
+        self.acc = r["acc"]
+        self.hist = {k: list(r["history"][k]) for k in HISTORY_KEYS}
+        self.probe_hist = list(r["probes"])
+        self.frames = list(r["frames"])
+
+    def _frames_due(self, t, U):
+        acc, times = self.acc, self.frame_times
+        while acc["frame_index"] < len(times) and t >= times[acc["frame_index"]] - 1e-9 * self.dt:
+            self.frames.append((t, U.copy()))
+            acc["frame_index"] += 1
+
+    def advance(self, state, n_steps, sample_every, check, bar, *, callback, checkpoint, checkpoint_info) -> bool:
+        """Step ``state`` to ``n_steps`` (Eq. 20-22); True if the callback stopped the run."""
+        dt, P, minv, free, mass, acc = self.dt, self.P, self.minv, self.free, self.mass, self.acc
+        U, V = state.U, state.V
+        check_every = min(sample_every, 50)
+        Ufix = U.copy()
+        fixed_any = bool((~free).any())
+        damp = 1.0 - self.alpha * dt
+        Vnew = np.empty_like(V)
+        step = state.step
+        stopped = False
+        while step < n_steps:
+            t = step * dt
+            sample = step % sample_every == 0
+            checked = sample or step % check_every == 0
+            if checked:
+                f, W = self.kernel(U, energy=True, candidates=state.candidates)
+            else:
+                f = self.kernel(U, candidates=state.candidates)
+            self._frames_due(t, U)
+            # Eq. 20-21, with the damping force lagged half a step
+            np.subtract(P, f, out=f)
+            f *= minv
+            np.multiply(V, damp, out=Vnew)
+            f *= dt
+            Vnew += f
+            if self.alpha:
+                acc["damping"] += self.alpha * dt * float(np.einsum("n,ni,ni->", mass, V, Vnew))
+            if checked:
+                rec = _sample(t, U, V, Vnew, W, P, f, dt, mass, minv, free, acc)
+                check(rec, step, dt, acc)
+                if sample:
+                    self._record(rec, U)
+                    bar.update(t, f"KE {rec['kinetic']:.3g} J")
+                    if callback is not None:
+                        state.U, state.V, state.t, state.step = U, V, t, step
+                        stopped = bool(callback(state, rec))
+            V, Vnew = Vnew, V
+            # Eq. 22
+            U += dt * V
+            if self.obstacles:
+                self.n_contact = _contact(self.model, self.obstacles, U, V, mass, acc)
+                if fixed_any:
+                    np.copyto(U, Ufix, where=~free)
+            step += 1
+            state.U, state.V, state.t, state.step = U, V, step * dt, step
+            if stopped:
+                break
+            if checkpoint is not None and checkpoint.due(step) and step < n_steps:
+                checkpoint.save(self.model, self.obstacles, state, dt=dt, n_steps=n_steps,
+                                estimate=checkpoint_info["estimate"], acc=acc, history=self.hist,
+                                probes=self.probe_hist, frames=self.frames, options=checkpoint_info["options"])
+        return stopped
+
+    def _record(self, rec, U):
+        for k in HISTORY_KEYS:
+            self.hist[k].append(rec[k])
+        self.probe_hist.append(U[self.probes].copy())
+
+    def final_sample(self, state, check):
+        """The history sample (and any frame due) at the end state."""
+        t, U, V, dt = state.t, state.U, state.V, self.dt
+        f, W = self.kernel(U, energy=True, candidates=state.candidates)
+        self._frames_due(t, U)
+        g = (self.P - f) * self.minv * dt
+        Vend = V * (1.0 - self.alpha * dt) + g
+        rec = _sample(t, U, V, Vend, W, self.P, g, dt, self.mass, self.minv, self.free, self.acc)
+        check(rec, state.step, dt, self.acc)
+        if not self.hist["time"] or self.hist["time"][-1] != t:
+            self._record(rec, U)
 
 
 def _choose_step(model, U, dt, *, alpha, mass_scale, safety, needed):
@@ -303,6 +321,20 @@ def _sample(t, U, V, Vnew, W, P, g, dt, mass, minv, free, acc) -> dict:
     return {"time": t, "kinetic": kinetic, "potential": W - ext, "strain": W, "external_work": ext,
             "dissipated": dissipated, "contact_loss": acc["contact"], "total": kinetic + W - ext + dissipated,
             "residual": float(np.linalg.norm(r))}
+
+
+class _EnergyCheck:
+    """Raise :class:`~rftstatic.errors.InstabilityError` when the total energy grows beyond ``tol`` times
+    the run's energy scale or stops being finite (disabled: only the peak kinetic energy is tracked)."""
+
+    def __init__(self, model, estimate, *, mass_scale, alpha, safety, tol, enabled):
+        self.model, self.estimate, self.mass_scale, self.alpha = model, estimate, mass_scale, alpha
+        self.safety, self.tol, self.enabled = safety, tol, enabled
+
+    def __call__(self, rec, step, dt, acc):
+        if self.enabled:
+            _check_energy(rec, step, dt, self.estimate, self.model, self.mass_scale, self.alpha, self.safety,
+                          self.tol, acc)
 
 
 def _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, energy_tol, acc):

@@ -16,21 +16,20 @@ An increment that does not converge is cut back (``increment / 4``) from the las
 below ``min_increment`` the solve stops with :class:`~rftstatic.errors.ConvergenceError`, which
 carries the last equilibrium, labelled as not converged.
 
-The route that chains these load steps with dynamic relaxation is :mod:`rftstatic.solvers.static`.
+This module holds the iteration at one load factor (:func:`newton`), its options and result; the load
+steps are :mod:`rftstatic.solvers.load_steps`, the route that chains them with dynamic relaxation
+:mod:`rftstatic.solvers.static`.
 """
 
 from __future__ import annotations
 
 import logging
-import time
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError
-from rftstatic.progress import Progress
-from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
-from rftstatic.solvers.perturbation import start_perturbation
+from rftstatic.model.state import State
+from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 
 log = logging.getLogger(__name__)
 
@@ -178,111 +177,39 @@ class _Newton:
     descending: bool = False  # the energy still fell markedly over the last iterations
 
 
-def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
-    """The load-scaled Newton iteration of :func:`solve_static`."""
-    opts = options or StaticOptions()
-    t0 = time.perf_counter()
-    n = model.mesh.n_nodes
-    U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
-    seed = None
-    if opts.perturbation and U0 is None:
-        seed = opts.seed
-        U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
-    solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
-    diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
-    max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
-    target = opts.increment_displacement if opts.increment_displacement is not None else 0.05 * diagonal
-    result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
-    modes = {"exact": 0, "psd": 0, "shift": 0}
-    lam = 0.0
-    dlam = _first_increment(model, U, opts, solver, target)
-    U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
-    continuing = None  # Newton state of an increment that is still snapping through
-    continuations = 0
-    bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
-    try:
-        while lam < 1.0:
-            if len(result.load_steps) >= opts.max_load_steps:
-                raise ConvergenceError(
-                    f"load factor {lam:.6g}: {opts.max_load_steps} load increments used without reaching "
-                    "full load; raise solver.max_load_steps or solver.initial_increment")
-            lam_next = min(1.0, lam + dlam)
-            start = U
-            if continuing is not None:
-                start = continuing
-            elif U_prev is not None:  # secant predictor along the equilibrium path
-                start = U + (lam_next - lam) / (lam - lam_prev) * (U - U_prev)
-            nt = _newton(model, start, lam_next, opts, solver, max_step, modes)
-            continuing = None
-            result.iterations += nt.iterations
-            if nt.converged:
-                continuations = 0
-                U_prev, lam_prev = U, lam
-                lam, U = lam_next, nt.U
-                for term in model.load_terms:  # fix the branch of angle-type potentials
-                    term.commit(model.positions(U))
-                result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
-                                          "increment": dlam})
-                result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
-                bar.update(lam, f"it {nt.iterations}")
-                if callback is not None:
-                    callback(lam, U)
-                if nt.iterations <= 4:
-                    target *= 1.5
-                elif nt.iterations >= 10:
-                    target *= 0.5
-                rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
-                grow = 2.0 * (lam - lam_prev)  # never more than double the last increment
-                dlam = float(np.clip(target / max(rate, 1e-300), opts.min_increment, min(opts.max_increment, grow)))
-                continue
-            if nt.descending and continuations < opts.max_continuations:
-                continuations += 1
-                continuing = nt.U
-                log.info("load factor %.6g: still descending after %d iterations (snap-through); continuing "
-                         "(%d/%d)", lam_next, nt.iterations, continuations, opts.max_continuations)
-                continue
-            result.cutbacks += 1
-            log.info("load factor %.6g: %s after %d iterations (|r| = %.3e); cutting back the increment",
-                     lam_next, nt.reason, nt.iterations, nt.residual)
-            dlam /= 4.0
-            target /= 4.0
-            if dlam < opts.min_increment:
-                raise ConvergenceError(
-                    f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
-                    f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
-                    f"min_increment = {opts.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
-        result.converged = True
-        result.message = "converged"
-    except ConvergenceError as exc:
-        result.message = str(exc)
-        exc.result = result
-        raise
-    finally:
-        bar.close()
-        result.tangent_modes = dict(modes)
-        result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam)
-    return result
+@dataclass
+class NewtonWorkspace:
+    """What the Newton phases of one static solve share and update (never the Model).
+
+    Attributes
+    ----------
+    state : the solve's :class:`~rftstatic.model.state.State` (its contact candidate list is used by
+        every energy, residual and tangent evaluation)
+    solver : the linear solver (symbolic analysis reused between factorisations)
+    modes : counts of the tangents used: exact, psd, shift, reused
+    lm_scale : mean tangent diagonal [N/m], the scale of the Levenberg-Marquardt damping, computed once
+        per solve at the state where damping is first needed
+    """
+
+    state: State
+    solver: object = None
+    modes: dict = field(default_factory=lambda: {"exact": 0, "psd": 0, "shift": 0})
+    lm_scale: float | None = None
+
+    @classmethod
+    def for_model(cls, model) -> NewtonWorkspace:
+        """A fresh workspace: the flat state at load factor 0 (the solver is made by each phase)."""
+        return cls(State.initial(model, lam=0.0))
+
+    @property
+    def candidates(self):
+        return self.state.candidates
 
 
-def _first_increment(model, U, opts, solver, target) -> float:
-    """First load increment: the tangent displacement rate d|U|/d lam at the start, scaled to ``target``."""
-    free = model.free.ravel()
-    P = model.load.ravel()[free]
-    if not np.any(P) or model.load_terms:
-        return opts.initial_increment
-    try:
-        _, K = model.tangent(U, psd=True)
-        du = np.zeros(3 * model.mesh.n_nodes)
-        du[free] = solver.solve(K, P)
-    except (NotPositiveDefinite, LinearSolveError):
-        return opts.initial_increment
-    rate = float(np.linalg.norm(du.reshape(-1, 3), axis=1).max())
-    return float(np.clip(target / max(rate, 1e-300), opts.min_increment, opts.initial_increment))
 
-
-def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
+def newton(model, U, lam, opts, ws, max_step) -> _Newton:
     """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified)."""
+    solver, modes, cand = ws.solver, ws.modes, ws.candidates
     rtol = opts.rtol if lam >= 1.0 else max(opts.rtol, opts.intermediate_rtol)
     # the final increment converges to the tight tolerance and may need longer
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
@@ -296,8 +223,8 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
     ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
     atol = 0.0
     U = U.copy()
-    Pi = model.potential(U, lam)
-    r = (model.residual(U, lam)).ravel()[free]
+    Pi = model.potential(U, lam, candidates=cand)
+    r = (model.residual(U, lam, candidates=cand)).ravel()[free]
     rnorm = float(np.linalg.norm(r))
     if not np.isfinite(rnorm):
         return _Newton(False, U, 0, rnorm, "non-finite residual")
@@ -327,14 +254,14 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
                 age += 1
         if d is None:
             try:
-                d, mode = _direction(model, U, lam, r, opts, solver, modes, damping=mu)
+                d, mode, shift = _direction(model, U, lam, r, opts, ws, damping=mu)
             except LinearSolveError as exc:
                 return _Newton(False, U, it, rnorm, f"linear solve failed ({exc})")
             stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
             age = 0
             fresh = True
             # curvature of the quadratic model along d: (K + s I) d = -r  =>  d.K.d = -d.r - s d.d
-            dKd = -float(r @ d) - _direction.shift * float(d @ d)
+            dKd = -float(r @ d) - shift * float(d @ d)
         dfull = np.zeros(3 * model.mesh.n_nodes)
         dfull[free] = d
         step = dfull.reshape(-1, 3)
@@ -344,7 +271,7 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
             cap = max_step / biggest
             step *= cap
         slope = float(r @ step.ravel()[free])
-        alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts)
+        alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts, cand)
         if alpha is None:
             return _Newton(False, U, it, rnorm, "line search found no decrease of the energy")
         U = U + alpha * step
@@ -366,12 +293,12 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
                 mu = max(4.0 * mu, 1e-6)
             elif rho > 0.75:
                 mu = mu / 3.0 if mu > 1e-9 else 0.0
-        r_new = model.residual(U, lam).ravel()[free]
+        r_new = model.residual(U, lam, candidates=cand).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r_new))
         if work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
             # (a good predictor makes the first step tiny; round-off must not stall the criterion)
-            parts = model.energies(U, lam)
+            parts = model.energies(U, lam, candidates=cand)
             work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))),
                         parts["bending"] + parts["membrane"], 1e-300)
         last_work = work
@@ -392,24 +319,26 @@ def _newton(model, U, lam, opts, solver, max_step, modes) -> _Newton:
                    descending=descending)
 
 
-def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
-    """Newton direction on the free dofs, with the indefinite-tangent safeguard.
+def _direction(model, U, lam, r, opts, ws, damping=0.0):
+    """Newton direction on the free dofs, with the indefinite-tangent safeguard: ``(d, mode, shift)``.
 
-    ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt).
+    ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt); ``shift`` [N/m]
+    is the diagonal shift of the tangent that gave ``d``.
     """
+    solver, modes, cand = ws.solver, ws.modes, ws.candidates
     sequence = {"auto": ["exact", "psd", "shift"], "exact": ["exact", "shift"], "psd": ["psd", "shift"]}[opts.tangent]
     last_error = None
     base = 0.0
     if damping:
-        base = damping * _diagonal_scale(model, U)
+        base = damping * _diagonal_scale(model, U, ws)
     for mode in sequence:
         shifts = [base] if mode != "shift" else None
         if mode == "shift":
-            _, K = model.tangent(U, psd=True, lam=lam)
+            _, K = model.tangent(U, psd=True, lam=lam, candidates=cand)
             scale = float(np.abs(K.diagonal()).mean())
             shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
         for shift in shifts:
-            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam)
+            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam, candidates=cand)
             try:
                 d = solver.solve(K, -r)
             except NotPositiveDefinite as exc:
@@ -420,8 +349,7 @@ def _direction(model, U, lam, r, opts, solver, modes, damping=0.0):
                 continue
             if float(r @ d) < 0.0 or not np.any(r):
                 modes[mode] += 1
-                _direction.shift = shift
-                return d, mode
+                return d, mode, shift
             last_error = LinearSolveError("the step is not a descent direction of the energy")
     raise LinearSolveError(str(last_error))
 
@@ -439,30 +367,28 @@ def _roundoff_floor(model, U) -> float:
     return 100 * np.finfo(float).eps * float(np.linalg.norm(fabs.ravel()[model.free.ravel()]))
 
 
-def _diagonal_scale(model, U) -> float:
-    """Mean diagonal of the tangent [N/m], computed once per model (the scale of the LM damping)."""
-    scale = getattr(model, "_lm_scale", None)
-    if scale is None:
-        _, K0 = model.tangent(U, psd=True)
-        scale = float(np.abs(K0.diagonal()).mean())
-        model._lm_scale = scale
-    return scale
+def _diagonal_scale(model, U, ws) -> float:
+    """Mean diagonal of the tangent [N/m], computed once per solve (the scale of the LM damping)."""
+    if ws.lm_scale is None:
+        _, K0 = model.tangent(U, psd=True, candidates=ws.candidates)
+        ws.lm_scale = float(np.abs(K0.diagonal()).mean())
+    return ws.lm_scale
 
 
-def _line_search(model, U, step, lam, Pi0, slope, opts, max_trials=12):
+def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, max_trials=12):
     """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""
     if not opts.line_search:
-        return 1.0, model.potential(U + step, lam)
-    parts = model.energies(U, lam)
+        return 1.0, model.potential(U + step, lam, candidates=candidates)
+    parts = model.energies(U, lam, candidates=candidates)
     scale = abs(parts["bending"]) + abs(parts["membrane"]) + abs(parts["contact"]) + abs(parts["external_work"])
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence
-        return 1.0, model.potential(U + step, lam)
+        return 1.0, model.potential(U + step, lam, candidates=candidates)
     roundoff = 1e-13 * scale
     alpha = 1.0
     for _ in range(max_trials):
-        Pi = model.potential(U + alpha * step, lam)
+        Pi = model.potential(U + alpha * step, lam, candidates=candidates)
         if np.isfinite(Pi) and Pi <= Pi0 + 1e-4 * alpha * slope + roundoff:
             return alpha, Pi
         # minimiser of the quadratic through Pi0, slope and Pi(alpha), safeguarded

@@ -20,6 +20,26 @@ RELAX_MASS_SCALE = 100.0
 
 
 @dataclass
+class AtRest:
+    """The rest test of dynamic relaxation, as an explicit-run callback ``(state, sample) -> bool``.
+
+    At rest: kinetic energy / peak kinetic energy < ``tol_kinetic`` and the out-of-balance force on the
+    free dofs < ``tol_force`` times ``load_norm`` [N]. ``peak_kinetic`` [J] is the peak so far (updated
+    at every sample; start it from an earlier run's peak to resume).
+    """
+
+    tol_kinetic: float
+    tol_force: float
+    load_norm: float
+    peak_kinetic: float = 0.0
+
+    def __call__(self, state, rec) -> bool:
+        self.peak_kinetic = peak = max(self.peak_kinetic, rec["kinetic"])
+        return bool(peak > 0 and rec["kinetic"] < self.tol_kinetic * peak
+                    and rec["residual"] < self.tol_force * self.load_norm)
+
+
+@dataclass
 class RelaxResult:
     """Outcome of :func:`relax`: resting displacements ``U (N, 3)`` [m], whether the criteria were
     met, the time [s] and steps used, the explicit run (histories), the final half-step velocity
@@ -57,12 +77,7 @@ def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kine
     P = model.load if load is None else load
     P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
 
-    def at_rest(state, rec):
-        peak = max(at_rest.peak, rec["kinetic"])
-        at_rest.peak = peak
-        return bool(peak > 0 and rec["kinetic"] < tol_kinetic * peak and rec["residual"] < tol_force * P_norm)
-
-    at_rest.peak = float(peak_kinetic)
+    at_rest = AtRest(tol_kinetic=tol_kinetic, tol_force=tol_force, load_norm=P_norm, peak_kinetic=peak_kinetic)
     run = run_explicit(model, t_end=max_time, dt=dt, alpha=alpha, mass_scale=mass_scale, obstacles=obstacles,
                        U0=U0, V0=V0, start="consistent" if V0 is None else "given", sample_every=sample_every,
                        callback=at_rest, progress=progress, backend=backend, load=load)
@@ -70,4 +85,4 @@ def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kine
         log.warning("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
                     run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])
     return RelaxResult(U=run.U, converged=run.stopped, t=run.t, steps=run.steps, run=run, V=run.V,
-                       peak_kinetic=at_rest.peak)
+                       peak_kinetic=at_rest.peak_kinetic)

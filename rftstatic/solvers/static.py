@@ -17,7 +17,8 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError, InstabilityError
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
-from rftstatic.solvers.newton import StaticOptions, StaticResult, solve_load_steps
+from rftstatic.solvers.load_steps import solve_load_steps
+from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, relax
 from rftstatic.solvers.timestep import stable_time_step
@@ -51,15 +52,17 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         fails too); ``.result`` holds the last equilibrium (``converged=False``).
     """
     opts = options or StaticOptions()
+    ws = NewtonWorkspace.for_model(model)  # shared by the Newton phases of this solve
     if opts.start == "relax":
-        return _check_stability(model, _relax_then_newton(model, opts, callback, first=None), opts)
+        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, first=None), opts)
     try:
-        return _check_stability(model, solve_load_steps(model, U0=U0, options=opts, callback=callback), opts)
+        return _check_stability(model, solve_load_steps(model, U0=U0, options=opts, callback=callback,
+                                                        workspace=ws), opts)
     except ConvergenceError as exc:
         if not opts.relax_fallback or model.load_terms or not np.any(model.load):
             raise
         log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
-        return _check_stability(model, _relax_then_newton(model, opts, callback, first=exc), opts)
+        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, first=exc), opts)
 
 
 def _check_stability(model, result, opts):
@@ -89,7 +92,7 @@ iterations took four tries and 8,700 explicit steps more). Later handovers get
 :data:`RELAX_NEWTON_ITERATIONS` again."""
 
 
-def _relax_then_newton(model, opts, callback, *, first):
+def _relax_then_newton(model, opts, callback, ws, *, first):
     """Dynamic relaxation at full load to near rest, then Newton to the full tolerance.
 
     The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while
@@ -168,7 +171,7 @@ def _relax_then_newton(model, opts, callback, *, first):
             long_try = tol_force < 1.0 and not any(h.get("basin") for h in info["handovers"][:-1])
             handover["basin"] = tol_force < 1.0
             res = solve_load_steps(model, U0=U, options=polish if final else basin if long_try else short,
-                                    callback=callback)
+                                   callback=callback, workspace=ws)
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
             if final:

@@ -1,0 +1,59 @@
+"""Candidate lists: the nodes near an obstacle, so that a step pays only for them.
+
+A signed distance changes no faster than the point moves (it is 1-Lipschitz). When the list is made,
+every point's distance ``phi`` is computed and the candidates are the points with ``phi < margin``.
+Until some point has moved more than ``margin / 2`` since then, every other point is still more than
+``margin / 2`` from the obstacles, so only the candidates need their distance: the contact computed
+with the list is the same as without it. The list is a cache of the solve (it lives in the
+:class:`~rftstatic.model.state.State`, not in the Model) and never changes a result.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class CandidateList:
+    """The points within ``margin`` [m] of the obstacles at the last refresh.
+
+    Parameters
+    ----------
+    margin : candidate distance [m]; a few contact onset widths, or a fraction of a node spacing
+    """
+
+    def __init__(self, margin: float):
+        self.margin = float(margin)
+        self.refreshes = 0
+        self._indices = None  # (C,) candidate indices
+        self._x = None  # (N, 3) positions at the refresh [m]
+        self._gap = None  # (N,) distances at the refresh [m]
+
+    def reset(self, margin: float | None = None) -> None:
+        """Forget the list (e.g. a new mesh); optionally a new ``margin`` [m]."""
+        if margin is not None:
+            self.margin = float(margin)
+        self._indices = self._x = self._gap = None
+
+    def lookup(self, x: np.ndarray):
+        """``(indices (C,), lower bounds (N,) of every point's distance [m])`` while the list is valid for
+        positions ``x (N, 3)`` [m], else None (refresh it: :meth:`refresh`). The bounds are exact
+        values at the refresh minus the largest motion since; callers fill in the candidates' exact
+        distances."""
+        if self._x is None or self._x.shape != x.shape:
+            return None
+        d = x - self._x
+        moved = float(np.sqrt(np.max(np.einsum("ni,ni->n", d, d), initial=0.0)))
+        if moved > 0.5 * self.margin:
+            return None
+        return self._indices, self._gap - moved
+
+    def refresh(self, x: np.ndarray, gap: np.ndarray) -> np.ndarray:
+        """Make the list from every point's distance ``gap (N,)`` [m] at ``x (N, 3)`` [m]; return the indices."""
+        self._indices = np.flatnonzero(gap < self.margin)
+        self._x = np.array(x, dtype=float, copy=True)
+        self._gap = np.array(gap, dtype=float, copy=True)
+        self.refreshes += 1
+        return self._indices
+
+    def __len__(self) -> int:
+        return 0 if self._indices is None else len(self._indices)

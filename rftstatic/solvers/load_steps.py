@@ -1,0 +1,134 @@
+"""The load-scaled route of the static solver (method.md, §4): the load factor rises from 0 to 1 in
+adaptive increments, each solved by Newton's method (:func:`rftstatic.solvers.newton.newton`).
+
+Increments are sized from the secant displacement rate d|U|/d lam (the first from the tangent rate), a
+secant predictor starts each one, an increment that does not converge is cut back (``increment / 4``)
+from the last equilibrium, and one still sliding downhill when its iterations run out continues
+(snap-through into a fold). Below ``min_increment`` the solve stops with
+:class:`~rftstatic.errors.ConvergenceError`, which carries the last equilibrium.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+
+from rftstatic.errors import ConvergenceError
+from rftstatic.progress import Progress
+from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
+from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult, newton
+from rftstatic.solvers.perturbation import start_perturbation
+
+log = logging.getLogger(__name__)
+
+
+def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None,
+                     workspace: NewtonWorkspace | None = None) -> StaticResult:
+    """The load-scaled Newton iteration of :func:`solve_static` (module docstring).
+
+    ``workspace``: shared with the other phases of one solve (:class:`NewtonWorkspace`; default a new one).
+    """
+    opts = options or StaticOptions()
+    t0 = time.perf_counter()
+    n = model.mesh.n_nodes
+    U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
+    seed = None
+    if opts.perturbation and U0 is None:
+        seed = opts.seed
+        U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
+    ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
+    ws.modes = modes = {"exact": 0, "psd": 0, "shift": 0}
+    solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    ws.solver = solver
+    diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
+    max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
+    target = opts.increment_displacement if opts.increment_displacement is not None else 0.05 * diagonal
+    result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
+    lam = 0.0
+    dlam = _first_increment(model, U, opts, ws, target)
+    U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
+    continuing = None  # Newton state of an increment that is still snapping through
+    continuations = 0
+    bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
+    try:
+        while lam < 1.0:
+            if len(result.load_steps) >= opts.max_load_steps:
+                raise ConvergenceError(
+                    f"load factor {lam:.6g}: {opts.max_load_steps} load increments used without reaching "
+                    "full load; raise solver.max_load_steps or solver.initial_increment")
+            lam_next = min(1.0, lam + dlam)
+            start = U
+            if continuing is not None:
+                start = continuing
+            elif U_prev is not None:  # secant predictor along the equilibrium path
+                start = U + (lam_next - lam) / (lam - lam_prev) * (U - U_prev)
+            nt = newton(model, start, lam_next, opts, ws, max_step)
+            continuing = None
+            result.iterations += nt.iterations
+            if nt.converged:
+                continuations = 0
+                U_prev, lam_prev = U, lam
+                lam, U = lam_next, nt.U
+                for term in model.load_terms:  # fix the branch of angle-type potentials
+                    term.commit(model.positions(U))
+                result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
+                                          "increment": dlam})
+                result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
+                bar.update(lam, f"it {nt.iterations}")
+                if callback is not None:
+                    callback(lam, U)
+                if nt.iterations <= 4:
+                    target *= 1.5
+                elif nt.iterations >= 10:
+                    target *= 0.5
+                rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
+                grow = 2.0 * (lam - lam_prev)  # never more than double the last increment
+                dlam = float(np.clip(target / max(rate, 1e-300), opts.min_increment, min(opts.max_increment, grow)))
+                continue
+            if nt.descending and continuations < opts.max_continuations:
+                continuations += 1
+                continuing = nt.U
+                log.info("load factor %.6g: still descending after %d iterations (snap-through); continuing "
+                         "(%d/%d)", lam_next, nt.iterations, continuations, opts.max_continuations)
+                continue
+            result.cutbacks += 1
+            log.info("load factor %.6g: %s after %d iterations (|r| = %.3e); cutting back the increment",
+                     lam_next, nt.reason, nt.iterations, nt.residual)
+            dlam /= 4.0
+            target /= 4.0
+            if dlam < opts.min_increment:
+                raise ConvergenceError(
+                    f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
+                    f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
+                    f"min_increment = {opts.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
+        result.converged = True
+        result.message = "converged"
+    except ConvergenceError as exc:
+        result.message = str(exc)
+        exc.result = result
+        raise
+    finally:
+        bar.close()
+        result.tangent_modes = dict(modes)
+        result.wall_time = time.perf_counter() - t0
+        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates)
+        ws.state.U, ws.state.lam = result.U, result.lam
+    return result
+
+
+def _first_increment(model, U, opts, ws, target) -> float:
+    """First load increment: the tangent displacement rate d|U|/d lam at the start, scaled to ``target``."""
+    free = model.free.ravel()
+    P = model.load.ravel()[free]
+    if not np.any(P) or model.load_terms:
+        return opts.initial_increment
+    try:
+        _, K = model.tangent(U, psd=True, candidates=ws.candidates)
+        du = np.zeros(3 * model.mesh.n_nodes)
+        du[free] = ws.solver.solve(K, P)
+    except (NotPositiveDefinite, LinearSolveError):
+        return opts.initial_increment
+    rate = float(np.linalg.norm(du.reshape(-1, 3), axis=1).max())
+    return float(np.clip(target / max(rate, 1e-300), opts.min_increment, opts.initial_increment))
