@@ -1,4 +1,4 @@
-"""Command line: ``python -m rftstatic {case, list, bench, validate}``."""
+"""Command line: ``python -m rftstatic {case, list, bench, validate}``, on the Python API (:mod:`rftstatic.api`)."""
 
 from __future__ import annotations
 
@@ -36,27 +36,20 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
-    from rftstatic.errors import ConvergenceError, SceneError
+    from rftstatic import api
 
     try:
         if args.command == "list":
-            from rftstatic.scenes.schema import list_scenes
-
-            for name, title in list_scenes():
+            for name, title in api.list_scenes():
                 print(f"{name:32s} {title}")
             return 0
         if args.command == "case":
-            from rftstatic.app.registry import run_scene
-            from rftstatic.scenes.schema import load_scene
-
-            scene = load_scene(args.name, args.set)
+            scene = api.load_scene(args.name, args.set)
             out = Path(args.out) if args.out else Path("out") / scene.name
             if args.resume:
-                from rftstatic.app.registry import resume_scene
-
-                summary = resume_scene(scene, out, progress=True, figures=not args.no_figures)
+                summary = api.resume(scene, out, progress=True, figures=not args.no_figures)
             else:
-                summary = run_scene(scene, out, progress=True, figures=not args.no_figures)
+                summary = api.run(scene, out, progress=True, figures=not args.no_figures).summary
             keys = ("scene", "element", "nodes", "converged", "load_steps", "newton_iterations", "wall_time_s",
                     "probes")
             if summary.get("analysis", "static") != "static":  # trajectories are too long to print
@@ -74,10 +67,10 @@ def main(argv=None) -> int:
             from rftstatic.validate import main as validate_main
 
             return validate_main(args.names, quick=args.quick, out=args.out)
-    except SceneError as exc:
+    except api.SceneError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    except ConvergenceError as exc:
+    except api.ConvergenceError as exc:
         print(f"error: the solve did not converge: {exc}\nThe last equilibrium was written, labelled "
               "converged = false.", file=sys.stderr)
         return 3

@@ -50,8 +50,8 @@ def test_bad_scene_values_name_file_and_key(override, fragment):
     assert "strip.toml" in str(info.value) and fragment in str(info.value)
 
 
-def test_cli_reports_scene_errors_without_traceback(capsys):
-    assert main(["case", "strip", "--set", "mesh.kind=hexagon", "--no-figures", "--out", "/tmp/x"]) == 2
+def test_cli_reports_scene_errors_without_traceback(capsys, tmp_path):
+    assert main(["case", "strip", "--set", "mesh.kind=hexagon", "--no-figures", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
     assert "mesh.kind" in err and "hexagon" in err and "Traceback" not in err
 
