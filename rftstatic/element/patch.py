@@ -82,7 +82,6 @@ def build_patches(mesh: TriMesh, *, clamped_nodes=None, check=True) -> Patches:
     check : raise :class:`PatchError` for singular patches, log badly conditioned ones
     """
     tri, X = mesh.tri, mesh.X
-    E = len(tri)
     topo = mesh.topology
     has_opp = ~topo.is_boundary
     nb = np.maximum(topo.neighbour, 0)

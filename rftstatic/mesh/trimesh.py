@@ -271,18 +271,15 @@ def rectangle(lx, ly, nx, ny, *, origin=(0.0, 0.0), pattern="right", z0=0.0) -> 
 
 
 def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern="alternate",
-          square=False, z0=0.0) -> TriMesh:
-    """Polar mesh of a disc or annulus, or of a square by mapping the rings onto squares.
+          z0=0.0) -> TriMesh:
+    """Polar mesh of a disc or annulus (a square sheet meshed in rings is :func:`square_polar`).
 
     Parameters
     ----------
-    r_outer : outer radius (or half side when ``square``) [m]
+    r_outer : outer radius [m]
     n_radial : nodes along a radius, including the inner ring (and the centre for a disc)
     n_circ : nodes around each ring
     r_inner : inner radius [m]; 0 gives a disc with a centre node (fan of triangles around it)
-    square : map every ring onto the square of the same "radius" (Chebyshev norm) so that a
-        square sheet is meshed with ``n_radial`` x ``n_circ`` nodes -- how we read the paper's
-        21 x 160 and 31 x 240 meshes of the 50 x 50 cm sheet of §4.4.
     pattern : diagonal of each quadrilateral: ``"right"``, ``"left"`` or ``"alternate"``.
     """
     n_radial, n_circ = int(n_radial), int(n_circ)
@@ -294,8 +291,6 @@ def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern=
         raise MeshError(f'unknown diagonal pattern "{pattern}" for a polar mesh; use right, left or alternate')
     theta = 2 * np.pi * np.arange(n_circ) / n_circ
     direction = np.column_stack([np.cos(theta), np.sin(theta)])
-    if square:
-        direction = direction / np.abs(direction).max(axis=1, keepdims=True)
     disc = r_inner == 0.0
     rings = np.linspace(r_inner, r_outer, n_radial)
     first = 1 if disc else 0
@@ -322,7 +317,7 @@ def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern=
         c = np.arange(n_circ)
         fan = np.stack([np.zeros(n_circ, int), 1 + c, 1 + (c + 1) % n_circ], 1)
         tri = np.vstack([fan, tri])
-    kind = "square-polar" if square else ("disc" if disc else "annulus")
+    kind = "disc" if disc else "annulus"
     info = {"generator": kind, "r_outer": r_outer, "r_inner": r_inner, "nodes_radial_circ": [n_radial, n_circ]}
     return TriMesh(X, tri, z0=z0, name=f"{kind} {n_radial}x{n_circ}", info=info)
 

@@ -240,13 +240,3 @@ class Model:
         mag = np.sqrt(k[:, 0] ** 2 + k[:, 1] ** 2 + 0.5 * k[:, 2] ** 2)
         return mag * self.mesh.element_size
 
-    def summary(self) -> dict:
-        return {
-            "element": self.element,
-            "nodes": self.mesh.n_nodes,
-            "elements": self.mesh.n_elements,
-            "free_dofs": int(self.free.sum()),
-            "clamped_nodes": int(len(self.supports.clamped)),
-            "pinned_nodes": int(len(self.supports.pinned)),
-            "membrane": self.with_membrane,
-        }

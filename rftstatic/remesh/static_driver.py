@@ -43,9 +43,6 @@ class RemeshStaticResult:
     records: list
     converged: bool
 
-    def table(self) -> list[dict]:
-        return [r.as_dict() for r in self.records]
-
 
 def _continuation(options):
     """Options that solve at full load straight from a transferred equilibrium (Newton from it: a

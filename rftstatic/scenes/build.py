@@ -42,8 +42,7 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
             if "radius" not in m:
                 raise scene.error("mesh.radius", f"a {kind} mesh needs its radius")
             return meshmod.polar(m["radius"] * u, nr, nc, r_inner=m.get("inner_radius", 0.0) * u,
-                                 centre=(cx * u, cy * u), pattern=m.get("pattern", "alternate"),
-                                 square=(kind == "square-polar"), z0=z0)
+                                 centre=(cx * u, cy * u), pattern=m.get("pattern", "alternate"), z0=z0)
         if kind == "file":
             if "path" not in m:
                 raise scene.error("mesh.path", "a file mesh needs the path of the mesh file")

@@ -89,12 +89,6 @@ class ExplicitResult:
     element_steps_per_second: float = 0.0
     state: State | None = None
 
-    def summary(self) -> dict:
-        return {"t": self.t, "steps": self.steps, "dt": self.dt, "time_at_rest": self.time_at_rest,
-                "stopped": self.stopped, "wall_time": self.wall_time,
-                "element_steps_per_second": self.element_steps_per_second,
-                "final_total_energy": float(self.history["total"][-1]) if len(self.history["time"]) else None}
-
 
 def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float = 0.0, mass_scale: float = 1.0,
                  obstacles=(), U0=None, V0=None, start: str = "consistent", frame_times=(), probes=None,

@@ -66,7 +66,7 @@ def make_solver(name: str = "auto", *, coordinates=None, free_dofs=None):
     if name == "cholmod":
         if not cholmod_available():
             raise ValueError('linear solver "cholmod" needs scikit-sparse: pip install "rftstatic[cholmod]" '
-                             "(on Debian first apt-get install libsuitesparse-dev), or use solver.linear = \"scipy\"")
+                             "(on Debian first apt-get install libsuitesparse-dev), or use solver.linear_solver = \"scipy\"")
         return CholmodSolver()
     if name == "scipy":
         return ScipySolver()

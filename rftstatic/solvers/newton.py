@@ -24,7 +24,7 @@ steps are :mod:`rftstatic.solvers.load_steps`, the route that chains them with d
 from __future__ import annotations
 
 import logging
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -160,11 +160,6 @@ class StaticResult:
     route: str = "load-steps"
     relax: dict = field(default_factory=dict)
 
-    def summary(self) -> dict:
-        d = {k: v for k, v in asdict(self).items() if k != "U"}
-        d["load_step_count"] = len(self.load_steps)
-        return d
-
 
 @dataclass
 class _Newton:
@@ -204,7 +199,6 @@ class NewtonWorkspace:
     @property
     def candidates(self):
         return self.state.candidates
-
 
 
 def newton(model, U, lam, opts, ws, max_step) -> _Newton:
