@@ -192,7 +192,11 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
         "time_at_rest": None if t_rest is None else t_rest / u.time,
         "rest_tolerance": o.rest_tolerance,
         "at_rest": t_rest is not None,
-        "converged": bool(run.steps > 0 and np.isfinite(h["total"]).all()),
+        # a dynamic run has nothing to converge to: "converged" means the integration reached t_end
+        # with a finite state (relax: overwritten with "at rest", below)
+        "finite": bool(run.steps > 0 and np.isfinite(h["total"]).all()),
+        "completed": bool(run.t >= o.t_end * (1 - 1e-9)),
+        "converged": bool(run.steps > 0 and np.isfinite(h["total"]).all() and run.t >= o.t_end * (1 - 1e-9)),
         "stopped_early": bool(run.stopped),
         "energies": {"final": final, "peak_kinetic": energy(h["kinetic"].max()),
                      "energy_drift": energy(h["total"][-1] - h["total"][0])},
