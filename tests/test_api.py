@@ -43,3 +43,10 @@ def test_run_by_name_with_overrides_and_bad_input(tmp_path):
         api.run("strip", tmp_path / "t", overrides=["mesh.kind=hexagon"])
     with pytest.raises(ValueError, match="overrides"):
         api.run(api.load_scene("strip"), tmp_path / "u", overrides=["element=RFT3"])
+
+
+def test_the_penalty_contact_is_a_contact_law():
+    from rftstatic.contact.law import ContactLaw
+
+    model, _ = api.build_model(api.load_scene("pedestal-square-20", ["mesh.nodes=[9,9]"]))
+    assert isinstance(model.contact, ContactLaw)

@@ -10,9 +10,10 @@ name           what it does                                                  mod
 ``remeshed``   a scene with ``[remesh]``: global adaptive remeshing (§5-6)   :mod:`rftstatic.app.remeshed`
 =============  ============================================================  =========================
 
-A new analysis type is one module with ``run`` and one line in :data:`ANALYSES`; the modules are
-imported only when a scene asks for them, so a static drape does not pay for the explicit solver's
-or the mesher's imports.
+A new analysis type is one module with ``run`` and one line in
+:data:`rftstatic.scenes.analyses.ANALYSES` (which the scene schema checks); the modules are imported
+only when a scene asks for them, so a static drape does not pay for the explicit solver's or the
+mesher's imports.
 """
 
 from __future__ import annotations
@@ -20,14 +21,9 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
-ANALYSES = {
-    "static": "rftstatic.app.static",
-    "dynamic": "rftstatic.app.dynamic",
-    "relax": "rftstatic.app.dynamic",
-    "remeshed": "rftstatic.app.remeshed",
-}
-"""Analysis name -> module that runs it."""
+from rftstatic.scenes.analyses import ANALYSES, SCENE_ANALYSES
 
+__all__ = ["ANALYSES", "analysis_of", "run", "run_scene", "resume_scene"]
 
 def analysis_of(scene) -> str:
     """The registered analysis that runs ``scene``: ``remeshed`` when it has a ``[remesh]`` table, else its
@@ -36,8 +32,7 @@ def analysis_of(scene) -> str:
         return "remeshed"
     name = scene.get("analysis", "static")
     if name not in ANALYSES:
-        raise scene.error("analysis", f'"{name}" is not an analysis; use one of '
-                          f'{", ".join(n for n in ANALYSES if n != "remeshed")}')
+        raise scene.error("analysis", f'"{name}" is not an analysis; use one of {", ".join(SCENE_ANALYSES)}')
     return name
 
 

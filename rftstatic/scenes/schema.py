@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rftstatic.errors import SceneError
+from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
@@ -27,7 +28,8 @@ SCHEMA = {
     "figure": (str, "the paper figure or section it reproduces"),
     "units": (str, "unit system: " + ", ".join(UNIT_SYSTEMS)),
     "element": (str, "RFT3 or RFT6"),
-    "analysis": (str, "static (Newton), dynamic (explicit) or relax (dynamic relaxation)"),
+    "analysis": (str, "static (Newton), dynamic (explicit) or relax (dynamic relaxation): "
+                      "rftstatic.scenes.analyses"),
     "mesh": ({
         "kind": (str, "rectangle, polar, square-polar, file or unstructured"),
         "size": (LIST, "[lx, ly] of a rectangle"),
@@ -240,8 +242,9 @@ def validate(scene: Scene) -> None:
         raise scene.error("units", f'unknown unit system "{scene.data["units"]}"; use one of {", ".join(UNIT_SYSTEMS)}')
     if scene.data.get("element", "RFT6") not in ("RFT3", "RFT6"):
         raise scene.error("element", f'"{scene.data["element"]}" is not an element; use RFT3 or RFT6')
-    if scene.data.get("analysis", "static") not in ("static", "dynamic", "relax"):
-        raise scene.error("analysis", f'"{scene.data["analysis"]}" is not an analysis; use static, dynamic or relax')
+    if scene.data.get("analysis", "static") not in SCENE_ANALYSES:
+        raise scene.error("analysis", f'"{scene.data["analysis"]}" is not an analysis; use one of '
+                          f'{", ".join(SCENE_ANALYSES)}')
 
 
 def _check_table(scene, table, schema, prefix):
