@@ -208,3 +208,22 @@ def test_drape_measures_is_json_ready():
     assert out["fold_count"] == 6
     assert 0.0 < out["drape_coefficient"] < 1.0
     assert out["boundary_radius_max"] == pytest.approx(0.09 + 0.06 * 0.7, rel=0.01)
+
+
+def test_one_curvature_norm_for_model_size_field_and_measures():
+    """Model.relative_curvature, the Eq. 29 size field and the sharp-fold indicator share one |kappa|."""
+    from rftstatic.bench.problems import strip_model
+    from rftstatic.element.curvature import curvature_norm as norm
+    from rftstatic.remesh.sizefield import curvature_magnitude
+
+    model = strip_model(11, 3, element="RFT3")
+    rng = np.random.default_rng(3)
+    U = 1e-3 * rng.standard_normal((model.mesh.n_nodes, 3))
+    k = model.curvature(U)
+    h = model.mesh.element_size
+    assert curvature_magnitude is norm
+    np.testing.assert_array_equal(model.relative_curvature(U), norm(k) * h)
+    out = sharp_fold_indicator(model.positions(U), model.mesh.tri, k, h)
+    assert out["max_relative_curvature"] == float(np.max(norm(k) * h))
+    with pytest.raises(ValueError, match=r"\(E, 3\)"):
+        norm(np.ones((4, 2)))

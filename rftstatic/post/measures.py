@@ -22,6 +22,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from rftstatic.element.curvature import curvature_norm
+
 __all__ = [
     "shadow_area", "drape_coefficient", "boundary_loop", "FoldProfile", "fold_count",
     "dihedral_angles", "curvature_norm", "sharp_fold_indicator", "drape_measures",
@@ -398,28 +400,6 @@ def dihedral_angles(x: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndar
     return edges, ang
 
 
-def curvature_norm(curvature: np.ndarray) -> np.ndarray:
-    """Frobenius norm of the curvature tensor from the curvature vector.
-
-    The vector is (κ_xx, κ_yy, 2κ_xy) (engineering twist, as the strains), so the shear term
-    is halved back: |κ| = sqrt(κ_xx² + κ_yy² + 2 κ_xy²) = sqrt(k₀² + k₁² + k₂²/2).
-
-    Parameters
-    ----------
-    curvature : (E, 3) ndarray
-        Curvature vector per element [1/m].
-
-    Returns
-    -------
-    (E,) ndarray
-        |κ| [1/m], invariant under in-plane rotation of the axes.
-    """
-    k = np.asarray(curvature, dtype=float)
-    if k.ndim != 2 or k.shape[1] != 3:
-        raise ValueError(f"curvature_norm: curvature.shape = {k.shape}, expected (E, 3)")
-    return np.sqrt(k[:, 0] ** 2 + k[:, 1] ** 2 + 0.5 * k[:, 2] ** 2)
-
-
 def sharp_fold_indicator(x: np.ndarray, tri: np.ndarray, curvature: np.ndarray | None = None,
                          h: np.ndarray | None = None) -> dict:
     """Largest relative curvature |κ|h and largest dihedral angle, and where they occur.
@@ -431,7 +411,8 @@ def sharp_fold_indicator(x: np.ndarray, tri: np.ndarray, curvature: np.ndarray |
     tri : (E, 3) int ndarray
         Triangles.
     curvature : (E, 3) ndarray, optional
-        Curvature vector (κ_xx, κ_yy, 2κ_xy) per element [1/m]; see :func:`curvature_norm`.
+        Curvature vector (κ_xx, κ_yy, 2κ_xy) per element [1/m]; see
+        :func:`rftstatic.element.curvature.curvature_norm`.
     h : (E,) ndarray, optional
         Element size [m] (e.g. the longest edge); needed with ``curvature``.
 
