@@ -1,20 +1,15 @@
-"""Drape measures: rftstatic.measures."""
+"""Drape measures: rftstatic.post.measures (shadow, boundary, sharp, summary)."""
 
 import json
 
 import numpy as np
 import pytest
 
-from rftstatic.post.measures import (
-    boundary_loop,
-    curvature_norm,
-    dihedral_angles,
-    drape_coefficient,
-    drape_measures,
-    fold_count,
-    shadow_area,
-    sharp_fold_indicator,
-)
+from rftstatic.element.curvature import curvature_norm
+from rftstatic.post.measures.boundary import boundary_loop, fold_count
+from rftstatic.post.measures.shadow import drape_coefficient, shadow_area
+from rftstatic.post.measures.sharp import dihedral_angles, sharp_fold_indicator
+from rftstatic.post.measures.summary import drape_measures
 
 
 def square_grid(n, side=1.0):

@@ -117,7 +117,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
 
 def drape_summary(scene, model, extras, U) -> dict:
     """Drape coefficient, fold count and sharp-fold indicator (method.md), scene units."""
-    from rftstatic.post.measures import drape_measures
+    from rftstatic.post.measures.summary import drape_measures
 
     u = scene.units.length
     x = model.positions(U)

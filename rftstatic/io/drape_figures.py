@@ -93,7 +93,7 @@ def boundary_xy(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
     x : (N, 3) node positions [any length unit]
     tri : (E, 3) triangles
     """
-    from rftstatic.post.measures import boundary_loop
+    from rftstatic.post.measures.boundary import boundary_loop
 
     loop = boundary_loop(tri, x)
     return np.asarray(x, float)[loop, :2]
