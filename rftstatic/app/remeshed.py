@@ -312,7 +312,7 @@ def _write(scene, run, out: Path, summary: dict, *, figures=True) -> None:
 
 def _frames(scene, run, out: Path) -> list:
     """``mesh_<k>_{top,iso}.png`` per mesh (edges drawn) and their GIF ``remesh.gif``."""
-    from rftstatic.io.plots import plot_views
+    from rftstatic.io.views import plot_views
 
     u = scene.units
     lu = {"cm-gf-s": "cm", "mm-N-s": "mm", "SI": "m"}.get(u.name, "")
@@ -354,7 +354,8 @@ def _gif(path: Path, pngs: list) -> None:
 
 
 def _node_plot(scene, summary, out: Path) -> None:
-    from rftstatic.io.plots import _figure, _save
+    from rftstatic.io.figure import new_figure as _figure
+    from rftstatic.io.figure import save_png as _save
 
     recs = summary["records"]
     relax = summary["route"] == "remesh_relax"

@@ -400,7 +400,8 @@ def _figures(result, out) -> list[str]:
     """Error against wall time and against unknowns: one panel per plate case, every element in each."""
     from matplotlib.ticker import NullFormatter, NullLocator
 
-    from rftstatic.io.plots import _figure, _save
+    from rftstatic.io.figure import new_figure as _figure
+    from rftstatic.io.figure import save_png as _save
 
     names = []
     styles = {"RFT3=RFT6": ("C0", "o"), f"Morley ({PEER})": ("C1", "s"), f"Argyris ({PEER})": ("C2", "d")}

@@ -254,7 +254,7 @@ def _f(v) -> str:
 
 
 def _overlays(curves, out) -> list:
-    from rftstatic.io.plots import plot_boundary_overlay
+    from rftstatic.io.charts import plot_boundary_overlay
 
     files = []
     for name, c in curves.items():
