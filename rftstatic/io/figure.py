@@ -72,8 +72,10 @@ def set_2d_limits(ax, lo, hi):
 
 
 def figsize_2d(lo, hi) -> tuple[float, float]:
-    """(width, height) [inch] of a 2-D view of the (2,) data bounds ``lo``, ``hi``: 6.4 wide, the height
-    following the aspect ratio (clipped to 2.2-7.0) plus room for the title and labels."""
+    """(width, height) [inch] of a 2-D view of the (2,) data bounds ``lo``, ``hi``.
+
+    6.4 wide; the height follows the aspect ratio (clipped to 2.2-7.0) plus room for the title and labels.
+    """
     dx, dy = np.maximum(hi - lo, 1e-12)
     height = float(np.clip(5.6 * dy / dx, 2.2, 7.0)) + 0.9      # room for the title and labels
     return 6.4, height

@@ -147,8 +147,10 @@ def add_surface_3d(ax, x, tri, color_by=None, *, clim=None):
 
 
 def set_3d_limits(ax, lo, hi):
-    """Padded limits of a 3-D axes from (3,) data bounds ``lo``, ``hi``, equal aspect, the iso camera
-    (:data:`ELEV`, :data:`AZIM`)."""
+    """Padded limits of a 3-D axes from (3,) data bounds ``lo``, ``hi``, equal aspect, the iso camera.
+
+    The camera is ``view_init(elev=ELEV, azim=AZIM)``; a flat box gets few z ticks (``MaxNLocator(nbins=3)``).
+    """
     lo, hi = padded_limits(lo, hi)
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
