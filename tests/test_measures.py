@@ -1,20 +1,15 @@
-"""Drape measures: rftstatic.measures."""
+"""Drape measures: rftstatic.post.measures (shadow, boundary, sharp, summary)."""
 
 import json
 
 import numpy as np
 import pytest
 
-from rftstatic.post.measures import (
-    boundary_loop,
-    curvature_norm,
-    dihedral_angles,
-    drape_coefficient,
-    drape_measures,
-    fold_count,
-    shadow_area,
-    sharp_fold_indicator,
-)
+from rftstatic.element.curvature import curvature_norm
+from rftstatic.post.measures.boundary import boundary_loop, fold_count
+from rftstatic.post.measures.shadow import drape_coefficient, shadow_area
+from rftstatic.post.measures.sharp import dihedral_angles, sharp_fold_indicator
+from rftstatic.post.measures.summary import drape_measures
 
 
 def square_grid(n, side=1.0):
@@ -208,3 +203,24 @@ def test_drape_measures_is_json_ready():
     assert out["fold_count"] == 6
     assert 0.0 < out["drape_coefficient"] < 1.0
     assert out["boundary_radius_max"] == pytest.approx(0.09 + 0.06 * 0.7, rel=0.01)
+
+
+def test_one_curvature_norm_for_model_size_field_and_measures():
+    """Model.relative_curvature, the Eq. 29 size field and the sharp-fold indicator share one |kappa|."""
+    from rftstatic.bench.problems import strip_model
+    from rftstatic.element.curvature import curvature_norm as norm
+    from rftstatic.remesh.sizefield import target_sizes
+
+    model = strip_model(11, 3, element="RFT3")
+    rng = np.random.default_rng(3)
+    U = 1e-3 * rng.standard_normal((model.mesh.n_nodes, 3))
+    k = model.curvature(U)
+    h = model.mesh.element_size
+    # the size field of Eq. 29 uses the same |kappa|: h = sqrt(const / |kappa|) where not clipped
+    hs = target_sizes(k, const=1e-4, h_lower=1e-12, h_upper=1e12)
+    np.testing.assert_allclose(hs, np.sqrt(1e-4 / norm(k)), rtol=1e-14)
+    np.testing.assert_array_equal(model.relative_curvature(U), norm(k) * h)
+    out = sharp_fold_indicator(model.positions(U), model.mesh.tri, k, h)
+    assert out["max_relative_curvature"] == float(np.max(norm(k) * h))
+    with pytest.raises(ValueError, match=r"\(E, 3\)"):
+        norm(np.ones((4, 2)))

@@ -9,8 +9,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
+from rftstatic.io import animation, charts, outlines, views
 from rftstatic.io import files as output
-from rftstatic.io import plots
 
 
 def rectangle(nx=5, ny=5, lx=4.0, ly=2.0):
@@ -41,7 +41,8 @@ def no_temp_files(directory):
 
 
 def test_import_is_light():
-    code = ("import sys, rftstatic.io.files, rftstatic.io.plots; "
+    code = ("import sys, rftstatic.io.files, rftstatic.io.figure, rftstatic.io.surface, rftstatic.io.views, "
+            "rftstatic.io.charts, rftstatic.io.animation, rftstatic.io.outlines, rftstatic.io.drape_figures; "
             "print('matplotlib' in sys.modules, 'meshio' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
@@ -110,10 +111,9 @@ def test_json_numpy_types_and_nonfinite(tmp_path):
 def test_atomic_write_keeps_old_file_when_writer_raises(tmp_path):
     target = tmp_path / "summary.json"
     output.write_json(target, {"version": 1})
-    with pytest.raises(RuntimeError):
-        with output.atomic_write(target) as tmp:
-            tmp.write_text('{"version": 2, "trunc')
-            raise RuntimeError("interrupted")
+    with pytest.raises(RuntimeError), output.atomic_write(target) as tmp:
+        tmp.write_text('{"version": 2, "trunc')
+        raise RuntimeError("interrupted")
     assert json.loads(target.read_text()) == {"version": 1}
     assert no_temp_files(tmp_path)
     with pytest.raises(TypeError):
@@ -125,13 +125,13 @@ def test_plot_views_writes_three_pngs(tmp_path):
     X3, tri = rectangle()
     x = draped(X3)
     kappa = np.linspace(0, 1, len(tri))
-    obstacle = plots.outline_drawer(plots.outline_square(2.0, 1.0, 0.5, corner_radius=0.1), z=0.0)
-    out = plots.plot_views(tmp_path / "drape", x, tri, title="test", color_by=kappa, frame_x0=X3,
+    obstacle = outlines.outline_drawer(outlines.outline_square(2.0, 1.0, 0.5, corner_radius=0.1), z=0.0)
+    out = views.plot_views(tmp_path / "drape", x, tri, title="test", color_by=kappa, frame_x0=X3,
                            obstacles_draw=[obstacle], length_unit="cm", color_label="relative curvature")
     assert set(out) == {"side", "top", "iso"}
     for view, path in out.items():
         assert path.name == f"drape_{view}.png" and png_ok(path)
-    assert png_ok(plots.plot_views(tmp_path / "plain", x, tri, views=("top",))["top"])
+    assert png_ok(views.plot_views(tmp_path / "plain", x, tri, views=("top",))["top"])
     assert no_temp_files(tmp_path)
 
 
@@ -139,28 +139,28 @@ def test_boundary_profiles_history_load_deflection(tmp_path):
     s = np.linspace(0, 2 * np.pi, 60, endpoint=False)
     curves = {"reference": np.column_stack([10 * np.cos(s), 10 * np.sin(s)]),
               "RFT6": np.column_stack([9 * np.cos(s), 9.5 * np.sin(s)])}
-    assert png_ok(plots.plot_boundary_overlay(tmp_path / "b.png", curves, title="Fig. 6a",
-                                              reference_label="reference",
-                                              obstacle_outline=plots.outline_square(0, 0, 5)))
+    assert png_ok(charts.plot_boundary_overlay(tmp_path / "b.png", curves, title="Fig. 6a",
+                                               reference_label="reference",
+                                               obstacle_outline=outlines.outline_square(0, 0, 5)))
     xs = np.linspace(0, 5, 20)
     prof = {"RFT3": np.column_stack([xs, -0.05 * xs**2]), "RFT6": np.column_stack([xs, -0.04 * xs**2])}
-    assert png_ok(plots.plot_side_profiles(tmp_path / "p.png", prof, title="Fig. 5b",
-                                           reference=prof["RFT6"][::4] + 0.01))
+    assert png_ok(charts.plot_side_profiles(tmp_path / "p.png", prof, title="Fig. 5b",
+                                            reference=prof["RFT6"][::4] + 0.01))
     t = np.linspace(0, 1, 50)
-    assert png_ok(plots.plot_history(tmp_path / "h.png", t, {"kinetic": t**2, "potential": 1 - t},
-                                     xlabel="t [s]", ylabel="energy", title="energies", logy=True))
+    assert png_ok(charts.plot_history(tmp_path / "h.png", t, {"kinetic": t**2, "potential": 1 - t},
+                                      xlabel="t [s]", ylabel="energy", title="energies", logy=True))
     load = np.linspace(0, 1, 11)
-    assert png_ok(plots.plot_load_deflection(tmp_path / "ld.png", {"RFT6": (load, 3 * load)},
-                                             {"S4R": (load[::2], 3 * load[::2] + 0.05)},
-                                             xlabel="tip deflection", ylabel="load fraction",
-                                             title="end shear"))
+    assert png_ok(charts.plot_load_deflection(tmp_path / "ld.png", {"RFT6": (load, 3 * load)},
+                                              {"S4R": (load[::2], 3 * load[::2] + 0.05)},
+                                              xlabel="tip deflection", ylabel="load fraction",
+                                              title="end shear"))
 
 
 def test_plot_convergence_fits_rate(tmp_path):
     n = np.array([100.0, 400.0, 1600.0, 6400.0])
     series = {"RFT6": (n, 3.0 * n**-2.0), "RFT3": (n, 0.5 * n**-1.0),
               "broken": (n, [1e-2, 0.0, np.nan, 1e-3])}
-    path, slopes = plots.plot_convergence(tmp_path / "c.png", series, xlabel="nodes", title="convergence")
+    path, slopes = charts.plot_convergence(tmp_path / "c.png", series, xlabel="nodes", title="convergence")
     assert png_ok(path)
     assert slopes["RFT6"] == pytest.approx(-2.0, abs=1e-12)
     assert slopes["RFT3"] == pytest.approx(-1.0, abs=1e-12)
@@ -172,18 +172,18 @@ def test_animate_writes_gif(tmp_path):
 
     X3, tri = rectangle()
     frames = [X3 + s * (draped(X3) - X3) for s in (0.0, 0.5, 1.0)]
-    path = plots.animate(tmp_path / "drop.gif", frames, tri, times=[0.0, 0.16, 0.32], fps=5)
+    path = animation.animate(tmp_path / "drop.gif", frames, tri, times=[0.0, 0.16, 0.32], fps=5)
     with Image.open(path) as im:
         assert im.format == "GIF" and im.n_frames == 3
-    assert png_ok(plots.plot_views(tmp_path / "a", frames[-1], tri, views=("side",))["side"])
+    assert png_ok(views.plot_views(tmp_path / "a", frames[-1], tri, views=("side",))["side"])
     assert no_temp_files(tmp_path)
 
 
 def test_outlines_closed_ccw():
-    for pts in (plots.outline_square(1, 2, 3), plots.outline_square(1, 2, 3, corner_radius=0.5),
-                plots.outline_circle(1, 2, 3, n=64)):
+    for pts in (outlines.outline_square(1, 2, 3), outlines.outline_square(1, 2, 3, corner_radius=0.5),
+                outlines.outline_circle(1, 2, 3, n=64)):
         np.testing.assert_allclose(pts[0], pts[-1])
         x, y = pts[:, 0], pts[:, 1]
         assert 0.5 * np.sum(x[:-1] * y[1:] - x[1:] * y[:-1]) > 0
-    sq = plots.outline_square(1, 2, 3)
+    sq = outlines.outline_square(1, 2, 3)
     assert sq[:, 0].min() == -2 and sq[:, 1].max() == 5

@@ -4,12 +4,13 @@ import numpy as np
 import pytest
 
 from rftstatic import material
+from rftstatic.element.curvature import curvature_norm
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.mesh.mesher import Domain, generate
 from rftstatic.model import model
 from rftstatic.remesh.adapt import adapt_mesh, reference_domain, refinable_maxima, transfer_state
 from rftstatic.remesh.relax_driver import NearObstacle, critical_damping, explicit_advance, remesh_relax
-from rftstatic.remesh.sizefield import curvature_magnitude, size_field, target_sizes
+from rftstatic.remesh.sizefield import size_field, target_sizes
 from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.remesh.transfer import interpolate, locate, transfer_fields
 from rftstatic.scenes.schema import scene_from_dict
@@ -111,19 +112,19 @@ def test_interpolate_reproduces_nodal_values():
 # ------------------------------------------------------------------------------------------ size field
 def test_target_sizes_follow_eq29():
     kappa = np.array([[100.0, 0, 0], [0, 0, 2 * 100.0 / np.sqrt(2)], [1e4, 0, 0], [0, 0, 0]])
-    assert np.allclose(curvature_magnitude(kappa)[:2], 100.0)          # k_xy = (2 k_xy) / 2
+    assert np.allclose(curvature_norm(kappa)[:2], 100.0)          # k_xy = (2 k_xy) / 2
     h = target_sizes(kappa, const=1e-4, h_lower=2e-4, h_upper=5e-3)
     assert np.allclose(h[:2], 1e-3)                                     # |kappa| h^2 = const
     assert h[2] == 2e-4 and h[3] == 5e-3                                # clipped
 
 
-def test_curvature_magnitude_is_invariant_under_rotation():
+def test_curvature_norm_is_invariant_under_rotation():
     k = np.array([[3.0, -1.0], [-1.0, 2.0]])
     c, s = np.cos(0.7), np.sin(0.7)
     R = np.array([[c, -s], [s, c]])
     kr = R @ k @ R.T
     vec = lambda t: np.array([[t[0, 0], t[1, 1], 2 * t[0, 1]]])  # noqa: E731
-    assert np.isclose(curvature_magnitude(vec(k))[0], curvature_magnitude(vec(kr))[0])
+    assert np.isclose(curvature_norm(vec(k))[0], curvature_norm(vec(kr))[0])
 
 
 def test_size_field_clipping_and_gradation():

@@ -245,7 +245,9 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
     write_json(out / "summary.json", summary)
     if not figures:
         return
-    from rftstatic.io.plots import animate, plot_history, plot_views
+    from rftstatic.io.animation import animate
+    from rftstatic.io.charts import plot_history
+    from rftstatic.io.views import plot_views
 
     lu = {"cm-gf-s": "cm", "mm-N-s": "mm", "SI": "m"}.get(u.name, "")
     short = f"{scene.name} ({model.element}, {model.mesh.n_nodes} nodes)"

@@ -227,7 +227,7 @@ def _write(scene, solved, out: Path, summary: dict, *, figures=True) -> None:
 
 def _frames(scene, run, out: Path) -> list:
     """``mesh_<k>_{top,iso}.png`` per mesh (edges drawn) and their GIF ``remesh.gif``."""
-    from rftstatic.io.plots import plot_views
+    from rftstatic.io.views import plot_views
 
     u = scene.units
     lu = {"cm-gf-s": "cm", "mm-N-s": "mm", "SI": "m"}.get(u.name, "")
@@ -269,7 +269,7 @@ def _gif(path: Path, pngs: list) -> None:
 
 
 def _node_plot(scene, summary, out: Path) -> None:
-    from rftstatic.io.plots import _figure, _save
+    from rftstatic.io.figure import new_figure, save_png
 
     recs = summary["records"]
     relax = summary["route"] == "remesh_relax"
@@ -277,7 +277,7 @@ def _node_plot(scene, summary, out: Path) -> None:
     n = [r["nodes"] for r in recs] + ([recs[-1]["nodes"]] if relax else [])
     if not relax:
         x = [r["cycle"] for r in recs]
-    fig = _figure((6.4, 4.0))
+    fig = new_figure((6.4, 4.0))
     ax = fig.add_subplot()
     ax.step(x, n, where="post", marker="o")
     ax.set_xlabel(f"time [{scene.units.name.split('-')[-1] if '-' in scene.units.name else 's'}]" if relax
@@ -285,4 +285,4 @@ def _node_plot(scene, summary, out: Path) -> None:
     ax.set_ylabel("nodes")
     ax.set_title(f"{scene.name}: node count ({summary['element']})")
     ax.grid(alpha=0.3)
-    _save(fig, out / "nodes.png")
+    save_png(fig, out / "nodes.png")

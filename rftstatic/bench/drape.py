@@ -50,7 +50,7 @@ def target_for(nodes: int) -> float | None:
 
 def extra_indicators(x, tri) -> dict:
     """Distribution of the dihedral angles [deg]: percentiles 50/90/99/99.9 and the count above 90 deg."""
-    from rftstatic.post.measures import dihedral_angles
+    from rftstatic.post.measures.sharp import dihedral_angles
 
     _, ang = dihedral_angles(x, tri)
     deg = np.degrees(ang)

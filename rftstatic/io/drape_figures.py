@@ -1,7 +1,7 @@
 """Figures of draped sheets in the style of the paper (Sze & Zhou 2016, Figs. 6-11).
 
 - :func:`obstacle_drawers`: the obstacles of a scene as ``draw(ax, view)`` callables for
-  :func:`rftstatic.plots.plot_views` (pedestal top outlines through ``plots.outline_drawer``, the
+  :func:`rftstatic.io.views.plot_views` (pedestal top outlines through ``outlines.outline_drawer``, the
   sphere as its silhouette), in the scene's length unit;
 - :func:`boundary_xy`: the projected outer boundary of a drape (Fig. 6a);
 - :func:`boundary_distance`: the largest distance between two projected boundary curves
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["obstacle_drawers", "obstacle_outline", "boundary_xy", "boundary_distance", "plot_side_by_side"]
+__all__ = ["boundary_distance", "boundary_xy", "obstacle_drawers", "obstacle_outline", "plot_side_by_side"]
 
 
 def obstacle_outline(d: dict, length_scale: float = 1.0) -> tuple[np.ndarray | None, float | None]:
@@ -23,7 +23,7 @@ def obstacle_outline(d: dict, length_scale: float = 1.0) -> tuple[np.ndarray | N
     Lengths are divided by ``length_scale`` (the scene's length unit in metres). Returns
     ``(None, None)`` for obstacles without a top outline (floor).
     """
-    from rftstatic.io.plots import outline_circle, outline_square
+    from rftstatic.io.outlines import outline_circle, outline_square
 
     s = float(length_scale)
     t = d.get("type", "")
@@ -63,14 +63,14 @@ def _sphere_drawer(centre, radius, color="0.55"):
 
 
 def obstacle_drawers(obstacles, length_scale: float = 1.0) -> list:
-    """``draw(ax, view)`` callables for ``plots.plot_views(obstacles_draw=...)``, in scene units.
+    """``draw(ax, view)`` callables for ``views.plot_views(obstacles_draw=...)``, in scene units.
 
     Parameters
     ----------
     obstacles : sequence of :class:`rftstatic.obstacles.Obstacle` (their ``as_dict()`` is read, [m])
     length_scale : the scene's length unit [m] (0.01 for cm)
     """
-    from rftstatic.io.plots import outline_drawer
+    from rftstatic.io.outlines import outline_drawer
 
     draws = []
     for ob in obstacles:
@@ -93,7 +93,7 @@ def boundary_xy(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
     x : (N, 3) node positions [any length unit]
     tri : (E, 3) triangles
     """
-    from rftstatic.post.measures import boundary_loop
+    from rftstatic.post.measures.boundary import boundary_loop
 
     loop = boundary_loop(tri, x)
     return np.asarray(x, float)[loop, :2]

@@ -18,7 +18,7 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
         write_vtu(out / "deformed.vtu", model.X3, U, model.mesh.tri, length_unit_scale=u, cell_data=cell)
     if figures:
         from rftstatic.io.drape_figures import obstacle_drawers
-        from rftstatic.io.plots import plot_views
+        from rftstatic.io.views import plot_views
 
         views = tuple(scene.get("output.views", ["side", "top", "iso"]))
         status = "" if summary.get("converged", True) else " (NOT CONVERGED)"

@@ -12,7 +12,7 @@ import copy
 
 import numpy as np
 
-from rftstatic.post.measures import drape_measures
+from rftstatic.post.measures.summary import drape_measures
 from rftstatic.post.probes import probe_positions
 from rftstatic.provenance import peak_memory_mb, software
 

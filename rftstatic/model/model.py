@@ -19,6 +19,7 @@ from functools import cached_property
 
 import numpy as np
 
+from rftstatic.element.curvature import curvature_norm
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
 from rftstatic.material import Material
@@ -235,8 +236,10 @@ class Model:
         return self.membrane.strain(U)
 
     def relative_curvature(self, U) -> np.ndarray:
-        """(E,) |kappa| h, the relative curvature of §2.2 and §5.1 [-]."""
-        k = self.curvature(U)
-        mag = np.sqrt(k[:, 0] ** 2 + k[:, 1] ** 2 + 0.5 * k[:, 2] ** 2)
-        return mag * self.mesh.element_size
+        """(E,) |kappa| h, the relative curvature of §2.2 and §5.1 [-].
+
+        |kappa| [1/m] is :func:`rftstatic.element.curvature.curvature_norm` of :meth:`curvature`,
+        h [m] the mean side length (``mesh.element_size``).
+        """
+        return curvature_norm(self.curvature(U)) * self.mesh.element_size
 

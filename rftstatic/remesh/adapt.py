@@ -40,8 +40,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rftstatic.element.curvature import curvature_norm
 from rftstatic.errors import ParameterError
-from rftstatic.remesh.sizefield import curvature_magnitude, size_field
+from rftstatic.remesh.sizefield import size_field
 from rftstatic.remesh.transfer import METHODS, transfer_fields
 
 DAMPING = ("fixed", "critical")
@@ -190,7 +191,7 @@ def _factory(problem):
 
 def _curvature_figures(model, U):
     kappa = model.curvature(U)
-    mag = curvature_magnitude(kappa)
+    mag = curvature_norm(kappa)
     h = model.mesh.element_size
     return kappa, float((mag * h).max()), float((mag * h * h).max())
 
@@ -219,7 +220,7 @@ def refinable_maxima(mesh, kappa, *, const, h_lower):
     -------
     (max |kappa| h [-], max |kappa| h^2 [m]); 0 when every element is at the size floor
     """
-    mag = curvature_magnitude(kappa)
+    mag = curvature_norm(kappa)
     h = mesh.element_size
     with np.errstate(divide="ignore"):
         wanted = np.sqrt(const / mag)  # inf where flat

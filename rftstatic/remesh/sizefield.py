@@ -9,9 +9,11 @@ with the curvature vector of Eq. 7, ``kappa = (k_xx, k_yy, 2 k_xy)`` as returned
 
     |kappa| = sqrt(k_xx^2 + k_yy^2 + 2 k_xy^2),   k_xy = (2 k_xy) / 2,
 
-the same measure as :meth:`~rftstatic.model.Model.relative_curvature` (``|kappa| h``), so it does not
-depend on the orientation of the in-plane axes. ``const`` is a length [m] (Eq. 28 compares
-``|kappa| h^2`` with it): a triangle of the new mesh of size h_new has ``|kappa| h_new = const / h_new``.
+:func:`rftstatic.element.curvature.curvature_norm` (here also under the name
+:func:`rftstatic.element.curvature.curvature_norm`), the same measure as :meth:`~rftstatic.model.Model.relative_curvature`
+(``|kappa| h``), so it does not depend on the orientation of the in-plane axes. ``const`` is a
+length [m] (Eq. 28 compares ``|kappa| h^2`` with it): a triangle of the new mesh of size h_new has
+``|kappa| h_new = const / h_new``.
 A flat triangle (|kappa| = 0) takes h_upper.
 
 Step f of §5.2: the per-triangle h_target is put on the square background grid of the mesher
@@ -24,15 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["curvature_magnitude", "target_sizes", "size_field", "check_size_bounds"]
+from rftstatic.element.curvature import curvature_norm
 
-
-def curvature_magnitude(kappa) -> np.ndarray:
-    """(E,) |kappa| = sqrt(k_xx^2 + k_yy^2 + 2 k_xy^2) [1/m] of ``kappa (E, 3)`` = (k_xx, k_yy, 2 k_xy) [1/m]."""
-    k = np.asarray(kappa, dtype=float)
-    if k.ndim != 2 or k.shape[1] != 3:
-        raise ValueError(f"kappa must have shape (E, 3) = (k_xx, k_yy, 2 k_xy) [1/m], got {k.shape}")
-    return np.sqrt(k[:, 0] ** 2 + k[:, 1] ** 2 + 0.5 * k[:, 2] ** 2)
+__all__ = ["check_size_bounds", "size_field", "target_sizes"]
 
 
 def check_size_bounds(*, const, h_lower, h_upper, extent=None) -> None:
@@ -67,7 +63,7 @@ def target_sizes(kappa, *, const, h_lower, h_upper) -> np.ndarray:
     h_lower, h_upper : bounds on the new size [m]
     """
     check_size_bounds(const=const, h_lower=h_lower, h_upper=h_upper)
-    mag = curvature_magnitude(kappa)
+    mag = curvature_norm(kappa)
     with np.errstate(divide="ignore"):
         h_new = np.sqrt(const / mag)          # inf where flat, clipped to h_upper below
     return np.clip(h_new, h_lower, h_upper)

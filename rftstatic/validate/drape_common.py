@@ -98,7 +98,7 @@ def free_indicators(rec: dict, scene: str, *, reach: float = 2.0) -> dict:
     import numpy as np
 
     from rftstatic.contact.obstacles import from_spec
-    from rftstatic.post.measures import dihedral_angles
+    from rftstatic.post.measures.sharp import dihedral_angles
     from rftstatic.scenes.schema import load_scene
 
     sc = load_scene(scene, rec["overrides"])

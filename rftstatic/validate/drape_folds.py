@@ -269,7 +269,7 @@ def _profiles(out, recs, *, name="drape_folds_profiles.png",
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from rftstatic.post.measures import boundary_loop, fold_count
+    from rftstatic.post.measures.boundary import boundary_loop, fold_count
 
     fig, ax = plt.subplots(figsize=(7.5, 4.2))
     for k, (nodes, rec) in enumerate(recs.items()):

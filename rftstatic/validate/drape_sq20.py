@@ -114,7 +114,8 @@ def _folds(rec) -> str:
 
 def _overlay(out, cfg, ref, ref_curve) -> str:
     """Fig. 6a: deformed boundaries from the top, the pedestal filled grey."""
-    from rftstatic.io.plots import outline_square, plot_boundary_overlay
+    from rftstatic.io.charts import plot_boundary_overlay
+    from rftstatic.io.outlines import outline_square
 
     nref = cfg["reference"]
     n1, n2 = (33, 61) if cfg is FULL else tuple(cfg["meshes"]["RFT6"][-2:])

@@ -400,12 +400,12 @@ def _figures(result, out) -> list[str]:
     """Error against wall time and against unknowns: one panel per plate case, every element in each."""
     from matplotlib.ticker import NullFormatter, NullLocator
 
-    from rftstatic.io.plots import _figure, _save
+    from rftstatic.io.figure import new_figure, save_png
 
     names = []
     styles = {"RFT3=RFT6": ("C0", "o"), f"Morley ({PEER})": ("C1", "s"), f"Argyris ({PEER})": ("C2", "d")}
     for key, xlabel, stem in (("wall_time_s", "wall time [s]", "time"), ("unknowns", "unknowns", "unknowns")):
-        fig = _figure(figsize=(10.0, 8.0))
+        fig = new_figure(figsize=(10.0, 8.0))
         axes = fig.subplots(2, 2).ravel()
         for ax, (edges, load) in zip(axes, CASES):
             case = f"{edges} {load}"
@@ -434,6 +434,6 @@ def _figures(result, out) -> list[str]:
             ax.legend(fontsize="x-small", loc="best")
         fig.suptitle(f"Square Kirchhoff plates vs Timoshenko: error vs {xlabel} (p: rate in h, resolved meshes)")
         path = out / f"peers_error_vs_{stem}.png"
-        _save(fig, path)
+        save_png(fig, path)
         names.append(path.name)
     return names

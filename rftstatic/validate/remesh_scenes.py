@@ -54,7 +54,7 @@ STATIC_REMESH = ["analysis=static", "contact.penalty=auto", "solver.rtol=1e-5", 
 
 def boundary_curve(summary_x, tri):
     """(B, 2) top-view outline [scene length] of the deformed sheet (ordered boundary loop)."""
-    from rftstatic.post.measures import boundary_loop
+    from rftstatic.post.measures.boundary import boundary_loop
 
     loop = boundary_loop(tri, summary_x)
     return summary_x[loop][:, :2]
@@ -253,7 +253,7 @@ def _f(v) -> str:
 
 
 def _overlays(curves, out) -> list:
-    from rftstatic.io.plots import plot_boundary_overlay
+    from rftstatic.io.charts import plot_boundary_overlay
 
     files = []
     for name, c in curves.items():

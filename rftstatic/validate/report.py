@@ -148,7 +148,7 @@ def fmt_err(e: float) -> str:
 
 def convergence_figures(result: BenchmarkResult, out: Path, *, studies=None, stem=None, title=None) -> list[str]:
     """Error against node count and against wall time, every element of every case on one plot each."""
-    from rftstatic.io.plots import plot_convergence
+    from rftstatic.io.charts import plot_convergence
 
     studies = result.studies if studies is None else studies
     stem = stem or result.name

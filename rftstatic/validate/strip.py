@@ -115,7 +115,7 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
 
 def _profile_figure(out, side_mesh) -> str:
     """Side profiles (mid-width line) of the strip for the three patterns against the elastica."""
-    from rftstatic.io.plots import plot_side_profiles
+    from rftstatic.io.charts import plot_side_profiles
 
     nx, ny = side_mesh
     curves = {}

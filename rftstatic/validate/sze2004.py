@@ -273,7 +273,7 @@ def _table(result, case, table) -> str:
 
 
 def _curve_figures(result, out, tables) -> list[str]:
-    from rftstatic.io.plots import plot_load_deflection
+    from rftstatic.io.charts import plot_load_deflection
 
     names = []
     spec = {"end shear": ("end_shear", ("minus_u", "w"), ("minus_u_tip", "w_tip"), ("-U", "W"), END_SHEAR.load_max),
