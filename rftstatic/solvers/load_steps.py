@@ -115,6 +115,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         result.wall_time = time.perf_counter() - t0
         result.energies = model.energies(result.U, result.lam, candidates=ws.candidates)
         ws.state.U, ws.state.lam = result.U, result.lam
+        result.state = ws.state
     return result
 
 

@@ -141,6 +141,7 @@ class StaticResult:
     lam : load factor reached [-]
     converged : True only if lam = 1 was reached in equilibrium
     load_steps : one record per accepted increment (load factor, iterations, residual, tangents)
+    state : the solve's final :class:`~rftstatic.model.state.State` (U, load factor, contact candidates)
     """
 
     U: np.ndarray
@@ -159,6 +160,7 @@ class StaticResult:
     seed: int | None = None
     route: str = "load-steps"
     relax: dict = field(default_factory=dict)
+    state: State | None = None
 
 
 @dataclass
