@@ -3,12 +3,11 @@
 import numpy as np
 import pytest
 
+from rftstatic.bench.problems import strip_model
 from rftstatic.references import plates
 from rftstatic.references.elastica import heavy_elastica
 from rftstatic.solvers import perturbation, static
 from rftstatic.validate.plates import plate_coefficient
-
-from conftest import clamped_strip
 
 
 def plate_centre_coefficient(n, edges, load, *, pattern="right"):
@@ -62,7 +61,7 @@ def test_plates_fine_mesh_within_one_percent(edges, load, n, tol):
 
 
 def strip_tip_error(nx, ny, element):
-    mod = clamped_strip(nx, ny, element=element)
+    mod = strip_model(nx, ny, element=element)
     res = static.solve_static(mod, options=static.StaticOptions(progress=False))
     assert res.converged
     w, C, EI, L = mod.material.weight, mod.material.Dm[0, 0], mod.material.Db[0, 0], 0.05
@@ -84,7 +83,7 @@ def test_strip_tip_converges_to_heavy_elastica(element):
 def test_newton_from_a_nearby_state_reaches_round_off_in_three_iterations():
     from scipy.sparse.linalg import spsolve
 
-    mod = clamped_strip(21, 5, element="RFT6")
+    mod = strip_model(21, 5, element="RFT6")
     res = static.solve_static(mod, options=static.StaticOptions(progress=False))
     U = res.U.copy()
     U[:, 2] += 1e-6 * mod.free[:, 2] * np.sin(40 * mod.X3[:, 0])  # 1 micron wave on a 5 cm strip
@@ -103,7 +102,7 @@ def test_newton_from_a_nearby_state_reaches_round_off_in_three_iterations():
 
 
 def test_unconverged_state_is_never_reported_as_converged():
-    mod = clamped_strip(11, 3, element="RFT3")
+    mod = strip_model(11, 3, element="RFT3")
     opts = static.StaticOptions(progress=False, max_iterations=1, min_increment=1e-2, initial_increment=0.5,
                                 max_increment=1.0, relax_fallback=False)
     with pytest.raises(static.ConvergenceError, match=r"load factor .* iteration .*\|r\| = ") as info:
@@ -114,7 +113,7 @@ def test_unconverged_state_is_never_reported_as_converged():
 
 @pytest.mark.parametrize("solver", ["scipy", "amg"])
 def test_other_linear_solvers_agree(solver):
-    mod = clamped_strip(11, 3)
+    mod = strip_model(11, 3)
     a = static.solve_static(mod, options=static.StaticOptions(progress=False))
     b = static.solve_static(mod, options=static.StaticOptions(progress=False, linear_solver=solver))
     assert b.linear_solver == solver and b.converged
@@ -122,7 +121,7 @@ def test_other_linear_solvers_agree(solver):
 
 
 def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
-    mod = clamped_strip(11, 3)
+    mod = strip_model(11, 3)
     a = static.solve_static(mod, options=static.StaticOptions(progress=False))
     b = static.solve_static(mod, options=static.StaticOptions(progress=False, start="relax"))
     assert a.route == "load-steps" and b.route == "relax+newton" and b.relax["at_rest"]
@@ -155,7 +154,7 @@ def test_fold_perturbation_has_n_fold_symmetry():
 def test_guided_relaxation_restores_the_weight_and_reaches_the_same_equilibrium():
     """The n-fold weight modulation of the relaxation's first stage is undone before the sheet comes
     to rest: the strip (one equilibrium) ends where the unguided routes end, the model's load intact."""
-    mod = clamped_strip(11, 3)
+    mod = strip_model(11, 3)
     load = mod.load.copy()
     a = static.solve_static(mod, options=static.StaticOptions(progress=False))
     b = static.solve_static(mod, options=static.StaticOptions(progress=False, start="relax", guide_folds=3,
