@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import copy
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from rftstatic.contact.obstacles import scene_schema as obstacle_schema
 from rftstatic.errors import SceneError
 from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
@@ -22,7 +24,23 @@ CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 NUM = (int, float)
 LIST = (list,)
 
-# key -> (allowed python types, help). Nested tables are dicts; arrays of tables are [dict].
+
+class _ObstacleKeys(Mapping):
+    """Schema of an ``[[obstacles]]`` table: ``type`` and the keys of every registered obstacle type
+    (:func:`rftstatic.contact.obstacles.scene_schema`), read when a scene is checked, so that a type
+    registered after this module was imported is known too."""
+
+    def __getitem__(self, key):
+        return obstacle_schema()[key]
+
+    def __iter__(self):
+        return iter(obstacle_schema())
+
+    def __len__(self):
+        return len(obstacle_schema())
+
+
+# key -> (allowed python types, help). Nested tables are dicts; arrays of tables are [dict] (or [mapping]).
 SCHEMA = {
     "title": (str, "one line saying what the scene is"),
     "figure": (str, "the paper figure or section it reproduces"),
@@ -67,12 +85,7 @@ SCHEMA = {
         "edge": ([{"box": (LIST, "[xmin, xmax, ymin, ymax]"),
                    "force_per_length": (LIST, "[fx, fy, fz] per unit length")}], "boundary line loads"),
     }, "external loads at load factor 1"),
-    "obstacles": ([{
-        "type": (str, "floor, sphere, square-pedestal or round-pedestal"),
-        "centre": (LIST, "centre"), "radius": (NUM, "radius"), "half_width": (NUM, "half side"),
-        "size": (LIST, "sides"), "top": (NUM, "height of the top face"), "edge_radius": (NUM, "rounding"),
-        "height": (NUM, "height of a pedestal"),
-    }], "rigid obstacles"),
+    "obstacles": ([_ObstacleKeys()], "rigid obstacles (the keys every registered obstacle type declares)"),
     "contact": ({
         "penalty": ((str, *NUM), '"auto" or a penalty stiffness [force/length^3]'),
         "factor": (NUM, "multiplier of the automatic penalty"),

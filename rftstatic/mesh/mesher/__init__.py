@@ -15,7 +15,7 @@ Public API
     Size field [m] with bilinear ``size_at(points)``; constructors
     ``uniform(h, region)``, ``from_function(h, region, ...)`` and
     ``from_samples(points, sizes, region, ...)``, all with a gradation limit
-    (see :mod:`rftstatic.mesher.sizefield`).
+    (see :mod:`rftstatic.mesh.mesher.sizefield`).
 ``generate(domain, size_field, *, smooth_iterations=4) -> MeshResult``
     ``.points`` (N, 2) float64 [m], ``.triangles`` (E, 3) int64
     counter-clockwise, ``.boundary`` (N,) bool, ``.boundary_edges`` (B, 2),
@@ -28,7 +28,7 @@ Pipeline: discretise the loops from the size field (corners kept, circle
 nodes on the circle) -> advancing front (:mod:`.front`) -> Delaunay flips,
 constrained Laplacian smoothing, local optimisation of the worst nodes
 (:mod:`.improve`) -> quality figures (:mod:`.quality`).
-``python -m rftstatic.mesher.bench`` times meshes of 2k, 20k and 200k nodes.
+``python -m rftstatic.bench.mesher`` times meshes of 2k, 20k and 200k nodes.
 """
 
 from rftstatic.errors import MeshingError

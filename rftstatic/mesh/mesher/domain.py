@@ -347,7 +347,7 @@ class Domain:
 
         Parameters
         ----------
-        size_field : :class:`~rftstatic.mesher.BackgroundGrid`
+        size_field : :class:`~rftstatic.mesh.mesher.BackgroundGrid`
 
         Returns
         -------

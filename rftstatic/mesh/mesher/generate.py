@@ -76,7 +76,7 @@ def generate(domain, size_field, *, smooth_iterations=4, max_steps=None):
     """
     t0 = time.perf_counter()
     if not isinstance(domain, Domain):
-        raise MeshingError(f"domain must be a rftstatic.mesher.Domain, got {type(domain).__name__}")
+        raise MeshingError(f"domain must be a rftstatic.mesh.mesher.Domain, got {type(domain).__name__}")
     if isinstance(size_field, (int, float, np.floating, np.integer)):
         size_field = BackgroundGrid.uniform(float(size_field), domain)
     if not isinstance(size_field, BackgroundGrid):

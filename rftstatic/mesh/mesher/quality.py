@@ -24,7 +24,7 @@ class MeshQuality:
     band_share : share of edges with length / h(midpoint) in ``BAND`` = [0.7, 1.4]
     edge_ratio_min, edge_ratio_max : extreme length / h(midpoint) ratios
     n_nodes, n_triangles : counts
-    wall_time : seconds spent in :func:`~rftstatic.mesher.generate` [s]
+    wall_time : seconds spent in :func:`~rftstatic.mesh.mesher.generate` [s]
     triangles_per_second : n_triangles / wall_time [1/s]
     """
 

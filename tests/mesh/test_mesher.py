@@ -1,4 +1,4 @@
-"""Tests of the advancing-front mesher (rftstatic.mesher)."""
+"""Tests of the advancing-front mesher (rftstatic.mesh.mesher)."""
 
 import numpy as np
 import pytest
