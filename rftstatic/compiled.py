@@ -1,5 +1,5 @@
-"""Whether the optional compiled kernels (numba: ``_explicit_numba``, ``_membrane_numba``) can be
-used, and on how many threads."""
+"""Whether the optional compiled kernels (numba: ``element/_kernels_numba.py``, the compiled twins of
+``element/kernels.py``) can be used, and on how many threads."""
 
 import os
 from functools import cache

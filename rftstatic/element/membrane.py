@@ -9,6 +9,10 @@ the Green strains (Eq. 14) at Q points, each computed from a deformation gradien
     element's own CST gradient (§3, last paragraph), so no image node enters the membrane.
 The energy is ``E_m = A/2 eps^T D^m eps`` (Eq. 15) with the averaged strain (one-point rule).
 
+This module builds the gradients ``G`` (:func:`membrane_operator`); the strain, stress, energy, force
+and tangent are the kernels of :mod:`rftstatic.element.kernels`, written once and run compiled (numba)
+or vectorised (numpy), which the explicit force (:mod:`rftstatic.element.explicit_force`) calls too.
+
 Einsum letters: e element, q strain point, a/b local node, i/j space, J/K reference axis, k/l strain.
 """
 
@@ -20,10 +24,12 @@ from functools import cached_property
 import numpy as np
 
 from rftstatic.compiled import numba_available
+from rftstatic.element.kernels import element_last, energies_numpy, forces_numpy, strains_numpy, tangents_numpy
 from rftstatic.element.patch import Patches
 from rftstatic.mesh.trimesh import TriMesh
 
 ELEMENTS = ("RFT3", "RFT6")
+BACKENDS = ("auto", "numpy", "numba")
 
 # parametric coordinates (xi, eta) of the mid-side points I (5-6), II (6-4), III (4-5)
 _MIDSIDE = np.array([[0.5, 0.0], [0.5, 0.5], [0.0, 0.5]])
@@ -63,16 +69,19 @@ class MembraneOperator:
     area: np.ndarray
 
     @cached_property
-    def _G_aqJ(self) -> np.ndarray:
-        """G as ``(E, A, Q*2)`` for batched matrix products."""
-        E, Q, A, _ = self.G.shape
-        return np.ascontiguousarray(self.G.transpose(0, 2, 1, 3).reshape(E, A, 2 * Q))
+    def G_last(self) -> np.ndarray:
+        """G as ``(Q, A, 2, E)``, the element-last layout of the vectorised kernels."""
+        return element_last(self.G)
+
+    @cached_property
+    def _compiled_args(self):
+        """``nodes`` (int64), ``G`` and ``area``, contiguous, for the compiled kernels."""
+        return (np.ascontiguousarray(self.nodes, dtype=np.int64), np.ascontiguousarray(self.G, dtype=float),
+                np.ascontiguousarray(self.area, dtype=float))
 
     def displacement_gradient(self, U: np.ndarray) -> np.ndarray:
-        """``H = dU/dX (E, Q, 3, 2)`` at every strain point for displacements ``U (N, 3)`` [m]."""
-        E, Q = self.G.shape[:2]
-        Ue = U[self.nodes].transpose(0, 2, 1)  # (E, 3, A)
-        return np.matmul(Ue, self._G_aqJ).reshape(E, 3, Q, 2).transpose(0, 2, 1, 3)
+        """``H = dU/dX (E, Q, 3, 2)`` [-] at every strain point for displacements ``U (N, 3)`` [m]."""
+        return strains_numpy(self.G_last, self.nodes, U)[1].transpose(3, 0, 2, 1)
 
     def strain(self, U: np.ndarray) -> np.ndarray:
         """Averaged Green membrane strain ``(E, 3)``: (e_xx, e_yy, 2 e_xy), Eq. 14 [-].
@@ -80,39 +89,33 @@ class MembraneOperator:
         Computed from the displacement gradient, ``E = (H + H^T + H^T H) / 2`` with F = I + H, so
         that no round-off from cancelling reference coordinates enters small strains.
         """
-        return _green_voigt(self.displacement_gradient(U)).mean(axis=1)
+        return strains_numpy(self.G_last, self.nodes, U)[0]
 
-    def energy(self, U, Dm) -> float:
+    def energy(self, U, Dm, *, backend="auto") -> float:
         """Membrane energy, Eq. 15 [J]."""
-        return float(self.element_energy(U, Dm).sum())
+        return float(self.element_energy(U, Dm, backend=backend).sum())
 
-    def element_energy(self, U, Dm) -> np.ndarray:
+    def element_energy(self, U, Dm, *, backend="auto") -> np.ndarray:
         """(E,) membrane energy of every element [J]."""
-        eps = self.strain(U)
-        return 0.5 * self.area * np.einsum("ek,ek->e", eps @ Dm, eps)
+        U, Dm = _as_float(U), _as_float(Dm)
+        if _compiled(backend):
+            from rftstatic.element._kernels_numba import membrane_energies
 
-    def _kinematics(self, U, Dm):
-        H = self.displacement_gradient(U)
-        eps = _green_voigt(H).mean(axis=1)
-        F = H
-        F[..., 0, 0] += 1.0
-        F[..., 1, 1] += 1.0
-        S = eps @ Dm  # (E, 3) second Piola-Kirchhoff membrane stress resultant [N/m]
-        E, Q, A, _ = self.G.shape
-        # dEps_k / dx_ai averaged over the strain points: Bbar (E, 3, 3*A), columns (a, i)
-        G = self.G
-        FT = F.transpose(0, 3, 2, 1)  # (E, J, i, q)
-        B0 = np.matmul(FT[:, 0], G[..., 0])  # (E, i, a): sum_q F_q[i,0] G_q[a,0]
-        B1 = np.matmul(FT[:, 1], G[..., 1])
-        B2 = np.matmul(FT[:, 0], G[..., 1]) + np.matmul(FT[:, 1], G[..., 0])
-        Bbar = np.stack([B0, B1, B2], axis=1).transpose(0, 1, 3, 2).reshape(E, 3, 3 * A) / Q
-        return eps, S, Bbar
+            We = np.empty(len(self.nodes))
+            membrane_energies(*self._compiled_args, Dm, U, We)
+            return We
+        return energies_numpy(self.G_last, self.nodes, self.area, Dm, U)
 
-    def element_forces(self, U, Dm) -> np.ndarray:
+    def element_forces(self, U, Dm, *, backend="auto") -> np.ndarray:
         """Internal membrane forces ``(E, A, 3)`` [N], the gradient of :meth:`energy`."""
-        _, S, Bbar = self._kinematics(U, Dm)
-        E, A = self.nodes.shape
-        return (self.area[:, None] * np.matmul(S[:, None, :], Bbar)[:, 0]).reshape(E, A, 3)
+        U, Dm = _as_float(U), _as_float(Dm)
+        if _compiled(backend):
+            from rftstatic.element._kernels_numba import membrane_forces
+
+            fe = np.empty(self.nodes.shape + (3,))
+            membrane_forces(*self._compiled_args, Dm, U, fe, 0, len(fe))
+            return fe
+        return np.moveaxis(forces_numpy(self.G_last, self.nodes, self.area, Dm, U)[0], -1, 0)
 
     def element_tangents(self, U, Dm, *, psd=False, backend="auto"):
         """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m].
@@ -120,45 +123,31 @@ class MembraneOperator:
         With ``psd=True`` the geometric (initial-stress) part uses the positive part of the stress,
         so the tangent is positive semi-definite under compression (the safeguard of method.md);
         the material part ``Bbar^T D^m Bbar`` is always positive semi-definite.
-        ``backend``: ``"numba"`` (compiled, :mod:`rftstatic._membrane_numba`; 10-20 x faster),
-        ``"numpy"`` (batched matrix products), ``"auto"``: numba when installed.
+        ``backend`` (here and in the other methods): ``"numba"`` (the kernels of
+        :mod:`rftstatic.element.kernels` compiled, one element at a time), ``"numpy"`` (the same
+        kernels vectorised over the elements), ``"auto"``: numba when installed.
         """
-        if backend == "auto":
-            backend = "numba" if numba_available() else "numpy"
-        if backend == "numba":
-            from rftstatic.element._membrane_numba import element_tangents
+        U, Dm = _as_float(U), _as_float(Dm)
+        if _compiled(backend):
+            from rftstatic.element._kernels_numba import membrane_tangents
 
-            E, Q, A, _ = self.G.shape
+            E, A = self.nodes.shape
             f = np.empty((E, A, 3))
             K = np.empty((E, A, 3, A, 3))
-            element_tangents(np.ascontiguousarray(self.nodes, dtype=np.int64), np.ascontiguousarray(self.G),
-                             self.area, np.ascontiguousarray(Dm, dtype=float),
-                             np.ascontiguousarray(U, dtype=float), bool(psd), f, K)
+            membrane_tangents(*self._compiled_args, Dm, U, bool(psd), f, K)
             return f, K
-        _, S, Bbar = self._kinematics(U, Dm)
-        E, A = self.nodes.shape
-        Q = self.G.shape[1]
-        area = self.area
-        f = (area[:, None] * np.matmul(S[:, None, :], Bbar)[:, 0]).reshape(E, A, 3)
-        Km = np.matmul(Bbar.transpose(0, 2, 1), np.matmul(Dm, Bbar))  # (E, 3A, 3A)
-        St = np.stack([np.stack([S[:, 0], S[:, 2]], -1), np.stack([S[:, 2], S[:, 1]], -1)], -2)
-        if psd:
-            w, v = np.linalg.eigh(St)
-            St = np.matmul(v * np.maximum(w, 0.0)[:, None, :], v.transpose(0, 2, 1))
-        GS = np.matmul(self.G, St[:, None])  # (E, Q, A, 2)
-        g = np.matmul(GS.transpose(0, 2, 1, 3).reshape(E, A, 2 * Q), self._G_aqJ.transpose(0, 2, 1)) / Q
-        Km = Km.reshape(E, A, 3, A, 3)
-        Km += g[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
-        Km *= area[:, None, None, None, None]
-        return f, Km
+        return tangents_numpy(self.G_last, self.nodes, self.area, Dm, U, bool(psd))
 
 
+def _compiled(backend: str) -> bool:
+    """Whether ``backend`` (``"auto"``, ``"numpy"`` or ``"numba"``) means the compiled kernels."""
+    if backend not in BACKENDS:
+        raise ValueError(f'membrane backend must be one of {", ".join(BACKENDS)}, got "{backend}"')
+    return backend == "numba" or (backend == "auto" and numba_available())
 
-def _green_voigt(H: np.ndarray) -> np.ndarray:
-    """Green strain (e_xx, e_yy, 2 e_xy) from the displacement gradient ``H (..., 3, 2)``, F = I + H."""
-    HH = np.einsum("...iJ,...iK->...JK", H, H)
-    return np.stack([H[..., 0, 0] + 0.5 * HH[..., 0, 0], H[..., 1, 1] + 0.5 * HH[..., 1, 1],
-                     H[..., 0, 1] + H[..., 1, 0] + HH[..., 0, 1]], axis=-1)
+
+def _as_float(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float)
 
 
 def membrane_operator(kind: str, mesh: TriMesh, patches: Patches | None = None) -> MembraneOperator:

@@ -5,11 +5,22 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from rftstatic import material
-from rftstatic.element import patch
+from rftstatic.element import kernels, membrane, patch
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
 
 ELEMENTS = ["RFT3", "RFT6"]
+
+
+@pytest.fixture(params=["numpy", "numba"])
+def backend(request, monkeypatch):
+    """The membrane back end that the model's ``"auto"`` picks: the compiled kernels (skipped without
+    numba) or the vectorised numpy run of the same kernels."""
+    if request.param == "numba":
+        pytest.importorskip("numba")
+    else:
+        monkeypatch.setattr(membrane, "numba_available", lambda: False)
+    return request.param
 
 
 def _mesh(pattern="right"):
@@ -66,7 +77,7 @@ def test_singular_patch_is_reported_with_element_and_location():
 
 
 @pytest.mark.parametrize("element", ELEMENTS)
-def test_rigid_motions_give_zero_internal_force(element):
+def test_rigid_motions_give_zero_internal_force(element, backend):
     m = _mesh()
     mod = model.Model(m, _material(), element=element)
     X = mod.X3
@@ -94,7 +105,7 @@ def _energy_fd(mod, U, lam, h=1e-6):
 
 
 @pytest.mark.parametrize("element", ELEMENTS)
-def test_force_is_gradient_of_energy_at_large_deformation(element):
+def test_force_is_gradient_of_energy_at_large_deformation(element, backend):
     m = _mesh()
     mod = model.Model(m, _material(), element=element, load=model.gravity_load(m, 0.1))
     rng = np.random.default_rng(2)
@@ -104,7 +115,7 @@ def test_force_is_gradient_of_energy_at_large_deformation(element):
 
 
 @pytest.mark.parametrize("element", ELEMENTS)
-def test_tangent_is_gradient_of_force_at_large_deformation(element):
+def test_tangent_is_gradient_of_force_at_large_deformation(element, backend):
     m = _mesh()
     sup = model.Supports(m.nodes_in_box(-1, -1, -1, 1), np.zeros(0, int), np.zeros((m.n_nodes, 3), bool))
     mod = model.Model(m, _material(), element=element, supports=sup)
@@ -126,9 +137,9 @@ def test_tangent_is_gradient_of_force_at_large_deformation(element):
 
 
 @pytest.mark.parametrize("element", ELEMENTS)
-def test_compiled_tangent_equals_the_numpy_tangent(element):
-    """The numba kernel (used by Newton when numba is installed) and the batched numpy products give
-    the same forces and tangents, exact and PSD, with tension, compression and shear in the mix."""
+def test_compiled_kernels_equal_the_numpy_kernels(element):
+    """The compiled kernels (one element at a time) and their numpy run (all elements at once) give
+    the same energies, forces and tangents, exact and PSD, with tension, compression and shear in the mix."""
     pytest.importorskip("numba")
     m = _mesh()
     mod = model.Model(m, _material(), element=element)
@@ -136,17 +147,34 @@ def test_compiled_tangent_equals_the_numpy_tangent(element):
     shrink = -0.1 * np.c_[mod.X3[:, 0], 0.5 * mod.X3[:, 1], np.zeros(m.n_nodes)]
     U = shrink + 0.05 * rng.normal(size=mod.X3.shape)
     Dm = mod.material.Dm
+    mem = mod.membrane
+    e1, e2 = mem.element_energy(U, Dm, backend="numpy"), mem.element_energy(U, Dm, backend="numba")
+    np.testing.assert_allclose(e2, e1, rtol=0, atol=1e-12 * np.abs(e1).max())
+    f1, f2 = mem.element_forces(U, Dm, backend="numpy"), mem.element_forces(U, Dm, backend="numba")
+    np.testing.assert_allclose(f2, f1, rtol=0, atol=1e-12 * np.abs(f1).max())
     for psd in (False, True):
-        f1, K1 = mod.membrane.element_tangents(U, Dm, psd=psd, backend="numpy")
-        f2, K2 = mod.membrane.element_tangents(U, Dm, psd=psd, backend="numba")
+        f1, K1 = mem.element_tangents(U, Dm, psd=psd, backend="numpy")
+        f2, K2 = mem.element_tangents(U, Dm, psd=psd, backend="numba")
         np.testing.assert_allclose(f2, f1, rtol=0, atol=1e-12 * np.abs(f1).max())
         np.testing.assert_allclose(K2, K1, rtol=0, atol=1e-12 * np.abs(K1).max())
-    _, Kx = mod.membrane.element_tangents(U, Dm, psd=False, backend="numba")
+    _, Kx = mem.element_tangents(U, Dm, psd=False, backend="numba")
     assert np.abs(Kx - K2).max() > 1e-6 * np.abs(Kx).max()  # the mix has compression: PSD differs
 
 
+def test_positive_part_of_the_stress_is_its_eigen_decomposition():
+    """The closed form of the kernels: negative principal stresses dropped, eigenvectors kept
+    (isotropic, uniaxial, mixed and negative stress states)."""
+    rng = np.random.default_rng(4)
+    S = np.r_[rng.normal(size=(200, 3)), [[1.0, 1.0, 0.0], [-2.0, -2.0, 0.0], [0.0, 0.0, 0.0], [3.0, 0.0, 0.0]]]
+    pxx, pyy, pxy = kernels.positive_part(S[:, 0], S[:, 1], S[:, 2])
+    St = np.stack([np.stack([S[:, 0], S[:, 2]], -1), np.stack([S[:, 2], S[:, 1]], -1)], -2)
+    w, v = np.linalg.eigh(St)
+    P = np.matmul(v * np.maximum(w, 0.0)[:, None, :], v.transpose(0, 2, 1))
+    assert np.abs(np.c_[pxx, pyy, pxy] - P[:, [0, 1, 0], [0, 1, 1]]).max() < 1e-14 * np.abs(S).max()
+
+
 @pytest.mark.parametrize("element", ELEMENTS)
-def test_psd_tangent_is_positive_semidefinite_under_compression(element):
+def test_psd_tangent_is_positive_semidefinite_under_compression(element, backend):
     m = _mesh()
     mod = model.Model(m, _material(), element=element)
     U = -0.2 * np.c_[mod.X3[:, :2], np.zeros(m.n_nodes)]  # uniform 20 % shrink: compressive stress
@@ -157,14 +185,12 @@ def test_psd_tangent_is_positive_semidefinite_under_compression(element):
 
 
 @pytest.mark.parametrize("element", ELEMENTS)
-def test_membrane_patch_test_uniform_strain(element):
+def test_membrane_patch_test_uniform_strain(element, backend):
     # a homogeneous stretch gives the exact Green strain in every element, boundary ones included
     m = _mesh("union-jack")
     mod = model.Model(m, _material(), element=element)
     Fm = np.array([[1.1, 0.05], [-0.02, 0.95], [0.1, 0.2]])
-    U = m.X @ Fm.T - mod.X3 + [0, 0, 0]
-    U[:, 2] += 0.0
-    U = np.c_[m.X, np.zeros(m.n_nodes)] @ np.eye(3) * 0 + (np.c_[m.X @ Fm.T] - mod.X3)
+    U = m.X @ Fm.T - mod.X3  # x = Fm X: the deformation gradient Fm (3 x 2) everywhere
     C = Fm.T @ Fm
     exact = [0.5 * (C[0, 0] - 1), 0.5 * (C[1, 1] - 1), C[0, 1]]
     assert np.abs(mod.membrane_strain(U) - exact).max() < 1e-12

@@ -40,6 +40,8 @@ def tip(model):
 @pytest.mark.parametrize("element", ["RFT3", "RFT6"])
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
 def test_force_kernel_equals_model_internal_force(element, backend):
+    if backend == "numba":
+        pytest.importorskip("numba")
     mesh = rectangle(0.04, 0.03, 7, 6, pattern="union-jack")
     model = Model(mesh, preset("wool-kang-yu", warp_angle_deg=30.0), element=element)
     U = 2e-3 * np.random.default_rng(1).standard_normal((mesh.n_nodes, 3))
@@ -90,8 +92,6 @@ def test_undamped_energy_stays_bounded():
     r = run_explicit(model, t_end=0.4, progress=False)
     h = r.history
     scale = np.abs(h["external_work"]).max()
-    z = r.probes[:, 0, 2] if r.probes.size else None
-    assert z is None
     assert h["kinetic"].max() > 0.2 * scale  # it really vibrates
     assert np.abs(h["total"] - h["total"][0]).max() <= 1e-4 * scale
 
@@ -210,6 +210,7 @@ def test_resume_reproduces_the_uninterrupted_run(tmp_path):
 
 
 def test_numpy_and_numba_runs_agree():
+    pytest.importorskip("numba")
     model = strip(STIFF)
     a = run_explicit(model, t_end=0.01, backend="numpy", progress=False)
     b = run_explicit(model, t_end=0.01, backend="numba", progress=False)
