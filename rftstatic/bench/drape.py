@@ -1,9 +1,10 @@
 """Benchmark of the static drape scenes of §4.2-4.5: wall time and peak memory, end to end.
 
-``python -m rftstatic.bench_drape [LABEL ...]`` runs each scene of :data:`SCENES` as
+``python -m rftstatic.bench.drape [LABEL ...]`` runs each scene of :data:`SCENES` as
 ``python -m rftstatic case NAME --set ...`` would (build, load-scaled Newton, summary.json,
-deformed.vtu, PNG views with the obstacle), each in a fresh interpreter so that the peak resident
-memory (``ru_maxrss`` of that process) is the scene's own.
+deformed.vtu, PNG views with the obstacle), each in a fresh interpreter
+(:func:`rftstatic.bench.harness.run_child`) so that the peak resident memory (``ru_maxrss`` of that
+process) is the scene's own.
 
 Targets on the 2-core reference machine, by mesh size: 33 x 33 nodes under 10 s, 61 x 61 under 60 s,
 81 x 81 under 3 min (build + solve + outputs). Scenes larger than 81 x 81 are reported without a target.
@@ -17,9 +18,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -38,6 +36,7 @@ SCENES = {
 
 # (largest node count, target [s]) by mesh size: 33 x 33, 61 x 61, 81 x 81
 TARGETS = ((33 * 33, 10.0), (61 * 61, 60.0), (81 * 81, 180.0))
+TIMEOUT_S = 3600.0  # a run's child is killed after this long [s] (20 x the largest target)
 
 
 def target_for(nodes: int) -> float | None:
@@ -60,8 +59,15 @@ def extra_indicators(x, tri) -> dict:
             "interior_edges": int(deg.size)}
 
 
-def _child(name: str, out: str, overrides: list[str], figures: bool) -> None:
-    """Run one static scene in this process, save ``state.npz`` and print one JSON line of measures."""
+def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
+    """Run one static scene in this process; save ``state.npz`` and ``record.json``; return the record.
+
+    The record: scene, overrides, element, nodes, elements, converged, error (the solver's message),
+    load_factor, load_steps, newton_iterations, linear_solver, perturbation_seed, build_s, solve_s,
+    outputs_s, wall_s [s] (in this process, imports excluded), peak_rss_mb [MB] (this process),
+    max_penetration, h_mean [scene length unit], curvature and dihedral indicators (:func:`extra_indicators`)
+    and drape (the summary's drape measures).
+    """
     import resource
 
     from rftstatic.app.static import static_options, static_summary, write_outputs
@@ -100,36 +106,33 @@ def _child(name: str, out: str, overrides: list[str], figures: bool) -> None:
            "max_relative_curvature": float(rel.max()), "rel_curvature_p99": float(np.percentile(rel, 99)),
            "drape": drape, **extra_indicators(x, model.mesh.tri)}
     (out_dir / "record.json").write_text(json.dumps(rec, indent=1, default=float), encoding="utf-8")
-    print(json.dumps(rec, default=float))
+    return rec
 
 
-def run_one(name: str, overrides=(), out=None, *, figures: bool = True, timeout: float | None = None) -> dict:
-    """Run one static scene in a fresh interpreter; return its record (see :func:`_child`).
+def run_one(name: str, overrides=(), out=None, *, figures: bool = True, timeout: float = TIMEOUT_S) -> dict:
+    """Run one static scene in a fresh interpreter; return its record (see :func:`child`).
 
-    The record adds ``process_s`` (the whole subprocess, imports included), ``target_s`` and
-    ``within_target``. A solve that does not converge returns ``converged = False`` and the
-    solver's message in ``error``; a crash raises ``RuntimeError`` with the child's stderr.
+    The record adds ``process_s`` [s] (the whole child process, interpreter start-up and imports
+    included), ``cpu_s`` [s] (its user + system time), ``target_s`` and ``within_target``; its
+    ``peak_rss_mb`` [MB] is the child's peak to its exit. A solve that does not converge returns
+    ``converged = False`` and the solver's message in ``error``; a crash raises
+    :class:`rftstatic.bench.harness.ChildError` (a ``RuntimeError``) naming the scene, with the
+    child's stderr; a child still running after ``timeout`` [s] is killed
+    (:class:`~rftstatic.bench.harness.ChildTimeout`).
     """
+    from rftstatic.bench.harness import run_child
+
     with tempfile.TemporaryDirectory() as tmp:
         out_dir = Path(out) if out else Path(tmp) / "run"
-        cmd = [sys.executable, "-m", "rftstatic.bench.drape", "--child", name, str(out_dir)]
-        for o in overrides:
-            cmd += ["--set", o]
-        if not figures:
-            cmd.append("--no-figures")
-        t0 = time.perf_counter()
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-        process = time.perf_counter() - t0
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
-    if proc.returncode != 0:
-        raise RuntimeError(f"run of {name} {list(overrides)} failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
-    rec = json.loads(proc.stdout.strip().splitlines()[-1])
-    rec["process_s"] = process
-    rec["cpu_s"] = cpu  # user + system time of the child: what the run costs on a machine shared with others
+        run = run_child("rftstatic.bench.drape:child",
+                        {"name": name, "out": str(out_dir), "overrides": list(overrides), "figures": figures},
+                        name=f"drape run of {name} {list(overrides)}", timeout=timeout)
+    rec = run.result
+    rec["process_s"] = run.wall_s
+    rec["cpu_s"] = run.cpu_s  # user + system time of the child: what the run costs on a machine shared with others
+    rec["peak_rss_mb"] = run.peak_rss_mb  # the child's, to its exit (the child's own figure is its peak so far)
     rec["target_s"] = target_for(rec["nodes"])
-    rec["within_target"] = rec["target_s"] is None or process < rec["target_s"]
+    rec["within_target"] = rec["target_s"] is None or run.wall_s < rec["target_s"]
     if out:
         (Path(out) / "record.json").write_text(json.dumps(rec, indent=1, default=float), encoding="utf-8")
     return rec
@@ -162,7 +165,7 @@ def run_cached(name: str, overrides=(), *, root: Path, refresh: bool = False, fi
 
 
 def bench_drape_scenes(labels=None, *, out_root=None, verbose=True) -> list[dict]:
-    """Run each labelled scene of :data:`SCENES` end to end in a subprocess; return the records."""
+    """Run each labelled scene of :data:`SCENES` end to end in a fresh interpreter; return the records."""
     labels = list(labels or SCENES)
     unknown = [lb for lb in labels if lb not in SCENES]
     if unknown:
@@ -190,15 +193,9 @@ def bench_drape_scenes(labels=None, *, out_root=None, verbose=True) -> list[dict
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("labels", nargs="*", help=f"scene labels (default all): {', '.join(SCENES)}")
-    ap.add_argument("--child", nargs=2, metavar=("NAME", "OUT"), help=argparse.SUPPRESS)
-    ap.add_argument("--set", action="append", default=[], help=argparse.SUPPRESS)
-    ap.add_argument("--no-figures", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--out", default=None, help="keep the outputs in this folder")
     ap.add_argument("--json", default=None, help="also write the records to this JSON file")
     args = ap.parse_args(argv)
-    if args.child:
-        _child(args.child[0], args.child[1], args.set, not args.no_figures)
-        return 0
     results = bench_drape_scenes(args.labels, out_root=args.out)
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1, default=float), encoding="utf-8")
