@@ -12,6 +12,8 @@ Targets on the 2-core reference machine, by mesh size: 33 x 33 nodes under 10 s,
 The same child process is what the drape validation reports use (:func:`run_cached`): besides the
 summary it saves ``state.npz`` (deformed and reference positions in the scene's units, triangles,
 relative curvature |kappa| h and the dihedral angles) so that reports can be redrawn without solving.
+Its folder is keyed on the scene, its overrides and the code's fingerprint
+(:func:`rftstatic.provenance.code_fingerprint`), so that a run by other code is never reused.
 """
 
 from __future__ import annotations
@@ -65,13 +67,14 @@ def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
     The record: scene, overrides, element, nodes, elements, converged, error (the solver's message),
     load_factor, load_steps, newton_iterations, linear_solver, perturbation_seed, build_s, solve_s,
     outputs_s, wall_s [s] (in this process, imports excluded), peak_rss_mb [MB] (this process),
-    max_penetration, h_mean [scene length unit], curvature and dihedral indicators (:func:`extra_indicators`)
-    and drape (the summary's drape measures).
+    max_penetration, h_mean [scene length unit], curvature and dihedral indicators (:func:`extra_indicators`),
+    drape (the summary's drape measures) and software (:func:`rftstatic.provenance.software`).
     """
     import resource
 
     from rftstatic.app.static import static_options, static_summary, write_outputs
     from rftstatic.errors import ConvergenceError
+    from rftstatic.provenance import software
     from rftstatic.scenes.build import build_model
     from rftstatic.scenes.schema import load_scene
     from rftstatic.solvers.static import solve_static
@@ -104,7 +107,7 @@ def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
            "wall_s": wall, "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
            "max_penetration": summary.get("max_penetration"), "h_mean": float(model.mesh.element_size.mean()) / u,
            "max_relative_curvature": float(rel.max()), "rel_curvature_p99": float(np.percentile(rel, 99)),
-           "drape": drape, **extra_indicators(x, model.mesh.tri)}
+           "drape": drape, **extra_indicators(x, model.mesh.tri), "software": software()}
     (out_dir / "record.json").write_text(json.dumps(rec, indent=1, default=float), encoding="utf-8")
     return rec
 
@@ -138,22 +141,48 @@ def run_one(name: str, overrides=(), out=None, *, figures: bool = True, timeout:
     return rec
 
 
-def run_key(name: str, overrides=()) -> str:
-    """Folder name of a run: the scene and its overrides, file-system safe."""
+def run_label(name: str, overrides=()) -> str:
+    """The scene and its overrides as a file-system safe name (no code version: see :func:`run_key`)."""
     parts = [name] + [o.replace("mesh.nodes=", "n").replace("element=", "") for o in overrides]
     return "_".join(parts).replace("[", "").replace("]", "").replace(",", "x").replace(" ", "").replace("=", "-")
 
 
+def code_version() -> str:
+    """The code's fingerprint as recorded with a run (12 hex digits of :func:`rftstatic.provenance.code_fingerprint`)."""
+    from rftstatic import provenance
+
+    return provenance.code_fingerprint()[:12]
+
+
+def run_key(name: str, overrides=()) -> str:
+    """Cache folder name of a run: :func:`run_label` and the code version (``..._code-<12 hex>``).
+
+    Any edit of the package's sources changes the key, so a run made by other code is never reused.
+    """
+    return f"{run_label(name, overrides)}_code-{code_version()}"
+
+
+def cached_dir(name: str, overrides=(), *, root: Path) -> Path | None:
+    """``root/<key>/`` when it holds a finished run by this code (record, state, same fingerprint), else None."""
+    d = Path(root) / run_key(name, overrides)
+    if not ((d / "record.json").exists() and (d / "state.npz").exists()):
+        return None
+    try:
+        code = json.loads((d / "record.json").read_text(encoding="utf-8")).get("software", {}).get("code")
+    except (OSError, ValueError):
+        return None
+    return d if code == code_version() else None  # the child ran other code than the key says: stale
+
+
 def run_cached(name: str, overrides=(), *, root: Path, refresh: bool = False, figures: bool = True) -> dict:
-    """:func:`run_one` into ``root/<key>/``, reusing a finished run there unless ``refresh``.
+    """:func:`run_one` into ``root/<key>/`` (:func:`run_key`), reusing a finished run there unless ``refresh``.
 
     Returns the record with ``state`` (the arrays of ``state.npz``) and ``dir``.
     """
     d = Path(root) / run_key(name, overrides)
-    rec_path = d / "record.json"
-    if refresh or not (rec_path.exists() and (d / "state.npz").exists()):
+    if refresh or cached_dir(name, overrides, root=root) is None:
         run_one(name, list(overrides), d, figures=figures)
-    rec = json.loads(rec_path.read_text(encoding="utf-8"))
+    rec = json.loads((d / "record.json").read_text(encoding="utf-8"))
     if "process_s" not in rec:  # the child finished but its parent was stopped: in-process time only
         rec["process_s"] = rec["wall_s"]
         rec["target_s"] = target_for(rec["nodes"])
@@ -175,7 +204,7 @@ def bench_drape_scenes(labels=None, *, out_root=None, verbose=True) -> list[dict
         root = Path(out_root) if out_root else Path(tmp)
         for lb in labels:
             name, ov = SCENES[lb]
-            r = run_one(name, ov, root / run_key(name, ov))
+            r = run_one(name, ov, root / run_label(name, ov))
             r["label"] = lb
             results.append(r)
             if verbose:

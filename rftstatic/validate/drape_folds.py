@@ -184,14 +184,13 @@ def _energy(rec: dict) -> float:
 
 def _branches(quick: bool, result) -> list:
     """Run (or, quick, look up) the other starts on :data:`BRANCH_MESH`; add their table."""
-    from rftstatic.bench.drape import run_cached, run_key
+    from rftstatic.bench.drape import cached_dir, run_cached
 
     default = run_cached_only(SCENE, BRANCH_MESH, "RFT6")
     runs = [] if default is None else [(default, "random modes, seed 1 (default)", "RFT6", [])]
     for start, element, extra in BRANCHES:
         overrides = branch_overrides(element, extra)
-        d = cache_root() / run_key(SCENE, overrides)
-        cached = (d / "record.json").exists() and (d / "state.npz").exists()
+        cached = cached_dir(SCENE, overrides, root=cache_root()) is not None
         if (quick or os.environ.get("RFTSTATIC_DRAPE_CACHED_ONLY") == "1") and not cached:
             result.notes.append(f"branch run not in the cache, not solved here: {start} ({element}).")
             continue
