@@ -1,5 +1,6 @@
 """The fresh-process harness (rftstatic.bench.harness): result, measures, timeout and failures named."""
 
+import ast
 import time
 from pathlib import Path
 
@@ -46,3 +47,26 @@ def test_a_target_must_name_module_and_function():
     with pytest.raises(ValueError, match='"module:function"'):
         run_child("child_targets.sleep", name="x", timeout=1)
 
+
+def test_no_child_process_of_validate_or_bench_is_forked():
+    """Every child of validate and bench goes through the harness (a fresh interpreter): a fork copies
+    the locks of the parent's threads (numba, CHOLMOD's OpenMP, BLAS) but not the threads."""
+    package = Path(rftstatic.__file__).resolve().parent
+    harness = package / "bench" / "harness.py"
+    spawners = {"multiprocessing", "subprocess", "concurrent.futures", "concurrent"}
+    for folder in ("validate", "bench"):
+        for path in sorted((package / folder).rglob("*.py")):
+            where = path.relative_to(package)
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.Import):
+                    names = {a.name for a in node.names}
+                elif isinstance(node, ast.ImportFrom):
+                    names = {node.module or ""}
+                else:
+                    names = set()
+                if path != harness:
+                    assert not names & spawners, f"{where}:{node.lineno} imports {names & spawners}: use run_child"
+                if isinstance(node, ast.Attribute) and node.attr in ("fork", "forkpty"):
+                    raise AssertionError(f"{where}:{node.lineno} forks")
+                if isinstance(node, ast.Constant) and node.value in ("fork", "forkserver"):
+                    raise AssertionError(f"{where}:{node.lineno} names the fork start method")
