@@ -90,8 +90,8 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
                 result.notes.append(f"NOT RUN: {mesh_label(nodes)} (not in the cache, RFTSTATIC_DRAPE_CACHED_ONLY=1).")
                 continue
         recs[nodes] = rec
-    lines = ["| mesh | nodes | converged | stable minimum | load factor | Newton its | seed | folds | fold angles [deg] | "
-             "DC | max dihedral [deg] | max abs(kappa) h | build + solve [s] | peak memory [MB] |", "|" + "---|" * 14]
+    lines = [("| mesh | nodes | converged | stable minimum | load factor | Newton its | seed | folds | fold angles [deg] | "
+             "DC | max dihedral [deg] | max abs(kappa) h | build + solve [s] | peak memory [MB] |"), "|" + "---|" * 14]
     for nodes, rec in recs.items():
         d = rec["drape"]
         dc = d.get("drape_coefficient")
@@ -205,8 +205,8 @@ def _branches(quick: bool, result) -> list:
     energies = [(_energy(rec) if rec["converged"] else float("nan")) for rec, _, _, _ in runs]
     same = [e for e, c in zip(energies, comparable) if c and np.isfinite(e)]
     lowest = min(same) if same else float("nan")
-    lines = ["| start | element | converged | stable minimum | folds | DC | energy [gf cm] | above the lowest [gf cm] | "
-             "build + solve [s] |", "|" + "---|" * 9]
+    lines = [("| start | element | converged | stable minimum | folds | DC | energy [gf cm] | above the lowest [gf cm] | "
+             "build + solve [s] |"), "|" + "---|" * 9]
     out = []
     for (rec, start, element, extra), e, c in zip(runs, energies, comparable):
         d = rec["drape"]
