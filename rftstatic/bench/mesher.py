@@ -1,28 +1,27 @@
 """Benchmark of the mesher: wall time, triangles per second and peak memory (max RSS).
 
-``python -m rftstatic.mesher.bench [--nodes 2000 20000 200000]`` meshes a unit
+``python -m rftstatic.bench.mesher [--nodes 2000 20000 200000]`` meshes a unit
 square with a uniform size chosen for about that many nodes, and a graded
 (1:20) disc of about the same count, and prints one line per mesh. Each mesh is
-made in a fresh interpreter (``--in-process`` to use this one), so that its peak
-resident memory is its own and not that of an earlier, larger mesh.
+made in a fresh interpreter (:func:`rftstatic.bench.harness.run_child`;
+``--in-process`` to use this one), so that its peak resident memory is its own
+and not that of an earlier, larger mesh.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import resource
-import subprocess
-import sys
 import time
 
 import numpy as np
 
 from rftstatic.mesh.mesher import BackgroundGrid, Domain, generate
 
-__all__ = ["main", "run_case", "measure"]
+__all__ = ["main", "measure", "run_case"]
 
 CASES = ("square uniform", "disc graded 1:20")
+TIMEOUT_S = 1800.0  # a mesh's child is killed after this long [s]
 HEADER = (f"{'case':18s} {'nodes':>8s} {'tris':>8s} {'wall[s]':>8s} {'tri/s':>9s} {'maxRSS[MB]':>10s} "
           f"{'minang':>6s} {'meanmin':>7s} {'band':>5s}")
 
@@ -75,13 +74,12 @@ def measure(n_nodes: int, case: str) -> dict:
     raise ValueError(f'unknown case "{case}"; use one of {CASES}')
 
 
-def _fresh(n_nodes: int, case: str) -> dict:
-    """:func:`measure` in a fresh interpreter (its own peak memory)."""
-    cmd = [sys.executable, "-m", "rftstatic.bench.mesher", "--child", str(n_nodes), case]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise RuntimeError(f"mesher bench {n_nodes} {case} failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+def _fresh(n_nodes: int, case: str, *, timeout: float = TIMEOUT_S) -> dict:
+    """:func:`measure` in a fresh interpreter (its own peak memory); killed after ``timeout`` [s]."""
+    from rftstatic.bench.harness import run_child
+
+    return run_child("rftstatic.bench.mesher:measure", {"n_nodes": n_nodes, "case": case},
+                     name=f"mesher bench {case} at {n_nodes} nodes", timeout=timeout).result
 
 
 def main(argv=None) -> list[dict]:
@@ -90,11 +88,7 @@ def main(argv=None) -> list[dict]:
     ap.add_argument("--nodes", type=int, nargs="+", default=[2_000, 20_000, 200_000],
                     help="approximate node counts (default: 2000 20000 200000)")
     ap.add_argument("--in-process", action="store_true", help="mesh in this interpreter (peak memory cumulative)")
-    ap.add_argument("--child", nargs=2, metavar=("NODES", "CASE"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    if args.child:
-        print(json.dumps(measure(int(args.child[0]), args.child[1])))
-        return []
     print(HEADER)
     records = []
     for n in args.nodes:

@@ -1,10 +1,11 @@
-"""Benchmarks of adaptive remeshing: ``python -m rftstatic.bench_remesh [--nodes ...] [--scenes ...] [--json F]``.
+"""Benchmarks of adaptive remeshing: ``python -m rftstatic.bench.remesh [--nodes ...] [--scenes ...] [--json F]``.
 
 1. The advancing-front mesher at about 2 000, 20 000 and 200 000 nodes (uniform square and graded
-   disc; :mod:`rftstatic.mesher.bench`): wall time, triangles per second, peak memory, each mesh
+   disc; :mod:`rftstatic.bench.mesher`): wall time, triangles per second, peak memory, each mesh
    in a fresh interpreter.
 2. Each remeshed scene of ``cases/`` end to end (meshing, relaxation, transfers, summary; no
-   figures), each in a fresh interpreter as ``python -m rftstatic case NAME`` would run it: the
+   figures), each in a fresh interpreter (:func:`rftstatic.bench.harness.run_child`) as
+   ``python -m rftstatic case NAME`` would run it: the
    process's wall time (imports and the compiled kernel's loading included) against the target of
    3 minutes on a 2-core machine, its CPU time, peak resident memory, final nodes, remeshes, the
    simulated time at rest and whether it came to rest.
@@ -14,17 +15,21 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
-import subprocess
-import sys
 import time
 
 SCENES = ("remesh-pedestal-square-20", "remesh-pedestal-round-50", "remesh-sphere-30")
 TARGET_S = 180.0
+TIMEOUT_S = 1800.0  # a scene's child is killed after this long [s] (10 x the target)
 
 
-def _child(name: str, overrides) -> dict:
-    """Run one remeshed scene in this process, without figures; return its figures."""
+def child(name: str, overrides) -> dict:
+    """Run one remeshed scene in this process, without figures; return its figures.
+
+    scene, overrides, wall_time_s [s] (in this process, imports excluded), solve_time_s [s], nodes,
+    initial_nodes, remeshes, converged (at rest), t [s] (simulated time at rest), steps,
+    alpha_final [1/s], drape_coefficient, fold_count. (:func:`bench_scene` adds the process's CPU
+    time and peak memory.)
+    """
     import tempfile
 
     from rftstatic.app.remeshed import run_remesh_scene
@@ -33,30 +38,29 @@ def _child(name: str, overrides) -> dict:
     t0 = time.perf_counter()
     scene = load_scene(name, list(overrides))
     s = run_remesh_scene(scene, tempfile.mkdtemp(prefix="bench-remesh-"), progress=False, figures=False)
-    usage = resource.getrusage(resource.RUSAGE_SELF)
     drape = s.get("drape", {})
     return {"scene": name, "overrides": list(overrides), "wall_time_s": time.perf_counter() - t0,
-            "solve_time_s": s["wall_time_s"], "cpu_time_s": usage.ru_utime + usage.ru_stime,
-            "peak_rss_mb": usage.ru_maxrss / 1024, "nodes": s["nodes"], "initial_nodes": s["initial_nodes"],
+            "solve_time_s": s["wall_time_s"], "nodes": s["nodes"], "initial_nodes": s["initial_nodes"],
             "remeshes": s["remeshes"], "converged": s["converged"], "t": s.get("t"), "steps": s.get("steps"),
             "alpha_final": s.get("alpha_final"), "drape_coefficient": drape.get("drape_coefficient"),
             "fold_count": drape.get("fold_count")}
 
 
-def bench_scene(name: str, overrides=()) -> dict:
-    """Run one remeshed scene end to end in a fresh interpreter; return its figures (:func:`_child`)
-    with ``process_s`` (the whole process) and ``within_target`` (process_s <= 3 min)."""
-    cmd = [sys.executable, "-m", "rftstatic.bench.remesh", "--child", name]
-    for o in overrides:
-        cmd += ["--set", o]
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    process = time.perf_counter() - t0
-    if proc.returncode != 0:
-        raise RuntimeError(f"bench of {name} failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
-    r = json.loads(proc.stdout.strip().splitlines()[-1])
-    r["process_s"] = process
-    r["within_target"] = process <= TARGET_S
+def bench_scene(name: str, overrides=(), *, timeout: float = TIMEOUT_S) -> dict:
+    """Run one remeshed scene end to end in a fresh interpreter; return its figures (:func:`child`)
+    with ``process_s`` [s] (the whole process), ``cpu_time_s`` [s] (its user + system time),
+    ``peak_rss_mb`` [MB] (its peak resident memory) and ``within_target`` (process_s <= 3 min).
+
+    A failed run raises :class:`rftstatic.bench.harness.ChildError` naming the scene; one still
+    running after ``timeout`` [s] is killed (:class:`~rftstatic.bench.harness.ChildTimeout`).
+    """
+    from rftstatic.bench.harness import run_child
+
+    run = run_child("rftstatic.bench.remesh:child", {"name": name, "overrides": list(overrides)},
+                    name=f"remesh bench of {name} {list(overrides)}", timeout=timeout)
+    r = run.result
+    r.update(process_s=run.wall_s, cpu_time_s=run.cpu_s, peak_rss_mb=run.peak_rss_mb)
+    r["within_target"] = run.wall_s <= TARGET_S
     return r
 
 
@@ -68,12 +72,7 @@ def main(argv=None) -> int:
     ap.add_argument("--json", default=None, help="also write the records to this JSON file")
     ap.add_argument("--report", default=None, metavar="DIR",
                     help="also write DIR/bench_remesh.md and DIR/bench_remesh.json (e.g. validation)")
-    ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
-    ap.add_argument("--set", action="append", default=[], help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    if args.child:
-        print(json.dumps(_child(args.child, args.set), default=float))
-        return 0
     out = {"mesher": [], "scenes": [], "machine": _machine()}
     if args.nodes:
         from rftstatic.bench import mesher as bench
@@ -128,25 +127,25 @@ def write_report(out: dict, folder) -> None:
     m = out["machine"]
     load = lambda v: "-" if not v else " / ".join(f"{x:.1f}" for x in v)  # noqa: E731
     lines = ["# Remeshing benchmarks", "",
-             "Generated by `python -m rftstatic.bench_remesh --report validation` (the mesher at three sizes "
+             ("Generated by `python -m rftstatic.bench.remesh --report validation` (the mesher at three sizes "
              "and the three remeshed scenes of §6, each in a fresh interpreter). Machine: "
              f"{m['cpus']} cores, Python {m['python']}, rftstatic {m['rftstatic']}, {m['date']}; load average "
              f"(1/5/15 min) {load(m.get('load_before'))} before, {load(m.get('load_after'))} after: the machine "
-             "was shared with other jobs, so the wall times are pessimistic (CPU times are given too).", ""]
+             "was shared with other jobs, so the wall times are pessimistic (CPU times are given too)."), ""]
     if out["mesher"]:
         lines += ["## Mesher (advancing front)", "",
-                  "| case | nodes | triangles | wall [s] | triangles/s | peak RSS [MB] | min angle [deg] | "
-                  "mean min angle [deg] | edges in [0.7, 1.4] h |", "|---|---|---|---|---|---|---|---|---|"]
+                  ("| case | nodes | triangles | wall [s] | triangles/s | peak RSS [MB] | min angle [deg] | "
+                  "mean min angle [deg] | edges in [0.7, 1.4] h |"), "|---|---|---|---|---|---|---|---|---|"]
         for r in out["mesher"]:
             lines.append(f"| {r['case']} | {r['nodes']} | {r['triangles']} | {r['wall_s']:.2f} | "
                          f"{r['triangles_per_s']:.0f} | {r['peak_rss_mb']:.0f} | {r['min_angle']:.1f} | "
                          f"{r['mean_min_angle']:.1f} | {100 * r['band_share']:.1f} % |")
-        lines += ["", "Targets (issue 6): at least 5,000 triangles/s; minimum angle >= 30 deg, mean minimum angle "
-                  ">= 50 deg, >= 90 % of edges in the band.", ""]
+        lines += ["", ("Targets (issue 6): at least 5,000 triangles/s; minimum angle >= 30 deg, mean minimum angle "
+                  ">= 50 deg, >= 90 % of edges in the band."), ""]
     if out["scenes"]:
         lines += ["## Remeshed scenes end to end (dynamic relaxation with adaptive remeshing, §6)", "",
-                  "| scene | process wall [s] | target 180 s | CPU [s] | peak RSS [MB] | nodes (start -> end) | "
-                  "remeshes | at rest at t [s] | explicit steps | final alpha [1/s] | DC | folds | at rest |",
+                  ("| scene | process wall [s] | target 180 s | CPU [s] | peak RSS [MB] | nodes (start -> end) | "
+                  "remeshes | at rest at t [s] | explicit steps | final alpha [1/s] | DC | folds | at rest |"),
                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in out["scenes"]:
             t = "-" if r["t"] is None else f"{r['t']:.1f}"

@@ -1,10 +1,12 @@
 """Shared by the drape reports (``drape_sq20``, ``drape_sharp``, ``drape_folds``): cached scene runs.
 
 Each run is a scene of ``cases/`` with ``mesh.nodes`` and ``element`` overridden, solved in a fresh
-interpreter by :func:`rftstatic.bench_drape.run_one` (so its wall time and peak memory are its own)
-into ``out/validate-drape/<scene>_n<nx>x<ny>_<element>/`` of the repository: ``record.json``,
-``summary.json``, ``state.npz``, ``deformed.vtu`` and the PNG views. A finished run there is reused;
-set ``RFTSTATIC_DRAPE_REFRESH=1`` to solve again.
+interpreter by :func:`rftstatic.bench.drape.run_one` (so its wall time and peak memory are its own)
+into ``out/validate-drape/<scene>_n<nx>x<ny>_<element>_code-<fingerprint>/`` of the repository:
+``record.json``, ``summary.json``, ``state.npz``, ``deformed.vtu`` and the PNG views. The key holds
+the code's fingerprint (:func:`rftstatic.bench.drape.run_key`): a finished run there is reused by the
+same code only, never after an edit of the package. Set ``RFTSTATIC_DRAPE_REFRESH=1`` to solve again;
+folders of other code versions are left in place (delete them by hand).
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import os
 import shutil
 from pathlib import Path
 
-from rftstatic.bench.drape import run_cached
+from rftstatic.bench.drape import cached_dir, run_cached
 
 
 def cache_root() -> Path:
@@ -24,7 +26,7 @@ def cache_root() -> Path:
 
 
 def drape_run(scene: str, nodes, element: str, *, figures: bool = True) -> dict:
-    """The record of ``scene`` on ``nodes = (n1, n2)`` with ``element`` (see ``bench_drape._child``).
+    """The record of ``scene`` on ``nodes = (n1, n2)`` with ``element`` (see :func:`rftstatic.bench.drape.child`).
 
     ``figures=False`` skips the PNG views of a new run (the quick reports: they take a third of a
     small run's time).
@@ -32,12 +34,8 @@ def drape_run(scene: str, nodes, element: str, *, figures: bool = True) -> dict:
     (the reports then list it as not run).
     """
     overrides = [f"mesh.nodes=[{nodes[0]},{nodes[1]}]", f"element={element}"]
-    if os.environ.get("RFTSTATIC_DRAPE_CACHED_ONLY") == "1":
-        from rftstatic.bench.drape import run_key
-
-        d = cache_root() / run_key(scene, overrides)
-        if not ((d / "record.json").exists() and (d / "state.npz").exists()):
-            return None
+    if os.environ.get("RFTSTATIC_DRAPE_CACHED_ONLY") == "1" and cached_dir(scene, overrides, root=cache_root()) is None:
+        return None
     return run_cached(scene, overrides, root=cache_root(), refresh=os.environ.get("RFTSTATIC_DRAPE_REFRESH") == "1",
                       figures=figures)
 
@@ -78,12 +76,9 @@ def status(rec: dict) -> str:
 
 
 def run_cached_only(scene: str, nodes, element: str) -> dict | None:
-    """The cached record of a run, or None when it has not been run (nothing is solved)."""
-    from rftstatic.bench.drape import run_key
-
+    """The cached record of a run by this code, or None when it has not been run (nothing is solved)."""
     overrides = [f"mesh.nodes=[{nodes[0]},{nodes[1]}]", f"element={element}"]
-    d = cache_root() / run_key(scene, overrides)
-    if not ((d / "record.json").exists() and (d / "state.npz").exists()):
+    if cached_dir(scene, overrides, root=cache_root()) is None:
         return None
     return run_cached(scene, overrides, root=cache_root())
 

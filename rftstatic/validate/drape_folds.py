@@ -90,8 +90,8 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
                 result.notes.append(f"NOT RUN: {mesh_label(nodes)} (not in the cache, RFTSTATIC_DRAPE_CACHED_ONLY=1).")
                 continue
         recs[nodes] = rec
-    lines = ["| mesh | nodes | converged | stable minimum | load factor | Newton its | seed | folds | fold angles [deg] | "
-             "DC | max dihedral [deg] | max abs(kappa) h | build + solve [s] | peak memory [MB] |", "|" + "---|" * 14]
+    lines = [("| mesh | nodes | converged | stable minimum | load factor | Newton its | seed | folds | fold angles [deg] | "
+             "DC | max dihedral [deg] | max abs(kappa) h | build + solve [s] | peak memory [MB] |"), "|" + "---|" * 14]
     for nodes, rec in recs.items():
         d = rec["drape"]
         dc = d.get("drape_coefficient")
@@ -184,14 +184,13 @@ def _energy(rec: dict) -> float:
 
 def _branches(quick: bool, result) -> list:
     """Run (or, quick, look up) the other starts on :data:`BRANCH_MESH`; add their table."""
-    from rftstatic.bench.drape import run_cached, run_key
+    from rftstatic.bench.drape import cached_dir, run_cached
 
     default = run_cached_only(SCENE, BRANCH_MESH, "RFT6")
     runs = [] if default is None else [(default, "random modes, seed 1 (default)", "RFT6", [])]
     for start, element, extra in BRANCHES:
         overrides = branch_overrides(element, extra)
-        d = cache_root() / run_key(SCENE, overrides)
-        cached = (d / "record.json").exists() and (d / "state.npz").exists()
+        cached = cached_dir(SCENE, overrides, root=cache_root()) is not None
         if (quick or os.environ.get("RFTSTATIC_DRAPE_CACHED_ONLY") == "1") and not cached:
             result.notes.append(f"branch run not in the cache, not solved here: {start} ({element}).")
             continue
@@ -206,8 +205,8 @@ def _branches(quick: bool, result) -> list:
     energies = [(_energy(rec) if rec["converged"] else float("nan")) for rec, _, _, _ in runs]
     same = [e for e, c in zip(energies, comparable) if c and np.isfinite(e)]
     lowest = min(same) if same else float("nan")
-    lines = ["| start | element | converged | stable minimum | folds | DC | energy [gf cm] | above the lowest [gf cm] | "
-             "build + solve [s] |", "|" + "---|" * 9]
+    lines = [("| start | element | converged | stable minimum | folds | DC | energy [gf cm] | above the lowest [gf cm] | "
+             "build + solve [s] |"), "|" + "---|" * 9]
     out = []
     for (rec, start, element, extra), e, c in zip(runs, energies, comparable):
         d = rec["drape"]

@@ -8,6 +8,7 @@ from rftstatic.solvers import static
 from rftstatic.solvers.explicit import run_explicit
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.validate import stability as st
+from rftstatic.validate.stability.cell_functions import _hang, _strip
 
 
 def test_soft_membrane_strip_matches_heavy_elastica():
@@ -37,7 +38,7 @@ def test_degenerate_patch_is_reported_with_the_element():
 
 
 def test_explicit_step_above_critical_raises_with_a_working_suggestion():
-    mod, corner = st._hang(7)
+    mod, _ = _hang(7)
     est = stable_time_step(mod, alpha=5.0)
     t_end = 300 * est.dt
     with pytest.raises(InstabilityError) as info:
@@ -49,7 +50,7 @@ def test_explicit_step_above_critical_raises_with_a_working_suggestion():
 
 
 def test_a_cell_over_its_budget_is_a_fail_not_a_hang():
-    cell = st.Cell("test", "budget", "strip_cell", dict(nx=41, ny=9), budget=0.05, tolerance=0.01)
+    cell = st.Cell("test", "budget", "strip_cell", {"nx": 41, "ny": 9}, budget=0.05, tolerance=0.01)
     rec = st.run_cell(cell)
     assert rec["verdict"] == "FAIL" and rec["reason"].startswith("hang") and rec["wall_time_s"] < 10
 
@@ -64,14 +65,14 @@ def test_rft6_warns_of_membrane_locking_where_the_strip_stiffens(caplog):
     from rftstatic.model.model import LOCKING_WARN, locking_number
 
     with caplog.at_level(logging.WARNING, logger="rftstatic.model.model"):
-        coarse = st._strip(21, 5, element="RFT6", ratio=1e6)
+        coarse = _strip(21, 5, element="RFT6", ratio=1e6)
     assert locking_number(coarse.mesh, coarse.material) > LOCKING_WARN
     assert coarse.warnings and "RFT3" in coarse.warnings[0] and "Refine" in coarse.warnings[0]
     assert any("membrane locking" in r.message for r in caplog.records)
-    assert not st._strip(21, 5, element="RFT3", ratio=1e6).warnings  # the CST does not lock
-    wool = st._strip(21, 5, element="RFT6")
+    assert not _strip(21, 5, element="RFT3", ratio=1e6).warnings  # the CST does not lock
+    wool = _strip(21, 5, element="RFT6")
     assert locking_number(wool.mesh, wool.material) < LOCKING_WARN and not wool.warnings
     cell = st.Cell("g", "c", "strip_cell", {}, 10, 0.01)
     rec = {"converged": True, "error": 0.03}
-    assert st._verdict(cell, rec)[0] == "FAIL"
-    assert st._verdict(cell, dict(rec, warnings=coarse.warnings))[0] == "limitation"
+    assert st.verdict(cell, rec)[0] == "FAIL"
+    assert st.verdict(cell, dict(rec, warnings=coarse.warnings))[0] == "limitation"
