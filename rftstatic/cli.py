@@ -1,4 +1,9 @@
-"""Command line: ``python -m rftstatic {case, list, bench, validate}``, on the Python API (:mod:`rftstatic.api`)."""
+"""Command line: ``python -m rftstatic {case, list, bench, validate}``, on the Python API (:mod:`rftstatic.api`).
+
+Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
+not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs
+cannot be written; 130 interrupted; 1 an internal error, printed as one line (``-v``: the traceback).
+"""
 
 from __future__ import annotations
 
@@ -9,13 +14,22 @@ import sys
 from pathlib import Path
 
 
+EXIT = {"done": 0, "internal": 1, "input": 2, "goal": 3, "output": 4, "interrupted": 130}
+"""Exit status of each outcome (the README's table)."""
+
+
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="rftstatic", description="Rotation-free triangle drape simulation "
-                                     "(Sze & Zhou 2016).")
-    parser.add_argument("-v", "--verbose", action="store_true", help="log solver progress")
+    from rftstatic.provenance import __version__
+
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                        help="log solver progress; print tracebacks")
+    parser = argparse.ArgumentParser(prog="rftstatic", parents=[common],
+                                     description="Rotation-free triangle drape simulation (Sze & Zhou 2016).")
+    parser.add_argument("--version", action="version", version=f"rftstatic {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("case", help="run a scene: cases/NAME.toml or a path to a .toml file")
+    p = sub.add_parser("case", parents=[common], help="run a scene: cases/NAME.toml or a path to a .toml file")
     p.add_argument("name")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene key, e.g. --set element=RFT3 --set mesh.nodes=[21,101]")
@@ -23,20 +37,35 @@ def main(argv=None) -> int:
     p.add_argument("--no-figures", action="store_true", help="skip the PNG views")
     p.add_argument("--resume", action="store_true", help="continue a dynamic run from its last checkpoint")
 
-    sub.add_parser("list", help="list the scenes in cases/")
+    sub.add_parser("list", parents=[common], help="list the scenes in cases/")
 
-    b = sub.add_parser("bench", help="print wall time and peak memory of the benchmarks")
+    b = sub.add_parser("bench", parents=[common], help="print wall time and peak memory of the benchmarks")
     b.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
 
-    v = sub.add_parser("validate", help="regenerate the validation reports in validation/")
+    v = sub.add_parser("validate", parents=[common], help="regenerate the validation reports in validation/")
     v.add_argument("names", nargs="*")
     v.add_argument("--quick", action="store_true", help="coarse meshes only (about a minute)")
     v.add_argument("--out", default=None)
 
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+    verbose = getattr(args, "verbose", False)
+    logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return _command(args)
+    except KeyboardInterrupt:
+        print("interrupted (a dynamic run resumes from its last checkpoint with --resume)", file=sys.stderr)
+        return EXIT["interrupted"]
+    except Exception as exc:  # noqa: BLE001 - the one place an unexpected error is reported
+        if verbose:
+            raise
+        print(f"internal error: {type(exc).__name__}: {exc} (run with -v for the traceback)", file=sys.stderr)
+        return EXIT["internal"]
+
+
+def _command(args) -> int:
     from rftstatic import api
+    from rftstatic.errors import CheckpointError, MeshError, MeshingError, PatchError
 
     try:
         if args.command == "list":
@@ -58,7 +87,12 @@ def main(argv=None) -> int:
             brief = {k: summary.get(k) for k in keys}
             print(json.dumps(brief, indent=1, default=str))
             print(f"outputs written to {out}/")
-            return 0
+            if summary.get("analysis") in ("relax",) or summary.get("route", "").startswith("remesh_relax"):
+                if not summary.get("converged", False):
+                    print(f"error: the sheet did not come to rest by t_end = {summary.get('t_end')} s; the last "
+                          "state was written, labelled converged = false", file=sys.stderr)
+                    return EXIT["goal"]
+            return EXIT["done"]
         if args.command == "bench":
             from rftstatic.bench.main import main as bench_main
 
@@ -67,11 +101,17 @@ def main(argv=None) -> int:
             from rftstatic.validate import main as validate_main
 
             return validate_main(args.names, quick=args.quick, out=args.out)
-    except api.SceneError as exc:
+    except (api.SceneError, MeshError, MeshingError, PatchError, CheckpointError) as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT["input"]
     except api.ConvergenceError as exc:
-        print(f"error: the solve did not converge: {exc}\nThe last equilibrium was written, labelled "
+        print(f"error: the solve did not converge: {exc}\nThe last equilibrium (if any) was written, labelled "
               "converged = false.", file=sys.stderr)
-        return 3
-    return 1
+        return EXIT["goal"]
+    except api.InstabilityError as exc:
+        print(f"error: the explicit run became unstable: {exc}", file=sys.stderr)
+        return EXIT["goal"]
+    except OSError as exc:
+        print(f"error: the outputs cannot be written: {exc}", file=sys.stderr)
+        return EXIT["output"]
+    return EXIT["internal"]

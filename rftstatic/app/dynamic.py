@@ -41,7 +41,7 @@ from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import dynamics_options, static_options
 from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
 from rftstatic.solvers.checkpoint import resume as resume_run
-from rftstatic.solvers.explicit import run_explicit
+from rftstatic.solvers.explicit import run_explicit, step_count
 from rftstatic.solvers.relaxation import AtRest
 from rftstatic.solvers.static import compare_with_static, solve_static
 from rftstatic.solvers.timestep import stable_time_step
@@ -141,12 +141,16 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         dt = o.dt if o.dt is not None else estimate.dt
         if dt > estimate.dt * (1 + 1e-3):
             log.warning("dynamics.dt = %.4g s exceeds the stable estimate %.4g s", dt, estimate.dt)
-        n_steps = max(1, int(np.ceil(t_end / dt - 1e-9)))
+        try:
+            n_steps = step_count(t_end, dt, o.max_steps)
+        except ValueError as exc:
+            raise scene.error("dynamics.dt" if o.dt is not None else "dynamics.t_end", str(exc)) from None
         dt = t_end / n_steps
         ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
         run = run_explicit(model, t_end=t_end, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
                            obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(), callback=watch,
-                           checkpoint=ckpt, progress=progress, rest_tol=o.rest_tolerance, backend=backend)
+                           checkpoint=ckpt, progress=progress, rest_tol=o.rest_tolerance, backend=backend,
+                           max_steps=o.max_steps)
         run.estimate = run.estimate or estimate
     wall = time.perf_counter() - wall0
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from rftstatic.errors import ParameterError, SceneError
 from rftstatic.remesh.adapt import check_remesh_parameters
+from rftstatic.solvers.explicit import MAX_STEPS
 from rftstatic.solvers.newton import StaticOptions
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 
@@ -68,6 +69,7 @@ class DynamicsOptions:
     force_tolerance : relax: out-of-balance force / load at rest [-]
     samples : regular states saved for the VTU series and the GIF
     compare_static : relax: report the difference from the static Newton solution
+    max_steps : refuse a run of more explicit steps than this
     """
 
     t_end: float
@@ -80,6 +82,7 @@ class DynamicsOptions:
     force_tolerance: float = 1e-4
     samples: int = 30
     compare_static: bool = False
+    max_steps: int = MAX_STEPS
 
 
 CHECKPOINT_EVERY_S = 0.2
@@ -108,6 +111,8 @@ def dynamics_options(scene) -> DynamicsOptions:
     for key in ("t_end", "mass_scale", "rest_tolerance", "force_tolerance", "checkpoint_every"):
         positive(key)
     positive("alpha", strict=False)
+    if not (isinstance(opts["max_steps"], int) and opts["max_steps"] >= 1):
+        raise scene.error("dynamics.max_steps", f"must be a positive integer, got {opts['max_steps']!r}")
     if opts.get("dt") is not None:
         positive("dt")
     if opts["samples"] < 0:
@@ -121,7 +126,7 @@ def dynamics_options(scene) -> DynamicsOptions:
         mass_scale=float(opts["mass_scale"]), frames=np.array(sorted(set(float(f) * t for f in frames))),
         checkpoint_every=opts["checkpoint_every"] * t, rest_tolerance=float(opts["rest_tolerance"]),
         force_tolerance=float(opts["force_tolerance"]), samples=int(opts["samples"]),
-        compare_static=bool(opts["compare_static"]))
+        compare_static=bool(opts["compare_static"]), max_steps=int(opts["max_steps"]))
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ into a :class:`rftstatic.model.Model` in SI units; the schema is documented in t
 from __future__ import annotations
 
 import copy
+import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -117,6 +118,7 @@ SCHEMA = {
         "samples": (int, "regular states saved for the VTU series and the GIF"),
         "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
         "compare_static": (bool, "relax: report the difference from the static Newton solution"),
+        "max_steps": (int, "refuse a run of more explicit steps than this (default 10^7)"),
     }, "explicit dynamics options"),
     "remesh": ({
         "const": (NUM, "const of Eq. 29, |kappa| h^2 = const [length]"),
@@ -260,6 +262,18 @@ def validate(scene: Scene) -> None:
                           f'{", ".join(SCENE_ANALYSES)}')
 
 
+def _non_finite(value):
+    """The first NaN or infinite number in ``value`` (a number or nested lists), else None."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return value
+    if isinstance(value, list):
+        for item in value:
+            bad = _non_finite(item)
+            if bad is not None:
+                return bad
+    return None
+
+
 def _check_table(scene, table, schema, prefix):
     if not isinstance(table, dict):
         raise scene.error(prefix.rstrip("."), f"expected a table, got {table!r}")
@@ -282,3 +296,7 @@ def _check_table(scene, table, schema, prefix):
             if not ok:
                 names = "/".join(t.__name__ for t in types)
                 raise scene.error(full, f"expected {names}, got {value!r} ({type(value).__name__})")
+            bad = _non_finite(value)
+            if bad is not None:
+                where = f" (in {value!r})" if isinstance(value, list) else ""
+                raise scene.error(full, f"{bad!r} is not a finite number{where}; give a finite value")

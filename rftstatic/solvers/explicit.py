@@ -94,7 +94,7 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
                  obstacles=(), U0=None, V0=None, start: str = "consistent", frame_times=(), probes=None,
                  sample_every: int | None = None, callback=None, checkpoint=None, progress: bool = True,
                  energy_check: bool = True, energy_tol: float = 0.25, rest_tol: float = 1e-6,
-                 safety: float = 0.9, backend: str = "auto", load=None,
+                 safety: float = 0.9, backend: str = "auto", load=None, max_steps: int = None,
                  _restart: dict | None = None) -> ExplicitResult:
     """Integrate the motion of ``model`` from t = 0 to ``t_end`` (module docstring).
 
@@ -122,6 +122,8 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
     rest_tol : kinetic / peak kinetic energy below which the sheet counts as at rest [-]
     safety : safety factor on the critical step [-]
     backend : force back end, ``"auto"``, ``"numpy"`` or ``"numba"``
+    max_steps : refuse (ValueError, before the first step) a run of more steps than this (default
+        :data:`MAX_STEPS`)
 
     Returns
     -------
@@ -146,7 +148,7 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
         state.V *= model.free
         estimate, dt = _choose_step(model, state.U, dt, alpha=alpha, mass_scale=mass_scale, safety=safety,
                                     needed=energy_check or dt is None)
-        n_steps = max(1, int(np.ceil(t_end / dt - 1e-9)))
+        n_steps = step_count(t_end, dt, max_steps)
         dt = t_end / n_steps
         loop.begin(dt, start_consistent=start == "consistent", state=state)
     else:
@@ -177,6 +179,21 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
         frames=loop.frames, time_at_rest=_time_at_rest(history, rest_tol), stopped=stopped,
         contact_nodes=loop.n_contact, wall_time=wall,
         element_steps_per_second=model.mesh.n_elements * state.step / max(wall, 1e-12), state=state)
+
+
+MAX_STEPS = 10_000_000
+"""Default limit on the steps of one explicit run (hours of computing on a large sheet): a run that asks
+for more is refused before it starts, naming t_end, dt and the limit."""
+
+
+def step_count(t_end: float, dt: float, max_steps: int | None = None) -> int:
+    """Steps of ``dt`` [s] (rounded up) that reach ``t_end`` [s]; ValueError beyond ``max_steps``."""
+    limit = MAX_STEPS if max_steps is None else int(max_steps)
+    steps = t_end / dt - 1e-9
+    if not np.isfinite(steps) or steps > limit:
+        raise ValueError(f"t_end = {t_end:.6g} s with dt = {dt:.6g} s needs {steps:.3g} explicit steps, more than "
+                         f"the limit of {limit:d} (dynamics.max_steps); shorten t_end or lengthen dt")
+    return max(1, int(np.ceil(steps)))
 
 
 class _Loop:

@@ -38,6 +38,10 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
     if opts.perturbation and U0 is None:
         seed = opts.seed
         U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
+    if not (np.isfinite(U).all() and np.isfinite(model.load).all()):
+        what = "the load (nodal forces)" if not np.isfinite(model.load).all() else "the start displacements"
+        raise ConvergenceError(f"load factor 0: {what} are not finite (NaN or inf); check the scene's loads, "
+                               "weight and mesh coordinates", None)
     ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
     ws.modes = modes = {"exact": 0, "psd": 0, "shift": 0}
     solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
@@ -98,7 +102,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                      lam_next, nt.reason, nt.iterations, nt.residual)
             dlam /= 4.0
             target /= 4.0
-            if dlam < opts.min_increment:
+            if not dlam >= opts.min_increment:  # also stops on a NaN increment
                 raise ConvergenceError(
                     f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
                     f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "

@@ -117,6 +117,18 @@ class StaticOptions:
             raise ValueError('solver.guide_folds guides the dynamic relaxation: it needs solver.start = "relax"')
         if self.rtol <= 0 or self.max_iterations < 1:
             raise ValueError(f"need rtol > 0 and max_iterations >= 1, got {self.rtol}, {self.max_iterations}")
+        for name in ("rtol", "intermediate_rtol", "etol", "max_step", "increment_displacement", "guide_weight",
+                     "perturbation"):
+            v = getattr(self, name)
+            if v is not None and not np.isfinite(v):
+                raise ValueError(f"solver.{name} must be a finite number, got {v!r}")
+        for name in ("intermediate_rtol", "max_step", "increment_displacement"):
+            v = getattr(self, name)
+            if v is not None and not v > 0:
+                raise ValueError(f"solver.{name} must be > 0, got {v!r}")
+        if self.perturbation < 0 or self.etol < 0:
+            raise ValueError(f"need solver.perturbation >= 0 and solver.etol >= 0, got {self.perturbation}, "
+                             f"{self.etol}")
 
     def single_step(self) -> StaticOptions:
         """These options with the whole load in one increment (no displacement-sized increments)."""

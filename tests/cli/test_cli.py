@@ -87,3 +87,50 @@ def test_bad_guide_options_name_the_scene_file_and_the_solver_key():
                                               "solver.guide_weight=0.2"])
     with pytest.raises(SceneError, match=r'solver: .*needs solver.start = "relax"'):
         static_options(scene)
+
+
+# ------------------------------------------------------------------------ exit statuses and bounded work
+def test_non_finite_scene_numbers_are_input_errors(capsys, tmp_path):
+    # TOML accepts nan and inf; a scene may not (a NaN weight once looped for ever in the load steps)
+    for override in ("material.weight=nan", "mesh.nodes=[nan,5]", "mesh.z=inf"):
+        assert main(["case", "strip", "--set", override, "--no-figures", "--out", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err
+        assert "strip.toml" in err and "not a finite number" in err and "Traceback" not in err
+
+
+def test_an_explicit_run_beyond_the_step_limit_is_refused_before_it_starts(capsys, tmp_path):
+    import time
+
+    t0 = time.perf_counter()
+    code = main(["case", "hang-20", "--set", "mesh.nodes=[7,7]", "--set", "dynamics.dt=1e-300", "--no-figures",
+                 "--out", str(tmp_path / "o")])
+    assert code == 2 and time.perf_counter() - t0 < 60
+    err = capsys.readouterr().err
+    assert "dynamics.dt" in err and "max_steps" in err
+
+
+def test_a_relaxation_not_at_rest_by_t_end_exits_3(capsys, tmp_path):
+    code = main(["case", "strip", "--set", "mesh.nodes=[11,3]", "--set", "analysis=relax", "--set",
+                 "dynamics.t_end=0.05", "--no-figures", "--out", str(tmp_path / "o")])
+    assert code == 3 and "did not come to rest" in capsys.readouterr().err
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["converged"] is False
+
+
+def test_internal_errors_are_one_line_and_verbose_shows_the_traceback(monkeypatch, capsys, tmp_path):
+    from rftstatic import api
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("a bug")
+
+    monkeypatch.setattr(api, "run", broken)
+    assert main(["case", "strip", "--out", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("internal error: ZeroDivisionError: a bug") and "\n" not in err
+    with pytest.raises(ZeroDivisionError):
+        main(["case", "strip", "-v", "--out", str(tmp_path / "o")])  # -v after the subcommand too
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0 and capsys.readouterr().out.startswith("rftstatic ")
