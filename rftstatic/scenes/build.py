@@ -242,8 +242,11 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     h = float(mesh.element_size.mean())
     penalty = c.get("penalty", "auto")
     if penalty == "auto":
-        k = auto_penalty(membrane_rigidity=material.membrane_scale, bending_rigidity=material.bending_scale,
-                         weight=max(material.weight, 1e-300), h=h, factor=c.get("factor", 1.0))
+        try:
+            k = auto_penalty(membrane_rigidity=material.membrane_scale, bending_rigidity=material.bending_scale,
+                             weight=max(material.weight, 1e-300), h=h, factor=c.get("factor", 1.0))
+        except ValueError as exc:
+            raise scene.error("contact.factor", f"{exc}; use a positive multiplier of the automatic penalty") from None
     elif isinstance(penalty, (int, float)) and penalty > 0:
         k = scene.units.to_si(float(penalty), "stiffness_volumetric")
     else:
@@ -281,6 +284,12 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     """
     mesh = build_mesh(scene) if mesh is None else mesh
     material = build_material(scene)
+    if material.weight < 0:
+        raise scene.error("material.weight", f"{material.weight!r} N/m^2 is negative; give the fabric's areal weight "
+                          "(>= 0; upward loads are loads.pressure < 0)")
+    if scene.get("analysis", "static") != "static" and not material.mass_per_area > 0:
+        raise scene.error("material.weight", "an explicit (dynamic or relax) run needs a positive areal weight "
+                          "(the mass); got 0")
     supports = build_supports(scene, mesh)
     load = build_load(scene, mesh, material)
     contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
@@ -292,6 +301,9 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     for i, spec in enumerate(scene.get("probes", [])):
         if "name" not in spec or "at" not in spec:
             raise scene.error(f"probes.{i}", "a probe needs a name and at = [x, y]")
+        if spec["name"] in probes:
+            raise scene.error(f"probes.{i}.name", f'"{spec["name"]}" names an earlier probe too; give each a name '
+                              "of its own")
         probes[spec["name"]] = np.asarray(spec["at"], float) * u
     return model, {"obstacles": obstacles, "probes": probes}
 

@@ -9,6 +9,7 @@ into a :class:`rftstatic.model.Model` in SI units; the schema is documented in t
 from __future__ import annotations
 
 import copy
+import difflib
 import math
 import tomllib
 from collections.abc import Mapping
@@ -24,6 +25,58 @@ CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
 NUM = (int, float)
 LIST = (list,)
+
+
+@dataclass(frozen=True)
+class ListOf:
+    """A TOML array whose items are ``item`` (python types, or a nested :class:`ListOf`), ``length`` of
+    them (None: any number, at least ``min_length``), optionally from ``choices``."""
+
+    item: object
+    length: int | None = None
+    min_length: int = 0
+    choices: tuple = ()
+
+    def problem(self, value) -> str | None:
+        """What is wrong with ``value`` (None: nothing)."""
+        if not isinstance(value, list):
+            return f"expected an array, got {value!r} ({type(value).__name__})"
+        if self.length is not None and len(value) != self.length:
+            return f"expected {self.length} items, got {len(value)} ({value!r})"
+        if len(value) < self.min_length:
+            return f"expected at least {self.min_length} items, got {value!r}"
+        for i, item in enumerate(value):
+            if isinstance(self.item, ListOf):
+                inner = self.item.problem(item)
+                if inner is not None:
+                    return f"item {i}: {inner}"
+                continue
+            types = self.item if isinstance(self.item, tuple) else (self.item,)
+            if not isinstance(item, types) or (isinstance(item, bool) and bool not in types):
+                names = "number" if set(types) == {int, float} else "/".join(t.__name__ for t in types)
+                return f"item {i} = {item!r} is not {'an ' if names == 'int' else 'a '}{names}"
+            if self.choices and item not in self.choices:
+                close = difflib.get_close_matches(str(item), self.choices, n=1)
+                hint = f' (did you mean "{close[0]}"?)' if close else ""
+                return f'item {i} = "{item}" is not one of {", ".join(self.choices)}{hint}'
+        return None
+
+
+XY = ListOf(NUM, 2)
+XYZ = ListOf(NUM, 3)
+BOX = ListOf(NUM, 4)
+
+
+class PointsXY(ListOf):
+    """One reference point ``[x, y]`` or several ``[[x, y], ...]``."""
+
+    def __init__(self):
+        super().__init__(NUM, None, 1)
+
+    def problem(self, value) -> str | None:
+        if isinstance(value, list) and value and all(isinstance(v, list) for v in value):
+            return ListOf(XY, None, 1).problem(value)
+        return XY.problem(value)
 
 
 class _ObstacleKeys(Mapping):
@@ -51,10 +104,10 @@ SCHEMA = {
                       "rftstatic.scenes.analyses"),
     "mesh": ({
         "kind": (str, "rectangle, polar, square-polar, file or unstructured"),
-        "size": (LIST, "[lx, ly] of a rectangle"),
-        "nodes": (LIST, "[nx, ny] (rectangle) or [n_radial, n_circ] (polar)"),
-        "origin": (LIST, "lower-left corner of a rectangle"),
-        "centre": (LIST, "centre of a polar mesh"),
+        "size": (XY, "[lx, ly] of a rectangle"),
+        "nodes": (ListOf(int, 2), "[nx, ny] (rectangle) or [n_radial, n_circ] (polar), integers"),
+        "origin": (XY, "lower-left corner of a rectangle"),
+        "centre": (XY, "centre of a polar mesh"),
         "pattern": (str, "diagonal pattern: right, left, alternate, union-jack"),
         "radius": (NUM, "outer radius (polar) or half side (square-polar)"),
         "inner_radius": (NUM, "inner radius of an annulus"),
@@ -75,16 +128,16 @@ SCHEMA = {
     }, "fabric or shell rigidities"),
     "supports": ([{
         "kind": (str, "clamped, pinned or fixed"),
-        "box": (LIST, "[xmin, xmax, ymin, ymax] in reference coordinates"),
-        "at": (LIST, "[[x, y], ...] reference points (nearest nodes)"),
+        "box": (BOX, "[xmin, xmax, ymin, ymax] in reference coordinates"),
+        "at": (PointsXY(), "[x, y] or [[x, y], ...] reference points (nearest nodes)"),
         "components": (str, "for kind = fixed: which of x, y, z are held, e.g. 'xy'"),
     }], "prescribed (zero) displacements"),
     "loads": ({
         "gravity": (bool, "the material's weight, along -z"),
         "pressure": (NUM, "uniform transverse load along -z [force/area]"),
-        "point": ([{"at": (LIST, "[x, y]"), "force": (LIST, "[fx, fy, fz]")}], "nodal forces"),
-        "edge": ([{"box": (LIST, "[xmin, xmax, ymin, ymax]"),
-                   "force_per_length": (LIST, "[fx, fy, fz] per unit length")}], "boundary line loads"),
+        "point": ([{"at": (PointsXY(), "[x, y]"), "force": (XYZ, "[fx, fy, fz]")}], "nodal forces"),
+        "edge": ([{"box": (BOX, "[xmin, xmax, ymin, ymax]"),
+                   "force_per_length": (XYZ, "[fx, fy, fz] per unit length")}], "boundary line loads"),
     }, "external loads at load factor 1"),
     "obstacles": ([_ObstacleKeys()], "rigid obstacles (the keys every registered obstacle type declares)"),
     "contact": ({
@@ -113,7 +166,7 @@ SCHEMA = {
     "dynamics": ({
         "t_end": (NUM, "end time [time]"), "dt": (NUM, "time step (default: automatic)"),
         "alpha": (NUM, "mass damping [1/time]"), "mass_scale": (NUM, "mass scaling factor"),
-        "frames": (LIST, "times of the saved frames"), "checkpoint_every": (NUM, "[time]"),
+        "frames": (ListOf(NUM), "times of the saved frames"), "checkpoint_every": (NUM, "[time]"),
         "rest_tolerance": (NUM, "kinetic-energy ratio at which the sheet is at rest"),
         "samples": (int, "regular states saved for the VTU series and the GIF"),
         "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
@@ -134,9 +187,9 @@ SCHEMA = {
         "damping": (str, "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's slowest "
                          "swing, at most dynamics.alpha)"),
     }, "global adaptive remeshing (§5)"),
-    "probes": ([{"name": (str, "probe name"), "at": (LIST, "[x, y] reference point")}], "tracked points"),
+    "probes": ([{"name": (str, "probe name"), "at": (XY, "[x, y] reference point")}], "tracked points"),
     "output": ({
-        "views": (LIST, "PNG views: side, top, iso"),
+        "views": (ListOf(str, choices=("side", "top", "iso")), "PNG views: side, top, iso"),
         "vtu": (bool, "write the deformed mesh as VTU"),
     }, "what a run writes"),
 }
@@ -179,8 +232,10 @@ def find_scene(name: str) -> Path:
     candidate = CASES_DIR / f"{name}.toml"
     if candidate.exists():
         return candidate
-    known = ", ".join(sorted(q.stem for q in CASES_DIR.glob("*.toml")))
-    raise SceneError(f'no scene "{name}" in {CASES_DIR}; known scenes: {known}')
+    names = sorted(q.stem for q in CASES_DIR.glob("*.toml"))
+    near = difflib.get_close_matches(name, names, n=1)
+    hint = f'did you mean "{near[0]}"? ' if near else ""
+    raise SceneError(f'no scene "{name}" in {CASES_DIR}; {hint}known scenes: {", ".join(names)}')
 
 
 def list_scenes() -> list[tuple[str, str]]:
@@ -216,7 +271,13 @@ def apply_override(data: dict, key: str, value, source="--set") -> None:
             except (ValueError, IndexError):
                 raise SceneError(f'{source} {key}: "{part}" is not an index of the array {".".join(parts[:i])}') from None
             continue
+        if not isinstance(node, dict):
+            raise SceneError(f'{source} {key}: "{".".join(parts[:i])}" is a value, not a table; set '
+                             f'{".".join(parts[:i])} itself')
         node = node.setdefault(part, {})
+        if not isinstance(node, (dict, list)):
+            raise SceneError(f'{source} {key}: "{".".join(parts[:i + 1])}" is a value ({node!r}), not a table; '
+                             f'set {".".join(parts[:i + 1])} itself')
     last = parts[-1]
     if isinstance(node, list):
         try:
@@ -280,8 +341,9 @@ def _check_table(scene, table, schema, prefix):
     for key, value in table.items():
         full = prefix + key
         if key not in schema:
-            close = ", ".join(sorted(schema))
-            raise scene.error(full, f"unknown key (value {value!r}); known keys here: {close}")
+            near = difflib.get_close_matches(key, list(schema), n=1)
+            hint = f'did you mean "{prefix}{near[0]}"? ' if near else ""
+            raise scene.error(full, f"unknown key (value {value!r}); {hint}known keys here: {', '.join(sorted(schema))}")
         spec, _ = schema[key]
         if isinstance(spec, dict):
             _check_table(scene, value, spec, full + ".")
@@ -290,13 +352,17 @@ def _check_table(scene, table, schema, prefix):
                 raise scene.error(full, f"expected an array of tables ([[{full}]]), got {value!r}")
             for i, item in enumerate(value):
                 _check_table(scene, item, spec[0], f"{full}.{i}.")
+        elif isinstance(spec, ListOf):
+            bad = spec.problem(value)
+            if bad is not None:
+                raise scene.error(full, bad)
         else:
             types = spec if isinstance(spec, tuple) else (spec,)
             ok = isinstance(value, types) and not (isinstance(value, bool) and bool not in types)
             if not ok:
                 names = "/".join(t.__name__ for t in types)
                 raise scene.error(full, f"expected {names}, got {value!r} ({type(value).__name__})")
-            bad = _non_finite(value)
-            if bad is not None:
-                where = f" (in {value!r})" if isinstance(value, list) else ""
-                raise scene.error(full, f"{bad!r} is not a finite number{where}; give a finite value")
+        bad = _non_finite(value)
+        if bad is not None:
+            where = f" (in {value!r})" if isinstance(value, list) else ""
+            raise scene.error(full, f"{bad!r} is not a finite number{where}; give a finite value")

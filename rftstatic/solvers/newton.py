@@ -101,6 +101,9 @@ class StaticOptions:
     def __post_init__(self):
         if self.start not in ("load-steps", "relax"):
             raise ValueError(f'solver.start must be "load-steps" or "relax", got "{self.start}"')
+        if self.linear_solver not in ("auto", "cholmod", "scipy", "amg"):
+            raise ValueError(f'solver.linear_solver must be "auto", "cholmod", "scipy" or "amg", got '
+                             f'"{self.linear_solver}"')
         if self.tangent not in ("auto", "exact", "psd"):
             raise ValueError(f'solver.tangent must be "auto", "exact" or "psd", got "{self.tangent}"')
         if not (0 < self.min_increment <= self.initial_increment <= self.max_increment <= 1):

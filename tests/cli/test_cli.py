@@ -40,7 +40,7 @@ def test_case_accepts_a_path(tmp_path):
 @pytest.mark.parametrize("override,fragment", [
     ("mesh.sise=[1, 2]", "mesh.sise: unknown key"),
     ("element=RFT9", 'element: "RFT9" is not an element'),
-    ("mesh.nodes=3", "mesh.nodes: expected list"),
+    ("mesh.nodes=3", "mesh.nodes: expected an array"),
     ("units=furlongs", "unknown unit system"),
     ("solver.rtol=[1]", "solver.rtol: expected"),
 ])
@@ -92,7 +92,7 @@ def test_bad_guide_options_name_the_scene_file_and_the_solver_key():
 # ------------------------------------------------------------------------ exit statuses and bounded work
 def test_non_finite_scene_numbers_are_input_errors(capsys, tmp_path):
     # TOML accepts nan and inf; a scene may not (a NaN weight once looped for ever in the load steps)
-    for override in ("material.weight=nan", "mesh.nodes=[nan,5]", "mesh.z=inf"):
+    for override in ("material.weight=nan", "mesh.size=[nan,5]", "mesh.z=inf"):
         assert main(["case", "strip", "--set", override, "--no-figures", "--out", str(tmp_path / "o")]) == 2
         err = capsys.readouterr().err
         assert "strip.toml" in err and "not a finite number" in err and "Traceback" not in err
@@ -134,3 +134,26 @@ def test_version(capsys):
     with pytest.raises(SystemExit) as info:
         main(["--version"])
     assert info.value.code == 0 and capsys.readouterr().out.startswith("rftstatic ")
+
+
+@pytest.mark.parametrize("override, fragment", [
+    ('supports.0.box=["a",0,0,0]', "supports.0.box: item 0 = 'a' is not a number"),
+    ("probes.0.at=[5.0]", "probes.0.at: expected 2 items"),
+    ('output.views=["front"]', 'output.views: item 0 = "front" is not one of side, top, iso'),
+    ("mesh.nodes=[11.7,5]", "mesh.nodes: item 0 = 11.7 is not an int"),
+    ("mesh.patern=left", 'did you mean "mesh.pattern"?'),
+    ("title.x=1", '"title" is a value'),
+    ("solver.linear_solver=mumps", 'solver.linear_solver must be "auto", "cholmod", "scipy" or "amg"'),
+    ("solver.max_step=-1.0", "solver.max_step must be > 0"),
+])
+def test_list_contents_enums_and_typos_are_scene_errors(override, fragment):
+    with pytest.raises(SceneError) as info:
+        from rftstatic.scenes.options import static_options
+
+        static_options(load_scene("strip", [override]))
+    assert fragment in str(info.value)
+
+
+def test_a_misspelt_scene_name_gets_the_closest_suggested():
+    with pytest.raises(SceneError, match='did you mean "strip"'):
+        load_scene("strp")
