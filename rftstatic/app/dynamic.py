@@ -111,6 +111,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         return bool(stop or (analysis == "relax" and at_rest))
 
     ckpt_path = out / CHECKPOINT
+    for stale in out.glob(CHECKPOINT + ".*.tmp"):  # a checkpoint write cut short by a kill
+        stale.unlink(missing_ok=True)
     wall0 = time.perf_counter()
     resumed_from = None
     if resume and ckpt_path.exists():

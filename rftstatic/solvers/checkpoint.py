@@ -17,6 +17,7 @@ import logging
 import os
 import tempfile
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -121,20 +122,26 @@ def load_checkpoint(path) -> dict:
     path = Path(path)
     if not path.exists():
         raise CheckpointError(f"checkpoint {path} does not exist")
-    with np.load(path, allow_pickle=False) as z:
-        if int(z["format"]) != FORMAT:
-            raise CheckpointError(f"checkpoint {path}: format {int(z['format'])}, this version reads {FORMAT}")
-        est = json.loads(str(z["estimate"]))
-        out = {
-            "fingerprint": str(z["fingerprint"]), "obstacles": str(z["obstacles"]),
-            "t": float(z["t"]), "step": int(z["step"]), "n_steps": int(z["n_steps"]), "dt": float(z["dt"]),
-            "U": z["U"].copy(), "V_half": z["V_half"].copy(), "acc": json.loads(str(z["acc"])),
-            "estimate": None if est is None else StepEstimate(**est),
-            "history": {k: z["history_" + k].tolist() for k in HISTORY_KEYS},
-            "probes": list(z["probes"]),
-            "frames": list(zip(z["frame_t"].tolist(), list(z["frame_U"]))),
-            "options": {k[len("option_"):]: z[k] for k in z.files if k.startswith("option_")},
-        }
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if int(z["format"]) != FORMAT:
+                raise CheckpointError(f"checkpoint {path}: format {int(z['format'])}, this version reads {FORMAT}")
+            est = json.loads(str(z["estimate"]))
+            out = {
+                "fingerprint": str(z["fingerprint"]), "obstacles": str(z["obstacles"]),
+                "t": float(z["t"]), "step": int(z["step"]), "n_steps": int(z["n_steps"]), "dt": float(z["dt"]),
+                "U": z["U"].copy(), "V_half": z["V_half"].copy(), "acc": json.loads(str(z["acc"])),
+                "estimate": None if est is None else StepEstimate(**est),
+                "history": {k: z["history_" + k].tolist() for k in HISTORY_KEYS},
+                "probes": list(z["probes"]),
+                "frames": list(zip(z["frame_t"].tolist(), list(z["frame_U"]))),
+                "options": {k[len("option_"):]: z[k] for k in z.files if k.startswith("option_")},
+            }
+    except (OSError, ValueError, KeyError, TypeError, zipfile.BadZipFile, json.JSONDecodeError) as exc:
+        if isinstance(exc, CheckpointError):
+            raise
+        raise CheckpointError(f"checkpoint {path} is corrupt or incomplete ({type(exc).__name__}: {exc}); "
+                              "run without --resume to start again") from None
     return out
 
 

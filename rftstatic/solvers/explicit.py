@@ -166,8 +166,10 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
     bar = Progress(t_end, "explicit", unit=" s", enabled=progress)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            stopped = loop.advance(state, n_steps, int(sample_every), check, bar, callback=callback,
-                                   checkpoint=checkpoint, checkpoint_info={"estimate": estimate, "options": opts})
+            info = {"estimate": estimate, "options": opts}
+            with _StopOnInterrupt(loop, enabled=checkpoint is not None):
+                stopped = loop.advance(state, n_steps, int(sample_every), check, bar, callback=callback,
+                                       checkpoint=checkpoint, checkpoint_info=info)
             loop.final_sample(state, check)
     finally:
         bar.close()
@@ -196,6 +198,35 @@ def step_count(t_end: float, dt: float, max_steps: int | None = None) -> int:
     return max(1, int(np.ceil(steps)))
 
 
+class _StopOnInterrupt:
+    """While a checkpointed run steps, Ctrl-C (SIGINT) only asks the loop to stop at the end of the step
+    (so that the checkpoint it saves is a whole step); a second Ctrl-C stops at once. Only in the main
+    thread, and only when ``enabled``."""
+
+    def __init__(self, loop, *, enabled):
+        self.loop, self.enabled, self.previous = loop, enabled, None
+
+    def __enter__(self):
+        import signal
+        import threading
+
+        if self.enabled and threading.current_thread() is threading.main_thread():
+            def ask(signum, frame):
+                if self.loop.interrupted:
+                    raise KeyboardInterrupt
+                self.loop.interrupted = True
+
+            self.previous = signal.signal(signal.SIGINT, ask)
+        return self
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            import signal
+
+            signal.signal(signal.SIGINT, self.previous)
+        return False
+
+
 class _Loop:
     """The central-difference loop of :func:`run_explicit` (Eq. 20-22) and its bookkeeping: energy
     accumulators, history samples, probe records and frames. The solve's state is a :class:`State`."""
@@ -209,6 +240,7 @@ class _Loop:
         self.probes, self.frame_times = probes, frame_times
         self.minv = self.free / self.mass[:, None]  # (N, 3) inverse mass, zero on supported dofs
         self.n_contact = 0
+        self.interrupted = False  # set by Ctrl-C (:class:`_StopOnInterrupt`); checked after every step
 
     def begin(self, dt, *, start_consistent, state):
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
@@ -284,11 +316,19 @@ class _Loop:
             state.U, state.V, state.t, state.step = U, V, step * dt, step
             if stopped:
                 break
+            if self.interrupted:  # Ctrl-C, at a whole step: save, then stop (--resume continues)
+                if checkpoint is not None and step < n_steps:
+                    self.save_checkpoint(checkpoint, state, n_steps, checkpoint_info)
+                raise KeyboardInterrupt(f"interrupted at t = {state.t:.6g} s (step {step}); checkpoint saved")
             if checkpoint is not None and checkpoint.due(step) and step < n_steps:
-                checkpoint.save(self.model, self.obstacles, state, dt=dt, n_steps=n_steps,
-                                estimate=checkpoint_info["estimate"], acc=acc, history=self.hist,
-                                probes=self.probe_hist, frames=self.frames, options=checkpoint_info["options"])
+                self.save_checkpoint(checkpoint, state, n_steps, checkpoint_info)
         return stopped
+
+    def save_checkpoint(self, checkpoint, state, n_steps, info):
+        """Save ``state`` (after a whole step) with the records so far."""
+        checkpoint.save(self.model, self.obstacles, state, dt=self.dt, n_steps=n_steps, estimate=info["estimate"],
+                        acc=self.acc, history=self.hist, probes=self.probe_hist, frames=self.frames,
+                        options=info["options"])
 
     def _record(self, rec, U):
         for k in HISTORY_KEYS:

@@ -209,6 +209,38 @@ def test_resume_reproduces_the_uninterrupted_run(tmp_path):
         resume(path, strip(WOOL))
 
 
+def test_ctrl_c_saves_a_whole_step_and_resume_reproduces_the_run(tmp_path):
+    """SIGINT during a checkpointed run: the loop stops at the end of that step, saves it, raises
+    KeyboardInterrupt; resuming gives the uninterrupted run bit for bit."""
+    import signal
+
+    model = strip(STIFF)
+    kw = dict(t_end=0.02, alpha=5.0, probes=[tip(model)], sample_every=7, progress=False)
+    full = run_explicit(model, **kw)
+    path = tmp_path / "run.npz"
+
+    def press_ctrl_c(state, rec):
+        if state.step >= 250:
+            signal.raise_signal(signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt, match="checkpoint saved"):
+        run_explicit(model, callback=press_ctrl_c, checkpoint=Checkpointer(path, every_steps=100), **kw)
+    saved = load_checkpoint(path)["step"]
+    assert 250 < saved < 260  # the step after the signal, not the last periodic checkpoint (200)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the handler is restored
+    res = resume(path, model)
+    assert np.array_equal(res.U, full.U) and np.array_equal(res.V, full.V)
+    for k in full.history:
+        assert np.array_equal(res.history[k], full.history[k]), k
+
+
+def test_a_corrupt_checkpoint_is_reported_as_such(tmp_path):
+    path = tmp_path / "run.npz"
+    path.write_bytes(b"PK\x03\x04 not really a zip")
+    with pytest.raises(CheckpointError, match="corrupt or incomplete"):
+        load_checkpoint(path)
+
+
 def test_numpy_and_numba_runs_agree():
     pytest.importorskip("numba")
     model = strip(STIFF)
