@@ -9,12 +9,15 @@
 from __future__ import annotations
 
 import copy
+import logging
 
 import numpy as np
 
 from rftstatic.post.measures.summary import drape_measures
 from rftstatic.post.probes import probe_positions
 from rftstatic.provenance import peak_memory_mb, software
+
+log = logging.getLogger(__name__)
 
 
 def summary_header(scene, model, analysis: str) -> dict:
@@ -45,6 +48,17 @@ def drape_summary(scene, model, extras, U) -> dict:
     x = model.positions(U)
     obstacles = extras["obstacles"]
     disc_area, centre = obstacles[0].footprint() if obstacles else (None, np.zeros(2))
+    sheet_area = float(model.mesh.area.sum())
+    reason = None
+    if disc_area is not None and not sheet_area > disc_area:
+        reason = (f"the sheet ({sheet_area / u**2:.4g} square units) is not larger than the obstacle's footprint "
+                  f"({disc_area / u**2:.4g}): no drape coefficient")
+    elif model.mesh.locate(np.asarray(centre, float)[None, :2])[0][0] < 0:
+        reason = (f"the obstacle's centre {np.round(np.asarray(centre) / u, 6).tolist()} is not under the sheet: "
+                  "the drape measures (coefficient, folds about the centre) do not apply")
+    if reason is not None:
+        log.warning("drape measures skipped: %s", reason)
+        return {"applicable": False, "reason": reason}
     m = drape_measures(x, model.mesh.tri, sheet_area=float(model.mesh.area.sum()), disc_area=disc_area,
                        centre=centre, curvature=model.curvature(U), h=model.mesh.element_size)
     return _scale_lengths(m, u)
