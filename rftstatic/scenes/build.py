@@ -14,11 +14,29 @@ from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.scenes.schema import Scene
 from rftstatic.units import unit_system
 
+MESH_KEYS = {
+    "rectangle": {"size", "nodes", "origin", "pattern"},
+    "polar": {"radius", "inner_radius", "nodes", "centre", "pattern"},
+    "square-polar": {"radius", "inner_radius", "nodes", "centre", "pattern"},
+    "file": {"path"},
+    "unstructured": {"h", "size", "origin", "radius", "centre"},
+}
+"""The ``[mesh]`` keys each mesh kind reads (besides ``kind`` and ``z``); any other is a scene error."""
+
 
 def build_mesh(scene: Scene) -> meshmod.TriMesh:
+    """The scene's flat reference mesh [m] (``[mesh]``: :data:`MESH_KEYS` of its kind)."""
     u = scene.units.length
     m = scene.get("mesh", {})
     kind = m.get("kind", "rectangle")
+    if kind in MESH_KEYS:
+        extra = sorted(set(m) - MESH_KEYS[kind] - {"kind", "z"})
+        if "mesh.kind" in scene.overrides:  # --set mesh.kind=...: the file's keys of its own kind give way
+            extra = [k for k in extra if f"mesh.{k}" in scene.overrides]
+            m = {k: v for k, v in m.items() if k in MESH_KEYS[kind] | {"kind", "z"}}
+        if extra:
+            raise scene.error(f"mesh.{extra[0]}", f"does not apply to a {kind} mesh (it reads "
+                              f"{', '.join(sorted(MESH_KEYS[kind]))}, kind and z); remove it")
     z0 = m.get("z", 0.0) * u
     try:
         if kind == "rectangle":
@@ -88,7 +106,9 @@ def build_material(scene: Scene) -> mat.Material:
     try:
         if "preset" in m:
             name = m.pop("preset")
-            m.pop("kind", None)
+            if "kind" in m:
+                raise scene.error("material.kind", f'does not apply next to preset = "{name}" (a preset is a fabric '
+                                  "with its rigidities); remove kind, or the preset and give the rigidities")
             # preset values are in the preset's own units; overrides in the scene's units
             base = mat.preset(name, warp_angle_deg=angle)
             if not m:

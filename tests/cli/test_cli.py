@@ -157,3 +157,16 @@ def test_list_contents_enums_and_typos_are_scene_errors(override, fragment):
 def test_a_misspelt_scene_name_gets_the_closest_suggested():
     with pytest.raises(SceneError, match='did you mean "strip"'):
         load_scene("strp")
+
+
+@pytest.mark.parametrize("scene, override, fragment", [
+    ("pedestal-round-50", "mesh.size=[1.0,1.0]", "mesh.size: does not apply to a square-polar mesh"),
+    ("strip", "mesh.radius=3.0", "mesh.radius: does not apply to a rectangle mesh"),
+    ("strip", "material.kind=isotropic", 'material.kind: does not apply next to preset = "wool-kang-yu"'),
+])
+def test_keys_that_do_not_apply_are_scene_errors(scene, override, fragment):
+    from rftstatic.scenes.build import build_model
+
+    with pytest.raises(SceneError) as info:
+        build_model(load_scene(scene, [override]))
+    assert fragment in str(info.value)
