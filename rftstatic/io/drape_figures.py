@@ -1,8 +1,8 @@
 """Figures of draped sheets in the style of the paper (Sze & Zhou 2016, Figs. 6-11).
 
 - :func:`obstacle_drawers`: the obstacles of a scene as ``draw(ax, view)`` callables for
-  :func:`rftstatic.io.views.plot_views` (pedestal top outlines through ``outlines.outline_drawer``, the
-  sphere as its silhouette), in the scene's length unit;
+  :func:`rftstatic.io.views.plot_views` (each obstacle's plan outline, from its signed distance, at its
+  top), in the scene's length unit;
 - :func:`boundary_xy`: the projected outer boundary of a drape (Fig. 6a);
 - :func:`boundary_distance`: the largest distance between two projected boundary curves
   (symmetric Hausdorff distance of the closed polylines);
@@ -14,74 +14,30 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["boundary_distance", "boundary_xy", "obstacle_drawers", "obstacle_outline", "plot_side_by_side"]
-
-
-def obstacle_outline(d: dict, length_scale: float = 1.0) -> tuple[np.ndarray | None, float | None]:
-    """Top outline (K, 2) and top height of an obstacle given by ``Obstacle.as_dict()`` [m].
-
-    Lengths are divided by ``length_scale`` (the scene's length unit in metres). Returns
-    ``(None, None)`` for obstacles without a top outline (floor).
-    """
-    from rftstatic.io.outlines import outline_circle, outline_square
-
-    s = float(length_scale)
-    t = d.get("type", "")
-    if t == "square-pedestal":
-        hw = np.broadcast_to(np.asarray(d["half_width"], float), (2,)) / s
-        c = np.asarray(d["centre"], float)[:2] / s
-        out = outline_square(c[0], c[1], float(hw[0]), corner_radius=float(d.get("edge_radius", 0.0)) / s)
-        if hw[0] != hw[1]:
-            out = (out - c) * [1.0, hw[1] / hw[0]] + c
-        return out, float(d["top"]) / s
-    if t == "round-pedestal":
-        c = np.asarray(d["centre"], float)[:2] / s
-        return outline_circle(c[0], c[1], float(d["radius"]) / s), float(d["top"]) / s
-    if t == "sphere":
-        c = np.asarray(d["centre"], float) / s
-        return outline_circle(c[0], c[1], float(d["radius"]) / s), float(c[2] + float(d["radius"]) / s)
-    return None, None
-
-
-def _sphere_drawer(centre, radius, color="0.55"):
-    """``draw(ax, view)`` for a sphere: filled disc in the top and side views, three great circles in 3-D."""
-    a = np.linspace(0.0, 2.0 * np.pi, 129)
-    cx, cy, cz = centre
-
-    def draw(ax, view: str) -> None:
-        if view == "top":
-            ax.fill(cx + radius * np.cos(a), cy + radius * np.sin(a), color=color, alpha=0.6, zorder=1)
-        elif view == "side":
-            ax.fill(cx + radius * np.cos(a), cz + radius * np.sin(a), color=color, alpha=0.6, zorder=1)
-        elif view == "iso":
-            c, s = radius * np.cos(a), radius * np.sin(a)
-            for xs, ys, zs in ((cx + c, cy + s, np.full_like(a, cz)), (cx + c, np.full_like(a, cy), cz + s),
-                               (np.full_like(a, cx), cy + c, cz + s)):
-                ax.plot(xs, ys, zs, color=color, lw=1.0)
-
-    return draw
+__all__ = ["boundary_distance", "boundary_xy", "obstacle_drawers", "plot_side_by_side"]
 
 
 def obstacle_drawers(obstacles, length_scale: float = 1.0) -> list:
     """``draw(ax, view)`` callables for ``views.plot_views(obstacles_draw=...)``, in scene units.
 
+    Each bounded obstacle is drawn from its interface alone (:meth:`Obstacle.plan_outline` at the top of
+    its bounding box; :func:`rftstatic.io.outlines.outline_drawer`), whatever its type: a new obstacle
+    type is drawn without a line here. Unbounded ones (a floor) are not drawn.
+
     Parameters
     ----------
-    obstacles : sequence of :class:`rftstatic.obstacles.Obstacle` (their ``as_dict()`` is read, [m])
+    obstacles : sequence of :class:`rftstatic.contact.obstacles.Obstacle` [m]
     length_scale : the scene's length unit [m] (0.01 for cm)
     """
     from rftstatic.io.outlines import outline_drawer
 
     draws = []
     for ob in obstacles:
-        d = ob.as_dict()
-        if d.get("type") == "sphere":
-            draws.append(_sphere_drawer(np.asarray(d["centre"], float) / length_scale,
-                                        float(d["radius"]) / length_scale))
+        outline = ob.plan_outline()
+        if outline is None:
             continue
-        outline, top = obstacle_outline(d, length_scale)
-        if outline is not None:
-            draws.append(outline_drawer(outline, z=top))
+        top = float(np.asarray(ob.bounding_box()[1], float)[2])
+        draws.append(outline_drawer(outline / length_scale, z=top / length_scale))
     return draws
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rftstatic.contact.obstacles import RoundPedestal, Sphere, SquarePedestal
-from rftstatic.io.drape_figures import boundary_distance, boundary_xy, obstacle_drawers, obstacle_outline
+from rftstatic.io.drape_figures import boundary_distance, boundary_xy, obstacle_drawers
 from rftstatic.mesh.trimesh import rectangle
 
 
@@ -39,14 +39,18 @@ def test_boundary_xy_of_flat_square_is_its_perimeter():
     assert np.allclose(np.abs(c).max(axis=0), [2.0, 2.0]) and np.allclose(c.min(axis=0), [0.0, 0.0])
 
 
-def test_obstacle_outlines_in_scene_units():
-    sq, top = obstacle_outline(SquarePedestal([0.0, 0.0], 0.05, top_z=0.01, edge_radius=0.002).as_dict(), 0.01)
-    assert top == pytest.approx(1.0)
-    assert np.abs(sq).max() == pytest.approx(5.0)
-    rd, top = obstacle_outline(RoundPedestal([0.1, 0.0], 0.1).as_dict(), 0.01)
-    assert np.linalg.norm(rd - [10.0, 0.0], axis=1) == pytest.approx(np.full(len(rd), 10.0))
-    sp, top = obstacle_outline(Sphere([0.0, 0.0, -0.05], 0.05).as_dict(), 0.01)
-    assert top == pytest.approx(0.0)
+def test_plan_outlines_come_from_the_signed_distance_of_any_obstacle():
+    from rftstatic.contact.obstacles import Floor
+
+    sq = SquarePedestal([0.0, 0.0], 0.05, top_z=0.01, edge_radius=0.002).plan_outline()
+    assert np.abs(sq).max() == pytest.approx(0.05, rel=1e-6)  # the sides at +-5 cm (the corners rounded)
+    corner = np.hypot(*sq[np.argmax(np.abs(sq[:, 0]) + np.abs(sq[:, 1]))])
+    assert corner == pytest.approx(np.hypot(0.048, 0.048) + 0.002, rel=1e-3)  # corner radius 0.2 cm
+    rd = RoundPedestal([0.1, 0.0], 0.1).plan_outline()
+    assert np.linalg.norm(rd - [0.1, 0.0], axis=1) == pytest.approx(np.full(len(rd), 0.1), rel=1e-6)
+    sp = Sphere([0.0, 0.0, -0.05], 0.05).plan_outline()  # the equator, not the pole
+    assert np.linalg.norm(sp, axis=1) == pytest.approx(np.full(len(sp), 0.05), rel=1e-6)
+    assert Floor(0.0).plan_outline() is None
 
 
 def test_obstacle_drawers_draw_every_view():
