@@ -20,8 +20,8 @@ __all__ = ["boundary_distance", "boundary_xy", "obstacle_drawers", "plot_side_by
 def obstacle_drawers(obstacles, length_scale: float = 1.0) -> list:
     """``draw(ax, view)`` callables for ``views.plot_views(obstacles_draw=...)``, in scene units.
 
-    Each bounded obstacle is drawn from its interface alone (:meth:`Obstacle.plan_outline` at the top of
-    its bounding box; :func:`rftstatic.io.outlines.outline_drawer`), whatever its type: a new obstacle
+    Each bounded obstacle is drawn from its interface alone (:meth:`Obstacle.plan_outline`, drawn at the height
+    where the solid is that wide; :func:`rftstatic.io.outlines.outline_drawer`), whatever its type: a new obstacle
     type is drawn without a line here. Unbounded ones (a floor) are not drawn.
 
     Parameters
@@ -33,11 +33,11 @@ def obstacle_drawers(obstacles, length_scale: float = 1.0) -> list:
 
     draws = []
     for ob in obstacles:
-        outline = ob.plan_outline()
-        if outline is None:
+        plan = ob.plan_outline()
+        if plan is None:
             continue
-        top = float(np.asarray(ob.bounding_box()[1], float)[2])
-        draws.append(outline_drawer(outline / length_scale, z=top / length_scale))
+        outline, height = plan
+        draws.append(outline_drawer(outline / length_scale, z=height / length_scale))
     return draws
 
 

@@ -42,14 +42,16 @@ def test_boundary_xy_of_flat_square_is_its_perimeter():
 def test_plan_outlines_come_from_the_signed_distance_of_any_obstacle():
     from rftstatic.contact.obstacles import Floor
 
-    sq = SquarePedestal([0.0, 0.0], 0.05, top_z=0.01, edge_radius=0.002).plan_outline()
+    sq, z = SquarePedestal([0.0, 0.0], 0.05, top_z=0.01, edge_radius=0.002).plan_outline()
+    assert 0.01 - 0.002 - 0.1 / 32 <= z <= 0.01  # at the top, below the edge rounding (33 heights)
     assert np.abs(sq).max() == pytest.approx(0.05, rel=1e-6)  # the sides at +-5 cm (the corners rounded)
     corner = np.hypot(*sq[np.argmax(np.abs(sq[:, 0]) + np.abs(sq[:, 1]))])
     assert corner == pytest.approx(np.hypot(0.048, 0.048) + 0.002, rel=1e-3)  # corner radius 0.2 cm
-    rd = RoundPedestal([0.1, 0.0], 0.1).plan_outline()
+    rd, _ = RoundPedestal([0.1, 0.0], 0.1).plan_outline()
     assert np.linalg.norm(rd - [0.1, 0.0], axis=1) == pytest.approx(np.full(len(rd), 0.1), rel=1e-6)
-    sp = Sphere([0.0, 0.0, -0.05], 0.05).plan_outline()  # the equator, not the pole
+    sp, z = Sphere([0.0, 0.0, -0.05], 0.05).plan_outline()  # the equator, not the pole
     assert np.linalg.norm(sp, axis=1) == pytest.approx(np.full(len(sp), 0.05), rel=1e-6)
+    assert z == pytest.approx(-0.05, abs=0.05 / 32)
     assert Floor(0.0).plan_outline() is None
 
 

@@ -227,13 +227,15 @@ class Obstacle(abc.ABC):
         coefficient); area ``None`` for an unbounded obstacle (a floor)."""
         return None, np.zeros(2)
 
-    def plan_outline(self, n: int = 128) -> np.ndarray | None:
-        """The solid's outline seen from above, ``(n, 2)`` [m], for drawing it; None when unbounded (a floor).
+    def plan_outline(self, n: int = 128) -> tuple[np.ndarray, float] | None:
+        """The solid's outline seen from above, ``(n, 2)`` [m], and the height [m] where it is that wide,
+        for drawing it; None when unbounded (a floor).
 
         Found from the signed distance alone (any obstacle type): along ``n`` rays from the footprint's
-        centre, the farthest point whose vertical line enters the solid (phi < 0 at one of 17 heights
-        over its top part), by bisection to 1e-9 of the box size. Exact for solids that are star-shaped
-        about that centre in plan (every type here); a type may give its own.
+        centre, the farthest point whose vertical line enters the solid (phi < 0 at one of 33 heights
+        over its top part), by bisection to 1e-9 of the box size; the height is the median over the rays
+        of the highest height of least phi there (the top of a vertical side). Exact for solids that are star-shaped about that centre in
+        plan (every type here); a type may give its own.
         """
         lo, hi = (np.asarray(b, float) for b in self.bounding_box())
         if not (np.isfinite(lo[:2]).all() and np.isfinite(hi[:2]).all() and np.isfinite(hi[2])):
@@ -241,7 +243,7 @@ class Obstacle(abc.ABC):
         _, centre = self.footprint()
         centre = np.asarray(centre, float)[:2]
         size = float(np.max(hi[:2] - lo[:2]))
-        z = np.linspace(max(lo[2], hi[2] - size), hi[2], 17)
+        z = np.linspace(max(lo[2], hi[2] - size), hi[2], 33)
         theta = 2.0 * np.pi * np.arange(n) / n
         d = np.column_stack([np.cos(theta), np.sin(theta)])
         inner, outer = np.zeros(n), np.full(n, float(np.hypot(*(hi[:2] - lo[:2]))))
@@ -249,9 +251,15 @@ class Obstacle(abc.ABC):
             mid = 0.5 * (inner + outer)
             xy = centre + mid[:, None] * d  # (n, 2)
             pts = np.concatenate([np.repeat(xy, len(z), axis=0), np.tile(z, n)[:, None]], axis=1)
-            inside = self.signed_distance(pts)[0].reshape(n, len(z)).min(axis=1) < 0.0
+            phi = self.signed_distance(pts)[0].reshape(n, len(z))
+            inside = phi.min(axis=1) < 0.0
             inner, outer = np.where(inside, mid, inner), np.where(inside, outer, mid)
-        return centre + inner[:, None] * d
+        xy = centre + inner[:, None] * d
+        pts = np.concatenate([np.repeat(xy, len(z), axis=0), np.tile(z, n)[:, None]], axis=1)
+        phi = self.signed_distance(pts)[0].reshape(n, len(z))
+        widest = phi <= phi.min(axis=1, keepdims=True) + 1e-6 * size  # a vertical side: all of it
+        height = float(np.median(np.max(np.where(widest, z[None, :], -np.inf), axis=1)))  # its top
+        return xy, height
 
     def closest_point(self, x: np.ndarray) -> np.ndarray:
         """Closest surface point ``x - phi * normal`` of every point.
