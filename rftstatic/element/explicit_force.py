@@ -57,7 +57,6 @@ class ForceKernel:
         self.model = model
         self.Kb = model.Kb.tocsr()
         self.Dm = np.ascontiguousarray(model.material.Dm, dtype=float)
-        self.Db = np.asarray(model.material.Db, float)
         self.with_membrane = model.with_membrane
         self.contact = model.contact
         self.X3 = model.X3
