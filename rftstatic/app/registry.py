@@ -19,6 +19,8 @@ mesher's imports.
 from __future__ import annotations
 
 import importlib
+import os
+import shutil
 from pathlib import Path
 
 from rftstatic.scenes.analyses import ANALYSES, SCENE_ANALYSES
@@ -36,13 +38,59 @@ def analysis_of(scene) -> str:
     return name
 
 
+PARTIAL = ".partial"
+"""Suffix of the folder a run writes into before it replaces ``--out`` as a whole."""
+
+
+def _check_out(out: Path) -> None:
+    """``out`` may be replaced: absent, empty, or an earlier run's folder (it holds ``summary.json``)."""
+    if out.exists() and (not out.is_dir() or (any(out.iterdir()) and not (out / "summary.json").exists())):
+        what = "a file" if not out.is_dir() else "a folder that is not an rftstatic output (no summary.json)"
+        raise OSError(f"--out {out} is {what}; a run replaces its output folder as a whole: choose a new "
+                      "or an earlier run's folder")
+
+
+def _publish(partial: Path, out: Path) -> None:
+    """Move the finished run ``partial`` into place as ``out``, replacing an earlier run as a whole."""
+    old = None
+    if out.exists():
+        old = out.with_name(f"{out.name}.old-{os.getpid()}")
+        out.rename(old)
+    partial.rename(out)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
 def run(scene, out_dir, *, progress=True, figures=True):
-    """Run ``scene`` with its analysis (:func:`analysis_of`), writing into ``out_dir`` (created);
-    return the :class:`~rftstatic.app.result.RunResult`."""
+    """Run ``scene`` with its analysis (:func:`analysis_of`) and return the
+    :class:`~rftstatic.app.result.RunResult`.
+
+    The run writes into ``<out_dir>.partial`` and replaces ``out_dir`` as a whole when it ends (also when
+    its goal was not reached: the last state is written, labelled ``converged = false``), so that a
+    reader never sees two runs mixed. An interrupted or killed dynamic run leaves its checkpoint in
+    ``<out_dir>.partial``, where ``--resume`` finds it.
+    """
+    from rftstatic.errors import ConvergenceError, InstabilityError
+
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    _check_out(out)
+    partial = out.with_name(out.name + PARTIAL)
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
     module = importlib.import_module(ANALYSES[analysis_of(scene)])
-    return module.run(scene, out, progress=progress, figures=figures)
+    try:
+        result = module.run(scene, partial, progress=progress, figures=figures)
+    except (ConvergenceError, InstabilityError):
+        if (partial / "summary.json").exists():  # the last state was written: it is the run's result
+            _publish(partial, out)
+        raise
+    except Exception:
+        if not (partial / "checkpoint.npz").exists():  # nothing to resume: leave no partial folder
+            shutil.rmtree(partial, ignore_errors=True)
+        raise
+    _publish(partial, out)
+    result.out = out
+    return result
 
 
 def run_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
@@ -51,7 +99,18 @@ def run_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
-    """Continue a dynamic or relax run of ``scene`` from ``out_dir/checkpoint.npz``; return its summary."""
+    """Continue a dynamic or relax run of ``scene`` from its checkpoint; return its summary.
+
+    The checkpoint of an interrupted run is in ``<out_dir>.partial`` (:func:`run`); that run continues
+    there and then replaces ``out_dir``. Without one, the run continues from ``out_dir/checkpoint.npz``
+    in place.
+    """
     from rftstatic.app.dynamic import resume_scene as resume
 
-    return resume(scene, out_dir, progress=progress, figures=figures)
+    out = Path(out_dir)
+    partial = out.with_name(out.name + PARTIAL)
+    if (partial / "checkpoint.npz").exists():
+        summary = resume(scene, partial, progress=progress, figures=figures)
+        _publish(partial, out)
+        return summary
+    return resume(scene, out, progress=progress, figures=figures)

@@ -163,3 +163,35 @@ def test_full_hanging_sheets_come_to_rest_hanging(tmp_path, name, side, t_end, w
     assert mid["final"][2] == pytest.approx(-side, rel=0.05) and abs(mid["final"][0]) < 0.05 * side
     assert min(mid["x"]) < -0.05 * side  # swung past the vertical on the way
     assert len(s["frames"]) == 4 and all(len(f["files"]) == 2 for f in s["frames"])
+
+
+# --------------------------------------------------------------- the output folder is replaced as a whole
+def test_a_run_replaces_an_earlier_run_as_a_whole_and_refuses_a_foreign_folder(tmp_path, capsys):
+    out = tmp_path / "h"
+    assert main(["case", "hang-20", *_args(), "--out", str(out), "--no-figures"]) == 0
+    (out / "frame_t9.png").write_bytes(b"stale")  # a file only an earlier run wrote
+    assert main(["case", "hang-20", *_args(), "--out", str(out), "--no-figures"]) == 0
+    assert not (out / "frame_t9.png").exists() and (out / "summary.json").exists()
+    assert not (tmp_path / "h.partial").exists() and sorted(p.name for p in tmp_path.iterdir()) == ["h"]
+    foreign = tmp_path / "mine"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("keep me")
+    assert main(["case", "hang-20", *_args(), "--out", str(foreign), "--no-figures"]) == 4
+    assert "not an rftstatic output" in capsys.readouterr().err
+    assert (foreign / "notes.txt").read_text() == "keep me"
+
+
+def test_an_interrupted_run_resumes_from_its_partial_folder(tmp_path):
+    scene = _tiny_scene()
+    full = _run(scene, tmp_path / "full")
+    out = tmp_path / "cut"
+
+    def interrupt(state, sample):
+        if state.t > 0.03:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):  # as registry.run leaves it: the checkpoint in cut.partial
+        _run(scene, tmp_path / "cut.partial", callback=interrupt)
+    resumed = resume_scene(scene, out, progress=False, figures=False)
+    assert not (tmp_path / "cut.partial").exists() and (out / "summary.json").exists()
+    assert resumed["steps"] == full["steps"] and resumed["energies"] == full["energies"]
