@@ -149,6 +149,8 @@ def build_material(scene: Scene) -> mat.Material:
 def select_nodes(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
     """Nodes named by a ``box`` or ``at`` entry of a scene table (reference coordinates)."""
     u = scene.units.length
+    if "box" in spec and "at" in spec:
+        raise scene.error(f"{key}.at", "give box = [...] or at = [...], not both")
     if "box" in spec:
         box = spec["box"]
         if not (isinstance(box, list) and len(box) == 4):
@@ -158,6 +160,7 @@ def select_nodes(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
         pts = np.atleast_2d(np.asarray(spec["at"], float))
         if pts.shape[1] != 2:
             raise scene.error(f"{key}.at", f"expected [[x, y], ...], got {spec['at']!r}")
+        check_on_sheet(scene, mesh, pts * u, f"{key}.at")
         nodes = np.unique(mesh.nearest_node(pts * u))
     else:
         raise scene.error(key, "needs a box = [xmin, xmax, ymin, ymax] or at = [[x, y], ...]")
@@ -165,6 +168,22 @@ def select_nodes(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
         raise scene.error(f"{key}.box", f"{spec['box']} contains no node of the mesh; check the coordinates "
                           f"(scene units, reference configuration)")
     return nodes
+
+
+def check_on_sheet(scene: Scene, mesh, pts: np.ndarray, key: str) -> None:
+    """Scene error unless every reference point ``pts (P, 2)`` [m] lies on the sheet: inside an element,
+    or within half the largest element size of a node (a boundary point the point location misses)."""
+    elem, _ = mesh.locate(pts)
+    off = elem < 0
+    if off.any():
+        d = np.linalg.norm(mesh.X[mesh.nearest_node(pts[off])] - pts[off], axis=1)
+        far = d > 0.5 * float(mesh.element_size.max())
+        if far.any():
+            u = scene.units.length
+            p = pts[off][far][0] / u
+            lo, hi = mesh.X.min(axis=0) / u, mesh.X.max(axis=0) / u
+            raise scene.error(key, f"[{p[0]:g}, {p[1]:g}] is not on the sheet (reference coordinates, scene "
+                              f"units; the sheet spans x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
 
 
 def build_supports(scene: Scene, mesh) -> Supports:
@@ -325,6 +344,7 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
             raise scene.error(f"probes.{i}.name", f'"{spec["name"]}" names an earlier probe too; give each a name '
                               "of its own")
         probes[spec["name"]] = np.asarray(spec["at"], float) * u
+        check_on_sheet(scene, mesh, probes[spec["name"]][None, :], f"probes.{i}.at")
     return model, {"obstacles": obstacles, "probes": probes}
 
 

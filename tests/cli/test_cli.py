@@ -170,3 +170,21 @@ def test_keys_that_do_not_apply_are_scene_errors(scene, override, fragment):
     with pytest.raises(SceneError) as info:
         build_model(load_scene(scene, [override]))
     assert fragment in str(info.value)
+
+
+@pytest.mark.parametrize("override, key", [
+    ("probes.0.at=[50.0,0.0]", "probes.0.at"),
+    ("loads.point=[{at=[9.0,9.0],force=[0,0,-1]}]", "loads.point.0.at"),
+])
+def test_points_off_the_sheet_are_scene_errors_not_snapped(override, key):
+    from rftstatic.scenes.build import build_model
+
+    with pytest.raises(SceneError, match=f"{key}: .* is not on the sheet"):
+        build_model(load_scene("strip", [override]))
+
+
+def test_a_support_with_both_box_and_at_is_a_scene_error():
+    from rftstatic.scenes.build import build_model
+
+    with pytest.raises(SceneError, match="supports.0.at: give box"):
+        build_model(load_scene("strip", ["supports.0.at=[[0.0,0.0]]"]))
