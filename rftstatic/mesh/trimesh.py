@@ -401,8 +401,17 @@ def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
     if not tris:
         kinds = sorted({c.type for c in m.cells})
         raise MeshError(f"{path}: no triangle cells (found {kinds}); export the mesh as triangles")
+    other = sorted({c.type for c in m.cells} - {"triangle", "vertex", "line"})
+    if other:
+        raise MeshError(f"{path}: holds {', '.join(other)} cells besides triangles; the RF triangle needs a "
+                        "triangle mesh: split the other cells into triangles before exporting")
     tri = np.vstack(tris)
     P = np.asarray(m.points, float) * length_scale
+    if tri.size and (tri.min() < 0 or tri.max() >= len(P)):
+        bad = int(tri.max()) if tri.max() >= len(P) else int(tri.min())
+        raise MeshError(f"{path}: a triangle names node {bad}, but the file has nodes 0..{len(P) - 1}")
+    if not np.isfinite(P).all():
+        raise MeshError(f"{path}: node coordinates are not all finite (NaN or inf)")
     z = P[:, 2] if P.shape[1] == 3 else np.zeros(len(P))
     span = max(np.ptp(P[:, :2], axis=0).max(), 1e-300)
     if np.ptp(z) > 1e-9 * span:
@@ -411,6 +420,11 @@ def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
             "configuration of a fabric is flat: export it in the x-y plane"
         )
     used = np.unique(tri)
+    _, first, count = np.unique(np.round(P[used, :2] / span, 12), axis=0, return_index=True, return_counts=True)
+    if (count > 1).any():
+        i = int(used[first[np.argmax(count > 1)]])
+        raise MeshError(f"{path}: node {i} at {P[i, :2].tolist()} is repeated (coincident nodes); merge "
+                        "duplicate nodes before exporting (the sheet would come apart there)")
     remap = np.full(len(P), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
     mesh_z0 = float(z[used].mean()) if z0 is None else z0

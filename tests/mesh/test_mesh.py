@@ -81,3 +81,23 @@ def test_patches_and_bending_of_a_large_mesh_build_vectorised():
     assert abs(Kb - Kb.T).max() <= 1e-12 * abs(Kb).max()
     for rigid in (np.ones(m.n_nodes), m.X[:, 0], m.X[:, 1]):  # translation and rotations about x, y
         assert np.abs(Kb @ rigid).max() <= 1e-9 * abs(Kb).max()
+
+
+def test_mesh_files_that_are_not_a_clean_triangle_mesh_are_refused(tmp_path):
+    import meshio
+
+    pts = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]])
+    cases = {
+        "quads": ([("triangle", np.array([[0, 1, 2]])), ("quad", np.array([[1, 4, 2, 3]]))], "quad cells"),
+        "missing": ([("triangle", np.array([[0, 1, 7]]))], "names node 7"),
+    }
+    for name, (cells, fragment) in cases.items():
+        path = tmp_path / f"{name}.vtu"
+        meshio.write(path, meshio.Mesh(pts, cells))
+        with pytest.raises(mesh.MeshError, match=fragment):
+            mesh.read(path)
+    dup = np.vstack([pts[:4], pts[2:3]])  # node 4 sits on node 2
+    path = tmp_path / "dup.vtu"
+    meshio.write(path, meshio.Mesh(dup, [("triangle", np.array([[0, 1, 2], [0, 4, 3]]))]))
+    with pytest.raises(mesh.MeshError, match="repeated"):
+        mesh.read(path)
