@@ -291,11 +291,18 @@ def apply_override(data: dict, key: str, value, source="--set") -> None:
 def load_scene(name_or_path: str, overrides=()) -> Scene:
     """Read, override and validate a scene (``overrides``: ``["key=value", ...]``)."""
     path = find_scene(name_or_path)
+    if not path.is_file():
+        raise SceneError(f"{path}: not a scene file (a directory or a special file); give a .toml file")
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not a text file in UTF-8 (byte {exc.start}: {exc.reason}); save the scene "
+                         "as UTF-8 TOML") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot be read ({exc.strerror})") from None
     applied = {}
     for text in overrides:
         key, value = parse_override(text)

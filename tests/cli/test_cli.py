@@ -188,3 +188,16 @@ def test_a_support_with_both_box_and_at_is_a_scene_error():
 
     with pytest.raises(SceneError, match="supports.0.at: give box"):
         build_model(load_scene("strip", ["supports.0.at=[[0.0,0.0]]"]))
+
+
+def test_broken_scene_files_are_scene_errors(tmp_path):
+    garbage = tmp_path / "garbage.toml"
+    garbage.write_bytes(bytes(range(128, 256)))
+    latin = tmp_path / "latin.toml"
+    latin.write_bytes('title = "laine mérinos"\n'.encode("latin-1"))
+    folder = tmp_path / "folder.toml"
+    folder.mkdir()
+    for path, fragment in ((garbage, "not a text file in UTF-8"), (latin, "not a text file in UTF-8"),
+                           (folder, "not a scene file")):
+        with pytest.raises(SceneError, match=fragment):
+            load_scene(str(path))
