@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rftstatic.app.registry import ANALYSES, analysis_of
+from rftstatic.app.registry import ANALYSES, analysis_of, resume_scene
 from rftstatic.app.registry import run as _run
 from rftstatic.app.result import RunResult
 from rftstatic.errors import ConvergenceError, InstabilityError, SceneError
@@ -54,8 +54,6 @@ def run(scene: Scene | str, out: str | Path | None = None, *, overrides=(), prog
 def resume(scene: Scene | str, out: str | Path | None = None, *, overrides=(), progress: bool = False,
            figures: bool = True) -> dict:
     """Continue a dynamic or relax run from ``out/checkpoint.npz``; return its summary."""
-    from rftstatic.app.registry import resume_scene
-
     if not isinstance(scene, Scene):
         scene = load_scene(str(scene), overrides)
     out = Path(out) if out is not None else Path("out") / scene.name

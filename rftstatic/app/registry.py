@@ -23,6 +23,7 @@ import os
 import shutil
 from pathlib import Path
 
+from rftstatic.errors import ConvergenceError, InstabilityError
 from rftstatic.scenes.analyses import ANALYSES, SCENE_ANALYSES
 
 __all__ = ["ANALYSES", "analysis_of", "run", "run_scene", "resume_scene"]
@@ -70,8 +71,6 @@ def run(scene, out_dir, *, progress=True, figures=True):
     reader never sees two runs mixed. An interrupted or killed dynamic run leaves its checkpoint in
     ``<out_dir>.partial``, where ``--resume`` finds it.
     """
-    from rftstatic.errors import ConvergenceError, InstabilityError
-
     out = Path(out_dir)
     _check_out(out)
     partial = out.with_name(out.name + PARTIAL)

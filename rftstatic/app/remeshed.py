@@ -36,6 +36,7 @@ import numpy as np
 
 from rftstatic.app.result import RunResult
 from rftstatic.contact.kinematic import contact_reaction_residual
+from rftstatic.errors import ParameterError
 from rftstatic.io.files import to_jsonable, write_json
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import drape_summary, probe_summary, summary_header
@@ -99,12 +100,12 @@ def solve_remesh_scene(scene, opts=None) -> dict:
     opts = remesh_options(scene) if opts is None else opts
     analysis = scene.get("analysis", "static")
     t0 = time.perf_counter()
-    if analysis == "static":
-        solved = _static(scene, opts)
-    elif analysis == "relax":
-        solved = _relax(scene, opts)
-    else:
+    if analysis not in ("static", "relax"):
         raise scene.error("analysis", f'"{analysis}" cannot be remeshed; use "static" or "relax" with [remesh]')
+    try:
+        solved = (_static if analysis == "static" else _relax)(scene, opts)
+    except ParameterError as exc:  # checked against the mesh: sizes larger than the sheet
+        raise scene.error(f"remesh.{exc.key}", exc.detail) from None
     solved["wall_time_s"] = time.perf_counter() - t0
     return solved
 

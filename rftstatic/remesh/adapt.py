@@ -42,7 +42,7 @@ import numpy as np
 
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.errors import ParameterError
-from rftstatic.remesh.sizefield import size_field
+from rftstatic.remesh.sizefield import check_size_bounds, size_field
 from rftstatic.remesh.transfer import METHODS, transfer_fields
 
 DAMPING = ("fixed", "critical")
@@ -265,14 +265,10 @@ def check_remesh_parameters(*, const, h_lower, h_upper, gradation=1.3, max_cycle
         raise ParameterError("kappa_h2_max", f"must be a positive length or None (Eq. 28), got {kappa_h2_max!r}")
 
 
-def _check_extent(mesh, h_lower, h_upper):
-    """Element size bounds no larger than the sheet (the smaller side of its bounding box)."""
+def _check_extent(mesh, const, h_lower, h_upper):
+    """The Eq. 29 parameters, with size bounds no larger than the sheet (the smaller side of its box)."""
     lo, hi = mesh.X.min(axis=0), mesh.X.max(axis=0)
-    extent = float((hi - lo).min())
-    for name, v in (("h_lower", h_lower), ("h_upper", h_upper)):
-        if v > extent:
-            raise ParameterError(name, f"{name} = {v!r} m is larger than the sheet (smaller side {extent:.6g} m); "
-                                 f"a flat region would get elements bigger than the domain: use {name} < {extent:.6g}")
+    check_size_bounds(const=const, h_lower=h_lower, h_upper=h_upper, extent=float((hi - lo).min()))
 
 
 

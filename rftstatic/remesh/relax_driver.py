@@ -250,7 +250,7 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         def residual(model, U):
             return model.residual(U)
     model, extras = make(None)
-    _check_extent(model.mesh, h_lower, h_upper)
+    _check_extent(model.mesh, const, h_lower, h_upper)
     if advance is None:
         if alpha is None:
             raise ValueError("alpha (mass damping [1/s]) is needed by the default explicit stepper; or pass advance=")

@@ -27,12 +27,14 @@ from __future__ import annotations
 import numpy as np
 
 from rftstatic.element.curvature import curvature_norm
+from rftstatic.errors import ParameterError
 
 __all__ = ["check_size_bounds", "size_field", "target_sizes"]
 
 
 def check_size_bounds(*, const, h_lower, h_upper, extent=None) -> None:
-    """Raise ``ValueError`` naming the parameter if the Eq. 29 parameters are unusable.
+    """Raise :class:`~rftstatic.errors.ParameterError` (a ``ValueError``) naming the parameter if the Eq. 29
+    parameters are unusable.
 
     Parameters
     ----------
@@ -42,15 +44,16 @@ def check_size_bounds(*, const, h_lower, h_upper, extent=None) -> None:
     """
     for name, v in (("const", const), ("h_lower", h_lower), ("h_upper", h_upper)):
         if not (isinstance(v, (int, float, np.floating, np.integer)) and np.isfinite(v) and v > 0):
-            raise ValueError(f"{name} = {v!r} must be a positive finite number [m] (Eq. 29)")
+            raise ParameterError(name, f"{name} = {v!r} must be a positive finite number [m] (Eq. 29)")
     if h_lower > h_upper:
-        raise ValueError(f"h_lower = {h_lower!r} m is larger than h_upper = {h_upper!r} m; "
+        raise ParameterError("h_lower", f"h_lower = {h_lower!r} m is larger than h_upper = {h_upper!r} m; "
                          "Eq. 29 clips h_target to [h_lower, h_upper]: swap them")
     if extent is not None:
         for name, v in (("h_lower", h_lower), ("h_upper", h_upper)):
             if v > extent:
-                raise ValueError(f"{name} = {v!r} m is larger than the sheet (smaller side {extent:.6g} m); "
-                                 f"a flat region would get elements bigger than the domain: use {name} < {extent:.6g}")
+                raise ParameterError(name, f"{name} = {v!r} m is larger than the sheet (smaller side {extent:.6g} "
+                                     f"m); a flat region would get elements bigger than the domain: use {name} < "
+                                     f"{extent:.6g}")
 
 
 def target_sizes(kappa, *, const, h_lower, h_upper) -> np.ndarray:

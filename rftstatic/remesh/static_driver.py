@@ -94,7 +94,7 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         options = StaticOptions(progress=False)
     t0 = time.perf_counter()
     model, extras = make(None)
-    _check_extent(model.mesh, h_lower, h_upper)
+    _check_extent(model.mesh, const, h_lower, h_upper)
     if domain is None:
         domain = reference_domain(model.mesh)
     result = solve_static(model, options=options)

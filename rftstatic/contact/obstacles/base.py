@@ -234,8 +234,8 @@ class Obstacle(abc.ABC):
         Found from the signed distance alone (any obstacle type): along ``n`` rays from the footprint's
         centre, the farthest point whose vertical line enters the solid (phi < 0 at one of 33 heights
         over its top part), by bisection to 1e-9 of the box size; the height is the median over the rays
-        of the highest height of least phi there (the top of a vertical side). Exact for solids that are star-shaped about that centre in
-        plan (every type here); a type may give its own.
+        of the highest height of least phi there (the top of a vertical side). Exact for solids that are
+        star-shaped about that centre in plan (every type here); a type may give its own.
         """
         lo, hi = (np.asarray(b, float) for b in self.bounding_box())
         if not (np.isfinite(lo[:2]).all() and np.isfinite(hi[:2]).all() and np.isfinite(hi[2])):
@@ -246,17 +246,18 @@ class Obstacle(abc.ABC):
         z = np.linspace(max(lo[2], hi[2] - size), hi[2], 33)
         theta = 2.0 * np.pi * np.arange(n) / n
         d = np.column_stack([np.cos(theta), np.sin(theta)])
+
+        def columns(radius):  # (n, 2) points at ``radius`` along the rays, (n, 33) phi up their columns
+            xy = centre + radius[:, None] * d
+            pts = np.concatenate([np.repeat(xy, len(z), axis=0), np.tile(z, n)[:, None]], axis=1)
+            return xy, self.signed_distance(pts)[0].reshape(n, len(z))
+
         inner, outer = np.zeros(n), np.full(n, float(np.hypot(*(hi[:2] - lo[:2]))))
         while np.max(outer - inner) > 1e-9 * size:
             mid = 0.5 * (inner + outer)
-            xy = centre + mid[:, None] * d  # (n, 2)
-            pts = np.concatenate([np.repeat(xy, len(z), axis=0), np.tile(z, n)[:, None]], axis=1)
-            phi = self.signed_distance(pts)[0].reshape(n, len(z))
-            inside = phi.min(axis=1) < 0.0
+            inside = columns(mid)[1].min(axis=1) < 0.0
             inner, outer = np.where(inside, mid, inner), np.where(inside, outer, mid)
-        xy = centre + inner[:, None] * d
-        pts = np.concatenate([np.repeat(xy, len(z), axis=0), np.tile(z, n)[:, None]], axis=1)
-        phi = self.signed_distance(pts)[0].reshape(n, len(z))
+        xy, phi = columns(inner)
         widest = phi <= phi.min(axis=1, keepdims=True) + 1e-6 * size  # a vertical side: all of it
         height = float(np.median(np.max(np.where(widest, z[None, :], -np.inf), axis=1)))  # its top
         return xy, height
