@@ -72,6 +72,23 @@ def averaged_strain(H):
     return exx / Q, eyy / Q, gxy / Q
 
 
+def strain_increment(H, h):
+    """The linearised change of the membrane strain, ``Bbar(U) dU = 1/Q sum_q sym(F_q^T h_q)`` in
+    the order (e_xx, e_yy, 2 e_xy) [-]: the derivative of Eq. 14 along ``dU``, from the displacement
+    gradients ``H`` of U and ``h`` of dU ``(Q, 2, 3)`` [-] (:func:`strain_point_gradients`)."""
+    Q = H.shape[0]
+    dxx = 0.0 * h[0, 0, 0]
+    dyy = 0.0 * h[0, 0, 0]
+    dxy = 0.0 * h[0, 0, 0]
+    for q in range(Q):
+        for i in range(3):
+            fx, fy = _deformation(H, q, i)
+            dxx = dxx + fx * h[q, 0, i]
+            dyy = dyy + fy * h[q, 1, i]
+            dxy = dxy + (fx * h[q, 1, i] + fy * h[q, 0, i])
+    return dxx / Q, dyy / Q, dxy / Q
+
+
 def stress(Dm, exx, eyy, gxy):
     """Second Piola-Kirchhoff stress resultant ``S = D^m eps = (S_xx, S_yy, S_xy)`` [N/m] (Eq. 15),
     ``Dm (3, 3)`` [N/m]."""
@@ -232,17 +249,24 @@ def membrane_force_blocks(nodes, G, area, Dm, U, fe, chunks):
     return W
 
 
-def membrane_tangents(nodes, G, area, Dm, U, psd, fe, ke):
-    """Fill ``fe (E, A, 3)`` [N] and ``ke (E, A, 3, A, 3)`` [N/m] for every element."""
+def membrane_tangents(nodes, G, area, Dm, U, psd, S, fe, ke):
+    """Fill ``fe (E, A, 3)`` [N] and ``ke (E, A, 3, A, 3)`` [N/m] for every element.
+
+    ``S (E, 3)`` [N/m]: the stress of the geometric part (the mixed stress of
+    :func:`linearised_strain`, MIP Newton); ``S (0, 3)``: the element's own stress ``D^m eps(U)``,
+    the exact Hessian. The force is always the gradient of Eq. 15 at ``U``."""
     E, Q, A = G.shape[0], G.shape[1], G.shape[2]
     H = np.empty((Q, 2, 3))
     u = np.empty((A, 3))
     B = np.empty((3, A, 3))
     DB = np.empty((3, A, 3))
+    given = S.shape[0] > 0
     for e in range(E):
         g = G[e]
         _, _, _, sxx, syy, sxy = membrane_state(g, _gather(U, nodes[e], u), Dm, H)
         element_force(g, H, sxx, syy, sxy, area[e], fe[e])
+        if given:
+            sxx, syy, sxy = S[e, 0], S[e, 1], S[e, 2]
         element_tangent(g, H, sxx, syy, sxy, area[e], Dm, psd, B, DB, ke[e])
 
 
@@ -302,6 +326,18 @@ def strains_numpy(G_last, nodes, U):
     return np.stack(averaged_strain(H), axis=-1), H
 
 
+def linearised_strain_numpy(G_last, nodes, U, dU):
+    """``(E, 3)`` linearised membrane strain ``eps(U) + Bbar(U) dU`` [-] of every element: the strain
+    that the mixed (MIP) Newton iteration carries to the next iterate (:func:`strain_increment`)."""
+    u, H = _vectorised(G_last, nodes, U)
+    du, h = _vectorised(G_last, nodes, dU)
+    strain_point_gradients(G_last, u, H)
+    strain_point_gradients(G_last, du, h)
+    eps = averaged_strain(H)
+    inc = strain_increment(H, h)
+    return np.stack([eps[k] + inc[k] for k in range(3)], axis=-1)
+
+
 def energies_numpy(G_last, nodes, area, Dm, U):
     """``(E,)`` membrane energy [J] of every element (:func:`membrane_energies`)."""
     u, H = _vectorised(G_last, nodes, U)
@@ -318,14 +354,17 @@ def forces_numpy(G_last, nodes, area, Dm, U):
     return fe, strain_energy(area, exx, eyy, gxy, sxx, syy, sxy)
 
 
-def tangents_numpy(G_last, nodes, area, Dm, U, psd):
-    """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m] (:func:`membrane_tangents`).
-    The kernels write through element-last views of the outputs (cheaper than a transposed copy)."""
+def tangents_numpy(G_last, nodes, area, Dm, U, psd, S=None):
+    """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m] (:func:`membrane_tangents`;
+    ``S (E, 3)`` or None as there). The kernels write through element-last views of the outputs
+    (cheaper than a transposed copy)."""
     u, H = _vectorised(G_last, nodes, U)
     E, A = nodes.shape
     _, _, _, sxx, syy, sxy = membrane_state(G_last, u, Dm, H)
     fe = np.empty((E, A, 3))
     element_force(G_last, H, sxx, syy, sxy, area, np.moveaxis(fe, 0, -1))
+    if S is not None and len(S):
+        sxx, syy, sxy = S[:, 0], S[:, 1], S[:, 2]
     ke = np.empty((E, A, 3, A, 3))
     scratch = np.empty((2, 3, A, 3, E))
     element_tangent(G_last, H, sxx, syy, sxy, area, Dm, psd, scratch[0], scratch[1], np.moveaxis(ke, 0, -1))

@@ -24,7 +24,14 @@ from functools import cached_property
 import numpy as np
 
 from rftstatic.compiled import numba_available
-from rftstatic.element.kernels import element_last, energies_numpy, forces_numpy, strains_numpy, tangents_numpy
+from rftstatic.element.kernels import (
+    element_last,
+    energies_numpy,
+    forces_numpy,
+    linearised_strain_numpy,
+    strains_numpy,
+    tangents_numpy,
+)
 from rftstatic.element.patch import Patches
 from rftstatic.mesh.trimesh import TriMesh
 
@@ -91,6 +98,24 @@ class MembraneOperator:
         """
         return strains_numpy(self.G_last, self.nodes, U)[0]
 
+    def linearised_strain(self, U: np.ndarray, dU: np.ndarray) -> np.ndarray:
+        """``eps(U) + Bbar(U) dU (E, 3)`` [-]: the averaged strain of Eq. 14 linearised about ``U (N, 3)``
+        along ``dU (N, 3)`` [m] (exact to first order; the Green strain's quadratic term in dU left out)."""
+        return linearised_strain_numpy(self.G_last, self.nodes, _as_float(U), _as_float(dU))
+
+    def force_roundoff(self, U: np.ndarray, Dm: np.ndarray) -> np.ndarray:
+        """``(E, A)`` [N]: the size of the round-off in the element forces at ``U (N, 3)`` [m], per unit
+        roundoff ``eps``: ``A |g_a| |F| |D^m| (|H| + |H|^2)``. The strain of Eq. 14 sums terms of size |H|
+        and |H|^2 (a rotated element: both of order 1 while the strain itself is tiny), so its error is
+        ``eps (|H| + |H|^2)`` whatever the strain, and a membrane as stiff as ``|D^m|`` [N/m] turns it
+        into a stress error that no force residual can go below (the strip at C/B = 1e9 /cm^2 stalls
+        at 1e-9 N, 1e-5 of its weight)."""
+        H = self.displacement_gradient(_as_float(U))  # (E, Q, 3, 2)
+        hmag = np.sqrt((H * H).sum(axis=(2, 3))).max(axis=1)  # (E,)
+        gmag = np.sqrt((self.G * self.G).sum(axis=-1)).max(axis=1)  # (E, A)
+        dnorm = float(np.abs(Dm).sum(axis=1).max())
+        return (self.area * (1.0 + hmag) * dnorm * (hmag + hmag * hmag))[:, None] * gmag
+
     def energy(self, U, Dm, *, backend="auto") -> float:
         """Membrane energy, Eq. 15 [J]."""
         return float(self.element_energy(U, Dm, backend=backend).sum())
@@ -117,12 +142,14 @@ class MembraneOperator:
             return fe
         return np.moveaxis(forces_numpy(self.G_last, self.nodes, self.area, Dm, U)[0], -1, 0)
 
-    def element_tangents(self, U, Dm, *, psd=False, backend="auto"):
+    def element_tangents(self, U, Dm, *, psd=False, stress=None, backend="auto"):
         """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m].
 
         With ``psd=True`` the geometric (initial-stress) part uses the positive part of the stress,
         so the tangent is positive semi-definite under compression (the safeguard of method.md);
         the material part ``Bbar^T D^m Bbar`` is always positive semi-definite.
+        ``stress (E, 3)`` [N/m]: the stress of the geometric part in place of ``D^m eps(U)`` (the mixed
+        stress of MIP Newton, :mod:`rftstatic.solvers.newton`); None: the exact Hessian.
         ``backend`` (here and in the other methods): ``"numba"`` (the kernels of
         :mod:`rftstatic.element.kernels` compiled, one element at a time), ``"numpy"`` (the same
         kernels vectorised over the elements), ``"auto"``: numba when installed.
@@ -134,9 +161,10 @@ class MembraneOperator:
             E, A = self.nodes.shape
             f = np.empty((E, A, 3))
             K = np.empty((E, A, 3, A, 3))
-            membrane_tangents(*self._compiled_args, Dm, U, bool(psd), f, K)
+            S = np.zeros((0, 3)) if stress is None else _as_float(stress)
+            membrane_tangents(*self._compiled_args, Dm, U, bool(psd), S, f, K)
             return f, K
-        return tangents_numpy(self.G_last, self.nodes, self.area, Dm, U, bool(psd))
+        return tangents_numpy(self.G_last, self.nodes, self.area, Dm, U, bool(psd), stress)
 
 
 def _compiled(backend: str) -> bool:

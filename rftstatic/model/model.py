@@ -155,7 +155,8 @@ class Model:
 
     @cached_property
     def _membrane_map(self) -> np.ndarray:
-        return self.plan.element_map(self.membrane.nodes)
+        # contiguous: scatter_matrices ravels it at every tangent (a strided copy took 3 x the scatter)
+        return np.ascontiguousarray(self.plan.element_map(self.membrane.nodes))
 
     @property
     def X3(self) -> np.ndarray:
@@ -201,18 +202,20 @@ class Model:
             r += lam * term.force(self.positions(U))
         return r
 
-    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None):
+    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None, stress=None):
         """Internal force ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m] at load factor ``lam``.
 
         ``psd=True`` drops compressive stress from the geometric stiffness (positive semi-definite
-        membrane tangent); ``shift`` adds ``shift * I`` (Levenberg-Marquardt).
+        membrane tangent); ``shift`` adds ``shift * I`` (Levenberg-Marquardt); ``stress (E, 3)``
+        [N/m]: the membrane stress of the geometric stiffness (MIP Newton's mixed stress,
+        :meth:`mixed_stress`) in place of :meth:`membrane_stress` (None: the exact Hessian).
         """
         plan = self.plan
         data = self._bending_data.copy()
         f = self.Kb @ U
         x = self.positions(U)
         if self.with_membrane:
-            fe, ke = self.membrane.element_tangents(U, self.material.Dm, psd=psd)
+            fe, ke = self.membrane.element_tangents(U, self.material.Dm, psd=psd, stress=stress)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
             data += scatter_matrices(self._membrane_map, ke, plan.nnz)
         if self.contact is not None:
@@ -234,6 +237,15 @@ class Model:
     def membrane_strain(self, U) -> np.ndarray:
         """(E, 3) averaged Green membrane strain (e_xx, e_yy, 2 e_xy) [-]."""
         return self.membrane.strain(U)
+
+    def membrane_stress(self, U) -> np.ndarray:
+        """(E, 3) membrane stress resultant ``S = D^m eps(U)`` (S_xx, S_yy, S_xy) [N/m], Eq. 15."""
+        return self.membrane.strain(U) @ self.material.Dm.T
+
+    def mixed_stress(self, U, dU) -> np.ndarray:
+        """(E, 3) stress of the linearised strain ``D^m (eps(U) + Bbar(U) dU)`` [N/m]: the membrane stress
+        that MIP Newton carries from ``U`` over the step ``dU (N, 3)`` [m] (:mod:`rftstatic.solvers.newton`)."""
+        return self.membrane.linearised_strain(U, dU) @ self.material.Dm.T
 
     def relative_curvature(self, U) -> np.ndarray:
         """(E,) |kappa| h, the relative curvature of §2.2 and §5.1 [-].

@@ -152,6 +152,7 @@ SCHEMA = {
         "max_step": (NUM, "cap on the largest nodal increment per iteration [length]"),
         "increment_displacement": (NUM, "target nodal displacement per increment [length]"),
         "line_search": (bool, ""), "tangent": (str, "auto, exact or psd"),
+        "iteration": (str, "mixed (MIP Newton) or displacement"),
         "max_continuations": (int, "snap-through continuations per increment"),
         "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),

@@ -1,17 +1,24 @@
 """Load-scaled Newton iteration on the total potential energy (method.md, §4).
 
 The gravity/load factor ``lam`` rises from 0 to 1 in adaptive increments. At each increment a
-Newton iteration minimises Pi(U) = E_b + E_m + E_c - lam P.U:
+Newton iteration minimises Pi(U) = E_b + E_m + E_c - lam P.U. Two iterations are offered:
 
-1. tangent: the exact Hessian first; if the Cholesky factorisation finds it indefinite (membrane
-   compression) or the step is not a descent direction, the compressive stress is dropped from the
-   geometric stiffness (positive semi-definite membrane tangent), and if needed a
-   Levenberg-Marquardt shift is added;
-2. the step is scaled so that no node moves more than ``max_step`` (the "simple scaling" of Liu &
-   Sze 2009), which keeps the first steps from a flat start in range;
-3. an Armijo backtracking line search on Pi makes every accepted step lower the energy;
-4. convergence needs both the force residual ``|r| <= rtol |lam P|`` and the energy criterion
-   ``|d . r_new| <= etol max(|d_1 . r_0|, |lam P.U|)`` (work of the residual on the last step).
+- ``iteration = "mixed"`` (default): MIP Newton (:mod:`rftstatic.solvers.mixed`), the membrane stress
+  of every element carried as an unknown of its own, so that a step that rotates a stiff membrane does
+  not see the spurious second-order stretch; no energy line search, the step cap only;
+- ``iteration = "displacement"``: Newton on the displacements alone, safeguarded for any start:
+
+  1. tangent: the exact Hessian first; if the Cholesky factorisation finds it indefinite (membrane
+     compression) or the step is not a descent direction, the compressive stress is dropped from the
+     geometric stiffness (positive semi-definite membrane tangent), and if needed a
+     Levenberg-Marquardt shift is added (the mixed iteration uses the same safeguards);
+  2. the step is scaled so that no node moves more than ``max_step`` (the "simple scaling" of Liu &
+     Sze 2009), which keeps the first steps from a flat start in range (both iterations);
+  3. an Armijo backtracking line search on Pi makes every accepted step lower the energy.
+
+Convergence (:class:`~rftstatic.solvers.iteration.Criteria`) needs both the force residual
+``|r| <= rtol |lam P|`` (plus the round-off floor of the internal force) and the energy criterion
+``|d . r_new| <= etol W`` (work of the residual on the last step, W the work of the applied load).
 An increment that does not converge is cut back (``increment / 4``) from the last equilibrium;
 below ``min_increment`` the solve stops with :class:`~rftstatic.errors.ConvergenceError`, which
 carries the last equilibrium, labelled as not converged.
@@ -29,7 +36,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from rftstatic.model.state import State
-from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
+from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction
+from rftstatic.solvers.linear import LinearSolveError
+from rftstatic.solvers.mixed import mixed_iterations
 
 log = logging.getLogger(__name__)
 
@@ -51,7 +60,10 @@ class StaticOptions:
     increment_displacement : target largest nodal displacement per load increment [m], from which
         the next increment is sized by the secant (first: tangent) rate d|U|/d lam; ``None``: 5 %
         of the sheet's diagonal. Halved or grown with the Newton iteration count.
-    line_search : Armijo backtracking on Pi
+    line_search : Armijo backtracking on Pi (displacement iteration)
+    iteration : ``"mixed"`` (MIP Newton, the membrane stress carried as an unknown; an increment it
+        cannot converge is retried with the displacement iteration) or ``"displacement"`` (Newton on
+        the displacements alone, energy line search)
     tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
     linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
     max_load_steps : give up after this many increments
@@ -84,6 +96,7 @@ class StaticOptions:
     max_step: float | None = None
     increment_displacement: float | None = None
     line_search: bool = True
+    iteration: str = "mixed"
     tangent: str = "auto"
     linear_solver: str = "auto"
     max_load_steps: int = 2000
@@ -104,6 +117,8 @@ class StaticOptions:
         if self.linear_solver not in ("auto", "cholmod", "scipy", "amg"):
             raise ValueError(f'solver.linear_solver must be "auto", "cholmod", "scipy" or "amg", got '
                              f'"{self.linear_solver}"')
+        if self.iteration not in ("mixed", "displacement"):
+            raise ValueError(f'solver.iteration must be "mixed" or "displacement", got "{self.iteration}"')
         if self.tangent not in ("auto", "exact", "psd"):
             raise ValueError(f'solver.tangent must be "auto", "exact" or "psd", got "{self.tangent}"')
         if not (0 < self.min_increment <= self.initial_increment <= self.max_increment <= 1):
@@ -155,7 +170,10 @@ class StaticResult:
     U : (N, 3) displacements of the last equilibrium [m]
     lam : load factor reached [-]
     converged : True only if lam = 1 was reached in equilibrium
-    load_steps : one record per accepted increment (load factor, iterations, residual, tangents)
+    load_steps : one record per accepted increment (load factor, iterations, residual, scheme)
+    iterations : Newton iterations in all, those of failed tries included
+    cutbacks : increments cut back after a failure
+    retries : increments whose mixed iteration failed and that the displacement iteration retried
     state : the solve's final :class:`~rftstatic.model.state.State` (U, load factor, contact candidates)
     """
 
@@ -165,6 +183,7 @@ class StaticResult:
     load_steps: list = field(default_factory=list)
     iterations: int = 0
     cutbacks: int = 0
+    retries: int = 0
     linear_solver: str = ""
     wall_time: float = 0.0
     energies: dict = field(default_factory=dict)
@@ -176,18 +195,6 @@ class StaticResult:
     route: str = "load-steps"
     relax: dict = field(default_factory=dict)
     state: State | None = None
-
-
-@dataclass
-class _Newton:
-    converged: bool
-    U: np.ndarray
-    iterations: int
-    residual: float
-    reason: str = ""
-    stable: bool | None = None
-    descending: bool = False  # the energy still fell markedly over the last iterations
-
 
 @dataclass
 class NewtonWorkspace:
@@ -218,27 +225,34 @@ class NewtonWorkspace:
         return self.state.candidates
 
 
-def newton(model, U, lam, opts, ws, max_step) -> _Newton:
-    """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified)."""
+def newton(model, U, lam, opts, ws, max_step, *, stress=None, scheme=None) -> Iteration:
+    """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified).
+
+    ``scheme``: ``"mixed"`` (MIP Newton, :func:`~rftstatic.solvers.mixed.mixed_iterations`) or ``"displacement"``
+    (:func:`displacement_iterations`); default ``opts.iteration``. ``stress (E, 3)`` [N/m]: the
+    mixed membrane stress at ``U`` (default ``D^m eps(U)``).
+    """
+    scheme = scheme or opts.iteration
+    if scheme == "mixed" and model.with_membrane:
+        return mixed_iterations(model, U, lam, opts, ws, max_step, stress)
+    return displacement_iterations(model, U, lam, opts, ws, max_step)
+
+def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
+    """Newton on the displacements alone (module docstring): exact or safeguarded tangent, step cap,
+    Armijo line search on Pi, Levenberg-Marquardt damping as a trust region, optional reuse of a
+    factorisation (modified Newton)."""
     solver, modes, cand = ws.solver, ws.modes, ws.candidates
-    rtol = opts.rtol if lam >= 1.0 else max(opts.rtol, opts.intermediate_rtol)
+    test = Criteria(model, lam, opts, U)
+    P = test.P
     # the final increment converges to the tight tolerance and may need longer
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
-    etol = opts.etol if lam >= 1.0 else max(opts.etol, opts.intermediate_rtol**2)
     free = model.free.ravel()
-    P = model.load
-    if model.load_terms:  # potential loads (end moments) count as applied forces
-        x0 = model.positions(U)
-        P = P - sum(t.force(x0) for t in model.load_terms)
-    # a floor keeps the tolerance above round-off for vanishing loads
-    ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
-    atol = 0.0
     U = U.copy()
     Pi = model.potential(U, lam, candidates=cand)
     r = (model.residual(U, lam, candidates=cand)).ravel()[free]
     rnorm = float(np.linalg.norm(r))
     if not np.isfinite(rnorm):
-        return _Newton(False, U, 0, rnorm, "non-finite residual")
+        return Iteration(False, U, 0, rnorm, "non-finite residual")
     work0 = None
     last_work = np.inf
     stable = None
@@ -246,11 +260,10 @@ def newton(model, U, lam, opts, ws, max_step) -> _Newton:
     Pi_history = [Pi]
     reuse = False  # the last factorisation may serve the next step (modified Newton)
     age = 0
+    hist = []
     for it in range(1, max_iterations + 1):
-        if rtol * ref < rnorm < 1e4 * rtol * ref:  # close: is the rest round-off?
-            atol = _roundoff_floor(model, U)
-        if rnorm <= rtol * ref + atol and (it > 1 and last_work <= etol * work0):
-            return _Newton(True, U, it - 1, rnorm, stable=stable)
+        if it > 1 and test.met(U, rnorm, last_work):
+            return Iteration(True, U, it - 1, rnorm, stable=stable, history=hist)
         d = None
         fresh = False
         if reuse and age < opts.reuse_factorisation:
@@ -265,28 +278,22 @@ def newton(model, U, lam, opts, ws, max_step) -> _Newton:
                 age += 1
         if d is None:
             try:
-                d, mode, shift = _direction(model, U, lam, r, opts, ws, damping=mu)
+                d, mode, shift = direction(model, U, lam, r, opts, ws, damping=mu)
             except LinearSolveError as exc:
-                return _Newton(False, U, it, rnorm, f"linear solve failed ({exc})")
+                return Iteration(False, U, it, rnorm, f"linear solve failed ({exc})")
             stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
             age = 0
             fresh = True
             # curvature of the quadratic model along d: (K + s I) d = -r  =>  d.K.d = -d.r - s d.d
             dKd = -float(r @ d) - shift * float(d @ d)
-        dfull = np.zeros(3 * model.mesh.n_nodes)
-        dfull[free] = d
-        step = dfull.reshape(-1, 3)
-        biggest = float(np.linalg.norm(step, axis=1).max())
-        cap = 1.0
-        if biggest > max_step:
-            cap = max_step / biggest
-            step *= cap
+        step, cap = capped_step(model, d, max_step)
         slope = float(r @ step.ravel()[free])
         alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts, cand)
         if alpha is None:
-            return _Newton(False, U, it, rnorm, "line search found no decrease of the energy")
+            return Iteration(False, U, it, rnorm, "line search found no decrease of the energy")
         U = U + alpha * step
         Pi = Pi_new
+        hist.append({"residual": rnorm, "alpha": alpha, "cap": cap, "mu": mu, "fresh": fresh})
         Pi_history.append(Pi)
         # Levenberg-Marquardt damping as a trust region (More's update): the ratio of the actual to
         # the predicted energy decrease of a fresh Newton step decides; a step the line search had to
@@ -312,6 +319,7 @@ def newton(model, U, lam, opts, ws, max_step) -> _Newton:
             parts = model.energies(U, lam, candidates=cand)
             work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))),
                         parts["bending"] + parts["membrane"], 1e-300)
+            test.work_ref = work0
         last_work = work
         # modified Newton: keep the factorisation while it still cuts the residual fast
         rnorm_new = float(np.linalg.norm(r_new))
@@ -319,72 +327,15 @@ def newton(model, U, lam, opts, ws, max_step) -> _Newton:
         r = r_new
         rnorm = rnorm_new
         if not np.isfinite(rnorm):
-            return _Newton(False, U, it, rnorm, "non-finite residual")
-    if rnorm <= rtol * ref + atol and last_work <= etol * work0:
-        return _Newton(True, U, max_iterations, rnorm, stable=stable)
+            return Iteration(False, U, it, rnorm, "non-finite residual")
+    if test.met(U, rnorm, last_work):
+        return Iteration(True, U, max_iterations, rnorm, stable=stable)
     # still sliding downhill? compare the energy drop of the last third with the scale of the work
     k = max(2, len(Pi_history) // 3)
     drop = Pi_history[-k] - Pi_history[-1]
     descending = drop > 1e-6 * max(work0 or 0.0, abs(lam * float(np.einsum("ni,ni->", P, U))))
-    return _Newton(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
-                   descending=descending)
-
-
-def _direction(model, U, lam, r, opts, ws, damping=0.0):
-    """Newton direction on the free dofs, with the indefinite-tangent safeguard: ``(d, mode, shift)``.
-
-    ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt); ``shift`` [N/m]
-    is the diagonal shift of the tangent that gave ``d``.
-    """
-    solver, modes, cand = ws.solver, ws.modes, ws.candidates
-    sequence = {"auto": ["exact", "psd", "shift"], "exact": ["exact", "shift"], "psd": ["psd", "shift"]}[opts.tangent]
-    last_error = None
-    base = 0.0
-    if damping:
-        base = damping * _diagonal_scale(model, U, ws)
-    for mode in sequence:
-        shifts = [base] if mode != "shift" else None
-        if mode == "shift":
-            _, K = model.tangent(U, psd=True, lam=lam, candidates=cand)
-            scale = float(np.abs(K.diagonal()).mean())
-            shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
-        for shift in shifts:
-            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam, candidates=cand)
-            try:
-                d = solver.solve(K, -r)
-            except NotPositiveDefinite as exc:
-                last_error = exc
-                continue
-            if not np.all(np.isfinite(d)):
-                last_error = LinearSolveError("non-finite step")
-                continue
-            if float(r @ d) < 0.0 or not np.any(r):
-                modes[mode] += 1
-                return d, mode, shift
-            last_error = LinearSolveError("the step is not a descent direction of the energy")
-    raise LinearSolveError(str(last_error))
-
-
-def _roundoff_floor(model, U) -> float:
-    """Residual [N] below which round-off rules: 100 eps times the summed magnitudes of the element
-    forces. A membrane 10^8 times stiffer than the bending (per unit area) carries element forces
-    that cancel to a residual far below them; no tolerance relative to the load can be met there."""
-    if not model.with_membrane:
-        return 0.0
-    from rftstatic.model.assembly import scatter_forces
-
-    fe = np.abs(model.membrane.element_forces(U, model.material.Dm))
-    fabs = scatter_forces(model.membrane.nodes, fe, model.mesh.n_nodes)
-    return 100 * np.finfo(float).eps * float(np.linalg.norm(fabs.ravel()[model.free.ravel()]))
-
-
-def _diagonal_scale(model, U, ws) -> float:
-    """Mean diagonal of the tangent [N/m], computed once per solve (the scale of the LM damping)."""
-    if ws.lm_scale is None:
-        _, K0 = model.tangent(U, psd=True, candidates=ws.candidates)
-        ws.lm_scale = float(np.abs(K0.diagonal()).mean())
-    return ws.lm_scale
-
+    return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
+                     descending=descending)
 
 def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, max_trials=12):
     """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""

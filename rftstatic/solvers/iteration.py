@@ -1,0 +1,138 @@
+"""What the Newton iterations at one load factor share (:mod:`rftstatic.solvers.newton`,
+:mod:`rftstatic.solvers.mixed`): their outcome, the safeguarded Newton direction, the step cap and the
+convergence test.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
+
+
+@dataclass
+class Iteration:
+    """Outcome of the Newton iterations at one load factor (``history``: one record per iteration)."""
+
+    converged: bool
+    U: np.ndarray
+    iterations: int
+    residual: float
+    reason: str = ""
+    stable: bool | None = None
+    descending: bool = False  # the energy still fell markedly over the last iterations
+    history: list = field(default_factory=list)  # per iteration: |r| before the step, step length, tangent
+    stress: np.ndarray | None = None  # the mixed scheme's membrane stress at U (E, 3) [N/m]
+    scheme: str = "displacement"
+
+
+class Criteria:
+    """The convergence test of one Newton iteration at load factor ``lam`` (module docstring, 4).
+
+    Force: ``|r| <= rtol |lam P| + floor``, the floor being the round-off of the internal force
+    (:func:`roundoff_floor`, evaluated only near convergence). Energy: the work of the residual on
+    the last step ``|d . r_new| <= etol W`` with ``W = |lam| max(|P . U|, |P . dU_1|)``, the work of the
+    applied load; both scales come from the loads alone, so the test does not tighten or loosen with
+    the membrane stiffness.
+    """
+
+    def __init__(self, model, lam, opts, U):
+        self.model, self.lam = model, lam
+        self.rtol = opts.rtol if lam >= 1.0 else max(opts.rtol, opts.intermediate_rtol)
+        self.etol = opts.etol if lam >= 1.0 else max(opts.etol, opts.intermediate_rtol**2)
+        P = model.load
+        if model.load_terms:  # potential loads (end moments) count as applied forces
+            P = P - sum(t.force(model.positions(U)) for t in model.load_terms)
+        self.P = P
+        # a floor keeps the tolerance above round-off for vanishing loads
+        self.ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
+        self.atol = 0.0
+        self.work_ref = 1e-300
+
+    def load_work(self, U, step) -> None:
+        """Raise the energy scale to the work of the load on ``U`` and on the first ``step`` [J]."""
+        P = self.P
+        self.work_ref = max(self.work_ref, abs(self.lam) * abs(float(np.einsum("ni,ni->", P, U))),
+                            abs(self.lam) * abs(float(np.einsum("ni,ni->", P, step))))
+
+    def met(self, U, rnorm, work) -> bool:
+        """Whether ``|r| = rnorm`` [N] and the last step's residual work ``work`` [J] pass."""
+        tol = self.rtol * self.ref
+        if tol < rnorm < 1e4 * tol:  # close: is the rest round-off?
+            self.atol = roundoff_floor(self.model, U)
+        return rnorm <= tol + self.atol and work <= self.etol * self.work_ref
+
+
+def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
+    """Newton direction on the free dofs, with the indefinite-tangent safeguard: ``(d, mode, shift)``.
+
+    ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt); ``shift`` [N/m]
+    is the diagonal shift of the tangent that gave ``d``; ``stress``: the mixed membrane stress of the
+    geometric stiffness (:func:`rftstatic.solvers.mixed.mixed_iterations`; None: the exact Hessian).
+    """
+    solver, modes, cand = ws.solver, ws.modes, ws.candidates
+    sequence = {"auto": ["exact", "psd", "shift"], "exact": ["exact", "shift"], "psd": ["psd", "shift"]}[opts.tangent]
+    last_error = None
+    base = 0.0
+    if damping:
+        base = damping * diagonal_scale(model, U, ws)
+    for mode in sequence:
+        shifts = [base] if mode != "shift" else None
+        if mode == "shift":
+            _, K = model.tangent(U, psd=True, lam=lam, candidates=cand, stress=stress)
+            scale = float(np.abs(K.diagonal()).mean())
+            shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
+        for shift in shifts:
+            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam, candidates=cand, stress=stress)
+            try:
+                d = solver.solve(K, -r)
+            except NotPositiveDefinite as exc:
+                last_error = exc
+                continue
+            if not np.all(np.isfinite(d)):
+                last_error = LinearSolveError("non-finite step")
+                continue
+            if float(r @ d) < 0.0 or not np.any(r):
+                modes[mode] += 1
+                return d, mode, shift
+            last_error = LinearSolveError("the step is not a descent direction of the energy")
+    raise LinearSolveError(str(last_error))
+
+def roundoff_floor(model, U) -> float:
+    """Residual [N] below which round-off rules: the larger of 100 eps times the summed magnitudes of
+    the element forces (forces that cancel at the nodes) and eps times the round-off size of the
+    membrane forces (:meth:`~rftstatic.element.membrane.MembraneOperator.force_roundoff`: the strain of
+    a rotated element is a small difference of order-one terms). A membrane 10^8 times stiffer than
+    the bending (per unit area) leaves a residual that no tolerance relative to the load can meet."""
+    if not model.with_membrane:
+        return 0.0
+    from rftstatic.model.assembly import scatter_forces
+
+    mem, Dm, n, free = model.membrane, model.material.Dm, model.mesh.n_nodes, model.free.ravel()
+    eps = np.finfo(float).eps
+    cancelling = scatter_forces(mem.nodes, np.abs(mem.element_forces(U, Dm)), n).ravel()[free]
+    size = mem.force_roundoff(U, Dm)
+    strain = scatter_forces(mem.nodes, np.repeat(size[:, :, None], 3, axis=2), n).ravel()[free]
+    return eps * max(100.0 * float(np.linalg.norm(cancelling)), float(np.linalg.norm(strain)))
+
+def diagonal_scale(model, U, ws) -> float:
+    """Mean diagonal of the tangent [N/m], computed once per solve (the scale of the LM damping)."""
+    if ws.lm_scale is None:
+        _, K0 = model.tangent(U, psd=True, candidates=ws.candidates)
+        ws.lm_scale = float(np.abs(K0.diagonal()).mean())
+    return ws.lm_scale
+
+def capped_step(model, d, max_step):
+    """The free-dof step ``d`` as ``(N, 3)`` displacements [m], scaled so that no node moves more than
+    ``max_step`` [m]; and the scale factor (1 when uncapped)."""
+    dfull = np.zeros(3 * model.mesh.n_nodes)
+    dfull[model.free.ravel()] = d
+    step = dfull.reshape(-1, 3)
+    biggest = float(np.linalg.norm(step, axis=1).max())
+    cap = 1.0
+    if biggest > max_step:
+        cap = max_step / biggest
+        step *= cap
+    return step, cap
