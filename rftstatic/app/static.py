@@ -53,7 +53,10 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "load_steps": len(result.load_steps),
         "newton_iterations": result.iterations,
         "cutbacks": result.cutbacks,
-        "solver_path": [{"lam": s["lam"], "iterations": s["iterations"]} for s in result.load_steps],
+        "factorisations": result.factorisations,
+        "iteration_retries": result.retries,
+        "solver_path": [{"lam": s["lam"], "iterations": s["iterations"], "scheme": s.get("scheme", "")}
+                        for s in result.load_steps],
         "tangent_modes": result.tangent_modes,
         "route": result.route,
         "relax": result.relax,

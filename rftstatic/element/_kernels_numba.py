@@ -19,8 +19,10 @@ import numba as nb
 from rftstatic.element import kernels
 
 _ELEMENT = ("strain_point_gradients", "green_strain", "averaged_strain", "stress", "membrane_state",
-            "strain_energy", "_deformation", "element_force", "positive_part", "element_tangent", "_gather")
-_LOOPS = ("membrane_energies", "membrane_forces", "membrane_tangents", "membrane_force_blocks", "internal_force")
+            "strain_energy", "_deformation", "element_force", "positive_part", "element_tangent", "_gather",
+            "strain_increment")
+_LOOPS = ("membrane_energies", "membrane_forces", "membrane_tangents", "membrane_tangents_into",
+          "membrane_linearised_strains", "membrane_force_blocks", "internal_force")
 _THREADED = ("membrane_force_blocks", "internal_force")
 
 
@@ -47,5 +49,7 @@ _compile(_THREADED, _parallel, "_parallel", parallel=True)
 membrane_energies = _serial["membrane_energies"]
 membrane_forces = _serial["membrane_forces"]
 membrane_tangents = _serial["membrane_tangents"]
+membrane_tangents_into = _serial["membrane_tangents_into"]
+membrane_linearised_strains = _serial["membrane_linearised_strains"]
 internal_force = _serial["internal_force"]
 internal_force_parallel = _parallel["internal_force"]

@@ -270,6 +270,51 @@ def membrane_tangents(nodes, G, area, Dm, U, psd, S, fe, ke):
         element_tangent(g, H, sxx, syy, sxy, area[e], Dm, psd, B, DB, ke[e])
 
 
+def membrane_tangents_into(nodes, G, area, Dm, U, psd, S, emap, fe, data):
+    """:func:`membrane_tangents` with every element tangent added straight into the CSR values
+    ``data (nnz,)`` [N/m] at the positions ``emap (E, A, 3, A, 3)`` (no (E, A, 3, A, 3) array, no
+    separate scatter), element by element in order; ``fe (E, A, 3)`` [N] is filled as there."""
+    E, Q, A = G.shape[0], G.shape[1], G.shape[2]
+    H = np.empty((Q, 2, 3))
+    u = np.empty((A, 3))
+    B = np.empty((3, A, 3))
+    DB = np.empty((3, A, 3))
+    ke = np.empty((A, 3, A, 3))
+    given = S.shape[0] > 0
+    for e in range(E):
+        g = G[e]
+        _, _, _, sxx, syy, sxy = membrane_state(g, _gather(U, nodes[e], u), Dm, H)
+        element_force(g, H, sxx, syy, sxy, area[e], fe[e])
+        if given:
+            sxx, syy, sxy = S[e, 0], S[e, 1], S[e, 2]
+        element_tangent(g, H, sxx, syy, sxy, area[e], Dm, psd, B, DB, ke)
+        m = emap[e]
+        for a in range(A):
+            for i in range(3):
+                for b in range(A):
+                    for j in range(3):
+                        data[m[a, i, b, j]] += ke[a, i, b, j]
+
+
+def membrane_linearised_strains(nodes, G, U, dU, out):
+    """Fill ``out (E, 3)`` [-] with ``eps(U) + Bbar(U) dU`` of every element (:func:`strain_increment`),
+    ``U, dU (N, 3)`` [m]."""
+    E, Q, A = G.shape[0], G.shape[1], G.shape[2]
+    H = np.empty((Q, 2, 3))
+    h = np.empty((Q, 2, 3))
+    u = np.empty((A, 3))
+    du = np.empty((A, 3))
+    for e in range(E):
+        g = G[e]
+        strain_point_gradients(g, _gather(U, nodes[e], u), H)
+        strain_point_gradients(g, _gather(dU, nodes[e], du), h)
+        exx, eyy, gxy = averaged_strain(H)
+        dxx, dyy, dxy = strain_increment(H, h)
+        out[e, 0] = exx + dxx
+        out[e, 1] = eyy + dyy
+        out[e, 2] = gxy + dxy
+
+
 def internal_force(indptr, indices, data, nodes, G, area, Dm, U, f, fe, slot_ptr, slots, with_membrane, chunks):
     """Fill ``f (N, 3)`` [N] with the internal force at ``U (N, 3)`` [m]; return the stored energy [J].
 

@@ -80,6 +80,11 @@ def _edge_topology(tri: np.ndarray, n_nodes: int) -> EdgeTopology:
     return EdgeTopology(nb_elem, nb_vert, edges, edge_of.reshape(E, 3))
 
 
+BRUTE_LOCATE_PAIRS = 4_000_000
+"""Up to this many point-triangle pairs :meth:`TriMesh.locate` tests every triangle (a few supports
+and probes: no matplotlib import, 0.5 s of a strip run's 1.5 s start-up); beyond, a trapezoid map."""
+
+
 @dataclass(frozen=True, eq=False)
 class TriMesh:
     """A triangle mesh of the flat reference configuration.
@@ -198,16 +203,32 @@ class TriMesh:
 
         Returns ``(elem (P,), bary (P, 3))``; elem is -1 for points outside the mesh.
         """
-        from matplotlib.tri import Triangulation
-
         pts = np.atleast_2d(np.asarray(points, float))
-        finder = Triangulation(self.X[:, 0], self.X[:, 1], self.tri).get_trifinder()
-        elem = np.asarray(finder(pts[:, 0], pts[:, 1]), dtype=np.int64)
+        if len(pts) * self.n_elements <= BRUTE_LOCATE_PAIRS:
+            elem = self._locate_brute(pts)
+        else:  # many points (a remesh transfer): matplotlib's trapezoid-map search
+            from matplotlib.tri import Triangulation
+
+            finder = Triangulation(self.X[:, 0], self.X[:, 1], self.tri).get_trifinder()
+            elem = np.asarray(finder(pts[:, 0], pts[:, 1]), dtype=np.int64)
         P = self.X[self.tri[np.maximum(elem, 0)]]
         T = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=2)
         l12 = np.linalg.solve(T, (pts - P[:, 0])[..., None])[..., 0]
         bary = np.column_stack([1 - l12.sum(axis=1), l12])
         return elem, bary
+
+    def _locate_brute(self, pts) -> np.ndarray:
+        """Element containing each point ``(P, 2)`` [m] by the barycentric coordinates against every
+        triangle (the one it lies deepest in, edges included to 1e-10 of the element; -1 outside)."""
+        P = self.X[self.tri]  # (E, 3, 2)
+        e1, e2 = P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
+        det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]  # (E,) twice the signed area
+        d = pts[:, None, :] - P[None, :, 0]  # (P, E, 2)
+        l1 = (d[..., 0] * e2[:, 1] - d[..., 1] * e2[:, 0]) / det
+        l2 = (e1[:, 0] * d[..., 1] - e1[:, 1] * d[..., 0]) / det
+        depth = np.minimum(np.minimum(l1, l2), 1.0 - l1 - l2)  # > 0 inside, 0 on an edge
+        best = depth.argmax(axis=1)  # the triangle the point is deepest in (one side of a shared edge)
+        return np.where(depth[np.arange(len(pts)), best] >= -1e-10, best, -1).astype(np.int64)
 
     def summary(self) -> dict:
         return {

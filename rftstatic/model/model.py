@@ -215,9 +215,8 @@ class Model:
         f = self.Kb @ U
         x = self.positions(U)
         if self.with_membrane:
-            fe, ke = self.membrane.element_tangents(U, self.material.Dm, psd=psd, stress=stress)
+            fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
-            data += scatter_matrices(self._membrane_map, ke, plan.nnz)
         if self.contact is not None:
             cs = self.contact.evaluate(x, candidates=candidates)
             f += cs.force

@@ -57,12 +57,29 @@ class Criteria:
         self.work_ref = max(self.work_ref, abs(self.lam) * abs(float(np.einsum("ni,ni->", P, U))),
                             abs(self.lam) * abs(float(np.einsum("ni,ni->", P, step))))
 
-    def met(self, U, rnorm, work) -> bool:
-        """Whether ``|r| = rnorm`` [N] and the last step's residual work ``work`` [J] pass."""
+    def met(self, U, r, work, solver=None) -> bool:
+        """Whether the residual ``r`` (free dofs) [N] and the last step's residual work ``work`` [J] pass.
+
+        The energy test passes on ``work`` or, when ``solver`` can re-solve with its last factorisation
+        (a back-substitution), on the energy of the correction still to come, ``|r . K^-1 r|``: after an
+        exact step (a linear problem) the residual is round-off, and its work over that full step,
+        ``|d| |r|``, says nothing about the energy left, which is quadratic in r."""
+        rnorm = float(np.linalg.norm(r))
         tol = self.rtol * self.ref
         if tol < rnorm < 1e4 * tol:  # close: is the rest round-off?
             self.atol = roundoff_floor(self.model, U)
-        return rnorm <= tol + self.atol and work <= self.etol * self.work_ref
+        if rnorm > tol + self.atol:
+            return False
+        limit = self.etol * self.work_ref
+        if work <= limit:
+            return True
+        if solver is None or not getattr(solver, "cheap_resolve", False):
+            return False
+        try:
+            left = abs(float(r @ solver.resolve(r)))
+        except LinearSolveError:
+            return False
+        return left <= limit
 
 
 def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
@@ -86,6 +103,7 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
             shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
         for shift in shifts:
             _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam, candidates=cand, stress=stress)
+            ws.factorisations += 1
             try:
                 d = solver.solve(K, -r)
             except NotPositiveDefinite as exc:

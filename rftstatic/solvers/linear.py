@@ -76,6 +76,7 @@ def make_solver(name: str = "auto", *, coordinates=None, free_dofs=None):
 class CholmodSolver:
     name = "cholmod"
     detects_indefinite = True
+    cheap_resolve = True  # resolve() is a back-substitution
 
     def __init__(self):
         self._factor = None
@@ -113,6 +114,7 @@ class CholmodSolver:
 class ScipySolver:
     name = "scipy"
     detects_indefinite = False
+    cheap_resolve = True
 
     def solve(self, K: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
         from scipy.sparse.linalg import splu
@@ -137,6 +139,7 @@ class ScipySolver:
 class AmgSolver:
     name = "amg"
     detects_indefinite = False
+    cheap_resolve = False  # resolve() is a whole preconditioned CG solve
 
     def __init__(self, coordinates, free_dofs, *, rtol=1e-10, maxiter=2000):
         if coordinates is None or free_dofs is None:

@@ -129,6 +129,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
     finally:
         bar.close()
         result.tangent_modes = dict(modes)
+        result.factorisations = ws.factorisations
         result.wall_time = time.perf_counter() - t0
         result.energies = model.energies(result.U, result.lam, candidates=ws.candidates)
         ws.state.U, ws.state.lam = result.U, result.lam
@@ -163,6 +164,7 @@ def _first_increment(model, U, opts, ws, target) -> float:
     try:
         _, K = model.tangent(U, psd=True, candidates=ws.candidates)
         du = np.zeros(3 * model.mesh.n_nodes)
+        ws.factorisations += 1
         du[free] = ws.solver.solve(K, P)
     except (NotPositiveDefinite, LinearSolveError):
         return opts.initial_increment

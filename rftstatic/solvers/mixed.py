@@ -45,7 +45,7 @@ def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
         return Iteration(False, U, 0, rnorm, "non-finite residual", scheme="mixed")
     work, stable, hist = np.inf, None, []
     for it in range(1, max_iterations + 1):
-        if it > 1 and test.met(U, rnorm, work):
+        if it > 1 and test.met(U, r, work, ws.solver):
             return Iteration(True, U, it - 1, rnorm, stable=stable, history=hist, stress=S, scheme="mixed")
         try:
             d, mode, _ = direction(model, U, lam, r, opts, ws, stress=S)
@@ -64,7 +64,7 @@ def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
         rnorm = float(np.linalg.norm(r))
         if not np.isfinite(rnorm):
             return Iteration(False, U, it, rnorm, "non-finite residual", history=hist, stress=S, scheme="mixed")
-    if test.met(U, rnorm, work):
+    if test.met(U, r, work, ws.solver):
         return Iteration(True, U, max_iterations, rnorm, stable=stable, history=hist, stress=S, scheme="mixed")
     modes["mixed failed"] = modes.get("mixed failed", 0) + 1
     return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} mixed iterations",

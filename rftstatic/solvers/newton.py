@@ -174,6 +174,8 @@ class StaticResult:
     iterations : Newton iterations in all, those of failed tries included
     cutbacks : increments cut back after a failure
     retries : increments whose mixed iteration failed and that the displacement iteration retried
+    factorisations : numeric factorisations of the tangent (Newton steps, failed Cholesky attempts, the
+        first increment's rate; not the stability check)
     state : the solve's final :class:`~rftstatic.model.state.State` (U, load factor, contact candidates)
     """
 
@@ -184,6 +186,7 @@ class StaticResult:
     iterations: int = 0
     cutbacks: int = 0
     retries: int = 0
+    factorisations: int = 0
     linear_solver: str = ""
     wall_time: float = 0.0
     energies: dict = field(default_factory=dict)
@@ -206,6 +209,7 @@ class NewtonWorkspace:
         every energy, residual and tangent evaluation)
     solver : the linear solver (symbolic analysis reused between factorisations)
     modes : counts of the tangents used: exact, psd, shift, reused
+    factorisations : numeric factorisations of a tangent (failed Cholesky attempts included)
     lm_scale : mean tangent diagonal [N/m], the scale of the Levenberg-Marquardt damping, computed once
         per solve at the state where damping is first needed
     """
@@ -214,6 +218,7 @@ class NewtonWorkspace:
     solver: object = None
     modes: dict = field(default_factory=lambda: {"exact": 0, "psd": 0, "shift": 0})
     lm_scale: float | None = None
+    factorisations: int = 0
 
     @classmethod
     def for_model(cls, model) -> NewtonWorkspace:
@@ -262,7 +267,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     age = 0
     hist = []
     for it in range(1, max_iterations + 1):
-        if it > 1 and test.met(U, rnorm, last_work):
+        if it > 1 and test.met(U, r, last_work, solver):
             return Iteration(True, U, it - 1, rnorm, stable=stable, history=hist)
         d = None
         fresh = False
@@ -328,7 +333,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
         rnorm = rnorm_new
         if not np.isfinite(rnorm):
             return Iteration(False, U, it, rnorm, "non-finite residual")
-    if test.met(U, rnorm, last_work):
+    if test.met(U, r, last_work, solver):
         return Iteration(True, U, max_iterations, rnorm, stable=stable)
     # still sliding downhill? compare the energy drop of the last third with the scale of the work
     k = max(2, len(Pi_history) // 3)

@@ -1,0 +1,129 @@
+"""Newton benchmark: ``python -m rftstatic bench newton``.
+
+Prints, for each problem, the Newton iterations, load increments, factorisations, the solve's wall time
+and the whole process (interpreter start, imports, build, solve, outputs without figures), every run
+in a fresh interpreter (:func:`rftstatic.bench.harness.run_child`) one after the other, so that the
+figures of one table come from one run on one machine state:
+
+- the §4.1 wool strip (5 x 1 cm, RFT6) at 51 x 11 and 101 x 21 nodes, and at 101 x 5 nodes, the
+  mesh whose tip-drop error (0.015 %) equals Kratos's on 51 x 11 (the error depends on the nodes
+  along the strip only);
+- the 21 x 5 stiff strip cells of the stability matrix, RFT3 and RFT6, C/B = 1e2 to 1e9 /cm^2;
+- ``pedestal-square-20`` at 33 x 33 nodes (the scene as it ships: relaxation, then Newton);
+- the peer: Kratos Multiphysics (:mod:`rftstatic.bench.kratos_peer`, one OpenMP thread) on the
+  strip at 51 x 11 nodes in 5 increments, when it is installed.
+
+Targets (issue "Newton, part 1"): 51 x 11 strip in at most 40 iterations and a solve under 0.3 s;
+stiff cells within 3 x the iterations of the C/B = 1e2 cell; at equal error the solve 3 x faster than
+Kratos's and the whole process faster than Kratos's.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+
+STRIPS = ((51, 11), (101, 21), (101, 5))
+RATIOS = (1e2, 1e5, 1e7, 1e8, 1e9)
+TIMEOUT_S = 600.0
+
+
+def strip_solve(nx: int, ny: int, element: str = "RFT6", ratio: float | None = None) -> dict:
+    """Child: build and solve the §4.1 strip (``ratio``: C/B [1/cm^2], None: wool); iterations,
+    increments, factorisations, times [s], the tip drop [cm] and its error against 4.34468 cm."""
+    import numpy as np
+
+    from rftstatic.bench.problems import STRIP_LENGTH, strip_model
+    from rftstatic.solvers import static
+
+    t0 = time.perf_counter()
+    model = strip_model(nx, ny, element=element, ratio=ratio)
+    t1 = time.perf_counter()
+    res = static.solve_static(model, options=static.StaticOptions(progress=False))
+    t2 = time.perf_counter()
+    tip = np.flatnonzero(np.abs(model.mesh.X[:, 0] - STRIP_LENGTH) < 1e-9 * STRIP_LENGTH)
+    drop_cm = -100.0 * float(res.U[tip, 2].mean())
+    return {"converged": res.converged, "iterations": res.iterations, "increments": len(res.load_steps),
+            "factorisations": res.factorisations, "build_s": t1 - t0, "solve_s": t2 - t1,
+            "tip_drop_cm": drop_cm, "error": drop_cm / 4.34468 - 1.0, "dofs": int(model.free.sum())}
+
+
+def case_process(name: str, overrides: list[str]) -> dict:
+    """Child: run scene ``name`` with ``overrides`` as ``python -m rftstatic case NAME --set ...
+    --no-figures`` does (:func:`rftstatic.api.run`); its iterations and times."""
+    from rftstatic.api import run
+
+    with tempfile.TemporaryDirectory() as tmp:
+        summary = run(name, f"{tmp}/out", overrides=overrides, figures=False).summary
+    return {"iterations": summary.get("newton_iterations"), "increments": summary.get("load_steps"),
+            "factorisations": summary.get("factorisations"), "solve_s": summary.get("wall_time_s"),
+            "build_s": summary.get("build_time_s"), "route": summary.get("route")}
+
+
+def _child(target: str, kwargs: dict, name: str):
+    from rftstatic.bench.harness import ChildError, run_child
+
+    try:
+        return run_child(f"rftstatic.bench.newton:{target}" if ":" not in target else target, kwargs, name=name,
+                         timeout=TIMEOUT_S)
+    except ChildError as exc:
+        print(f"{name:34s} FAILED: {exc}", flush=True)
+        return None
+
+
+def _row(label, r, run, extra=""):
+    print(f"{label:34s} {str(r.get('iterations')):>5s} {str(r.get('increments', '')):>5s} "
+          f"{str(r.get('factorisations', '')):>6s} {r['solve_s']:8.3f} {run.wall_s:8.3f}  {extra}", flush=True)
+
+
+def main(argv=None) -> int:
+    print(f"{'problem':34s} {'its':>5s} {'incs':>5s} {'facts':>6s} {'solve s':>8s} {'process':>8s}")
+    results = {}
+    for nx, ny in STRIPS:
+        run = _child("strip_solve", {"nx": nx, "ny": ny}, f"strip {nx}x{ny}")
+        if run:
+            r = run.result
+            results[f"strip {nx}x{ny}"] = (r, run)
+            _row(f"strip {nx}x{ny} RFT6", r, run, f"error {100 * r['error']:+.4f} %  {r['dofs']} dofs")
+    run = _child("case_process", {"name": "strip", "overrides": ["mesh.nodes=[101,5]"]}, "case strip 101x5")
+    if run:
+        results["case strip 101x5"] = (run.result, run)
+        _row("case strip 101x5 (whole CLI run)", run.result, run)
+    from rftstatic.bench.kratos_peer import kratos_available
+
+    if kratos_available():
+        run = _child("rftstatic.bench.kratos_peer:solve_strip", {"nx": 51, "ny": 11, "increments": 5, "threads": 1},
+                     "kratos 51x11")
+        if run:
+            r = run.result
+            results["kratos 51x11"] = (r, run)
+            _row("Kratos strip 51x11 (1 thread)", r, run, f"error {100 * r['error']:+.4f} %  {r['dofs']} dofs")
+    else:
+        print("Kratos Multiphysics not installed: pip install KratosMultiphysics "
+              "KratosStructuralMechanicsApplication KratosLinearSolversApplication for the peer row")
+    for element in ("RFT3", "RFT6"):
+        base = None
+        for ratio in RATIOS:
+            run = _child("strip_solve", {"nx": 21, "ny": 5, "element": element, "ratio": ratio},
+                         f"cell {element} {ratio:g}")
+            if run:
+                r = run.result
+                base = base or r["iterations"]
+                _row(f"strip 21x5 {element} C/B {ratio:.0e}", r, run,
+                     f"converged {r['converged']}  x{r['iterations'] / base:.2f} of C/B 1e2")
+    run = _child("case_process", {"name": "pedestal-square-20", "overrides": []}, "pedestal-square-20")
+    if run:
+        _row("pedestal-square-20 33x33 (CLI)", run.result, run, f"route {run.result['route']}")
+    if "kratos 51x11" in results and "strip 101x5" in results:
+        k, kr = results["kratos 51x11"]
+        s, sr = results["strip 101x5"]
+        print(f"equal error (rftstatic 101x5 {100 * s['error']:+.4f} %, Kratos 51x11 {100 * k['error']:+.4f} %): "
+              f"solve {k['solve_s'] / s['solve_s']:.2f} x faster, whole process "
+              f"{kr.wall_s / results['case strip 101x5'][1].wall_s:.2f} x faster (CLI run)" if "case strip 101x5"
+              in results else "")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
