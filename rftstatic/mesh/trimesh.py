@@ -215,6 +215,10 @@ class TriMesh:
         T = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=2)
         l12 = np.linalg.solve(T, (pts - P[:, 0])[..., None])[..., 0]
         bary = np.column_stack([1 - l12.sum(axis=1), l12])
+        # a point on an edge (to the 1e-10 tolerance of the search) gets coordinates >= 0
+        found = elem >= 0
+        bary[found] = np.clip(bary[found], 0.0, None)
+        bary[found] /= bary[found].sum(axis=1, keepdims=True)
         return elem, bary
 
     def _locate_brute(self, pts) -> np.ndarray:
