@@ -9,14 +9,35 @@ PARALLEL_MIN_ELEMENTS = 4000
 costs more than the work."""
 
 
+STATIC_COMPILED_MIN_ELEMENTS = 3000
+"""Smallest mesh whose static membrane kernels (energy, force, tangent) run compiled when numba has not
+been loaded yet: importing numba and loading the first cached kernel cost about 1 s, more than the numpy
+twins lose on a small mesh in a whole solve (measured, fresh processes, the §4.1 strip in 38 Newton
+iterations: 51 x 11 nodes, 1000 RFT6 elements, 2.95 s numpy against 4.3 s compiled; 101 x 5, 800
+elements, 2.3 s against 3.2 s; 101 x 21, 4000 elements, 8.5 s against 6.0 s)."""
+
+
 @cache
 def numba_available() -> bool:
-    """True when numba imports (the ``fast`` extra); the kernels' numpy twins are used otherwise."""
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return False
-    return True
+    """True when numba is installed (the ``fast`` extra); the kernels' numpy twins are used otherwise.
+    Found without importing it (that alone takes 0.6 s)."""
+    from importlib.util import find_spec
+
+    return find_spec("numba") is not None
+
+
+def compiled_loaded() -> bool:
+    """Whether the compiled kernels are already loaded in this process (then they cost nothing more)."""
+    import sys
+
+    return "rftstatic.element._kernels_numba" in sys.modules
+
+
+def static_kernels_compiled(n_elements: int) -> bool:
+    """Whether the static membrane kernels of a mesh of ``n_elements`` run compiled ("auto" back end):
+    numba installed, and the mesh large enough to repay loading it (:data:`STATIC_COMPILED_MIN_ELEMENTS`)
+    or the kernels loaded already."""
+    return numba_available() and (n_elements >= STATIC_COMPILED_MIN_ELEMENTS or compiled_loaded())
 
 
 def force_threads(n_elements: int) -> int:

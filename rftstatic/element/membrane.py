@@ -23,7 +23,7 @@ from functools import cached_property
 
 import numpy as np
 
-from rftstatic.compiled import numba_available
+from rftstatic.compiled import numba_available, static_kernels_compiled
 from rftstatic.element.kernels import (
     element_last,
     energies_numpy,
@@ -102,7 +102,7 @@ class MembraneOperator:
         """``eps(U) + Bbar(U) dU (E, 3)`` [-]: the averaged strain of Eq. 14 linearised about ``U (N, 3)``
         along ``dU (N, 3)`` [m] (exact to first order; the Green strain's quadratic term in dU left out)."""
         U, dU = _as_float(U), _as_float(dU)
-        if _compiled("auto"):
+        if _compiled("auto", len(self.nodes)):
             from rftstatic.element._kernels_numba import membrane_linearised_strains
 
             out = np.empty((len(self.nodes), 3))
@@ -130,7 +130,7 @@ class MembraneOperator:
     def element_energy(self, U, Dm, *, backend="auto") -> np.ndarray:
         """(E,) membrane energy of every element [J]."""
         U, Dm = _as_float(U), _as_float(Dm)
-        if _compiled(backend):
+        if _compiled(backend, len(self.nodes)):
             from rftstatic.element._kernels_numba import membrane_energies
 
             We = np.empty(len(self.nodes))
@@ -141,7 +141,7 @@ class MembraneOperator:
     def element_forces(self, U, Dm, *, backend="auto") -> np.ndarray:
         """Internal membrane forces ``(E, A, 3)`` [N], the gradient of :meth:`energy`."""
         U, Dm = _as_float(U), _as_float(Dm)
-        if _compiled(backend):
+        if _compiled(backend, len(self.nodes)):
             from rftstatic.element._kernels_numba import membrane_forces
 
             fe = np.empty(self.nodes.shape + (3,))
@@ -162,7 +162,7 @@ class MembraneOperator:
         kernels vectorised over the elements), ``"auto"``: numba when installed.
         """
         U, Dm = _as_float(U), _as_float(Dm)
-        if _compiled(backend):
+        if _compiled(backend, len(self.nodes)):
             from rftstatic.element._kernels_numba import membrane_tangents
 
             E, A = self.nodes.shape
@@ -180,7 +180,7 @@ class MembraneOperator:
         ``(E, A, 3)`` [N]. Compiled: one pass, no element-matrix array (the 101 x 21 strip: 4000
         elements, 1.3 M entries, 10 MB a tangent)."""
         U, Dm = _as_float(U), _as_float(Dm)
-        if _compiled(backend):
+        if _compiled(backend, len(self.nodes)):
             from rftstatic.element._kernels_numba import membrane_tangents_into
 
             fe = np.empty(self.nodes.shape + (3,))
@@ -192,11 +192,14 @@ class MembraneOperator:
         return fe
 
 
-def _compiled(backend: str) -> bool:
-    """Whether ``backend`` (``"auto"``, ``"numpy"`` or ``"numba"``) means the compiled kernels."""
+def _compiled(backend: str, n_elements: int) -> bool:
+    """Whether ``backend`` (``"auto"``, ``"numpy"`` or ``"numba"``) means the compiled kernels for a mesh
+    of ``n_elements`` (``"auto"``: :func:`rftstatic.compiled.static_kernels_compiled`)."""
     if backend not in BACKENDS:
         raise ValueError(f'membrane backend must be one of {", ".join(BACKENDS)}, got "{backend}"')
-    return backend == "numba" or (backend == "auto" and numba_available())
+    if backend == "numba" and not numba_available():
+        raise ValueError('membrane backend "numba" needs numba: pip install "rftstatic[fast]"')
+    return backend == "numba" or (backend == "auto" and static_kernels_compiled(n_elements))
 
 
 def _as_float(a) -> np.ndarray:
