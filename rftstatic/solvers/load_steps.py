@@ -74,12 +74,13 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                     stress = model.mixed_stress(U, start - U)
             # the displacement iteration takes over while snapping through, and after repeated failures
             # of the mixed one at this load level or where the increment cannot be cut back
-            fallback = continuing is not None or failures >= MIXED_FAILURES
+            fallback = continuing is not None or (opts.iteration_fallback and failures >= MIXED_FAILURES)
             nt = newton(model, start, lam_next, opts, ws, max_step, stress=stress,
                         scheme="displacement" if fallback else None)
             continuing = None
             result.iterations += nt.iterations
-            if not nt.converged and nt.scheme == "mixed" and not dlam / 4.0 >= opts.min_increment:
+            if (not nt.converged and nt.scheme == "mixed" and opts.iteration_fallback
+                    and not dlam / 4.0 >= opts.min_increment):
                 result.retries += 1
                 log.info("load factor %.6g: %s (|r| = %.3e); retrying with displacement iterations",
                          lam_next, nt.reason, nt.residual)

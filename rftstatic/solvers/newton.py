@@ -64,6 +64,9 @@ class StaticOptions:
     iteration : ``"mixed"`` (MIP Newton, the membrane stress carried as an unknown; an increment it
         cannot converge is retried with the displacement iteration) or ``"displacement"`` (Newton on
         the displacements alone, energy line search)
+    iteration_fallback : an increment the mixed iteration cannot converge and that cannot be cut back
+        (or has failed twice) is tried with the displacement iteration; off for the relaxation
+        route's intermediate handovers, where the relaxation goes on instead
     tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
     linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
     max_load_steps : give up after this many increments
@@ -97,6 +100,7 @@ class StaticOptions:
     increment_displacement: float | None = None
     line_search: bool = True
     iteration: str = "mixed"
+    iteration_fallback: bool = True
     tangent: str = "auto"
     linear_solver: str = "auto"
     max_load_steps: int = 2000

@@ -127,7 +127,9 @@ def _relax_then_newton(model, opts, callback, ws, *, first):
         U = np.zeros((model.mesh.n_nodes, 3))
         U[:, 2] = start_perturbation(model.mesh, opts) * model.free[:, 2]
     polish = opts.from_state(relax_fallback=False)
-    short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS)
+    # a handover that fails gives way to more relaxation, not to the slower displacement iteration
+    short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS,
+                    iteration_fallback=False)
     basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
     info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": 0.0, "steps": 0, "handovers": [],
             "after_failure": None if first is None else str(first)}
