@@ -22,11 +22,16 @@ Kratos's and the whole process faster than Kratos's.
 
 from __future__ import annotations
 
+import os
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 STRIPS = ((51, 11), (101, 21), (101, 5))
+TARGETS = ("Targets (issue \"Newton, part 1\"): the 51 x 11 strip in at most 40 iterations and a solve under 0.3 s "
+           "on an idle core; the stiff cells within 3 x the iterations of the C/B = 1e2 cell (RFT3 and RFT6); at "
+           "equal error the solve 3 x faster than Kratos's and the whole process faster than Kratos's.")
 RATIOS = (1e2, 1e5, 1e7, 1e8, 1e9)
 TIMEOUT_S = 600.0
 
@@ -86,37 +91,45 @@ def _child(target: str, kwargs: dict, name: str):
         return None
 
 
-def _row(label, r, run, extra=""):
+HEADER = f"{'problem':34s} {'its':>5s} {'incs':>5s} {'facts':>6s} {'solve s':>8s} {'process':>8s}"
+
+
+def _row(rows, label, r, run, extra=""):
+    """Print one line and keep it for the report."""
+    rows.append({"problem": label, "iterations": r.get("iterations"), "increments": r.get("increments"),
+                 "factorisations": r.get("factorisations"), "solve_s": r["solve_s"], "process_s": run.wall_s,
+                 "note": extra})
     print(f"{label:34s} {str(r.get('iterations')):>5s} {str(r.get('increments', '')):>5s} "
           f"{str(r.get('factorisations', '')):>6s} {r['solve_s']:8.3f} {run.wall_s:8.3f}  {extra}", flush=True)
 
 
-def main(argv=None) -> int:
-    print(f"{'problem':34s} {'its':>5s} {'incs':>5s} {'facts':>6s} {'solve s':>8s} {'process':>8s}")
-    results = {}
+def _strips(rows, results):
     for nx, ny in STRIPS:
         run = _child("strip_solve", {"nx": nx, "ny": ny, "warm": True}, f"strip {nx}x{ny}")
         if run:
             r = run.result
             results[f"strip {nx}x{ny}"] = (r, run)
-            warm = f"  warm solve {r['warm_solve_s']:.3f} s" if "warm_solve_s" in r else ""
-            _row(f"strip {nx}x{ny} RFT6", r, run, f"error {100 * r['error']:+.4f} %  {r['dofs']} dofs{warm}")
+            warm = f", warm solve {r['warm_solve_s']:.3f} s" if "warm_solve_s" in r else ""
+            _row(rows, f"strip {nx}x{ny} RFT6", r, run, f"error {100 * r['error']:+.4f} %, {r['dofs']} dofs{warm}")
     run = _child("case_process", {"name": "strip", "overrides": ["mesh.nodes=[101,5]"]}, "case strip 101x5")
     if run:
         results["case strip 101x5"] = (run.result, run)
-        _row("case strip 101x5 (whole CLI run)", run.result, run)
+        _row(rows, "case strip 101x5 (whole CLI run)", run.result, run)
     from rftstatic.bench.kratos_peer import kratos_available
 
-    if kratos_available():
-        run = _child("rftstatic.bench.kratos_peer:solve_strip", {"nx": 51, "ny": 11, "increments": 5, "threads": 1},
-                     "kratos 51x11")
-        if run:
-            r = run.result
-            results["kratos 51x11"] = (r, run)
-            _row("Kratos strip 51x11 (1 thread)", r, run, f"error {100 * r['error']:+.4f} %  {r['dofs']} dofs")
-    else:
+    if not kratos_available():
         print("Kratos Multiphysics not installed: pip install KratosMultiphysics "
               "KratosStructuralMechanicsApplication KratosLinearSolversApplication for the peer row")
+        return
+    run = _child("rftstatic.bench.kratos_peer:solve_strip", {"nx": 51, "ny": 11, "increments": 5, "threads": 1},
+                 "kratos 51x11")
+    if run:
+        r = run.result
+        results["kratos 51x11"] = (r, run)
+        _row(rows, "Kratos strip 51x11 (1 thread)", r, run, f"error {100 * r['error']:+.4f} %, {r['dofs']} dofs")
+
+
+def _cells(rows):
     for element in ("RFT3", "RFT6"):
         base = None
         for ratio in RATIOS:
@@ -125,18 +138,70 @@ def main(argv=None) -> int:
             if run:
                 r = run.result
                 base = base or r["iterations"]
-                _row(f"strip 21x5 {element} C/B {ratio:.0e}", r, run,
-                     f"converged {r['converged']}  x{r['iterations'] / base:.2f} of C/B 1e2")
+                _row(rows, f"strip 21x5 {element} C/B {ratio:.0e}", r, run,
+                     f"converged {r['converged']}, {r['iterations'] / base:.2f} x the C/B = 1e2 cell")
+
+
+def _comparison(results) -> str:
+    """The equal-error comparison with Kratos (one run), or '' without the peer."""
+    if not all(k in results for k in ("kratos 51x11", "strip 101x5", "case strip 101x5")):
+        return ""
+    k, kr = results["kratos 51x11"]
+    s, _ = results["strip 101x5"]
+    whole = results["case strip 101x5"][1]
+    return (f"equal error (rftstatic 101x5 {100 * s['error']:+.4f} %, Kratos 51x11 {100 * k['error']:+.4f} %): "
+            f"solve {k['solve_s'] / s['solve_s']:.2f} x faster, whole process {kr.wall_s / whole.wall_s:.2f} x "
+            "faster (CLI run)")
+
+
+def write_report(folder, rows, comparison, load) -> Path:
+    """``newton.md`` and ``newton.json`` in ``folder``: the table of one run, its machine load."""
+    import json
+    import platform
+
+    from rftstatic.provenance import code_fingerprint
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    lines = ["# Newton: iterations, factorisations and time (strip, stiff cells, pedestal, Kratos peer)", "",
+             "Benchmark `newton`; regenerate with `python -m rftstatic.bench.newton --report validation`.", "",
+             f"One run, {stamp}, {platform.node()}, {os.cpu_count()} cores, load average before / after: "
+             f"{load[0]} / {load[1]}; code {code_fingerprint()}. Every row a fresh interpreter, one after the "
+             "other; compare as ratios within this run. Solve: the first solve in the process (loading compiled "
+             "kernels included); process: the child's whole wall time.", "",
+             "| problem | Newton iterations | increments | factorisations | solve [s] | process [s] | note |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['problem']} | {r['iterations']} | {r['increments'] or ''} | {r['factorisations'] or ''} "
+                     f"| {r['solve_s']:.3f} | {r['process_s']:.3f} | {r['note']} |")
+    lines += ["", comparison or "Kratos not installed: no peer comparison.", "", TARGETS]
+    (folder / "newton.md").write_text("\n".join(lines) + "\n")
+    (folder / "newton.json").write_text(json.dumps({"rows": rows, "comparison": comparison, "load": load,
+                                                    "date": stamp}, indent=1))
+    return folder / "newton.md"
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="rftstatic bench newton", description=__doc__.split("\n")[0])
+    parser.add_argument("--report", metavar="DIR", help="also write DIR/newton.md and DIR/newton.json")
+    args = parser.parse_args(argv)
+    load_before = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    print(HEADER)
+    rows, results = [], {}
+    _strips(rows, results)
+    _cells(rows)
     run = _child("case_process", {"name": "pedestal-square-20", "overrides": []}, "pedestal-square-20")
     if run:
-        _row("pedestal-square-20 33x33 (CLI)", run.result, run, f"route {run.result['route']}")
-    if "kratos 51x11" in results and "strip 101x5" in results:
-        k, kr = results["kratos 51x11"]
-        s, sr = results["strip 101x5"]
-        print(f"equal error (rftstatic 101x5 {100 * s['error']:+.4f} %, Kratos 51x11 {100 * k['error']:+.4f} %): "
-              f"solve {k['solve_s'] / s['solve_s']:.2f} x faster, whole process "
-              f"{kr.wall_s / results['case strip 101x5'][1].wall_s:.2f} x faster (CLI run)" if "case strip 101x5"
-              in results else "")
+        _row(rows, "pedestal-square-20 33x33 (CLI)", run.result, run, f"route {run.result['route']}")
+    comparison = _comparison(results)
+    if comparison:
+        print(comparison)
+    if args.report:
+        path = write_report(args.report, rows, comparison, (load_before, " ".join(f"{x:.2f}" for x in os.getloadavg())))
+        print(f"report -> {path}")
     return 0
 
 
