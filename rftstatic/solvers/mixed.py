@@ -9,9 +9,9 @@ from rftstatic.solvers.linear import LinearSolveError
 
 MIXED_ITERATIONS = 12
 """Most mixed iterations per increment (twice at full load, at most ``max_iterations``): where it
-converges, the mixed iteration needs 5-8 (the §4.1 strip from C/B = 1e2 to 1e9 /cm^2); one that has
-not converged by 12 wanders (RFT6 at C/B = 1e8 went on for 30 without settling) and a smaller
-increment is the better remedy."""
+converges, the mixed iteration needs 3-8 (the §4.1 strip from C/B = 1e2 to 1e9 /cm^2); one that has
+not converged by 12 wanders (RFT6 at C/B = 1e8 from a secant start went on for 30 without settling) and
+a smaller increment is the better remedy."""
 
 
 def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
@@ -25,9 +25,9 @@ def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
     rotation and sees, at the next iterate, a membrane stress of order C theta^2 that is not there at
     the solution; its energy line search then cuts the step, and the iterations grow with C/B (strip
     cells, validation/stability.md: 1600 iterations at C/B = 1e7 /cm^2, none converging at 1e8). The
-    mixed stress does not carry that spurious stretch (the 21 x 5 strip, RFT3: 29 iterations at
-    C/B = 1e2, 80 at 1e9), and at the solution S = D^m eps(U), so the converged state and the
-    quadratic rate are those of the exact tangent. The steps do not lower Pi
+    mixed stress does not carry that spurious stretch (the 21 x 5 strip: 25 iterations at C/B = 1e2,
+    42 (RFT3) and 38 (RFT6) at 1e9), and at the solution S = D^m eps(U), so the converged state and
+    the quadratic rate are those of the exact tangent. The steps do not lower Pi
     monotonically, so there is no energy line search; only the step cap ``max_step`` applies. An
     iteration that fails returns to the load steps (:mod:`rftstatic.solvers.load_steps`), which cut the
     increment back and, after repeated failures, try the displacement iteration.

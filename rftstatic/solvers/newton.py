@@ -58,7 +58,7 @@ class StaticOptions:
     max_step : cap on the largest nodal increment per Newton iteration [m]; ``None``: 10 % of the
         sheet's diagonal
     increment_displacement : target largest nodal displacement per load increment [m], from which
-        the next increment is sized by the secant (first: tangent) rate d|U|/d lam; ``None``: 5 %
+        the next increment is sized by the secant (first: tangent) rate d|U|/d lam; ``None``: 10 %
         of the sheet's diagonal. Halved or grown with the Newton iteration count.
     line_search : Armijo backtracking on Pi (displacement iteration)
     iteration : ``"mixed"`` (MIP Newton, the membrane stress carried as an unknown; an increment it
