@@ -106,3 +106,15 @@ def test_iteration_option_is_checked():
     with pytest.raises(ValueError, match="solver.iteration"):
         static.StaticOptions(iteration="mip")
     assert dataclasses.replace(static.StaticOptions(), iteration="displacement").iteration == "displacement"
+
+
+def test_increments_grow_when_convergence_is_fast():
+    model = strip_model(21, 5)
+    res = static.solve_static(model, options=static.StaticOptions(progress=False))
+    steps = res.load_steps
+    assert res.converged and len(steps) <= 8
+    for a, b in zip(steps[:-2], steps[1:-1], strict=True):  # the last one is clipped at lam = 1
+        if a["iterations"] <= 5:
+            assert b["increment"] > a["increment"]
+    assert all(s["scheme"] == "mixed" for s in steps)
+    assert res.factorisations >= res.iterations
