@@ -66,7 +66,7 @@ class Criteria:
         ``|d| |r|``, says nothing about the energy left, which is quadratic in r."""
         rnorm = float(np.linalg.norm(r))
         tol = self.rtol * self.ref
-        if tol < rnorm < 1e4 * tol:  # close: is the rest round-off?
+        if tol < rnorm < 1e4 * tol and self.atol == 0.0:  # close: is the rest round-off? (once an increment)
             self.atol = roundoff_floor(self.model, U)
         if rnorm > tol + self.atol:
             return False
