@@ -33,11 +33,26 @@ def compiled_loaded() -> bool:
     return "rftstatic.element._kernels_numba" in sys.modules
 
 
+NUMPY_BUDGET_S = 1.0
+"""Seconds the "auto" back end may spend in the numpy twins before it loads the compiled kernels (about
+what loading costs): a process that solves one small scene never pays for numba, one that solves many
+(a validation report, a study) pays at most twice the cheaper choice (the ski-rental rule). The
+sze2004 report's small cantilevers took 0.37 s instead of 0.04 s each on the numpy twins alone."""
+
+_numpy_seconds = [0.0]
+
+
+def charge_numpy(seconds: float) -> None:
+    """Count ``seconds`` spent in a numpy twin chosen by the "auto" back end."""
+    _numpy_seconds[0] += seconds
+
+
 def static_kernels_compiled(n_elements: int) -> bool:
     """Whether the static membrane kernels of a mesh of ``n_elements`` run compiled ("auto" back end):
-    numba installed, and the mesh large enough to repay loading it (:data:`STATIC_COMPILED_MIN_ELEMENTS`)
-    or the kernels loaded already."""
-    return numba_available() and (n_elements >= STATIC_COMPILED_MIN_ELEMENTS or compiled_loaded())
+    numba installed, and the mesh large enough to repay loading it (:data:`STATIC_COMPILED_MIN_ELEMENTS`),
+    the kernels loaded already, or the numpy twins used up :data:`NUMPY_BUDGET_S` in this process."""
+    return numba_available() and (n_elements >= STATIC_COMPILED_MIN_ELEMENTS or compiled_loaded()
+                                  or _numpy_seconds[0] > NUMPY_BUDGET_S)
 
 
 def force_threads(n_elements: int) -> int:

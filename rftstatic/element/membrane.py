@@ -20,10 +20,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from time import perf_counter
 
 import numpy as np
 
-from rftstatic.compiled import numba_available, static_kernels_compiled
+from rftstatic.compiled import charge_numpy, numba_available, static_kernels_compiled
 from rftstatic.element.kernels import (
     element_last,
     energies_numpy,
@@ -108,7 +109,7 @@ class MembraneOperator:
             out = np.empty((len(self.nodes), 3))
             membrane_linearised_strains(self._compiled_args[0], self._compiled_args[1], U, dU, out)
             return out
-        return linearised_strain_numpy(self.G_last, self.nodes, U, dU)
+        return _numpy_path("auto", linearised_strain_numpy, self.G_last, self.nodes, U, dU)
 
     def force_roundoff(self, U: np.ndarray, Dm: np.ndarray) -> np.ndarray:
         """``(E, A)`` [N]: the size of the round-off in the element forces at ``U (N, 3)`` [m], per unit
@@ -136,7 +137,7 @@ class MembraneOperator:
             We = np.empty(len(self.nodes))
             membrane_energies(*self._compiled_args, Dm, U, We)
             return We
-        return energies_numpy(self.G_last, self.nodes, self.area, Dm, U)
+        return _numpy_path(backend, energies_numpy, self.G_last, self.nodes, self.area, Dm, U)
 
     def element_forces(self, U, Dm, *, backend="auto") -> np.ndarray:
         """Internal membrane forces ``(E, A, 3)`` [N], the gradient of :meth:`energy`."""
@@ -147,7 +148,7 @@ class MembraneOperator:
             fe = np.empty(self.nodes.shape + (3,))
             membrane_forces(*self._compiled_args, Dm, U, fe, 0, len(fe))
             return fe
-        return np.moveaxis(forces_numpy(self.G_last, self.nodes, self.area, Dm, U)[0], -1, 0)
+        return np.moveaxis(_numpy_path(backend, forces_numpy, self.G_last, self.nodes, self.area, Dm, U)[0], -1, 0)
 
     def element_tangents(self, U, Dm, *, psd=False, stress=None, backend="auto"):
         """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m].
@@ -171,7 +172,7 @@ class MembraneOperator:
             S = np.zeros((0, 3)) if stress is None else _as_float(stress)
             membrane_tangents(*self._compiled_args, Dm, U, bool(psd), S, f, K)
             return f, K
-        return tangents_numpy(self.G_last, self.nodes, self.area, Dm, U, bool(psd), stress)
+        return _numpy_path(backend, tangents_numpy, self.G_last, self.nodes, self.area, Dm, U, bool(psd), stress)
 
 
     def tangents_into(self, U, Dm, emap, data, *, psd=False, stress=None, backend="auto") -> np.ndarray:
@@ -190,6 +191,17 @@ class MembraneOperator:
         fe, ke = self.element_tangents(U, Dm, psd=psd, stress=stress, backend=backend)
         data += np.bincount(emap.ravel(), ke.ravel(), minlength=len(data))
         return fe
+
+
+def _numpy_path(backend, kernel, *args):
+    """``kernel(*args)``, a numpy twin; its time is charged to the "auto" back end's budget
+    (:func:`rftstatic.compiled.static_kernels_compiled`) when "auto" chose it."""
+    if backend != "auto":
+        return kernel(*args)
+    t0 = perf_counter()
+    out = kernel(*args)
+    charge_numpy(perf_counter() - t0)
+    return out
 
 
 def _compiled(backend: str, n_elements: int) -> bool:
