@@ -34,7 +34,7 @@ def main(argv=None) -> int:
                    help="override a scene key, e.g. --set element=RFT3 --set mesh.nodes=[21,101]")
     p.add_argument("--out", default=None, help="output folder (default out/NAME)")
     p.add_argument("--no-figures", action="store_true", help="skip the PNG views")
-    p.add_argument("--resume", action="store_true", help="continue a dynamic run from its last checkpoint")
+    p.add_argument("--resume", action="store_true", help="continue a run (static, dynamic, relax) from its last checkpoint")
 
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
 
@@ -53,7 +53,7 @@ def main(argv=None) -> int:
     try:
         return _command(args)
     except KeyboardInterrupt:
-        print("interrupted (a dynamic run resumes from its last checkpoint with --resume)", file=sys.stderr)
+        print("interrupted (the run resumes from its last checkpoint with --resume)", file=sys.stderr)
         return EXIT["interrupted"]
     except Exception as exc:  # noqa: BLE001 - the one place an unexpected error is reported
         if verbose:

@@ -19,6 +19,7 @@ mesher's imports.
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 import shutil
 from pathlib import Path
@@ -27,6 +28,8 @@ from rftstatic.errors import ConvergenceError, InstabilityError
 from rftstatic.scenes.analyses import ANALYSES, SCENE_ANALYSES
 
 __all__ = ["ANALYSES", "analysis_of", "run", "run_scene", "resume_scene"]
+
+log = logging.getLogger(__name__)
 
 def analysis_of(scene) -> str:
     """The registered analysis that runs ``scene``: ``remeshed`` when it has a ``[remesh]`` table, else its
@@ -98,18 +101,21 @@ def run_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
-    """Continue a dynamic or relax run of ``scene`` from its checkpoint; return its summary.
+    """Continue a run of ``scene`` (static, dynamic or relax) from its checkpoint; return its summary.
 
     The checkpoint of an interrupted run is in ``<out_dir>.partial`` (:func:`run`); that run continues
     there and then replaces ``out_dir``. Without one, the run continues from ``out_dir/checkpoint.npz``
-    in place.
+    in place; a static scene with neither runs from the start (:func:`run`).
     """
-    from rftstatic.app.dynamic import resume_scene as resume
-
+    static = analysis_of(scene) == "static"
+    resume = importlib.import_module(ANALYSES["static" if static else "dynamic"]).resume_scene
     out = Path(out_dir)
     partial = out.with_name(out.name + PARTIAL)
     if (partial / "checkpoint.npz").exists():
         summary = resume(scene, partial, progress=progress, figures=figures)
         _publish(partial, out)
         return summary
+    if static and not (out / "checkpoint.npz").exists():
+        log.warning("no checkpoint in %s or %s: running %s from the start", partial, out, scene.name)
+        return run(scene, out, progress=progress, figures=figures).summary
     return resume(scene, out, progress=progress, figures=figures)

@@ -4,10 +4,17 @@ The route (load-scaled Newton, dynamic relaxation, or both) is :func:`rftstatic.
 Every number written is in the scene's units. A solve that fails still writes its last equilibrium,
 labelled ``"converged": false``, before the :class:`~rftstatic.errors.ConvergenceError` is raised again
 (the command line exits with status 3).
+
+The solve saves ``checkpoint.npz`` in the run folder after converged increments and relaxation segments
+(:mod:`rftstatic.solvers.static_checkpoint`: at most one write per
+:data:`~rftstatic.solvers.static_checkpoint.CHECKPOINT_SECONDS` of wall time, the end of every phase
+always, the last converged increment on a Ctrl-C); ``--resume`` (:func:`resume_scene`) continues from it
+to the same equilibrium as the uninterrupted run.
 """
 
 from __future__ import annotations
 
+import logging
 import time
 from pathlib import Path
 
@@ -19,25 +26,63 @@ from rftstatic.io.summary import drape_summary, probe_summary, summary_header
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import static_options
 from rftstatic.solvers.static import solve_static
+from rftstatic.solvers.static_checkpoint import (
+    CHECKPOINT_SECONDS,
+    StaticCheckpointer,
+    load_static_checkpoint,
+    remove_stale,
+)
+
+log = logging.getLogger(__name__)
+
+CHECKPOINT = "checkpoint.npz"
 
 
-def run(scene, out: Path, *, progress=True, figures=True) -> RunResult:
-    """Build and solve ``scene``; write the outputs into ``out``; return the result."""
+def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback=None,
+        checkpoint_seconds: float = CHECKPOINT_SECONDS) -> RunResult:
+    """Build and solve ``scene``; write the outputs into ``out``; return the result.
+
+    ``resume``: continue from ``out/checkpoint.npz`` (a fresh solve, logged, when there is none; a
+    :class:`~rftstatic.errors.CheckpointError` when it is corrupt or another scene's, mesh's or options').
+    ``callback``: ``callback(lam, U)`` after every converged increment. ``checkpoint_seconds``: least wall
+    time between two checkpoint writes [s].
+    """
     t0 = time.perf_counter()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
     model, extras = build_model(scene)
     build_time = time.perf_counter() - t0
+    opts = static_options(scene, progress=progress)
+    path = out / CHECKPOINT
+    remove_stale(path)
+    restart = None
+    if resume and path.exists():
+        restart = load_static_checkpoint(path, model, opts, scene=scene.name)
+        log.info("resuming the static solve from %s (%s)", path, restart.where)
+    elif resume:
+        log.warning("no checkpoint %s: solving from the start", path)
+    saver = StaticCheckpointer(path, model, opts, scene=scene.name, every_seconds=checkpoint_seconds)
     error = None
     try:
-        result = solve_static(model, options=static_options(scene, progress=progress))
+        with saver.on_interrupt():
+            result = solve_static(model, options=opts, callback=callback, checkpoint=saver, restart=restart)
     except ConvergenceError as exc:
         error, result = exc, exc.result
         if result is None:
             raise
     summary = static_summary(scene, model, extras, result, build_time)
+    summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or restart else None, "writes": saver.writes,
+                             "write_time_s": saver.write_time,
+                             "resumed_from": None if restart is None else restart.where}
     write_outputs(scene, model, extras, result.U, out, summary, figures=figures)
     if error is not None:
         raise error
     return RunResult(to_jsonable(summary), model, result.U, extras, out)
+
+
+def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
+    """Continue the static solve of ``scene`` from ``out_dir/checkpoint.npz`` (``case NAME --resume``)."""
+    return run(scene, Path(out_dir), progress=progress, figures=figures, resume=True).summary
 
 
 def static_summary(scene, model, extras, result, build_time) -> dict:

@@ -91,27 +91,35 @@ class Checkpointer:
 
     def save(self, model, obstacles, state, *, dt, n_steps, estimate, acc, history, probes, frames, options):
         """Write the state after ``state.step`` steps (called by :func:`rftstatic.explicit.run_explicit`)."""
-        N = model.mesh.n_nodes
-        P = len(options["probe_nodes"])
-        arrays = {
-            "format": np.array(FORMAT), "fingerprint": np.array(model_fingerprint(model)),
-            "obstacles": np.array(_obstacles_spec(obstacles)),
-            "t": np.array(state.t), "step": np.array(state.step), "n_steps": np.array(n_steps),
-            "dt": np.array(dt), "U": state.U, "V_half": state.V_half,
-            "acc": np.array(json.dumps(acc)),
-            "estimate": np.array(json.dumps(None if estimate is None else estimate.__dict__)),
-            "probes": np.asarray(probes, dtype=float).reshape(len(probes), P, 3),
-            "frame_t": np.array([t for t, _ in frames], dtype=float),
-            "frame_U": np.asarray([u for _, u in frames], dtype=float).reshape(len(frames), N, 3),
-        }
-        for k, v in history.items():
-            arrays["history_" + k] = np.asarray(v, dtype=float)
-        for k, v in options.items():
-            arrays["option_" + k] = np.asarray(v)
-        save_atomic(self.path, arrays)
+        save_atomic(self.path, state_arrays(model, obstacles, state, dt=dt, n_steps=n_steps, estimate=estimate,
+                                            acc=acc, history=history, probes=probes, frames=frames, options=options))
         self._last_wall = time.monotonic()
         self.saved += 1
         log.info("checkpoint at t = %.6g s (step %d) -> %s", state.t, state.step, self.path)
+
+
+def state_arrays(model, obstacles, state, *, dt, n_steps, estimate, acc, history, probes, frames, options) -> dict:
+    """The arrays of a checkpoint of an explicit run after ``state.step`` steps (what :func:`load_checkpoint`
+    reads): the state ``U``, ``V_half`` (N, 3) [m, m/s], step, step size [s], accumulators, history,
+    probe records (S, P, 3) [m], frames and the run's options."""
+    N = model.mesh.n_nodes
+    P = len(options["probe_nodes"])
+    arrays = {
+        "format": np.array(FORMAT), "fingerprint": np.array(model_fingerprint(model)),
+        "obstacles": np.array(_obstacles_spec(obstacles)),
+        "t": np.array(state.t), "step": np.array(state.step), "n_steps": np.array(n_steps),
+        "dt": np.array(dt), "U": state.U, "V_half": state.V_half,
+        "acc": np.array(json.dumps(acc)),
+        "estimate": np.array(json.dumps(None if estimate is None else estimate.__dict__)),
+        "probes": np.asarray(probes, dtype=float).reshape(len(probes), P, 3),
+        "frame_t": np.array([t for t, _ in frames], dtype=float),
+        "frame_U": np.asarray([u for _, u in frames], dtype=float).reshape(len(frames), N, 3),
+    }
+    for k, v in history.items():
+        arrays["history_" + k] = np.asarray(v, dtype=float)
+    for k, v in options.items():
+        arrays["option_" + k] = np.asarray(v)
+    return arrays
 
 
 def load_checkpoint(path) -> dict:

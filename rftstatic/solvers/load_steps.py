@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import logging
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -26,17 +27,48 @@ from rftstatic.solvers.perturbation import start_perturbation
 log = logging.getLogger(__name__)
 
 
+@dataclass
+class LoadPath:
+    """Where the load steps stand after a converged increment: what :func:`solve_load_steps` hands its
+    ``checkpoint`` hook and continues from as ``resume``.
+
+    Attributes
+    ----------
+    lam : load factor of the equilibrium ``U`` [-]
+    U : (N, 3) displacements of that equilibrium [m]
+    dlam : the next load increment [-]
+    target : target largest nodal displacement of the next increment [m]
+    lam_prev, U_prev : the equilibrium before (load factor [-], (N, 3) [m]) for the secant predictor; None
+        before the first increment
+    result : the :class:`StaticResult` so far (load-step records, iteration counts, seed, tangent modes)
+    """
+
+    lam: float
+    U: np.ndarray
+    dlam: float
+    target: float
+    lam_prev: float | None
+    U_prev: np.ndarray | None
+    result: StaticResult
+
+
 def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None,
-                     workspace: NewtonWorkspace | None = None) -> StaticResult:
+                     workspace: NewtonWorkspace | None = None, checkpoint=None,
+                     resume: LoadPath | None = None) -> StaticResult:
     """The load-scaled Newton iteration of :func:`solve_static` (module docstring).
 
     ``workspace``: shared with the other phases of one solve (:class:`NewtonWorkspace`; default a new one).
+    ``checkpoint``: called as ``checkpoint(path)`` with the :class:`LoadPath` after every converged increment
+    (after ``callback``). ``resume``: such a path, from which the solve continues as the uninterrupted one
+    did (``U0`` is then unused).
     """
     opts = options or StaticOptions()
     t0 = time.perf_counter()
     n = model.mesh.n_nodes
+    if resume is not None:
+        U0 = resume.U
     U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
-    seed = None
+    seed = None if resume is None else resume.result.seed
     if opts.perturbation and U0 is None:
         seed = opts.seed
         U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
@@ -45,7 +77,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         raise ConvergenceError(f"load factor 0: {what} are not finite (NaN or inf); check the scene's loads, "
                                "weight and mesh coordinates", None)
     ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
-    ws.modes = modes = {"exact": 0, "psd": 0, "shift": 0}
+    ws.modes = modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
     solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     ws.solver = solver
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
@@ -54,8 +86,12 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
     result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
     lam = 0.0
     mixed = opts.iteration == "mixed" and model.with_membrane
-    dlam = _first_increment(model, U, opts, ws, target)
-    U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
+    if resume is None:
+        dlam = _first_increment(model, U, opts, ws, target)
+        U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
+    else:
+        lam, dlam, target, U_prev, lam_prev = resume.lam, resume.dlam, resume.target, resume.U_prev, resume.lam_prev
+        _continue_result(model, result, resume)
     continuing = None  # Newton state of an increment that is still snapping through
     continuations = 0
     failures = 0  # mixed iterations failed in a row at this load level
@@ -105,6 +141,8 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                 rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
                 grow = GROWTH * (lam - lam_prev)
                 dlam = float(np.clip(target / max(rate, 1e-300), opts.min_increment, min(opts.max_increment, grow)))
+                if checkpoint is not None:
+                    checkpoint(LoadPath(lam, U, dlam, target, lam_prev, U_prev, result))
                 continue
             if nt.descending and continuations < opts.max_continuations:
                 continuations += 1
@@ -138,6 +176,16 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         ws.state.U, ws.state.lam = result.U, result.lam
         result.state = ws.state
     return result
+
+
+def _continue_result(model, result, path: LoadPath) -> None:
+    """``result`` carries on from ``path.result`` (records, counts) at the equilibrium ``path.U``."""
+    old = path.result
+    result.load_steps = list(old.load_steps)
+    result.iterations, result.cutbacks, result.retries = old.iterations, old.cutbacks, old.retries
+    result.U, result.lam, result.residual = path.U, path.lam, old.residual
+    for term in model.load_terms:  # the branch of angle-type potentials, as committed at that increment
+        term.commit(model.positions(path.U))
 
 
 TARGET_SHARE = 0.1

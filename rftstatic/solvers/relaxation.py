@@ -56,7 +56,8 @@ class RelaxResult:
 
 def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kinetic: float = 1e-8, tol_force: float = 1e-4,
           max_time: float, dt: float | None = None, U0=None, V0=None, obstacles=(), sample_every: int = 20,
-          peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto", load=None) -> RelaxResult:
+          peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto", load=None, checkpoint=None,
+          restart: dict | None = None) -> RelaxResult:
     """Dynamic relaxation (§6): damped explicit motion until the sheet is at rest.
 
     At rest means, at a sample, kinetic energy / peak kinetic energy < ``tol_kinetic`` *and* the
@@ -73,14 +74,23 @@ def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kine
         relaxation from its :class:`RelaxResult` (``U``, ``V``)
     peak_kinetic : peak kinetic energy [J] of the motion so far, when resuming (``RelaxResult.peak_kinetic``)
     load : (N, 3) external nodal load [N] instead of ``model.load`` (the resting state then balances it)
+    checkpoint : saves the explicit state during the run, as in :func:`~rftstatic.solvers.explicit.run_explicit`
+        (and a Ctrl-C then stops at a whole step, saved)
+    restart : the explicit state saved during an earlier call with the same arguments
+        (:func:`~rftstatic.solvers.checkpoint.load_checkpoint`): the run continues from it, step for step as
+        the uninterrupted one (``peak_kinetic`` is the peak before that call; ``U0``, ``V0``, ``dt`` are unused)
     """
     P = model.load if load is None else load
     P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
+    if restart is not None:  # the peak of the samples before the interruption, as the rest test saw them
+        kinetic = np.asarray(restart["history"]["kinetic"], dtype=float)
+        peak_kinetic = max(peak_kinetic, float(kinetic.max())) if kinetic.size else peak_kinetic
 
     at_rest = AtRest(tol_kinetic=tol_kinetic, tol_force=tol_force, load_norm=P_norm, peak_kinetic=peak_kinetic)
     run = run_explicit(model, t_end=max_time, dt=dt, alpha=alpha, mass_scale=mass_scale, obstacles=obstacles,
                        U0=U0, V0=V0, start="consistent" if V0 is None else "given", sample_every=sample_every,
-                       callback=at_rest, progress=progress, backend=backend, load=load)
+                       callback=at_rest, progress=progress, backend=backend, load=load, checkpoint=checkpoint,
+                       _restart=restart)
     if not run.stopped:
         log.warning("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
                     run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])

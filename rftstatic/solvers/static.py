@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -24,12 +24,13 @@ from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, relax
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.units import STANDARD_GRAVITY
 
-__all__ = ["ConvergenceError", "StaticOptions", "StaticResult", "solve_static", "compare_with_static"]
+__all__ = ["ConvergenceError", "RelaxRoute", "StaticOptions", "StaticResult", "compare_with_static", "solve_static"]
 
 log = logging.getLogger(__name__)
 
 
-def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
+def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None, checkpoint=None,
+                 restart=None) -> StaticResult:
     """Solve the static equilibrium of ``model`` under its full load (see module docstring).
 
     The load-scaled Newton iteration is the main route. When it cannot get through (a drape whose
@@ -43,7 +44,11 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     model : :class:`rftstatic.model.Model`
     U0 : (N, 3) start [m] (default: the flat reference, optionally perturbed)
     options : :class:`StaticOptions`
-    callback : called as ``callback(lam, U)`` after every converged increment (checkpoints, frames)
+    callback : called as ``callback(lam, U)`` after every converged increment (frames, probes)
+    checkpoint : a :class:`~rftstatic.solvers.static_checkpoint.StaticCheckpointer` that saves the solve
+        after converged increments and relaxation segments (default: none)
+    restart : a :class:`~rftstatic.solvers.static_checkpoint.StaticRestart` (a loaded checkpoint of this
+        model and these options): the solve continues from it as the uninterrupted one did
 
     Raises
     ------
@@ -53,16 +58,28 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     """
     opts = options or StaticOptions()
     ws = NewtonWorkspace.for_model(model)  # shared by the Newton phases of this solve
-    if opts.start == "relax":
-        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, first=None), opts)
+    if checkpoint is not None:
+        checkpoint.workspace = ws
+    if restart is not None:
+        restart.restore(model, ws)
+        if restart.phase == "done":
+            return _check_stability(model, restart.result, opts)
+        if restart.route is not None:
+            return _check_stability(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint,
+                                                              route=restart.route, segment=restart.segment), opts)
+    elif opts.start == "relax":
+        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint), opts)
     try:
-        return _check_stability(model, solve_load_steps(model, U0=U0, options=opts, callback=callback,
-                                                        workspace=ws), opts)
+        return _check_stability(model, solve_load_steps(
+            model, U0=U0, options=opts, callback=callback, workspace=ws,
+            checkpoint=None if checkpoint is None else checkpoint.load_step,
+            resume=None if restart is None else restart.load_path), opts)
     except ConvergenceError as exc:
         if not opts.relax_fallback or model.load_terms or not np.any(model.load):
             raise
         log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
-        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, first=exc), opts)
+        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, first=exc,
+                                                          checkpoint=checkpoint), opts)
 
 
 def _check_stability(model, result, opts):
@@ -92,7 +109,74 @@ iterations took four tries and 8,700 explicit steps more). Later handovers get
 :data:`RELAX_NEWTON_ITERATIONS` again."""
 
 
-def _relax_then_newton(model, opts, callback, ws, *, first):
+@dataclass
+class RelaxRoute:
+    """Where the relaxation route of :func:`solve_static` stands between two of its steps: what its
+    checkpoints save and what a resumed solve continues from (SI units).
+
+    Attributes
+    ----------
+    phase : ``"start"`` (nothing relaxed yet), ``"guide"`` (the guided first stage, under way), ``"relax"``
+        (a relaxation segment to run, or under way), ``"handover"`` (a segment has ended: tangent check,
+        then Newton)
+    U, V : (N, 3) displacements [m] and half-step velocities [m/s] at the start of the next step (None
+        before the first segment; ``U`` then holds the start perturbation, if any)
+    t_used : relaxation time so far [s]
+    peak : peak kinetic energy of the relaxation so far [J]
+    tol_force : the out-of-balance force at which the next segment stops, relative to ``|P|`` [-]
+    span : the longest next segment [s]
+    at_rest : whether the last segment ended at rest
+    seed : seed of the start perturbation or fold guide (None: none)
+    info : the route's record (:attr:`StaticResult.relax`: mass scale, damping, time, steps, handovers)
+    first : the failure of the load steps that led here (None: ``start = "relax"``)
+    """
+
+    phase: str
+    U: np.ndarray | None
+    V: np.ndarray | None
+    t_used: float
+    peak: float
+    tol_force: float
+    span: float
+    at_rest: bool
+    seed: int | None
+    info: dict
+    first: ConvergenceError | None = None
+
+
+@dataclass(frozen=True)
+class _RelaxPlan:
+    """The fixed numbers of one model's relaxation route: mass scale [-], damping [1/s], the longest
+    relaxation, the segment between two tangent checks and the shortest segment [s]."""
+
+    mass_scale: float
+    alpha: float
+    max_time: float
+    chunk: float
+    min_span: float
+
+
+def _relax_plan(model, first) -> _RelaxPlan:
+    """The relaxation's damping, critical for the pendulum mode of the drape, and its time limits;
+    ConvergenceError when it would need more than :data:`MAX_RELAX_STEPS` explicit steps."""
+    size = float(np.ptp(model.mesh.X, axis=0).max())
+    omega1 = np.sqrt(STANDARD_GRAVITY / (0.25 * size))  # pendulum estimate of the lowest drape mode
+    mass_scale = RELAX_MASS_SCALE
+    alpha = 2.0 * omega1 / np.sqrt(mass_scale)  # about critical for that mode of the scaled system
+    max_time = 100.0 / alpha  # the relaxation's expected need: 100 damping times (checked below)
+    est = stable_time_step(model, mass_scale=mass_scale, alpha=alpha)
+    if max_time / est.dt > MAX_RELAX_STEPS:  # a membrane far stiffer than the bending: too many steps
+        message = (f"dynamic relaxation would need up to {max_time / est.dt:.3g} explicit steps (dt {est.dt:.3g} s); "
+                   f"not attempted (limit {MAX_RELAX_STEPS:g})")
+        if first is not None:
+            raise ConvergenceError(f"{first}; {message}", first.result) from None
+        raise ConvergenceError(message, None)
+    # settling folds on fine meshes (31 x 240 rings) take longer
+    return _RelaxPlan(mass_scale=mass_scale, alpha=alpha, max_time=max_time * RELAX_TIME_ALLOWANCE,
+                      chunk=4.0 / alpha, min_span=10 * est.dt)
+
+
+def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None, route=None, segment=None):
     """Dynamic relaxation at full load to near rest, then Newton to the full tolerance.
 
     The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while
@@ -105,114 +189,144 @@ def _relax_then_newton(model, opts, callback, ws, *, first):
     downhill for hundreds of iterations on the PSD tangent, to a point that need not be a minimum —
     the 80 cm sheet did). The relaxation ends at rest at half the solver's ``rtol`` or at its time
     limit; Newton then finishes with the solver's own budget.
+
+    ``checkpoint`` saves the :class:`RelaxRoute` at the end of every segment and after every failed
+    handover, and the explicit state during a segment; ``route`` (and ``segment``, the explicit state
+    saved during its segment) continue a saved solve.
     """
     t0 = time.perf_counter()
-    size = float(np.ptp(model.mesh.X, axis=0).max())
-    omega1 = np.sqrt(STANDARD_GRAVITY / (0.25 * size))  # pendulum estimate of the lowest drape mode
-    mass_scale = RELAX_MASS_SCALE
-    alpha = 2.0 * omega1 / np.sqrt(mass_scale)  # about critical for that mode of the scaled system
-    max_time = 100.0 / alpha  # the relaxation's expected need: 100 damping times (checked below)
-    chunk = 4.0 / alpha  # relaxation between two tangent checks [s]
-    est = stable_time_step(model, mass_scale=mass_scale, alpha=alpha)
-    if max_time / est.dt > MAX_RELAX_STEPS:  # a membrane far stiffer than the bending: too many steps
-        message = (f"dynamic relaxation would need up to {max_time / est.dt:.3g} explicit steps (dt {est.dt:.3g} s); "
-                   f"not attempted (limit {MAX_RELAX_STEPS:g})")
-        if first is not None:
-            raise ConvergenceError(f"{first}; {message}", first.result) from None
-        raise ConvergenceError(message, None)
-    max_time *= RELAX_TIME_ALLOWANCE  # settling folds on fine meshes (31 x 240 rings) take longer
-    U, V, seed = None, None, None
-    if opts.perturbation:  # the same seeded lift as the load steps' start picks the fold branch
-        seed = opts.seed
-        U = np.zeros((model.mesh.n_nodes, 3))
-        U[:, 2] = start_perturbation(model.mesh, opts) * model.free[:, 2]
+    first = route.first if route is not None else first
+    plan = _relax_plan(model, first)
+    if route is None:
+        route = _start_route(model, opts, plan, first)
+        if checkpoint is not None and first is not None:  # the end of the failed load steps' phase
+            checkpoint.route(route)
     polish = opts.from_state(relax_fallback=False)
     # a handover that fails gives way to more relaxation, not to the slower displacement iteration
     short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS,
                     iteration_fallback=False)
     basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
-    info = {"mass_scale": mass_scale, "alpha_per_s": alpha, "time_s": 0.0, "steps": 0, "handovers": [],
-            "after_failure": None if first is None else str(first)}
-    t_used, peak = 0.0, 0.0
-    tol_force, span = 1.0, max_time  # the first stop: motion died down, |r| < |P|
     checker = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    info = route.info
 
     def fail(text, result=None):
         if result is not None:
-            result.route, result.relax, result.seed = "relax+newton", info, seed
+            result.route, result.relax, result.seed = "relax+newton", info, route.seed
         if first is not None:
             text = f"{first}; {text}"
         return ConvergenceError(text, result if result is not None else (first.result if first else None))
 
-    if opts.guide_folds and opts.guide_weight:
-        rel = _guided_relaxation(model, opts, mass_scale=mass_scale, alpha=alpha, U0=U, fail=fail)
-        U, V, peak, t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
-        seed = opts.seed
-        info.update(time_s=t_used, steps=rel.steps, guide={"folds": opts.guide_folds, "weight": opts.guide_weight,
-                                                          "time_s": rel.t, "steps": rel.steps})
+    if route.phase in ("start", "guide"):
+        if opts.guide_folds and opts.guide_weight:
+            _guided_relaxation(model, opts, plan, route, fail, checkpoint, segment)
+            segment = None
+        route.phase = "relax"
     while True:
-        try:
-            rel = relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=tol_force,
-                        max_time=max(min(span, max_time - t_used), 10 * est.dt), U0=U, V0=V, peak_kinetic=peak,
-                        progress=opts.progress)
-        except InstabilityError as exc:
-            raise fail(f"dynamic relaxation became unstable ({exc})") from None
-        U, V, peak = rel.U, rel.V, rel.peak_kinetic
-        t_used += rel.t
-        info.update(time_s=t_used, steps=info["steps"] + rel.steps, at_rest=rel.converged,
-                    wall_time_s=time.perf_counter() - t0)
-        final = (rel.converged and tol_force < 1.0) or t_used >= max_time * (1 - 1e-9)
-        if not final and tol_force < 1.0 and not _positive_definite(model, U, checker):
+        if route.phase == "relax":
+            _relax_segment(model, opts, plan, route, fail, checkpoint, segment, t0)
+            segment = None
+        final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
+        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, checker):
+            route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
-        handover = {"time_s": t_used, "steps": info["steps"], "at_rest": rel.converged}
+        handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest}
         info["handovers"].append(handover)
         try:
             # the first handover inside a basin gets the long budget; if that fails, the landscape is
             # rougher than a slow valley and later ones get the short one (a 21 x 160 round-pedestal
             # start needed 19 of them: 80 iterations each cost it 20 minutes)
-            long_try = tol_force < 1.0 and not any(h.get("basin") for h in info["handovers"][:-1])
-            handover["basin"] = tol_force < 1.0
-            res = solve_load_steps(model, U0=U, options=polish if final else basin if long_try else short,
+            long_try = route.tol_force < 1.0 and not any(h.get("basin") for h in info["handovers"][:-1])
+            handover["basin"] = route.tol_force < 1.0
+            res = solve_load_steps(model, U0=route.U, options=polish if final else basin if long_try else short,
                                    callback=callback, workspace=ws)
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
             if final:
                 result = exc.result
                 if result is not None:  # write the relaxed shape at full load, labelled not converged
-                    result.U, result.lam = U, 1.0
-                    result.residual = float(np.linalg.norm(model.residual(U, 1.0).ravel()[model.free.ravel()]))
-                raise fail(f"{exc} (after dynamic relaxation to t = {t_used:.3g} s, {info['steps']} steps; "
+                    result.U, result.lam = route.U, 1.0
+                    result.residual = float(np.linalg.norm(model.residual(route.U, 1.0).ravel()[model.free.ravel()]))
+                raise fail(f"{exc} (after dynamic relaxation to t = {route.t_used:.3g} s, {info['steps']} steps; "
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
             log.info("Newton did not converge from the relaxed state at t = %.3g s (%s); relaxing further",
-                     t_used, exc)
-            tol_force, span = 0.5 * opts.rtol, chunk
+                     route.t_used, exc)
+            route.tol_force, route.span, route.phase = 0.5 * opts.rtol, plan.chunk, "relax"
+            if checkpoint is not None:
+                checkpoint.route(route)
             continue
         handover["newton"] = f"converged in {res.iterations} iterations"
         break
-    res.route, res.relax, res.seed = "relax+newton", info, seed
+    res.route, res.relax, res.seed = "relax+newton", info, route.seed
     res.wall_time = time.perf_counter() - t0 + (0.0 if first is None or first.result is None else first.result.wall_time)
     if first is not None and first.result is not None:
         res.cutbacks += first.result.cutbacks
         res.iterations += first.result.iterations
+    if checkpoint is not None:
+        checkpoint.done(res)
     return res
+
+
+def _start_route(model, opts, plan, first) -> RelaxRoute:
+    """The relaxation route before its first segment: from the flat sheet, lifted by the same seeded
+    perturbation as the load steps' start (it picks the fold branch)."""
+    U, seed = None, None
+    if opts.perturbation:
+        seed = opts.seed
+        U = np.zeros((model.mesh.n_nodes, 3))
+        U[:, 2] = start_perturbation(model.mesh, opts) * model.free[:, 2]
+    info = {"mass_scale": plan.mass_scale, "alpha_per_s": plan.alpha, "time_s": 0.0, "steps": 0, "handovers": [],
+            "after_failure": None if first is None else str(first)}
+    # the first stop: motion died down, |r| < |P|
+    return RelaxRoute(phase="start", U=U, V=None, t_used=0.0, peak=0.0, tol_force=1.0, span=plan.max_time,
+                      at_rest=False, seed=seed, info=info, first=first)
+
+
+def _relax_segment(model, opts, plan, route, fail, checkpoint, restart, t0) -> None:
+    """One relaxation segment from ``route`` (or from ``restart``, the explicit state saved during it): the
+    route then stands at its end (``"handover"``), which is saved."""
+    saver = None if checkpoint is None else checkpoint.segment(route)
+    span = max(min(route.span, plan.max_time - route.t_used), plan.min_span)
+    try:
+        rel = relax(model, mass_scale=plan.mass_scale, alpha=plan.alpha, tol_kinetic=1e-4, tol_force=route.tol_force,
+                    max_time=span if restart is None else float(restart["options"]["t_end"]), U0=route.U,
+                    V0=route.V, peak_kinetic=route.peak, progress=opts.progress, checkpoint=saver, restart=restart)
+    except InstabilityError as exc:
+        raise fail(f"dynamic relaxation became unstable ({exc})") from None
+    route.U, route.V, route.peak, route.at_rest = rel.U, rel.V, rel.peak_kinetic, rel.converged
+    route.t_used += rel.t
+    route.info.update(time_s=route.t_used, steps=route.info["steps"] + rel.steps, at_rest=rel.converged,
+                      wall_time_s=time.perf_counter() - t0)
+    route.phase = "handover"
+    if checkpoint is not None:
+        checkpoint.route(route)
 
 
 GUIDE_DAMPING_TIMES = 30.0  # length of the guided stage of the relaxation [damping times 1/alpha]
 
 
-def _guided_relaxation(model, opts: StaticOptions, *, mass_scale, alpha, U0, fail):
+def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, checkpoint, restart) -> None:
     """The guided first stage of :func:`_relax_then_newton`: relax under an n-fold modulated weight.
 
     The weight of every node is scaled by ``1 + guide_weight * fold_pattern(...)`` (so the total
     stays about the same and the load stays downward) for :data:`GUIDE_DAMPING_TIMES` damping
-    times; the model itself keeps its true load.
+    times; the model itself keeps its true load. ``restart``: the explicit state saved during this stage.
     """
     guided = model.load * (1.0 + opts.guide_weight * fold_pattern(model.mesh, opts.guide_folds, opts.seed))[:, None]
+    route.phase = "guide"
+    saver = None if checkpoint is None else checkpoint.segment(route)
     try:
-        return relax(model, mass_scale=mass_scale, alpha=alpha, tol_kinetic=1e-4, tol_force=1.0,
-                     max_time=GUIDE_DAMPING_TIMES / alpha, U0=U0, progress=opts.progress, load=guided)
+        rel = relax(model, mass_scale=plan.mass_scale, alpha=plan.alpha, tol_kinetic=1e-4, tol_force=1.0,
+                    max_time=GUIDE_DAMPING_TIMES / plan.alpha, U0=route.U, progress=opts.progress, load=guided,
+                    checkpoint=saver, restart=restart)
     except InstabilityError as exc:
         raise fail(f"the guided dynamic relaxation became unstable ({exc})") from None
+    route.U, route.V, route.peak, route.t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
+    route.seed = opts.seed
+    route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": opts.guide_folds, "weight": opts.guide_weight,
+                                                            "time_s": rel.t, "steps": rel.steps})
+    route.phase = "relax"
+    if checkpoint is not None:
+        checkpoint.route(route)
 
 
 def _positive_definite(model, U, solver, lam=1.0) -> bool:

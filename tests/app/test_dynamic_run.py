@@ -132,11 +132,6 @@ def test_bad_dynamics_key_names_it(tmp_path, capsys, override, fragment):
     assert fragment in err and "hang-20.toml" in err
 
 
-def test_resume_of_a_static_scene_is_refused(tmp_path, capsys):
-    assert main(["case", "strip", "--resume", "--out", str(tmp_path / "s")]) == 2
-    assert "--resume" in capsys.readouterr().err
-
-
 def test_relax_reaches_the_static_solution(tmp_path):
     """Dynamic relaxation (mass scaled, damped) of the clamped strip rests at the Newton solution."""
     scene = load_scene("strip", ["analysis=relax", "mesh.nodes=[11,3]", "element=RFT3", "dynamics.t_end=3",
