@@ -80,9 +80,12 @@ def _edge_topology(tri: np.ndarray, n_nodes: int) -> EdgeTopology:
     return EdgeTopology(nb_elem, nb_vert, edges, edge_of.reshape(E, 3))
 
 
+BRUTE_LOCATE_POINTS = 64
 BRUTE_LOCATE_PAIRS = 4_000_000
-"""Up to this many point-triangle pairs :meth:`TriMesh.locate` tests every triangle (a few supports
-and probes: no matplotlib import, 0.5 s of a strip run's 1.5 s start-up); beyond, a trapezoid map."""
+"""For a few points (supports, probes: up to :data:`BRUTE_LOCATE_POINTS`, and this many point-triangle
+pairs) :meth:`TriMesh.locate` tests every triangle (no matplotlib import: 0.5 s of a strip run's
+1.5 s start-up); for more (a remesh transfer), matplotlib's trapezoid map, whose choice of triangle for
+a point on a shared edge the transferred fields (and the remeshed relaxation's fold branch) depend on."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,7 +207,8 @@ class TriMesh:
         Returns ``(elem (P,), bary (P, 3))``; elem is -1 for points outside the mesh.
         """
         pts = np.atleast_2d(np.asarray(points, float))
-        if len(pts) * self.n_elements <= BRUTE_LOCATE_PAIRS:
+        brute = len(pts) <= BRUTE_LOCATE_POINTS and len(pts) * self.n_elements <= BRUTE_LOCATE_PAIRS
+        if brute:
             elem = self._locate_brute(pts)
         else:  # many points (a remesh transfer): matplotlib's trapezoid-map search
             from matplotlib.tri import Triangulation
@@ -215,10 +219,10 @@ class TriMesh:
         T = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=2)
         l12 = np.linalg.solve(T, (pts - P[:, 0])[..., None])[..., 0]
         bary = np.column_stack([1 - l12.sum(axis=1), l12])
-        # a point on an edge (to the 1e-10 tolerance of the search) gets coordinates >= 0
-        found = elem >= 0
-        bary[found] = np.clip(bary[found], 0.0, None)
-        bary[found] /= bary[found].sum(axis=1, keepdims=True)
+        if brute:  # a point on an edge (to the 1e-10 tolerance of the search) gets coordinates >= 0
+            found = elem >= 0
+            bary[found] = np.clip(bary[found], 0.0, None)
+            bary[found] /= bary[found].sum(axis=1, keepdims=True)
         return elem, bary
 
     def _locate_brute(self, pts) -> np.ndarray:
