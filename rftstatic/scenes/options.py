@@ -20,6 +20,8 @@ from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 
 _STATIC_KEYS = {f.name for f in fields(StaticOptions)} - {"progress"}
 _STATIC_LENGTH_KEYS = ("max_step", "increment_displacement")
+_STATIC_COUNTS = {"seed": 0, "max_continuations": 0, "reuse_factorisation": 0, "max_load_steps": 1}
+"""``[solver]`` integers and their least value (a seed: numpy's generators take none below 0)."""
 
 
 def static_options(scene, *, progress=True) -> StaticOptions:
@@ -37,6 +39,9 @@ def static_options(scene, *, progress=True) -> StaticOptions:
     unknown = set(s) - _STATIC_KEYS
     if unknown:
         raise scene.error("solver", f"unknown option(s) {sorted(unknown)}")
+    for key, least in _STATIC_COUNTS.items():
+        if key in s and s[key] < least:
+            raise scene.error(f"solver.{key}", f"{s[key]!r} must be an integer >= {least}")
     try:
         return StaticOptions(**s, progress=progress)
     except (TypeError, ValueError) as exc:

@@ -46,3 +46,19 @@ def test_strip_mutations_are_input_errors(capsys, tmp_path, sets, key, fragment)
 def test_bad_unstructured_sizes_are_input_errors(capsys, tmp_path, mesh, key, fragment):
     text = f'[mesh]\nkind = "unstructured"\n{mesh}\n[[supports]]\nkind = "pinned"\nat = [0.0, 0.0]\n'
     _assert_input_error(*_run(capsys, tmp_path, None, text=text), key, fragment)
+
+
+def test_a_negative_seed_is_an_input_error(capsys, tmp_path):
+    # was: internal error: ValueError: expected non-negative integer (numpy's generator, deep in the solver)
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", "solver.seed=-100000000000",
+                                                  "solver.perturbation=0.01"])
+    _assert_input_error(code, err, "solver.seed", "must be an integer >= 0")
+
+
+@pytest.mark.parametrize("scene, obstacle", [("pedestal-square-20", "half_width=1e300"),
+                                             ("pedestal-round-50", "radius=1e300")])
+def test_a_huge_pedestal_is_no_internal_error(capsys, tmp_path, scene, obstacle):
+    # was: RuntimeWarning: overflow in the footprint's area (an error under the test suite's warning filter)
+    nodes = "[5,5]" if scene == "pedestal-square-20" else "[3,8]"
+    code, err = _run(capsys, tmp_path, scene, [f"mesh.nodes={nodes}", f"obstacles.0.{obstacle}"])
+    assert code in (0, 3) and "internal error" not in err, err
