@@ -62,3 +62,10 @@ def test_a_huge_pedestal_is_no_internal_error(capsys, tmp_path, scene, obstacle)
     nodes = "[5,5]" if scene == "pedestal-square-20" else "[3,8]"
     code, err = _run(capsys, tmp_path, scene, [f"mesh.nodes={nodes}", f"obstacles.0.{obstacle}"])
     assert code in (0, 3) and "internal error" not in err, err
+
+
+@pytest.mark.parametrize("pattern", ["RIGHT", "union-jack"])
+def test_an_unknown_square_polar_pattern_is_an_input_error(capsys, tmp_path, pattern):
+    # was: accepted silently, and meshed as "left"
+    code, err = _run(capsys, tmp_path, "pedestal-round-50", ["mesh.nodes=[2,17]", f"mesh.pattern={pattern}"])
+    _assert_input_error(code, err, "mesh", f'unknown diagonal pattern "{pattern}" for a square-polar mesh')
