@@ -69,3 +69,32 @@ def test_an_unknown_square_polar_pattern_is_an_input_error(capsys, tmp_path, pat
     # was: accepted silently, and meshed as "left"
     code, err = _run(capsys, tmp_path, "pedestal-round-50", ["mesh.nodes=[2,17]", f"mesh.pattern={pattern}"])
     _assert_input_error(code, err, "mesh", f'unknown diagonal pattern "{pattern}" for a square-polar mesh')
+
+
+REMESH_TINY = ["mesh.h=4.0", "remesh.h_lower=5.0", "remesh.h_upper=8.0", "remesh.const=5.0", "dynamics.t_end=0.1",
+               "dynamics.frames=[0.1]"]
+
+
+def test_a_remeshed_relaxation_keeps_to_max_steps(capsys, tmp_path):
+    import json
+
+    # was: dynamics.max_steps ignored by the remeshed relaxation (10^9 steps), a tiny scene ran for minutes
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.mass_scale=1e-6",
+                                                                      "dynamics.max_steps=1000"])
+    _assert_input_error(code, err, "dynamics.t_end", "more than the limit of 1000 (dynamics.max_steps)")
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.max_steps=100"])
+    assert code == 3 and "within dynamics.max_steps = 100 explicit steps" in err, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["steps"] <= 200 and summary["stopped_by"] == "max_steps" and summary["converged"] is False
+
+
+def test_a_remeshed_relaxation_that_blows_up_is_unstable_not_an_internal_error(capsys, tmp_path):
+    # was: internal error: FloatingPointError: remesh_relax: non-finite state after step 200
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.dt=0.05"])
+    assert code == 3 and err.startswith("error: the explicit run became unstable: the state became non-finite"), err
+
+
+def test_a_remeshed_static_run_whose_mesh_still_changes_exits_3(capsys, tmp_path):
+    # was: exit 0 with summary.json saying converged = false
+    code, err = _run(capsys, tmp_path, "remesh-sphere-30", [*REMESH_TINY, "analysis=static", "remesh.max_cycles=0"])
+    assert code == 3 and "the mesh still changed after remesh.max_cycles = 0" in err, err
