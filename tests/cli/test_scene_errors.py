@@ -98,3 +98,13 @@ def test_a_remeshed_static_run_whose_mesh_still_changes_exits_3(capsys, tmp_path
     # was: exit 0 with summary.json saying converged = false
     code, err = _run(capsys, tmp_path, "remesh-sphere-30", [*REMESH_TINY, "analysis=static", "remesh.max_cycles=0"])
     assert code == 3 and "the mesh still changed after remesh.max_cycles = 0" in err, err
+
+
+def test_a_sheet_that_slides_off_the_sphere_gets_no_drape_measures(capsys, tmp_path):
+    import json
+
+    # was: internal error: ValueError: fold_count: the ray at 175.5 deg from centre = (0, 0) misses the boundary
+    code, err = _run(capsys, tmp_path, "sphere-30", ["mesh.nodes=[5,4]"])
+    assert code in (0, 3) and "internal error" not in err, err
+    drape = json.loads((tmp_path / "o" / "summary.json").read_text())["drape"]
+    assert drape["applicable"] is False and "does not surround the obstacle's centre" in drape["reason"]
