@@ -22,6 +22,10 @@ _STATIC_KEYS = {f.name for f in fields(StaticOptions)} - {"progress"}
 _STATIC_LENGTH_KEYS = ("max_step", "increment_displacement")
 _STATIC_COUNTS = {"seed": 0, "max_continuations": 0, "reuse_factorisation": 0, "max_load_steps": 1}
 """``[solver]`` integers and their least value (a seed: numpy's generators take none below 0)."""
+MAX_PERTURBATION = 10.0
+"""Largest ``solver.perturbation`` [element sizes]: the seeded lift tips a flat sheet off its bifurcation
+(0.01-0.5 in the scenes and validations); a lift of many element sizes stretches the membrane instead, and
+the relaxation from it becomes unstable (above about 200 its stable step collapses)."""
 
 
 def static_options(scene, *, progress=True) -> StaticOptions:
@@ -42,6 +46,11 @@ def static_options(scene, *, progress=True) -> StaticOptions:
     for key, least in _STATIC_COUNTS.items():
         if key in s and s[key] < least:
             raise scene.error(f"solver.{key}", f"{s[key]!r} must be an integer >= {least}")
+    lift = s.get("perturbation", 0.0)
+    if not 0.0 <= lift <= MAX_PERTURBATION:
+        raise scene.error("solver.perturbation", f"{lift!r} must lie in [0, {MAX_PERTURBATION:g}] (element sizes of "
+                          "a seeded lift that tips the sheet off its bifurcation; a larger lift stretches the "
+                          "membrane instead)")
     try:
         return StaticOptions(**s, progress=progress)
     except (TypeError, ValueError) as exc:

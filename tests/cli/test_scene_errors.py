@@ -108,3 +108,11 @@ def test_a_sheet_that_slides_off_the_sphere_gets_no_drape_measures(capsys, tmp_p
     assert code in (0, 3) and "internal error" not in err, err
     drape = json.loads((tmp_path / "o" / "summary.json").read_text())["drape"]
     assert drape["applicable"] is False and "does not surround the obstacle's centre" in drape["reason"]
+
+
+@pytest.mark.parametrize("lift", ["1e4", "9223372036854775807", "-1"])
+def test_a_perturbation_of_many_element_sizes_is_an_input_error(capsys, tmp_path, lift):
+    # was: internal error: ValueError: t_end = 87.45 s with dt = 1.6e-22 s needs 5.41e+23 explicit steps (the
+    # relaxation from the lifted start; solvers.static lets step_count's ValueError through)
+    code, err = _run(capsys, tmp_path, "sphere-30", ["mesh.nodes=[3,14]", f"solver.perturbation={lift}"])
+    _assert_input_error(code, err, "solver.perturbation", "must lie in [0, 10]")
