@@ -224,8 +224,8 @@ def summarize(scene, opts, solved) -> dict:
     if solved["route"] == "remesh_relax":
         d = solved["dynamics"]
         summary.update(t=solved["t"] / u.time, steps=solved["steps"], skipped_remeshes=solved["skipped"],
-                       stopped_by=solved["stopped_by"], max_steps=d.max_steps, t_end=d.t_end / u.time, alpha=d.alpha * u.time, mass_scale=d.mass_scale,
-                       damping=settings["damping"],
+                       stopped_by=solved["stopped_by"], max_steps=d.max_steps, t_end=d.t_end / u.time,
+                       alpha=d.alpha * u.time, mass_scale=d.mass_scale, damping=settings["damping"],
                        alpha_final=(solved["alphas"][-1] if solved.get("alphas") else d.alpha) * u.time)
         P = np.where(model.free, model.load, 0.0)
         r = np.where(model.free, contact_reaction_residual(model, solved["extras"].get("obstacles", ()), U), 0.0)
