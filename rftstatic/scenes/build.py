@@ -356,6 +356,27 @@ def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
     supports.fixed[a, 1] = True
 
 
+def check_static_scene(scene: Scene, material, supports: Supports, load: np.ndarray, obstacles: list) -> None:
+    """Scene error unless a static scene can have an equilibrium and its route can run: without obstacles,
+    every direction its load ``(N, 3)`` [N] pushes the sheet along is held by a support; the relaxation
+    start (``solver.start = "relax"``) needs the sheet's mass."""
+    if scene.get("solver.start") == "relax" and not material.mass_per_area > 0:
+        raise scene.error("solver.start", '"relax" (dynamic relaxation) moves the sheet\'s mass, and material.weight '
+                          'is 0; give a positive weight or use start = "load-steps"')
+    if obstacles:
+        return
+    held = supports.fixed_mask().any(axis=0)
+    resultant = load.sum(axis=0)
+    scale = float(np.abs(load).sum())
+    for i, axis in enumerate("xyz"):
+        if abs(resultant[i]) > 1e-9 * scale and not held[i]:
+            force = resultant[i] / scene.units.force
+            raise scene.error("supports", f"nothing holds the sheet along {axis}, and its load pushes it that way "
+                              f"(resultant {force:.4g}, {scene.units.name} units): no static equilibrium; add "
+                              f"[[supports]] that hold {axis} (clamped, pinned, or fixed with {axis} in "
+                              "components) or an obstacle")
+
+
 def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: bool = False) -> tuple[Model, dict]:
     """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras.
 
@@ -375,6 +396,8 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     supports = build_supports(scene, mesh)
     load = build_load(scene, mesh, material)
     contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
+    if scene.get("analysis", "static") == "static":
+        check_static_scene(scene, material, supports, load, obstacles)
     membrane = scene.get("solver.membrane", True)
     model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
                   contact=contact, membrane=membrane, quiet=quiet)

@@ -99,6 +99,9 @@ class DynamicsOptions:
     max_steps: int = MAX_STEPS
 
 
+MAX_SAMPLES = 1000
+"""Most regular states ``dynamics.samples`` a run may save (a VTU file and a GIF frame each)."""
+
 CHECKPOINT_EVERY_S = 0.2
 """Default simulated time between checkpoints [s]."""
 
@@ -129,8 +132,9 @@ def dynamics_options(scene) -> DynamicsOptions:
         raise scene.error("dynamics.max_steps", f"must be a positive integer, got {opts['max_steps']!r}")
     if opts.get("dt") is not None:
         positive("dt")
-    if opts["samples"] < 0:
-        raise scene.error("dynamics.samples", f"must be >= 0, got {opts['samples']}")
+    if not 0 <= opts["samples"] <= MAX_SAMPLES:
+        raise scene.error("dynamics.samples", f"must lie in [0, {MAX_SAMPLES}] (each is a VTU file), got "
+                          f"{opts['samples']}")
     frames = opts["frames"]
     if not all(isinstance(f, (int, float)) and 0 <= f <= opts["t_end"] for f in frames):
         raise scene.error("dynamics.frames", f"expected times in [0, t_end = {opts['t_end']}], got {frames!r}")

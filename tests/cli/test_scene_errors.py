@@ -116,3 +116,25 @@ def test_a_perturbation_of_many_element_sizes_is_an_input_error(capsys, tmp_path
     # relaxation from the lifted start; solvers.static lets step_count's ValueError through)
     code, err = _run(capsys, tmp_path, "sphere-30", ["mesh.nodes=[3,14]", f"solver.perturbation={lift}"])
     _assert_input_error(code, err, "solver.perturbation", "must lie in [0, 10]")
+
+
+@pytest.mark.parametrize("sets", [
+    ["supports=[]"],  # was: 20 s of load steps and relaxation, then exit 3
+    ["supports.0.kind=fixed", "supports.0.components=xy"],
+])
+def test_a_static_sheet_held_by_nothing_against_its_weight_is_an_input_error(capsys, tmp_path, sets):
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", *sets])
+    _assert_input_error(code, err, "supports", "nothing holds the sheet along z")
+
+
+def test_a_relaxation_start_without_mass_is_an_input_error(capsys, tmp_path):
+    # was: internal error: ValueError: material 'wool-kang-yu (modified)' has mass_per_area = 0.0 kg/m^2
+    code, err = _run(capsys, tmp_path, "pedestal-square-20", ["mesh.nodes=[5,5]", "material.weight=0.0"])
+    _assert_input_error(code, err, "solver.start", "material.weight is 0")
+
+
+def test_samples_beyond_a_thousand_are_an_input_error(capsys, tmp_path):
+    # was: a tiny 1 ms run saving 3,000,000 states, past any time bound
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "dynamics.t_end=0.001",
+                                                   "dynamics.frames=[0.001]", "dynamics.samples=3000000"])
+    _assert_input_error(code, err, "dynamics.samples", "must lie in [0, 1000]")
