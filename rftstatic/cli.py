@@ -62,6 +62,21 @@ def main(argv=None) -> int:
         return EXIT["internal"]
 
 
+def _goal_missed(summary: dict) -> str:
+    """Why a run that ended labelled ``converged = false`` fell short (from its summary)."""
+    if summary.get("route") == "remesh_static":
+        return (f"the mesh still changed after remesh.max_cycles = {summary['remesh'].get('max_cycles')} remeshing "
+                "cycles (node count change above remesh.tol)")
+    if summary.get("analysis") == "dynamic":
+        return f"the run stopped at t = {summary.get('t'):.4g} s, before t_end = {summary.get('t_end')} s"
+    if summary.get("stopped_by") == "max_steps":
+        return (f"the sheet did not come to rest within dynamics.max_steps = {summary.get('max_steps')} explicit "
+                f"steps (t = {summary.get('t'):.4g} s)")
+    if summary.get("stopped_by") == "max_remesh":
+        return "the sheet came to rest, but its mesh still changed after the most remeshes the run allows"
+    return f"the sheet did not come to rest by t_end = {summary.get('t_end')} s"
+
+
 def _command(args) -> int:
     from rftstatic import api
     from rftstatic.errors import CheckpointError, MeshError, MeshingError, PatchError
@@ -86,11 +101,10 @@ def _command(args) -> int:
             brief = {k: summary.get(k) for k in keys}
             print(json.dumps(brief, indent=1, default=str))
             print(f"outputs written to {out}/")
-            if summary.get("analysis") in ("relax",) or summary.get("route", "").startswith("remesh_relax"):
-                if not summary.get("converged", False):
-                    print(f"error: the sheet did not come to rest by t_end = {summary.get('t_end')} s; the last "
-                          "state was written, labelled converged = false", file=sys.stderr)
-                    return EXIT["goal"]
+            if summary.get("converged") is False:  # the run ended, short of its goal
+                print(f"error: {_goal_missed(summary)}; the last state was written, labelled converged = false",
+                      file=sys.stderr)
+                return EXIT["goal"]
             return EXIT["done"]
         if args.command == "bench":
             from rftstatic.bench.main import main as bench_main

@@ -36,7 +36,7 @@ import numpy as np
 
 from rftstatic.app.result import RunResult
 from rftstatic.contact.kinematic import contact_reaction_residual
-from rftstatic.errors import ParameterError
+from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable, write_json
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import drape_summary, probe_summary, summary_header
@@ -45,6 +45,8 @@ from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
 from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import REMESH_LENGTH_KEYS, dynamics_options, remesh_options, static_options
+from rftstatic.solvers.explicit import step_count
+from rftstatic.solvers.timestep import stable_time_step
 
 log = logging.getLogger(__name__)
 
@@ -136,6 +138,7 @@ def _relax(scene, opts) -> dict:
         return build_model(scene, mesh=mesh, quiet=mesh is not None)
 
     model0, extras0 = factory(None)
+    _check_step_budget(scene, d, model0)
     obstacles = tuple(extras0.get("obstacles", ()))
     stepper = explicit_advance(alpha=d.alpha, mass_scale=d.mass_scale, dt=d.dt, safety=SAFETY,
                                obstacles=obstacles, damping=opts.damping)
@@ -151,11 +154,18 @@ def _relax(scene, opts) -> dict:
     try:
         res = remesh_relax(make, const=opts.const, h_lower=opts.h_lower, h_upper=opts.h_upper,
                            advance=track, mass_scale=d.mass_scale, every=opts.every,
-                           kappa_h2_max=opts.kappa_h2_max, max_steps=10**9, tol=opts.tol,
+                           kappa_h2_max=opts.kappa_h2_max, max_steps=d.max_steps, tol=opts.tol,
                            tol_force=d.force_tolerance, tol_kinetic=d.rest_tolerance,
                            gradation=opts.gradation, transfer=opts.transfer, residual=residual)
         model, U, records, converged, skipped = res.model, res.U, res.records, res.converged, res.skipped
         t, steps = res.t, res.steps
+        stopped_by = "rest" if converged else "max_steps" if steps >= d.max_steps else "max_remesh"
+    except FloatingPointError:  # the explicit motion blew up: a goal not reached, not a bug
+        nodes = track.last[0].mesh.n_nodes if track.last else model0.mesh.n_nodes
+        raise InstabilityError(f"the state became non-finite by t = {track.t:.4g} s (step {track.steps}, a mesh of "
+                               f"{nodes} nodes); give a smaller dynamics.dt (or none: the stable step), or a larger "
+                               "dynamics.mass_scale or alpha", t=track.t, step=track.steps, dt=d.dt,
+                               suggested_dt=None) from None
     except _TimeUp:
         # the driver keeps its records to itself; rebuild them from the meshes the stepper saw
         model, U, _ = track.last
@@ -168,7 +178,7 @@ def _relax(scene, opts) -> dict:
         kappa, records[-1].max_kappa_h, records[-1].max_kappa_h2 = _curvature_figures(model, U)
         records[-1].refinable_kappa_h, records[-1].refinable_kappa_h2 = refinable_maxima(
             model.mesh, kappa, const=opts.const, h_lower=opts.h_lower)
-        converged, skipped, t, steps = False, 0, track.t, track.steps
+        converged, skipped, t, steps, stopped_by = False, 0, track.t, track.steps, "t_end"
         log.warning("remesh relax: t_end = %.4g s reached before the sheet came to rest on a settled mesh",
                     d.t_end)
     meshes = track.meshes
@@ -176,7 +186,19 @@ def _relax(scene, opts) -> dict:
     extras = extras0  # probes and obstacles are defined in reference coordinates: the same on every mesh
     return {"route": "remesh_relax", "model": model, "extras": extras, "U": U, "records": records,
             "converged": bool(converged), "meshes": meshes, "t": t, "steps": steps, "skipped": skipped,
-            "dynamics": d, "alphas": list(stepper.alphas)}
+            "dynamics": d, "alphas": list(stepper.alphas), "stopped_by": stopped_by}
+
+
+def _check_step_budget(scene, d, model) -> None:
+    """Refuse, before it starts, a remeshed relaxation whose first mesh needs more than ``dynamics.max_steps``
+    explicit steps to reach ``t_end`` (the run also stops at ``max_steps`` on the later meshes)."""
+    dt = d.dt if d.dt is not None else stable_time_step(model, mass_scale=d.mass_scale, alpha=d.alpha,
+                                                        safety=SAFETY).dt
+    try:
+        step_count(d.t_end, dt, d.max_steps)
+    except ValueError as exc:
+        raise scene.error("dynamics.dt" if d.dt is not None else "dynamics.t_end", f"{exc} (on the first "
+                          "mesh)") from None
 
 
 def summarize(scene, opts, solved) -> dict:
@@ -202,8 +224,8 @@ def summarize(scene, opts, solved) -> dict:
     if solved["route"] == "remesh_relax":
         d = solved["dynamics"]
         summary.update(t=solved["t"] / u.time, steps=solved["steps"], skipped_remeshes=solved["skipped"],
-                       t_end=d.t_end / u.time, alpha=d.alpha * u.time, mass_scale=d.mass_scale,
-                       damping=settings["damping"],
+                       stopped_by=solved["stopped_by"], max_steps=d.max_steps, t_end=d.t_end / u.time,
+                       alpha=d.alpha * u.time, mass_scale=d.mass_scale, damping=settings["damping"],
                        alpha_final=(solved["alphas"][-1] if solved.get("alphas") else d.alpha) * u.time)
         P = np.where(model.free, model.load, 0.0)
         r = np.where(model.free, contact_reaction_residual(model, solved["extras"].get("obstacles", ()), U), 0.0)

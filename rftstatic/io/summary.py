@@ -13,6 +13,7 @@ import logging
 
 import numpy as np
 
+from rftstatic.post.measures.boundary import boundary_loop, outline_surrounds
 from rftstatic.post.measures.summary import drape_measures
 from rftstatic.post.probes import probe_positions
 from rftstatic.provenance import peak_memory_mb, software
@@ -56,6 +57,10 @@ def drape_summary(scene, model, extras, U) -> dict:
     elif model.mesh.locate(np.asarray(centre, float)[None, :2])[0][0] < 0:
         reason = (f"the obstacle's centre {np.round(np.asarray(centre) / u, 6).tolist()} is not under the sheet: "
                   "the drape measures (coefficient, folds about the centre) do not apply")
+    elif not outline_surrounds(x, boundary_loop(model.mesh.tri, x), centre):
+        reason = (f"the draped sheet's outline (top view) does not surround the obstacle's centre "
+                  f"{np.round(np.asarray(centre) / u, 6).tolist()} (the sheet slid off it): the drape measures "
+                  "(coefficient, folds about the centre) do not apply")
     if reason is not None:
         log.warning("drape measures skipped: %s", reason)
         return {"applicable": False, "reason": reason}

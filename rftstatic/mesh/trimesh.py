@@ -375,6 +375,8 @@ def square_polar(half_side, n_radial, n_circ, *, centre=(0.0, 0.0), core_radius=
     n_radial, n_circ = int(n_radial), int(n_circ)
     if n_radial < 2 or n_circ < 8:
         raise MeshError(f"square_polar needs n_radial >= 2 and n_circ >= 8, got {n_radial}, {n_circ}")
+    if pattern not in ("right", "left", "alternate"):
+        raise MeshError(f'unknown diagonal pattern "{pattern}" for a square-polar mesh; use right, left or alternate')
     R = float(half_side)
     if core_radius is None:
         a = 2 * np.pi / n_circ * (n_radial - 1)

@@ -6,6 +6,8 @@ located on the mesh here, so that it carries over to any other mesh of the same 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from rftstatic import material as mat
@@ -38,6 +40,11 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
             raise scene.error(f"mesh.{extra[0]}", f"does not apply to a {kind} mesh (it reads "
                               f"{', '.join(sorted(MESH_KEYS[kind]))}, kind and z); remove it")
     z0 = m.get("z", 0.0) * u
+    nodes = m.get("nodes") if kind in ("rectangle", "polar", "square-polar") else None
+    if (isinstance(nodes, list) and len(nodes) == 2 and all(isinstance(n, int) for n in nodes)
+            and nodes[0] * nodes[1] > MAX_MESH_NODES):
+        raise scene.error("mesh.nodes", f"{nodes!r} asks for {nodes[0] * nodes[1]:.3g} nodes, more than "
+                          f"{MAX_MESH_NODES:,}; give fewer nodes")
     try:
         if kind == "rectangle":
             lx, ly = _pair(scene, "mesh.size", m.get("size", [1.0, 1.0]))
@@ -76,6 +83,7 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
 
 
 def _unstructured(scene, m, u, z0):
+    from rftstatic.errors import MeshingError
     from rftstatic.mesh.mesher import BackgroundGrid, Domain, generate
 
     if "h" not in m:
@@ -83,14 +91,44 @@ def _unstructured(scene, m, u, z0):
     h = m["h"] * u
     if "radius" in m:
         cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
-        domain = Domain.disc(cx * u, cy * u, m["radius"] * u)
+        if not m["radius"] > 0:
+            raise scene.error("mesh.radius", f"{m['radius']!r} must be > 0 (the radius of the disc)")
+        _check_unstructured_size(scene, m["h"], 2.0 * m["radius"], np.pi * m["radius"] * m["radius"])
+        shape = (Domain.disc, cx * u, cy * u, m["radius"] * u)
     else:
         lx, ly = _pair(scene, "mesh.size", m.get("size", [1.0, 1.0]))
         ox, oy = _pair(scene, "mesh.origin", m.get("origin", [-lx / 2, -ly / 2]))
-        domain = Domain.rectangle(ox * u, oy * u, lx * u, ly * u)
-    res = generate(domain, BackgroundGrid.uniform(h, domain))
+        if not (lx > 0 and ly > 0):
+            raise scene.error("mesh.size", f"{m.get('size')!r}: both sides must be > 0")
+        _check_unstructured_size(scene, m["h"], min(lx, ly), lx * ly)
+        shape = (Domain.rectangle, ox * u, oy * u, lx * u, ly * u)
+    try:
+        domain = shape[0](*shape[1:])
+        res = generate(domain, BackgroundGrid.uniform(h, domain))
+    except MeshingError as exc:
+        raise scene.error("mesh", str(exc)) from None
     return meshmod.TriMesh(res.points, res.triangles, z0=z0, name=f"unstructured h={m['h']}",
                            info={"generator": "advancing-front", "quality": res.quality.as_dict()})
+
+
+MAX_MESH_NODES = 2_000_000
+"""Largest mesh a scene may ask for: a bigger one is refused before it is built (its static solve would need
+tens of GB; a mistyped size usually asks for far more)."""
+
+
+def _check_unstructured_size(scene, h, width, area) -> None:
+    """Scene error unless ``mesh.h`` (scene units) is positive, at most the sheet's ``width`` and gives at
+    most :data:`MAX_MESH_NODES` nodes on its ``area`` (equilateral triangles of side h)."""
+    if not h > 0:
+        raise scene.error("mesh.h", f"{h!r} must be > 0 (the target element size)")
+    if h > width:
+        raise scene.error("mesh.h", f"{h!r} is larger than the sheet ({width:g} across, scene units); give an "
+                          "element size below it")
+    nodes = 2.0 / math.sqrt(3.0) * float(area) / h / h  # Python floats: inf (no warning) when it overflows
+    if nodes > MAX_MESH_NODES:
+        many = f"about {nodes:.3g}" if math.isfinite(nodes) else "countless"
+        raise scene.error("mesh.h", f"{h!r} would give {many} nodes, more than {MAX_MESH_NODES:,}; give a larger "
+                          "element size (scene length units)")
 
 
 def _pair(scene, key, value, kind=float):
@@ -109,6 +147,11 @@ def build_material(scene: Scene) -> mat.Material:
             if "kind" in m:
                 raise scene.error("material.kind", f'does not apply next to preset = "{name}" (a preset is a fabric '
                                   "with its rigidities); remove kind, or the preset and give the rigidities")
+            foreign = sorted(set(m) - set(mat._FABRIC_KINDS))
+            if foreign:
+                raise scene.error(f"material.{foreign[0]}", f'does not apply next to preset = "{name}" (a fabric; '
+                                  f"it takes {', '.join(mat._FABRIC_KINDS)} and warp_angle); remove it, or the "
+                                  'preset and give kind = "isotropic" with E, nu and thickness')
             # preset values are in the preset's own units; overrides in the scene's units
             base = mat.preset(name, warp_angle_deg=angle)
             if not m:
@@ -313,6 +356,27 @@ def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
     supports.fixed[a, 1] = True
 
 
+def check_static_scene(scene: Scene, material, supports: Supports, load: np.ndarray, obstacles: list) -> None:
+    """Scene error unless a static scene can have an equilibrium and its route can run: without obstacles,
+    every direction its load ``(N, 3)`` [N] pushes the sheet along is held by a support; the relaxation
+    start (``solver.start = "relax"``) needs the sheet's mass."""
+    if scene.get("solver.start") == "relax" and not material.mass_per_area > 0:
+        raise scene.error("solver.start", '"relax" (dynamic relaxation) moves the sheet\'s mass, and material.weight '
+                          'is 0; give a positive weight or use start = "load-steps"')
+    if obstacles:
+        return
+    held = supports.fixed_mask().any(axis=0)
+    resultant = load.sum(axis=0)
+    scale = float(np.abs(load).sum())
+    for i, axis in enumerate("xyz"):
+        if abs(resultant[i]) > 1e-9 * scale and not held[i]:
+            force = resultant[i] / scene.units.force
+            raise scene.error("supports", f"nothing holds the sheet along {axis}, and its load pushes it that way "
+                              f"(resultant {force:.4g}, {scene.units.name} units): no static equilibrium; add "
+                              f"[[supports]] that hold {axis} (clamped, pinned, or fixed with {axis} in "
+                              "components) or an obstacle")
+
+
 def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: bool = False) -> tuple[Model, dict]:
     """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras.
 
@@ -332,6 +396,8 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     supports = build_supports(scene, mesh)
     load = build_load(scene, mesh, material)
     contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
+    if scene.get("analysis", "static") == "static":
+        check_static_scene(scene, material, supports, load, obstacles)
     membrane = scene.get("solver.membrane", True)
     model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
                   contact=contact, membrane=membrane, quiet=quiet)

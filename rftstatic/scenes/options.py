@@ -20,6 +20,12 @@ from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 
 _STATIC_KEYS = {f.name for f in fields(StaticOptions)} - {"progress"}
 _STATIC_LENGTH_KEYS = ("max_step", "increment_displacement")
+_STATIC_COUNTS = {"seed": 0, "max_continuations": 0, "reuse_factorisation": 0, "max_load_steps": 1}
+"""``[solver]`` integers and their least value (a seed: numpy's generators take none below 0)."""
+MAX_PERTURBATION = 10.0
+"""Largest ``solver.perturbation`` [element sizes]: the seeded lift tips a flat sheet off its bifurcation
+(0.01-0.5 in the scenes and validations); a lift of many element sizes stretches the membrane instead, and
+the relaxation from it becomes unstable (above about 200 its stable step collapses)."""
 
 
 def static_options(scene, *, progress=True) -> StaticOptions:
@@ -37,6 +43,14 @@ def static_options(scene, *, progress=True) -> StaticOptions:
     unknown = set(s) - _STATIC_KEYS
     if unknown:
         raise scene.error("solver", f"unknown option(s) {sorted(unknown)}")
+    for key, least in _STATIC_COUNTS.items():
+        if key in s and s[key] < least:
+            raise scene.error(f"solver.{key}", f"{s[key]!r} must be an integer >= {least}")
+    lift = s.get("perturbation", 0.0)
+    if not 0.0 <= lift <= MAX_PERTURBATION:
+        raise scene.error("solver.perturbation", f"{lift!r} must lie in [0, {MAX_PERTURBATION:g}] (element sizes of "
+                          "a seeded lift that tips the sheet off its bifurcation; a larger lift stretches the "
+                          "membrane instead)")
     try:
         return StaticOptions(**s, progress=progress)
     except (TypeError, ValueError) as exc:
@@ -85,6 +99,9 @@ class DynamicsOptions:
     max_steps: int = MAX_STEPS
 
 
+MAX_SAMPLES = 1000
+"""Most regular states ``dynamics.samples`` a run may save (a VTU file and a GIF frame each)."""
+
 CHECKPOINT_EVERY_S = 0.2
 """Default simulated time between checkpoints [s]."""
 
@@ -115,8 +132,9 @@ def dynamics_options(scene) -> DynamicsOptions:
         raise scene.error("dynamics.max_steps", f"must be a positive integer, got {opts['max_steps']!r}")
     if opts.get("dt") is not None:
         positive("dt")
-    if opts["samples"] < 0:
-        raise scene.error("dynamics.samples", f"must be >= 0, got {opts['samples']}")
+    if not 0 <= opts["samples"] <= MAX_SAMPLES:
+        raise scene.error("dynamics.samples", f"must lie in [0, {MAX_SAMPLES}] (each is a VTU file), got "
+                          f"{opts['samples']}")
     frames = opts["frames"]
     if not all(isinstance(f, (int, float)) and 0 <= f <= opts["t_end"] for f in frames):
         raise scene.error("dynamics.frames", f"expected times in [0, t_end = {opts['t_end']}], got {frames!r}")

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import ClassVar
 
 import numpy as np
@@ -109,4 +110,4 @@ class RoundPedestal(Obstacle):
         }
 
     def footprint(self):
-        return float(np.pi * self.radius**2), self.centre_xy.copy()
+        return math.pi * float(self.radius) * float(self.radius), self.centre_xy.copy()  # inf for a huge one

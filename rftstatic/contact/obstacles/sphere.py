@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import ClassVar
 
 import numpy as np
@@ -61,4 +62,4 @@ class Sphere(Obstacle):
         return {"centre": self.centre.tolist(), "radius": self.radius}
 
     def footprint(self):
-        return float(np.pi * self.radius**2), self.centre[:2].copy()
+        return math.pi * float(self.radius) * float(self.radius), self.centre[:2].copy()  # inf for a huge one

@@ -71,7 +71,7 @@ class SquarePedestal(Obstacle):
         self.edge_radius = _positive("edge_radius", edge_radius, allow_zero=True)
         if self.edge_radius > half.min():
             raise ValueError(
-                f"edge_radius = {edge_radius!r} is larger than the half width {half.min()!r}; "
+                f"edge_radius = {edge_radius!r} is larger than the half width {float(half.min())!r}; "
                 "use edge_radius <= half_width"
             )
         self.height = _check_height(height, self.edge_radius, "square pedestal")
@@ -113,4 +113,4 @@ class SquarePedestal(Obstacle):
 
     def footprint(self):
         hx, hy = self.half_width
-        return float(4 * hx * hy), self.centre_xy.copy()
+        return 4.0 * float(hx) * float(hy), self.centre_xy.copy()  # Python floats: inf, no warning, for a huge one

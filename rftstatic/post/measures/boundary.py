@@ -151,6 +151,20 @@ def _ray_radius(xy: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return np.where(hit & (r > 0.0), r, -np.inf).max(axis=1)
 
 
+def _rays(x, loop, centre, n_angles):
+    """``theta (n,)`` [rad] and the projected boundary's radius ``r (n,)`` [m] along the rays from ``centre``
+    (``-inf`` where a ray misses it)."""
+    xy = np.asarray(x, dtype=float)[np.asarray(loop), :2] - np.asarray(centre, dtype=float)[:2]
+    theta = np.linspace(0.0, 2.0 * np.pi, int(n_angles), endpoint=False)
+    return theta, _ray_radius(xy, theta)
+
+
+def outline_surrounds(x: np.ndarray, loop: np.ndarray, centre=(0.0, 0.0), *, n_angles: int = 720) -> bool:
+    """Whether every ray from ``centre`` crosses the projected boundary ``loop`` (``x`` (N, 2 or 3) [m]), as
+    :func:`fold_count` needs: False when a draped sheet has slid off its support's axis."""
+    return bool(np.all(np.isfinite(_rays(x, loop, centre, n_angles)[1])))
+
+
 def fold_count(x: np.ndarray, loop: np.ndarray, centre=(0.0, 0.0), *, n_angles: int = 720,
                prominence: float = 0.1, min_amplitude: float = 0.01) -> FoldProfile:
     """Number of folds of a draped sheet from its projected outer boundary.
@@ -187,9 +201,7 @@ def fold_count(x: np.ndarray, loop: np.ndarray, centre=(0.0, 0.0), *, n_angles: 
     ValueError
         If some ray misses the boundary (``centre`` is outside the projected outline).
     """
-    xy = np.asarray(x, dtype=float)[np.asarray(loop), :2] - np.asarray(centre, dtype=float)[:2]
-    theta = np.linspace(0.0, 2.0 * np.pi, int(n_angles), endpoint=False)
-    r = _ray_radius(xy, theta)
+    theta, r = _rays(x, loop, centre, n_angles)
     if not np.all(np.isfinite(r)):
         bad = theta[~np.isfinite(r)][0]
         raise ValueError(f"fold_count: the ray at θ = {np.degrees(bad):.1f}° from centre = "

@@ -1,0 +1,140 @@
+"""Scenes the property test (tests/app/test_scene_property.py) found mishandled: each is now an input error
+(exit 2) of one line that names the scene file and the key."""
+
+import pytest
+
+from rftstatic.cli import main
+
+
+def _run(capsys, tmp_path, scene, sets=(), text=None):
+    """Exit status and stderr of ``case SCENE --set ...`` (``text``: a scene file of that content)."""
+    if text is not None:
+        scene = tmp_path / "scene.toml"
+        scene.write_text(text)
+    argv = ["case", str(scene), *(a for kv in sets for a in ("--set", kv)), "--out", str(tmp_path / "o"),
+            "--no-figures"]
+    code = main(argv)
+    return code, capsys.readouterr().err.strip()
+
+
+def _assert_input_error(code, err, key, fragment):
+    assert code == 2, err
+    assert "\n" not in err and "Traceback" not in err, err
+    assert f": {key}: " in err and fragment in err, err
+
+
+@pytest.mark.parametrize("sets, key, fragment", [
+    # was: internal error: KeyError: 'nu' (an isotropic shell's key next to a fabric preset)
+    (["material.nu=-1e-05"], "material.nu", 'does not apply next to preset = "wool-kang-yu"'),
+    (["material.E=1e6"], "material.E", "does not apply next to preset"),
+    # a mesh too big to build: was a MemoryError (an internal error) or a run that never ends
+    (["mesh.nodes=[100000000,1000000]"], "mesh.nodes", "more than 2,000,000"),
+])
+def test_strip_mutations_are_input_errors(capsys, tmp_path, sets, key, fragment):
+    _assert_input_error(*_run(capsys, tmp_path, "strip", sets), key, fragment)
+
+
+@pytest.mark.parametrize("mesh, key, fragment", [
+    # was: "error: the smallest target size 0.167 m exceeds the domain's width 0.01 m" (no file, no key)
+    ("h = 16.7", "mesh.h", "is larger than the sheet (1 across"),
+    ("h = 1e-300", "mesh.h", "would give countless nodes"),
+    ("h = 1e-4\nsize = [50.0, 50.0]", "mesh.h", "would give about 2.89e+11 nodes"),
+    ("h = -1.0", "mesh.h", "must be > 0"),
+    ("h = 1.0\nsize = [-5.0, 5.0]", "mesh.size", "both sides must be > 0"),
+    ("h = 1.0\nradius = 0.0", "mesh.radius", "must be > 0"),
+])
+def test_bad_unstructured_sizes_are_input_errors(capsys, tmp_path, mesh, key, fragment):
+    text = f'[mesh]\nkind = "unstructured"\n{mesh}\n[[supports]]\nkind = "pinned"\nat = [0.0, 0.0]\n'
+    _assert_input_error(*_run(capsys, tmp_path, None, text=text), key, fragment)
+
+
+def test_a_negative_seed_is_an_input_error(capsys, tmp_path):
+    # was: internal error: ValueError: expected non-negative integer (numpy's generator, deep in the solver)
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", "solver.seed=-100000000000",
+                                                  "solver.perturbation=0.01"])
+    _assert_input_error(code, err, "solver.seed", "must be an integer >= 0")
+
+
+@pytest.mark.parametrize("scene, obstacle", [("pedestal-square-20", "half_width=1e300"),
+                                             ("pedestal-round-50", "radius=1e300")])
+def test_a_huge_pedestal_is_no_internal_error(capsys, tmp_path, scene, obstacle):
+    # was: RuntimeWarning: overflow in the footprint's area (an error under the test suite's warning filter)
+    nodes = "[5,5]" if scene == "pedestal-square-20" else "[3,8]"
+    code, err = _run(capsys, tmp_path, scene, [f"mesh.nodes={nodes}", f"obstacles.0.{obstacle}"])
+    assert code in (0, 3) and "internal error" not in err, err
+
+
+@pytest.mark.parametrize("pattern", ["RIGHT", "union-jack"])
+def test_an_unknown_square_polar_pattern_is_an_input_error(capsys, tmp_path, pattern):
+    # was: accepted silently, and meshed as "left"
+    code, err = _run(capsys, tmp_path, "pedestal-round-50", ["mesh.nodes=[2,17]", f"mesh.pattern={pattern}"])
+    _assert_input_error(code, err, "mesh", f'unknown diagonal pattern "{pattern}" for a square-polar mesh')
+
+
+REMESH_TINY = ["mesh.h=4.0", "remesh.h_lower=5.0", "remesh.h_upper=8.0", "remesh.const=5.0", "dynamics.t_end=0.1",
+               "dynamics.frames=[0.1]"]
+
+
+def test_a_remeshed_relaxation_keeps_to_max_steps(capsys, tmp_path):
+    import json
+
+    # was: dynamics.max_steps ignored by the remeshed relaxation (10^9 steps), a tiny scene ran for minutes
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.mass_scale=1e-6",
+                                                                      "dynamics.max_steps=1000"])
+    _assert_input_error(code, err, "dynamics.t_end", "more than the limit of 1000 (dynamics.max_steps)")
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.max_steps=100"])
+    assert code == 3 and "within dynamics.max_steps = 100 explicit steps" in err, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["steps"] <= 200 and summary["stopped_by"] == "max_steps" and summary["converged"] is False
+
+
+def test_a_remeshed_relaxation_that_blows_up_is_unstable_not_an_internal_error(capsys, tmp_path):
+    # was: internal error: FloatingPointError: remesh_relax: non-finite state after step 200
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.dt=0.05"])
+    assert code == 3 and err.startswith("error: the explicit run became unstable: the state became non-finite"), err
+
+
+def test_a_remeshed_static_run_whose_mesh_still_changes_exits_3(capsys, tmp_path):
+    # was: exit 0 with summary.json saying converged = false
+    code, err = _run(capsys, tmp_path, "remesh-sphere-30", [*REMESH_TINY, "analysis=static", "remesh.max_cycles=0"])
+    assert code == 3 and "the mesh still changed after remesh.max_cycles = 0" in err, err
+
+
+def test_a_sheet_that_slides_off_the_sphere_gets_no_drape_measures(capsys, tmp_path):
+    import json
+
+    # was: internal error: ValueError: fold_count: the ray at 175.5 deg from centre = (0, 0) misses the boundary
+    code, err = _run(capsys, tmp_path, "sphere-30", ["mesh.nodes=[5,4]"])
+    assert code in (0, 3) and "internal error" not in err, err
+    drape = json.loads((tmp_path / "o" / "summary.json").read_text())["drape"]
+    assert drape["applicable"] is False and "does not surround the obstacle's centre" in drape["reason"]
+
+
+@pytest.mark.parametrize("lift", ["1e4", "9223372036854775807", "-1"])
+def test_a_perturbation_of_many_element_sizes_is_an_input_error(capsys, tmp_path, lift):
+    # was: internal error: ValueError: t_end = 87.45 s with dt = 1.6e-22 s needs 5.41e+23 explicit steps (the
+    # relaxation from the lifted start; solvers.static lets step_count's ValueError through)
+    code, err = _run(capsys, tmp_path, "sphere-30", ["mesh.nodes=[3,14]", f"solver.perturbation={lift}"])
+    _assert_input_error(code, err, "solver.perturbation", "must lie in [0, 10]")
+
+
+@pytest.mark.parametrize("sets", [
+    ["supports=[]"],  # was: 20 s of load steps and relaxation, then exit 3
+    ["supports.0.kind=fixed", "supports.0.components=xy"],
+])
+def test_a_static_sheet_held_by_nothing_against_its_weight_is_an_input_error(capsys, tmp_path, sets):
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", *sets])
+    _assert_input_error(code, err, "supports", "nothing holds the sheet along z")
+
+
+def test_a_relaxation_start_without_mass_is_an_input_error(capsys, tmp_path):
+    # was: internal error: ValueError: material 'wool-kang-yu (modified)' has mass_per_area = 0.0 kg/m^2
+    code, err = _run(capsys, tmp_path, "pedestal-square-20", ["mesh.nodes=[5,5]", "material.weight=0.0"])
+    _assert_input_error(code, err, "solver.start", "material.weight is 0")
+
+
+def test_samples_beyond_a_thousand_are_an_input_error(capsys, tmp_path):
+    # was: a tiny 1 ms run saving 3,000,000 states, past any time bound
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "dynamics.t_end=0.001",
+                                                   "dynamics.frames=[0.001]", "dynamics.samples=3000000"])
+    _assert_input_error(code, err, "dynamics.samples", "must lie in [0, 1000]")
