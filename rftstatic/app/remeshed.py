@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import time
 from pathlib import Path
 
@@ -43,7 +44,7 @@ from rftstatic.io.summary import drape_summary, probe_summary, summary_header
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
 from rftstatic.remesh.static_driver import remesh_static
-from rftstatic.scenes.build import build_model
+from rftstatic.scenes.build import MAX_MESH_NODES, build_model
 from rftstatic.scenes.options import REMESH_LENGTH_KEYS, dynamics_options, remesh_options, static_options
 from rftstatic.solvers.explicit import step_count
 from rftstatic.solvers.timestep import stable_time_step
@@ -117,6 +118,8 @@ def _static(scene, opts) -> dict:
 
     def factory(mesh=None):
         model, extras = build_model(scene, mesh=mesh, quiet=mesh is not None)
+        if mesh is None:
+            _check_node_budget(scene, opts, model.mesh)
         meshes.append({"model": model, "U": None, "t": 0.0, "step": 0})
         return model, extras
 
@@ -138,6 +141,7 @@ def _relax(scene, opts) -> dict:
         return build_model(scene, mesh=mesh, quiet=mesh is not None)
 
     model0, extras0 = factory(None)
+    _check_node_budget(scene, opts, model0.mesh)
     _check_step_budget(scene, d, model0)
     obstacles = tuple(extras0.get("obstacles", ()))
     stepper = explicit_advance(alpha=d.alpha, mass_scale=d.mass_scale, dt=d.dt, safety=SAFETY,
@@ -187,6 +191,17 @@ def _relax(scene, opts) -> dict:
     return {"route": "remesh_relax", "model": model, "extras": extras, "U": U, "records": records,
             "converged": bool(converged), "meshes": meshes, "t": t, "steps": steps, "skipped": skipped,
             "dynamics": d, "alphas": list(stepper.alphas), "stopped_by": stopped_by}
+
+
+def _check_node_budget(scene, opts, mesh) -> None:
+    """Refuse a ``remesh.h_lower`` [m in ``opts``] that would let a remeshed sheet (the area of ``mesh``) have
+    more than :data:`~rftstatic.scenes.build.MAX_MESH_NODES` nodes."""
+    nodes = 2.0 / math.sqrt(3.0) * float(mesh.area.sum()) / float(opts.h_lower) / float(opts.h_lower)  # inf, no warning
+    if nodes > MAX_MESH_NODES:
+        u = scene.units.length
+        raise scene.error("remesh.h_lower", f"{opts.h_lower / u:g} would let the remeshed sheet have up to "
+                          f"{nodes:.3g} nodes, more than {MAX_MESH_NODES:,}; give a larger h_lower (scene length "
+                          "units)")
 
 
 def _check_step_budget(scene, d, model) -> None:

@@ -429,14 +429,20 @@ def mutate(draw, data, kinds) -> str:
 
 
 def keep_tiny(data, base) -> None:
-    """Undo the mutations that would make a valid scene big rather than wrong: a mesh of more than
-    :data:`MAX_NODES` nodes (but not one ten times over the scenes' limit ``MAX_MESH_NODES``, which must be
-    refused), a higher or missing ``dynamics.max_steps``."""
+    """Undo the mutations that would make a valid scene big rather than wrong: a mesh (or a ``remesh.h_lower``
+    that allows a remeshed sheet) of more than :data:`MAX_NODES` nodes (but not one ten times over the scenes'
+    limit ``MAX_MESH_NODES``, which must be refused), a higher or missing ``dynamics.max_steps``."""
     d, b = data.get("dynamics"), base.get("dynamics")
     if isinstance(d, dict) and isinstance(b, dict):
         steps = d.get("max_steps")
         if steps is None or (isinstance(steps, int) and not isinstance(steps, bool) and steps > MAX_STEPS):
             d["max_steps"] = MAX_STEPS
+    r, br = data.get("remesh"), base.get("remesh")
+    if isinstance(r, dict) and isinstance(br, dict) and isinstance(data.get("mesh"), dict):
+        fine = {**data["mesh"], "kind": "unstructured", "h": r.get("h_lower")}  # the finest remeshed sheet
+        n = estimated_nodes(fine) if "size" in fine or "radius" in fine else None
+        if n is not None and MAX_NODES <= n <= 10 * MAX_MESH_NODES:
+            r["h_lower"] = br["h_lower"]
     m, bm = data.get("mesh"), base.get("mesh")
     if isinstance(m, dict) and isinstance(bm, dict):
         n = estimated_nodes(m)

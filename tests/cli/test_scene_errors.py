@@ -138,3 +138,11 @@ def test_samples_beyond_a_thousand_are_an_input_error(capsys, tmp_path):
     code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "dynamics.t_end=0.001",
                                                    "dynamics.frames=[0.001]", "dynamics.samples=3000000"])
     _assert_input_error(code, err, "dynamics.samples", "must lie in [0, 1000]")
+
+
+@pytest.mark.parametrize("analysis", ["relax", "static"])
+def test_a_remesh_h_lower_allowing_too_many_nodes_is_an_input_error(capsys, tmp_path, analysis):
+    # was: a 37-node sheet remeshed to 67,430 nodes, then more: a run without end
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [
+        *REMESH_TINY, "remesh.h_lower=1e-3", "remesh.const=1e-3", f"analysis={analysis}"])
+    _assert_input_error(code, err, "remesh.h_lower", "would let the remeshed sheet have up to 4.62e+08 nodes")
