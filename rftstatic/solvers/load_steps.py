@@ -67,6 +67,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
     n = model.mesh.n_nodes
     if resume is not None:
         U0 = resume.U
+    from_state = U0 is not None and resume is None and opts.initial_increment >= 1.0
     U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
     seed = None if resume is None else resume.result.seed
     if opts.perturbation and U0 is None:
@@ -117,8 +118,11 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
             nt = newton(model, start, lam_next, opts, ws, max_step, scheme="displacement" if fallback else None)
             continuing = None
             result.iterations += nt.iterations
+            # the whole load from a given state (a relaxed or transferred drape) retries with the
+            # displacement iteration before cutting back, which would unload the drape
+            whole_from_state = from_state and not result.load_steps and lam_next >= 1.0
             if (not nt.converged and nt.scheme == "mixed" and opts.iteration_fallback
-                    and not dlam / 4.0 >= opts.min_increment):
+                    and (whole_from_state or not dlam / 4.0 >= opts.min_increment)):
                 result.retries += 1
                 log.info("load factor %.6g: %s (|r| = %.3e); retrying with displacement iterations",
                          lam_next, nt.reason, nt.residual)
