@@ -249,6 +249,17 @@ def membrane_force_blocks(nodes, G, area, Dm, U, fe, chunks):
     return W
 
 
+def _force_and_tangent(g, u, area, Dm, psd, S, e, H, B, DB, fe, ke):
+    """Element ``e``'s force into ``fe (A, 3)`` and tangent into ``ke (A, 3, A, 3)`` from its
+    displacements ``u (A, 3)``; the geometric part takes ``S[e]`` when ``S`` is not empty (MIP Newton's
+    carried stress), else the element's own stress (:func:`membrane_tangents`)."""
+    _, _, _, sxx, syy, sxy = membrane_state(g, u, Dm, H)
+    element_force(g, H, sxx, syy, sxy, area, fe)
+    if S.shape[0] > 0:
+        sxx, syy, sxy = S[e, 0], S[e, 1], S[e, 2]
+    element_tangent(g, H, sxx, syy, sxy, area, Dm, psd, B, DB, ke)
+
+
 def membrane_tangents(nodes, G, area, Dm, U, psd, S, fe, ke):
     """Fill ``fe (E, A, 3)`` [N] and ``ke (E, A, 3, A, 3)`` [N/m] for every element.
 
@@ -260,14 +271,8 @@ def membrane_tangents(nodes, G, area, Dm, U, psd, S, fe, ke):
     u = np.empty((A, 3))
     B = np.empty((3, A, 3))
     DB = np.empty((3, A, 3))
-    given = S.shape[0] > 0
     for e in range(E):
-        g = G[e]
-        _, _, _, sxx, syy, sxy = membrane_state(g, _gather(U, nodes[e], u), Dm, H)
-        element_force(g, H, sxx, syy, sxy, area[e], fe[e])
-        if given:
-            sxx, syy, sxy = S[e, 0], S[e, 1], S[e, 2]
-        element_tangent(g, H, sxx, syy, sxy, area[e], Dm, psd, B, DB, ke[e])
+        _force_and_tangent(G[e], _gather(U, nodes[e], u), area[e], Dm, psd, S, e, H, B, DB, fe[e], ke[e])
 
 
 def membrane_tangents_into(nodes, G, area, Dm, U, psd, S, emap, fe, data):
@@ -280,14 +285,8 @@ def membrane_tangents_into(nodes, G, area, Dm, U, psd, S, emap, fe, data):
     B = np.empty((3, A, 3))
     DB = np.empty((3, A, 3))
     ke = np.empty((A, 3, A, 3))
-    given = S.shape[0] > 0
     for e in range(E):
-        g = G[e]
-        _, _, _, sxx, syy, sxy = membrane_state(g, _gather(U, nodes[e], u), Dm, H)
-        element_force(g, H, sxx, syy, sxy, area[e], fe[e])
-        if given:
-            sxx, syy, sxy = S[e, 0], S[e, 1], S[e, 2]
-        element_tangent(g, H, sxx, syy, sxy, area[e], Dm, psd, B, DB, ke)
+        _force_and_tangent(G[e], _gather(U, nodes[e], u), area[e], Dm, psd, S, e, H, B, DB, fe[e], ke)
         m = emap[e]
         for a in range(A):
             for i in range(3):
