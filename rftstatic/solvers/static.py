@@ -205,7 +205,9 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
     # a handover that fails gives way to more relaxation, not to the slower displacement iteration
     short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS,
                     iteration_fallback=False)
-    basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
+    # in the basin of a stable minimum the line-searched displacement iteration gets there where the
+    # mixed one (at most 2 x MIXED_ITERATIONS) wanders: the long try may fall back to it
+    basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS, iteration_fallback=True)
     checker = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     info = route.info
 
