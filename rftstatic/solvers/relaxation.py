@@ -57,7 +57,8 @@ class RelaxResult:
 def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kinetic: float = 1e-8, tol_force: float = 1e-4,
           max_time: float, dt: float | None = None, U0=None, V0=None, obstacles=(), sample_every: int = 20,
           peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto", load=None, checkpoint=None,
-          restart: dict | None = None) -> RelaxResult:
+          restart: dict | None = None, max_steps: int | None = None,
+          max_steps_name: str = "dynamics.max_steps") -> RelaxResult:
     """Dynamic relaxation (§6): damped explicit motion until the sheet is at rest.
 
     At rest means, at a sample, kinetic energy / peak kinetic energy < ``tol_kinetic`` *and* the
@@ -79,6 +80,8 @@ def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kine
     restart : the explicit state saved during an earlier call with the same arguments
         (:func:`~rftstatic.solvers.checkpoint.load_checkpoint`): the run continues from it, step for step as
         the uninterrupted one (``peak_kinetic`` is the peak before that call; ``U0``, ``V0``, ``dt`` are unused)
+    max_steps, max_steps_name : refuse a relaxation of more explicit steps than this, or whose stable step
+        collapsed (:class:`~rftstatic.errors.StepLimitError`, before the first step), naming that option
     """
     P = model.load if load is None else load
     P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
@@ -90,7 +93,7 @@ def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kine
     run = run_explicit(model, t_end=max_time, dt=dt, alpha=alpha, mass_scale=mass_scale, obstacles=obstacles,
                        U0=U0, V0=V0, start="consistent" if V0 is None else "given", sample_every=sample_every,
                        callback=at_rest, progress=progress, backend=backend, load=load, checkpoint=checkpoint,
-                       _restart=restart)
+                       max_steps=max_steps, max_steps_name=max_steps_name, _restart=restart)
     if not run.stopped:
         log.warning("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
                     run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])

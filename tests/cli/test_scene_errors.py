@@ -146,3 +146,36 @@ def test_a_remesh_h_lower_allowing_too_many_nodes_is_an_input_error(capsys, tmp_
     code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [
         *REMESH_TINY, "remesh.h_lower=1e-3", "remesh.const=1e-3", f"analysis={analysis}"])
     _assert_input_error(code, err, "remesh.h_lower", "would let the remeshed sheet have up to 4.62e+08 nodes")
+
+
+def test_a_relaxation_fallback_without_mass_is_a_reported_failure(capsys, tmp_path):
+    # was: internal error: ValueError: material 'wool-kang-yu (modified)' has mass_per_area = 0.0 kg/m^2 (the
+    # load steps failed and their relaxation fallback had no mass to move)
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", "material.weight=0.0", "loads.pressure=0.05",
+                                                 "solver.max_iterations=1", "solver.max_load_steps=3"])
+    assert code == 3 and "internal error" not in err, err
+    assert "no dynamic relaxation: the material's areal weight is 0 N/m^2" in err, err
+
+
+def test_a_collapsed_relaxation_step_is_a_convergence_error():
+    # was: ValueError from step_count (4.5e8 explicit steps of 1.9e-7 s) out of solve_static through the API
+    from rftstatic import api
+    from rftstatic.errors import ConvergenceError
+    from rftstatic.solvers.static import StaticOptions, solve_static
+
+    model, _ = api.build_model(api.load_scene("sphere-30", ["mesh.nodes=[3,14]"]))
+    with pytest.raises(ConvergenceError, match="relaxation route's segment limit"):
+        solve_static(model, options=StaticOptions(start="relax", perturbation=1e4, progress=False))
+
+
+def test_a_collapsed_explicit_step_is_a_step_limit_error():
+    import numpy as np
+
+    from rftstatic.errors import StepLimitError
+    from rftstatic.solvers.explicit import step_count
+
+    for dt in (0.0, np.nan, -1.0, np.inf):
+        with pytest.raises(StepLimitError, match="not a positive finite number"):
+            step_count(1.0, dt)
+    with pytest.raises(StepLimitError, match=r"more than the limit of 10 \(dynamics.max_steps\)"):
+        step_count(1.0, 0.01, 10)
