@@ -185,8 +185,28 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
 
 
 MAX_STEPS = 10_000_000
-"""Default limit on the steps of one explicit run (hours of computing on a large sheet): a run that asks
-for more is refused before it starts, naming t_end, dt and the limit."""
+"""Largest step limit of one explicit run (hours of computing on a large sheet), and :func:`run_explicit`'s
+default ``max_steps``: a run that asks for more is refused before it starts, naming t_end, dt and the limit."""
+
+STEPS_PER_SIDE_NODE = 10_000
+"""Default step limit of a scene's explicit run (:func:`default_max_steps`) per node along a side of the sheet."""
+
+MIN_DEFAULT_STEPS = 50_000
+"""Least default step limit of a scene's explicit run, however small its mesh."""
+
+
+def default_max_steps(n_nodes: float) -> int:
+    """The default step limit of a scene's explicit run on a mesh of ``n_nodes`` nodes:
+    ``STEPS_PER_SIDE_NODE sqrt(n_nodes)``, at least :data:`MIN_DEFAULT_STEPS`, at most :data:`MAX_STEPS`.
+
+    The stable step shrinks with the element size h (dt ~ h for the membrane) and the time a sheet takes to
+    swing and come to rest does not, so the steps a run needs grow like the nodes along a side, sqrt(N):
+    hang-20 (t_end 2 s) took 4554 steps on 7 x 7 nodes and 30370 on 41 x 41 (6.7 x for 5.9 x the side);
+    the remeshed relaxations of ``validation/remesh_scenes.md`` 22,000-43,000 steps on 500-1900 nodes. The
+    limit leaves a factor 10 over these: 410,000 steps on 41 x 41 nodes, 70,000 (about 2 s at 31 us a step)
+    on 7 x 7, where a limit of 10^7 let a tiny relaxation that cannot come to rest run for minutes.
+    """
+    return int(min(MAX_STEPS, max(MIN_DEFAULT_STEPS, STEPS_PER_SIDE_NODE * float(np.sqrt(max(n_nodes, 0.0))))))
 
 
 def step_count(t_end: float, dt: float, max_steps: int | None = None, *, limit_name: str = "dynamics.max_steps") -> int:

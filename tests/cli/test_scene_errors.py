@@ -179,3 +179,54 @@ def test_a_collapsed_explicit_step_is_a_step_limit_error():
             step_count(1.0, dt)
     with pytest.raises(StepLimitError, match=r"more than the limit of 10 \(dynamics.max_steps\)"):
         step_count(1.0, 0.01, 10)
+
+
+def test_a_relaxation_that_cannot_come_to_rest_stops_at_its_default_step_limit(capsys, tmp_path):
+    import json
+    import time
+
+    # was: a default limit of 10^7 steps: a tiny undamped relaxation to t_end = 1e4 s ran for about 5 minutes
+    t0 = time.perf_counter()
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "analysis=relax", "dynamics.t_end=1e4",
+                                                   "dynamics.alpha=0.0", "dynamics.frames=[]"])
+    assert code == 3 and "did not come to rest within dynamics.max_steps = 50000 explicit steps" in err, err
+    assert time.perf_counter() - t0 < 20
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["steps"] == 50000 and summary["stopped_by"] == "max_steps" and summary["converged"] is False
+
+
+def test_the_default_step_limit_grows_with_the_nodes_along_a_side():
+    from rftstatic.solvers.explicit import MAX_STEPS, default_max_steps
+
+    assert default_max_steps(25) == 50_000 and default_max_steps(41 * 41) == 410_000
+    assert default_max_steps(1e15) == MAX_STEPS
+
+
+def test_a_dynamic_run_beyond_the_default_step_limit_is_refused(capsys, tmp_path):
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[7,7]", "dynamics.t_end=1e4", "dynamics.frames=[]"])
+    _assert_input_error(code, err, "dynamics.t_end", "by default 10,000 x sqrt(nodes) = 70000 for 49 nodes")
+
+
+
+def test_an_unloaded_relaxation_is_at_rest(capsys, tmp_path):
+    import json
+
+    # was: never at rest (the rest test needed a peak kinetic energy and a load to measure the force by)
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "analysis=relax", "loads.gravity=false",
+                                                   "dynamics.t_end=1.0", "dynamics.frames=[]"])
+    assert code == 0, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["at_rest"] and summary["steps"] <= 1
+
+
+def test_the_rest_test_of_a_perturbed_unloaded_sheet_measures_its_own_peak_force():
+    from rftstatic.solvers.relaxation import AtRest
+
+    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    assert rest(None, {"kinetic": 0.0, "residual": 0.0})  # no motion, no force: at rest
+    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    assert not rest(None, {"kinetic": 0.0, "residual": 1.0})  # a perturbed start
+    assert not rest(None, {"kinetic": 1.0, "residual": 0.5})
+    assert rest(None, {"kinetic": 1e-9, "residual": 1e-5})
+    loaded = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=1.0)
+    assert not loaded(None, {"kinetic": 0.0, "residual": 1.0})  # the first sample of a loaded sheet
