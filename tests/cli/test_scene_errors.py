@@ -230,3 +230,10 @@ def test_the_rest_test_of_a_perturbed_unloaded_sheet_measures_its_own_peak_force
     assert rest(None, {"kinetic": 1e-9, "residual": 1e-5})
     loaded = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=1.0)
     assert not loaded(None, {"kinetic": 0.0, "residual": 1.0})  # the first sample of a loaded sheet
+
+
+@pytest.mark.parametrize("key, value", [("top", "-1e300"), ("top", "1e300"), ("centre", "[1e300, 0.0]")])
+def test_an_obstacle_far_from_the_sheet_is_an_input_error(capsys, tmp_path, key, value):
+    # was: RuntimeWarning: overflow encountered in multiply (an internal error under the warning filter)
+    code, err = _run(capsys, tmp_path, "pedestal-square-20", ["mesh.nodes=[9,9]", f"obstacles.0.{key}={value}"])
+    _assert_input_error(code, err, f"obstacles.0.{key}", "more than 1000 sheet sizes (20000 scene length units)")
