@@ -62,7 +62,8 @@ class _TimeUp(Exception):
 
 
 class _Tracker:
-    """Wraps the explicit stepper: snapshots each new mesh (model, U, t, steps) and stops at t_end."""
+    """Wraps the explicit stepper: snapshots each new mesh (model, U, t, steps) and stops at t_end (the stepper
+    takes ``max_time``: its last chunk ends there)."""
 
     def __init__(self, advance, t_end):
         self.advance, self.t_end = advance, t_end
@@ -71,12 +72,13 @@ class _Tracker:
     def __call__(self, model, U, V, n):
         if not self.meshes or self.meshes[-1]["model"] is not model:
             self.meshes.append({"model": model, "U": U.copy(), "t": self.t, "step": self.steps})
-        if self.t >= self.t_end:
+        if self.t >= self.t_end * (1 - 1e-12):
             self.last = (model, U, V)
             raise _TimeUp
-        U, V, dt = self.advance(model, U, V, n)
+        # the last chunk ends at t_end itself (its last step shortened), not a chunk beyond it
+        U, V, dt = self.advance(model, U, V, n, max_time=self.t_end - self.t)
         self.t += float(dt)
-        self.steps += n
+        self.steps += getattr(self.advance, "last_steps", n)
         self.last = (model, U, V)
         return U, V, dt
 

@@ -90,7 +90,9 @@ def test_a_remeshed_relaxation_keeps_to_max_steps(capsys, tmp_path):
 
 def test_a_remeshed_relaxation_that_blows_up_is_unstable_not_an_internal_error(capsys, tmp_path):
     # was: internal error: FloatingPointError: remesh_relax: non-finite state after step 200
-    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.dt=0.05"])
+    # (to t_end = 10 s: 200 steps; a run to 0.1 s is 2 steps, now that the last chunk ends at t_end)
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.dt=0.05",
+                                                                      "dynamics.t_end=10.0", "dynamics.frames=[10.0]"])
     assert code == 3 and err.startswith("error: the explicit run became unstable: the state became non-finite"), err
 
 
@@ -237,3 +239,14 @@ def test_an_obstacle_far_from_the_sheet_is_an_input_error(capsys, tmp_path, key,
     # was: RuntimeWarning: overflow encountered in multiply (an internal error under the warning filter)
     code, err = _run(capsys, tmp_path, "pedestal-square-20", ["mesh.nodes=[9,9]", f"obstacles.0.{key}={value}"])
     _assert_input_error(code, err, f"obstacles.0.{key}", "more than 1000 sheet sizes (20000 scene length units)")
+
+
+def test_a_remeshed_relaxation_ends_at_t_end(capsys, tmp_path):
+    import json
+
+    # was: t = 0.58 s for t_end = 0.1 s (the stepper's whole chunk of 200 steps ran past t_end)
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", REMESH_TINY)
+    assert code == 3 and "did not come to rest by t_end = 0.1 s" in err, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["t"] == pytest.approx(0.1, rel=1e-9) and summary["t"] <= 0.1 * (1 + 1e-12)
+    assert summary["steps"] < 200
