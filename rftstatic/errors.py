@@ -41,6 +41,12 @@ class CheckpointError(ValueError):
     """A checkpoint that cannot be used (wrong model, unknown format, missing file)."""
 
 
+class StepLimitError(ValueError):
+    """An explicit run that cannot be stepped: its stable step collapsed (not a finite positive number) or it
+    would need more steps than its limit. A run refused for it by a scene is an input error; the static
+    route's relaxation turns it into a :class:`ConvergenceError` (the goal not reached)."""
+
+
 class ConvergenceError(RuntimeError):
     """The static solve failed; ``result`` holds the last equilibrium reached (not converged)."""
 

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from rftstatic.app.result import RunResult
-from rftstatic.errors import CheckpointError
+from rftstatic.errors import CheckpointError, StepLimitError
 from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
 from rftstatic.io.summary import summary_header
 from rftstatic.post.probes import probe_interpolation
@@ -41,7 +41,7 @@ from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import dynamics_options, static_options
 from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
 from rftstatic.solvers.checkpoint import resume as resume_run
-from rftstatic.solvers.explicit import run_explicit, step_count
+from rftstatic.solvers.explicit import STEPS_PER_SIDE_NODE, default_max_steps, run_explicit, step_count
 from rftstatic.solvers.relaxation import AtRest
 from rftstatic.solvers.static import compare_with_static, solve_static
 from rftstatic.solvers.timestep import stable_time_step
@@ -110,6 +110,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         stop = callback(state, rec) if callback is not None else False
         return bool(stop or (analysis == "relax" and at_rest))
 
+    limit = o.step_limit(model.mesh.n_nodes)
     ckpt_path = out / CHECKPOINT
     for stale in out.glob(CHECKPOINT + ".*.tmp"):  # a checkpoint write cut short by a kill
         stale.unlink(missing_ok=True)
@@ -118,7 +119,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     if resume and ckpt_path.exists():
         data = load_checkpoint(ckpt_path)
         saved = data["options"]
-        for key, want in (("t_end", t_end), ("alpha", o.alpha), ("mass_scale", o.mass_scale)):
+        horizon = _horizon(scene, analysis, t_end, float(data["dt"]), limit, _limit_name(o, model.mesh.n_nodes))
+        for key, want in (("t_end", horizon), ("alpha", o.alpha), ("mass_scale", o.mass_scale)):
             if not np.isclose(float(saved[key]), want, rtol=1e-12, atol=0.0):
                 raise scene.error(f"dynamics.{key}", f"the checkpoint {ckpt_path} was written with {key} = "
                                   f"{float(saved[key]):g} (SI), the scene asks {want:g}; run without --resume")
@@ -127,6 +129,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
                               "without --resume")
         hist_k = np.asarray(data["history"]["kinetic"], float)
         rest.peak_kinetic = float(hist_k.max()) if hist_k.size else 0.0
+        hist_r = np.asarray(data["history"]["residual"], float)
+        rest.peak_residual = float(hist_r.max()) if hist_r.size else 0.0
         dt = data["dt"]
         ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
         resumed_from = data["t"]
@@ -143,26 +147,49 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         dt = o.dt if o.dt is not None else estimate.dt
         if dt > estimate.dt * (1 + 1e-3):
             log.warning("dynamics.dt = %.4g s exceeds the stable estimate %.4g s", dt, estimate.dt)
-        try:
-            n_steps = step_count(t_end, dt, o.max_steps)
-        except ValueError as exc:
-            raise scene.error("dynamics.dt" if o.dt is not None else "dynamics.t_end", str(exc)) from None
-        dt = t_end / n_steps
+        horizon = _horizon(scene, analysis, t_end, dt, limit, _limit_name(o, model.mesh.n_nodes))
+        dt = horizon / step_count(horizon, dt, limit)
         ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
-        run = run_explicit(model, t_end=t_end, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
+        run = run_explicit(model, t_end=horizon, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
                            obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(), callback=watch,
                            checkpoint=ckpt, progress=progress, rest_tol=o.rest_tolerance, backend=backend,
-                           max_steps=o.max_steps)
+                           max_steps=limit)
         run.estimate = run.estimate or estimate
     wall = time.perf_counter() - wall0
 
     summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)
+    summary["max_steps"] = limit
     if analysis == "relax":
         summary["converged"] = summary["at_rest"] = bool(run.stopped)
+        summary["stopped_by"] = "rest" if run.stopped else "t_end" if run.t >= t_end * (1 - 1e-9) else "max_steps"
         if o.compare_static:
             summary["static_comparison"] = _compare_static(scene, run.U)
     _write(scene, model, out, run, summary, o, save_times, figures=figures)
     return to_jsonable(summary), run
+
+
+def _limit_name(o, n_nodes) -> str:
+    """How the step limit came about, for the messages."""
+    if o.max_steps is not None:
+        return "dynamics.max_steps"
+    return (f"dynamics.max_steps, by default {STEPS_PER_SIDE_NODE:,} x sqrt(nodes) = {default_max_steps(n_nodes)} "
+            f"for {n_nodes} nodes")
+
+
+def _horizon(scene, analysis, t_end, dt, limit, name="dynamics.max_steps") -> float:
+    """The time [s] the explicit run goes to: ``t_end``; for a relaxation whose ``t_end`` lies more than
+    ``limit`` steps of ``dt`` away, the time of those steps (it stops there, not at rest: exit status 3).
+    A dynamic run that needs more steps, or a step that is not a positive finite number, is a scene error."""
+    try:
+        step_count(t_end, dt, limit, limit_name=name)
+        return t_end
+    except StepLimitError as exc:
+        if analysis != "relax" or not (np.isfinite(dt) and dt > 0) or not np.isfinite(limit * dt):
+            raise scene.error("dynamics.dt" if scene.get("dynamics.dt") is not None else "dynamics.t_end",
+                              str(exc)) from None
+    log.warning("the relaxation stops after dynamics.max_steps = %d steps of %.4g s (t = %.4g s) unless at rest "
+                "before; t_end = %.4g s is further", limit, dt, limit * dt, t_end)
+    return limit * dt * (1.0 - 1e-12)  # limit steps after step_count's rounding
 
 
 def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from) -> dict:

@@ -62,7 +62,8 @@ class _TimeUp(Exception):
 
 
 class _Tracker:
-    """Wraps the explicit stepper: snapshots each new mesh (model, U, t, steps) and stops at t_end."""
+    """Wraps the explicit stepper: snapshots each new mesh (model, U, t, steps) and stops at t_end (the stepper
+    takes ``max_time``: its last chunk ends there)."""
 
     def __init__(self, advance, t_end):
         self.advance, self.t_end = advance, t_end
@@ -71,12 +72,13 @@ class _Tracker:
     def __call__(self, model, U, V, n):
         if not self.meshes or self.meshes[-1]["model"] is not model:
             self.meshes.append({"model": model, "U": U.copy(), "t": self.t, "step": self.steps})
-        if self.t >= self.t_end:
+        if self.t >= self.t_end * (1 - 1e-12):
             self.last = (model, U, V)
             raise _TimeUp
-        U, V, dt = self.advance(model, U, V, n)
+        # the last chunk ends at t_end itself (its last step shortened), not a chunk beyond it
+        U, V, dt = self.advance(model, U, V, n, max_time=self.t_end - self.t)
         self.t += float(dt)
-        self.steps += n
+        self.steps += getattr(self.advance, "last_steps", n)
         self.last = (model, U, V)
         return U, V, dt
 
@@ -141,8 +143,9 @@ def _relax(scene, opts) -> dict:
         return build_model(scene, mesh=mesh, quiet=mesh is not None)
 
     model0, extras0 = factory(None)
-    _check_node_budget(scene, opts, model0.mesh)
-    _check_step_budget(scene, d, model0)
+    finest = _check_node_budget(scene, opts, model0.mesh)
+    max_steps = d.step_limit(max(finest, model0.mesh.n_nodes))
+    _check_step_budget(scene, d, model0, max_steps)
     obstacles = tuple(extras0.get("obstacles", ()))
     stepper = explicit_advance(alpha=d.alpha, mass_scale=d.mass_scale, dt=d.dt, safety=SAFETY,
                                obstacles=obstacles, damping=opts.damping)
@@ -158,12 +161,12 @@ def _relax(scene, opts) -> dict:
     try:
         res = remesh_relax(make, const=opts.const, h_lower=opts.h_lower, h_upper=opts.h_upper,
                            advance=track, mass_scale=d.mass_scale, every=opts.every,
-                           kappa_h2_max=opts.kappa_h2_max, max_steps=d.max_steps, tol=opts.tol,
+                           kappa_h2_max=opts.kappa_h2_max, max_steps=max_steps, tol=opts.tol,
                            tol_force=d.force_tolerance, tol_kinetic=d.rest_tolerance,
                            gradation=opts.gradation, transfer=opts.transfer, residual=residual)
         model, U, records, converged, skipped = res.model, res.U, res.records, res.converged, res.skipped
         t, steps = res.t, res.steps
-        stopped_by = "rest" if converged else "max_steps" if steps >= d.max_steps else "max_remesh"
+        stopped_by = "rest" if converged else "max_steps" if steps >= max_steps else "max_remesh"
     except FloatingPointError:  # the explicit motion blew up: a goal not reached, not a bug
         nodes = track.last[0].mesh.n_nodes if track.last else model0.mesh.n_nodes
         raise InstabilityError(f"the state became non-finite by t = {track.t:.4g} s (step {track.steps}, a mesh of "
@@ -190,27 +193,28 @@ def _relax(scene, opts) -> dict:
     extras = extras0  # probes and obstacles are defined in reference coordinates: the same on every mesh
     return {"route": "remesh_relax", "model": model, "extras": extras, "U": U, "records": records,
             "converged": bool(converged), "meshes": meshes, "t": t, "steps": steps, "skipped": skipped,
-            "dynamics": d, "alphas": list(stepper.alphas), "stopped_by": stopped_by}
+            "dynamics": d, "alphas": list(stepper.alphas), "stopped_by": stopped_by, "max_steps": max_steps}
 
 
-def _check_node_budget(scene, opts, mesh) -> None:
+def _check_node_budget(scene, opts, mesh) -> float:
     """Refuse a ``remesh.h_lower`` [m in ``opts``] that would let a remeshed sheet (the area of ``mesh``) have
-    more than :data:`~rftstatic.scenes.build.MAX_MESH_NODES` nodes."""
+    more than :data:`~rftstatic.scenes.build.MAX_MESH_NODES` nodes; return the nodes it may have."""
     nodes = 2.0 / math.sqrt(3.0) * float(mesh.area.sum()) / float(opts.h_lower) / float(opts.h_lower)  # inf, no warning
     if nodes > MAX_MESH_NODES:
         u = scene.units.length
         raise scene.error("remesh.h_lower", f"{opts.h_lower / u:g} would let the remeshed sheet have up to "
                           f"{nodes:.3g} nodes, more than {MAX_MESH_NODES:,}; give a larger h_lower (scene length "
                           "units)")
+    return nodes
 
 
-def _check_step_budget(scene, d, model) -> None:
-    """Refuse, before it starts, a remeshed relaxation whose first mesh needs more than ``dynamics.max_steps``
-    explicit steps to reach ``t_end`` (the run also stops at ``max_steps`` on the later meshes)."""
+def _check_step_budget(scene, d, model, max_steps) -> None:
+    """Refuse, before it starts, a remeshed relaxation whose first mesh needs more than ``max_steps`` (the step
+    limit, ``dynamics.max_steps`` or its default for the finest mesh ``remesh.h_lower`` allows) explicit steps to reach ``t_end`` (the run also stops at ``max_steps`` on the later meshes)."""
     dt = d.dt if d.dt is not None else stable_time_step(model, mass_scale=d.mass_scale, alpha=d.alpha,
                                                         safety=SAFETY).dt
     try:
-        step_count(d.t_end, dt, d.max_steps)
+        step_count(d.t_end, dt, max_steps)
     except ValueError as exc:
         raise scene.error("dynamics.dt" if d.dt is not None else "dynamics.t_end", f"{exc} (on the first "
                           "mesh)") from None
@@ -239,7 +243,7 @@ def summarize(scene, opts, solved) -> dict:
     if solved["route"] == "remesh_relax":
         d = solved["dynamics"]
         summary.update(t=solved["t"] / u.time, steps=solved["steps"], skipped_remeshes=solved["skipped"],
-                       stopped_by=solved["stopped_by"], max_steps=d.max_steps, t_end=d.t_end / u.time,
+                       stopped_by=solved["stopped_by"], max_steps=solved["max_steps"], t_end=d.t_end / u.time,
                        alpha=d.alpha * u.time, mass_scale=d.mass_scale, damping=settings["damping"],
                        alpha_final=(solved["alphas"][-1] if solved.get("alphas") else d.alpha) * u.time)
         P = np.where(model.free, model.load, 0.0)

@@ -149,7 +149,9 @@ class ExplicitStepper:
         self.alphas = []
         self._model, self._dt = None, None  # the mesh the candidate lists and the step belong to
 
-    def __call__(self, model, U, V, n_steps):
+    def __call__(self, model, U, V, n_steps, *, max_time=None):
+        """Advance ``n_steps`` steps, or fewer (the last one shortened) that end at ``max_time`` [s] when
+        ``n_steps`` would go beyond it; ``last_steps`` is the number taken."""
         from rftstatic.solvers.explicit import run_explicit
         from rftstatic.solvers.timestep import stable_time_step
 
@@ -167,9 +169,11 @@ class ExplicitStepper:
         a = self.alpha if self.damping == "fixed" else critical_damping(model, U, mass_scale=self.mass_scale,
                                                                        alpha_max=self.alpha)
         self.alphas.append(a)
-        run = run_explicit(model, t_end=n_steps * step, dt=step, alpha=a, mass_scale=self.mass_scale,
+        span = n_steps * step if max_time is None or not max_time < n_steps * step else max_time
+        run = run_explicit(model, t_end=span, dt=step, alpha=a, mass_scale=self.mass_scale,
                            obstacles=self.near, U0=U, V0=V, start="given", sample_every=max(1, n_steps),
                            progress=False, energy_check=self.energy_check, backend=self.backend)
+        self.last_steps = run.steps
         return run.U, run.V, run.t
 
 

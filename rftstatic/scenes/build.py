@@ -310,6 +310,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     and spins on the support; a true dynamic run does not."""
     if law not in CONTACT_LAWS:
         raise ValueError(f'contact law "{law}" is unknown; use one of {", ".join(CONTACT_LAWS)}')
+    check_obstacle_positions(scene, mesh)
     obstacles = build_obstacles(scene)
     if not obstacles:
         return None, []
@@ -337,6 +338,33 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
         hold_inplane_rigid_modes(mesh, supports)
     smoothing = c.get("smoothing", 0.05) * h
     return PenaltyContact(obstacles, mesh.node_area, k, smoothing=smoothing), obstacles
+
+
+OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z"}
+"""``[[obstacles]]`` keys that place an obstacle, and the axes of their numbers."""
+
+MAX_OBSTACLE_DISTANCE = 1000.0
+"""Farthest an obstacle may be placed from the sheet, in sheet sizes: further away it cannot touch the sheet
+in any run, and its distances overflow (``top = -1e300``: RuntimeWarnings in every contact evaluation)."""
+
+
+def check_obstacle_positions(scene: Scene, mesh) -> None:
+    """Scene error unless every obstacle's ``centre``, ``top`` and ``height`` lies within
+    :data:`MAX_OBSTACLE_DISTANCE` sheet sizes (the largest side of its reference mesh) of the sheet's centre."""
+    u = scene.units.length
+    lo, hi = mesh.X3.min(axis=0) / u, mesh.X3.max(axis=0) / u
+    centre, size = 0.5 * (lo + hi), max(float((hi - lo).max()), 1e-300)
+    bound = MAX_OBSTACLE_DISTANCE * size
+    for i, spec in enumerate(scene.get("obstacles", [])):
+        for key, axes in OBSTACLE_POSITION_KEYS.items():
+            value = spec.get(key) if isinstance(spec, dict) else None
+            numbers = value if isinstance(value, list) else [value]
+            for axis, v in zip(axes, numbers):
+                if isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v - centre["xyz".index(axis)]) > bound:
+                    raise scene.error(f"obstacles.{i}.{key}", f"{value!r} places the obstacle more than "
+                                      f"{MAX_OBSTACLE_DISTANCE:g} sheet sizes ({bound:g} scene length units) from the "
+                                      f"sheet (centre {axis} = {centre['xyz'.index(axis)]:g}); give a position near the "
+                                      "sheet")
 
 
 def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:

@@ -14,7 +14,7 @@ import numpy as np
 
 from rftstatic.errors import ParameterError, SceneError
 from rftstatic.remesh.adapt import check_remesh_parameters
-from rftstatic.solvers.explicit import MAX_STEPS
+from rftstatic.solvers.explicit import default_max_steps
 from rftstatic.solvers.newton import StaticOptions
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 
@@ -83,7 +83,9 @@ class DynamicsOptions:
     force_tolerance : relax: out-of-balance force / load at rest [-]
     samples : regular states saved for the VTU series and the GIF
     compare_static : relax: report the difference from the static Newton solution
-    max_steps : refuse a run of more explicit steps than this
+    max_steps : the step limit of the run (None: :func:`~rftstatic.solvers.explicit.default_max_steps` of
+        the mesh, :meth:`step_limit`): a dynamic run that needs more steps to reach ``t_end`` is refused before
+        it starts; a relaxation stops there, not at rest
     """
 
     t_end: float
@@ -96,7 +98,11 @@ class DynamicsOptions:
     force_tolerance: float = 1e-4
     samples: int = 30
     compare_static: bool = False
-    max_steps: int = MAX_STEPS
+    max_steps: int | None = None
+
+    def step_limit(self, n_nodes: float) -> int:
+        """The step limit on a mesh of ``n_nodes`` nodes: ``max_steps``, or its default for that mesh."""
+        return int(self.max_steps) if self.max_steps is not None else default_max_steps(n_nodes)
 
 
 MAX_SAMPLES = 1000
@@ -128,7 +134,7 @@ def dynamics_options(scene) -> DynamicsOptions:
     for key in ("t_end", "mass_scale", "rest_tolerance", "force_tolerance", "checkpoint_every"):
         positive(key)
     positive("alpha", strict=False)
-    if not (isinstance(opts["max_steps"], int) and opts["max_steps"] >= 1):
+    if opts["max_steps"] is not None and not (isinstance(opts["max_steps"], int) and opts["max_steps"] >= 1):
         raise scene.error("dynamics.max_steps", f"must be a positive integer, got {opts['max_steps']!r}")
     if opts.get("dt") is not None:
         positive("dt")
@@ -144,7 +150,8 @@ def dynamics_options(scene) -> DynamicsOptions:
         mass_scale=float(opts["mass_scale"]), frames=np.array(sorted(set(float(f) * t for f in frames))),
         checkpoint_every=opts["checkpoint_every"] * t, rest_tolerance=float(opts["rest_tolerance"]),
         force_tolerance=float(opts["force_tolerance"]), samples=int(opts["samples"]),
-        compare_static=bool(opts["compare_static"]), max_steps=int(opts["max_steps"]))
+        compare_static=bool(opts["compare_static"]),
+        max_steps=None if opts["max_steps"] is None else int(opts["max_steps"]))
 
 
 @dataclass(frozen=True)

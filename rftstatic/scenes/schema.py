@@ -172,7 +172,7 @@ SCHEMA = {
         "samples": (int, "regular states saved for the VTU series and the GIF"),
         "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
         "compare_static": (bool, "relax: report the difference from the static Newton solution"),
-        "max_steps": (int, "refuse a run of more explicit steps than this (default 10^7)"),
+        "max_steps": (int, "step limit: a dynamic run needing more is refused, a relaxation stops there (default 10^4 sqrt(nodes), 5e4..1e7)"),
     }, "explicit dynamics options"),
     "remesh": ({
         "const": (NUM, "const of Eq. 29, |kappa| h^2 = const [length]"),

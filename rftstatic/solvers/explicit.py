@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.element.explicit_force import ForceKernel
-from rftstatic.errors import InstabilityError
+from rftstatic.errors import InstabilityError, StepLimitError
 from rftstatic.model.state import State
 from rftstatic.progress import Progress
 from rftstatic.solvers.timestep import StepEstimate, lumped_mass, stable_time_step
@@ -95,7 +95,7 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
                  sample_every: int | None = None, callback=None, checkpoint=None, progress: bool = True,
                  energy_check: bool = True, energy_tol: float = 0.25, rest_tol: float = 1e-6,
                  safety: float = 0.9, backend: str = "auto", load=None, max_steps: int = None,
-                 _restart: dict | None = None) -> ExplicitResult:
+                 max_steps_name: str = "dynamics.max_steps", _restart: dict | None = None) -> ExplicitResult:
     """Integrate the motion of ``model`` from t = 0 to ``t_end`` (module docstring).
 
     Parameters
@@ -122,8 +122,9 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
     rest_tol : kinetic / peak kinetic energy below which the sheet counts as at rest [-]
     safety : safety factor on the critical step [-]
     backend : force back end, ``"auto"``, ``"numpy"`` or ``"numba"``
-    max_steps : refuse (ValueError, before the first step) a run of more steps than this (default
-        :data:`MAX_STEPS`)
+    max_steps : refuse (:class:`~rftstatic.errors.StepLimitError`, a ValueError, before the first step) a run
+        of more steps than this (default :data:`MAX_STEPS`), or whose stable step collapsed
+    max_steps_name : the option that sets ``max_steps``, named in that error
 
     Returns
     -------
@@ -148,7 +149,7 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
         state.V *= model.free
         estimate, dt = _choose_step(model, state.U, dt, alpha=alpha, mass_scale=mass_scale, safety=safety,
                                     needed=energy_check or dt is None)
-        n_steps = step_count(t_end, dt, max_steps)
+        n_steps = step_count(t_end, dt, max_steps, limit_name=max_steps_name)
         dt = t_end / n_steps
         loop.begin(dt, start_consistent=start == "consistent", state=state)
     else:
@@ -184,17 +185,42 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
 
 
 MAX_STEPS = 10_000_000
-"""Default limit on the steps of one explicit run (hours of computing on a large sheet): a run that asks
-for more is refused before it starts, naming t_end, dt and the limit."""
+"""Largest step limit of one explicit run (hours of computing on a large sheet), and :func:`run_explicit`'s
+default ``max_steps``: a run that asks for more is refused before it starts, naming t_end, dt and the limit."""
+
+STEPS_PER_SIDE_NODE = 10_000
+"""Default step limit of a scene's explicit run (:func:`default_max_steps`) per node along a side of the sheet."""
+
+MIN_DEFAULT_STEPS = 50_000
+"""Least default step limit of a scene's explicit run, however small its mesh."""
 
 
-def step_count(t_end: float, dt: float, max_steps: int | None = None) -> int:
-    """Steps of ``dt`` [s] (rounded up) that reach ``t_end`` [s]; ValueError beyond ``max_steps``."""
+def default_max_steps(n_nodes: float) -> int:
+    """The default step limit of a scene's explicit run on a mesh of ``n_nodes`` nodes:
+    ``STEPS_PER_SIDE_NODE sqrt(n_nodes)``, at least :data:`MIN_DEFAULT_STEPS`, at most :data:`MAX_STEPS`.
+
+    The stable step shrinks with the element size h (dt ~ h for the membrane) and the time a sheet takes to
+    swing and come to rest does not, so the steps a run needs grow like the nodes along a side, sqrt(N):
+    hang-20 (t_end 2 s) took 4554 steps on 7 x 7 nodes and 30370 on 41 x 41 (6.7 x for 5.9 x the side);
+    the remeshed relaxations of ``validation/remesh_scenes.md`` 22,000-43,000 steps on 500-1900 nodes. The
+    limit leaves a factor 10 over these: 410,000 steps on 41 x 41 nodes, 70,000 (about 2 s at 31 us a step)
+    on 7 x 7, where a limit of 10^7 let a tiny relaxation that cannot come to rest run for minutes.
+    """
+    return int(min(MAX_STEPS, max(MIN_DEFAULT_STEPS, STEPS_PER_SIDE_NODE * float(np.sqrt(max(n_nodes, 0.0))))))
+
+
+def step_count(t_end: float, dt: float, max_steps: int | None = None, *, limit_name: str = "dynamics.max_steps") -> int:
+    """Steps of ``dt`` [s] (rounded up) that reach ``t_end`` [s]; :class:`StepLimitError` (a ValueError)
+    beyond ``max_steps`` (``limit_name``: the option that sets it, for the message) or for a step that is
+    not a positive finite number."""
     limit = MAX_STEPS if max_steps is None else int(max_steps)
+    if not (np.isfinite(dt) and dt > 0):
+        raise StepLimitError(f"the explicit step dt = {dt!r} s is not a positive finite number (a stable step that "
+                             "collapsed: a stiffness without bound at this state)")
     steps = t_end / dt - 1e-9
     if not np.isfinite(steps) or steps > limit:
-        raise ValueError(f"t_end = {t_end:.6g} s with dt = {dt:.6g} s needs {steps:.3g} explicit steps, more than "
-                         f"the limit of {limit:d} (dynamics.max_steps); shorten t_end or lengthen dt")
+        raise StepLimitError(f"t_end = {t_end:.6g} s with dt = {dt:.6g} s needs {steps:.3g} explicit steps, more "
+                             f"than the limit of {limit:d} ({limit_name}); shorten t_end or lengthen dt")
     return max(1, int(np.ceil(steps)))
 
 

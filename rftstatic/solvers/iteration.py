@@ -50,6 +50,7 @@ class Criteria:
         self.ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
         self.atol = 0.0
         self.work_ref = 1e-300
+        self.unloaded = not np.any(P)  # no load: only the round-off of the internal force is left to test
 
     def load_work(self, U, step) -> None:
         """Raise the energy scale to the work of the load on ``U`` and on the first ``step`` [J]."""
@@ -66,7 +67,8 @@ class Criteria:
         ``|d| |r|``, says nothing about the energy left, which is quadratic in r."""
         rnorm = float(np.linalg.norm(r))
         tol = self.rtol * self.ref
-        if tol < rnorm < 1e4 * tol and self.atol == 0.0:  # close: is the rest round-off? (once an increment)
+        # close (or nothing to scale by: no load): is the rest round-off? (once an increment)
+        if (tol < rnorm < 1e4 * tol or (self.unloaded and rnorm > tol)) and self.atol == 0.0:
             self.atol = roundoff_floor(self.model, U)
         if rnorm > tol + self.atol:
             return False

@@ -43,6 +43,12 @@ from rftstatic.solvers.mixed import mixed_iterations
 log = logging.getLogger(__name__)
 
 
+_COUNTS = {"max_iterations": 1, "max_load_steps": 1, "max_continuations": 0, "reuse_factorisation": 0, "seed": 0,
+           "perturbation_folds": 0, "guide_folds": 0}
+"""The integer options of :class:`StaticOptions` and their least values (a seed: numpy's generators take
+none below 0)."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class StaticOptions:
     """Options of :func:`solve_static` (scene table ``[solver]``).
@@ -116,6 +122,10 @@ class StaticOptions:
     progress: bool = True
 
     def __post_init__(self):
+        for name, least in _COUNTS.items():
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
+                raise ValueError(f"solver.{name} must be an integer >= {least}, got {v!r}")
         if self.start not in ("load-steps", "relax"):
             raise ValueError(f'solver.start must be "load-steps" or "relax", got "{self.start}"')
         if self.linear_solver not in ("auto", "cholmod", "scipy", "amg"):

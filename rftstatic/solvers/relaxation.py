@@ -23,20 +23,27 @@ RELAX_MASS_SCALE = 100.0
 class AtRest:
     """The rest test of dynamic relaxation, as an explicit-run callback ``(state, sample) -> bool``.
 
-    At rest: kinetic energy / peak kinetic energy < ``tol_kinetic`` and the out-of-balance force on the
-    free dofs < ``tol_force`` times ``load_norm`` [N]. ``peak_kinetic`` [J] is the peak so far (updated
-    at every sample; start it from an earlier run's peak to resume).
+    At rest: kinetic energy <= ``tol_kinetic`` times the peak kinetic energy and the out-of-balance force on
+    the free dofs <= ``tol_force`` times ``load_norm`` [N]. ``peak_kinetic`` [J] is the peak so far (updated
+    at every sample; start it from an earlier run's peak to resume). A sheet without load (``load_norm`` 0)
+    measures its force against the largest out-of-balance force it has had (``peak_residual`` [N], the
+    internal force of a perturbed start); one with neither motion nor out-of-balance force (zero kinetic
+    energy, zero residual: an unloaded flat sheet) is already at rest.
     """
 
     tol_kinetic: float
     tol_force: float
     load_norm: float
     peak_kinetic: float = 0.0
+    peak_residual: float = 0.0
 
     def __call__(self, state, rec) -> bool:
         self.peak_kinetic = peak = max(self.peak_kinetic, rec["kinetic"])
-        return bool(peak > 0 and rec["kinetic"] < self.tol_kinetic * peak
-                    and rec["residual"] < self.tol_force * self.load_norm)
+        self.peak_residual = max(self.peak_residual, rec["residual"])
+        force_scale = self.load_norm if self.load_norm > 0 else self.peak_residual
+        still = rec["kinetic"] <= self.tol_kinetic * peak if peak > 0 else rec["kinetic"] == 0.0
+        return bool(still and rec["residual"] <= self.tol_force * force_scale
+                    and (peak > 0 or rec["residual"] == 0.0))
 
 
 @dataclass
@@ -57,7 +64,8 @@ class RelaxResult:
 def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kinetic: float = 1e-8, tol_force: float = 1e-4,
           max_time: float, dt: float | None = None, U0=None, V0=None, obstacles=(), sample_every: int = 20,
           peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto", load=None, checkpoint=None,
-          restart: dict | None = None) -> RelaxResult:
+          restart: dict | None = None, max_steps: int | None = None,
+          max_steps_name: str = "dynamics.max_steps") -> RelaxResult:
     """Dynamic relaxation (§6): damped explicit motion until the sheet is at rest.
 
     At rest means, at a sample, kinetic energy / peak kinetic energy < ``tol_kinetic`` *and* the
@@ -79,18 +87,25 @@ def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kine
     restart : the explicit state saved during an earlier call with the same arguments
         (:func:`~rftstatic.solvers.checkpoint.load_checkpoint`): the run continues from it, step for step as
         the uninterrupted one (``peak_kinetic`` is the peak before that call; ``U0``, ``V0``, ``dt`` are unused)
+    max_steps, max_steps_name : refuse a relaxation of more explicit steps than this, or whose stable step
+        collapsed (:class:`~rftstatic.errors.StepLimitError`, before the first step), naming that option
     """
     P = model.load if load is None else load
     P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
     if restart is not None:  # the peak of the samples before the interruption, as the rest test saw them
         kinetic = np.asarray(restart["history"]["kinetic"], dtype=float)
         peak_kinetic = max(peak_kinetic, float(kinetic.max())) if kinetic.size else peak_kinetic
+        residual = np.asarray(restart["history"]["residual"], dtype=float)
+        peak_residual = float(residual.max()) if residual.size else 0.0
+    else:
+        peak_residual = 0.0
 
-    at_rest = AtRest(tol_kinetic=tol_kinetic, tol_force=tol_force, load_norm=P_norm, peak_kinetic=peak_kinetic)
+    at_rest = AtRest(tol_kinetic=tol_kinetic, tol_force=tol_force, load_norm=P_norm, peak_kinetic=peak_kinetic,
+                     peak_residual=peak_residual)
     run = run_explicit(model, t_end=max_time, dt=dt, alpha=alpha, mass_scale=mass_scale, obstacles=obstacles,
                        U0=U0, V0=V0, start="consistent" if V0 is None else "given", sample_every=sample_every,
                        callback=at_rest, progress=progress, backend=backend, load=load, checkpoint=checkpoint,
-                       _restart=restart)
+                       max_steps=max_steps, max_steps_name=max_steps_name, _restart=restart)
     if not run.stopped:
         log.warning("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
                     run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError, InstabilityError
+from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
 from rftstatic.solvers.load_steps import solve_load_steps
 from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult
@@ -97,6 +97,11 @@ RELAX_TIME_ALLOWANCE = 2.0
 """The relaxation may run this many times its expected need (100 damping times) before Newton takes
 over for good; the step-count check uses the expected need."""
 
+RELAX_SEGMENT_STEPS = int(RELAX_TIME_ALLOWANCE * MAX_RELAX_STEPS)
+"""Most explicit steps of one relaxation segment: the longest segment (the route's whole time) at the
+reference state's step. A segment from a state whose stable step is far shorter (a start lifted by many
+element sizes stretches the membrane) is refused before its first step, a ConvergenceError."""
+
 RELAX_NEWTON_ITERATIONS = 10
 """Newton's ``max_iterations`` (doubled at full load: 20 iterations) from a relaxed state before the
 relaxation resumes; the final handover uses the solver's own budget."""
@@ -158,19 +163,30 @@ class _RelaxPlan:
 
 def _relax_plan(model, first) -> _RelaxPlan:
     """The relaxation's damping, critical for the pendulum mode of the drape, and its time limits;
-    ConvergenceError when it would need more than :data:`MAX_RELAX_STEPS` explicit steps."""
+    ConvergenceError when the sheet has no mass to move (a weightless material), when its stable step
+    collapsed or when it would need more than :data:`MAX_RELAX_STEPS` explicit steps."""
+
+    def refuse(message):
+        if first is not None:
+            return ConvergenceError(f"{first}; {message}", first.result)
+        return ConvergenceError(message, None)
+
+    if not model.material.mass_per_area > 0:  # the explicit motion needs a mass (lumped_mass refuses none)
+        raise refuse(f"no dynamic relaxation: the material's areal weight is {model.material.weight:g} N/m^2, so "
+                     "the sheet has no mass to move; give material.weight > 0 or load steps that converge "
+                     "(e.g. a larger solver.max_iterations)")
     size = float(np.ptp(model.mesh.X, axis=0).max())
     omega1 = np.sqrt(STANDARD_GRAVITY / (0.25 * size))  # pendulum estimate of the lowest drape mode
     mass_scale = RELAX_MASS_SCALE
     alpha = 2.0 * omega1 / np.sqrt(mass_scale)  # about critical for that mode of the scaled system
     max_time = 100.0 / alpha  # the relaxation's expected need: 100 damping times (checked below)
-    est = stable_time_step(model, mass_scale=mass_scale, alpha=alpha)
-    if max_time / est.dt > MAX_RELAX_STEPS:  # a membrane far stiffer than the bending: too many steps
-        message = (f"dynamic relaxation would need up to {max_time / est.dt:.3g} explicit steps (dt {est.dt:.3g} s); "
-                   f"not attempted (limit {MAX_RELAX_STEPS:g})")
-        if first is not None:
-            raise ConvergenceError(f"{first}; {message}", first.result) from None
-        raise ConvergenceError(message, None)
+    try:
+        est = stable_time_step(model, mass_scale=mass_scale, alpha=alpha)
+    except StepLimitError as exc:
+        raise refuse(f"no dynamic relaxation: {exc}") from None
+    if not max_time / est.dt <= MAX_RELAX_STEPS:  # a membrane far stiffer than the bending: too many steps
+        raise refuse(f"dynamic relaxation would need up to {max_time / est.dt:.3g} explicit steps (dt {est.dt:.3g} "
+                     f"s); not attempted (limit {MAX_RELAX_STEPS:g})")
     # settling folds on fine meshes (31 x 240 rings) take longer
     return _RelaxPlan(mass_scale=mass_scale, alpha=alpha, max_time=max_time * RELAX_TIME_ALLOWANCE,
                       chunk=4.0 / alpha, min_span=10 * est.dt)
@@ -291,9 +307,12 @@ def _relax_segment(model, opts, plan, route, fail, checkpoint, restart, t0) -> N
     try:
         rel = relax(model, mass_scale=plan.mass_scale, alpha=plan.alpha, tol_kinetic=1e-4, tol_force=route.tol_force,
                     max_time=span if restart is None else float(restart["options"]["t_end"]), U0=route.U,
-                    V0=route.V, peak_kinetic=route.peak, progress=opts.progress, checkpoint=saver, restart=restart)
+                    V0=route.V, peak_kinetic=route.peak, progress=opts.progress, checkpoint=saver, restart=restart,
+                    max_steps=RELAX_SEGMENT_STEPS, max_steps_name="the relaxation route's segment limit")
     except InstabilityError as exc:
         raise fail(f"dynamic relaxation became unstable ({exc})") from None
+    except StepLimitError as exc:  # the stable step at this state collapsed (a stretched start)
+        raise fail(f"dynamic relaxation cannot go on from t = {route.t_used:.3g} s: {exc}") from None
     route.U, route.V, route.peak, route.at_rest = rel.U, rel.V, rel.peak_kinetic, rel.converged
     route.t_used += rel.t
     route.info.update(time_s=route.t_used, steps=route.info["steps"] + rel.steps, at_rest=rel.converged,
@@ -319,9 +338,12 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, checkpoint
     try:
         rel = relax(model, mass_scale=plan.mass_scale, alpha=plan.alpha, tol_kinetic=1e-4, tol_force=1.0,
                     max_time=GUIDE_DAMPING_TIMES / plan.alpha, U0=route.U, progress=opts.progress, load=guided,
-                    checkpoint=saver, restart=restart)
+                    checkpoint=saver, restart=restart, max_steps=RELAX_SEGMENT_STEPS,
+                    max_steps_name="the relaxation route's segment limit")
     except InstabilityError as exc:
         raise fail(f"the guided dynamic relaxation became unstable ({exc})") from None
+    except StepLimitError as exc:
+        raise fail(f"the guided dynamic relaxation cannot run: {exc}") from None
     route.U, route.V, route.peak, route.t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
     route.seed = opts.seed
     route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": opts.guide_folds, "weight": opts.guide_weight,

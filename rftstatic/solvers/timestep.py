@@ -32,6 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from rftstatic.errors import StepLimitError
+
 log = logging.getLogger(__name__)
 
 SAFETY = 0.9
@@ -181,6 +183,9 @@ def stable_time_step(model, U=None, *, mass_scale: float = 1.0, alpha: float = 0
         omega, used = element_bound(model, U, mass_scale=mass_scale), "bound"
     else:
         raise ValueError(f'time-step method must be "lanczos" or "bound", got "{method}"')
+    if np.isnan(omega) or np.isinf(omega):
+        raise StepLimitError(f"the stable explicit step collapsed: omega_max = {omega!r} rad/s at this state (a "
+                             "stiffness or mass that is not finite)")
     if not omega > 0:
         raise ValueError("the model has no stiffness on its free dofs (omega_max = 0); cannot choose a step")
     dtc = critical_step(omega, alpha)

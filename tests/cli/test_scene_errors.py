@@ -90,7 +90,9 @@ def test_a_remeshed_relaxation_keeps_to_max_steps(capsys, tmp_path):
 
 def test_a_remeshed_relaxation_that_blows_up_is_unstable_not_an_internal_error(capsys, tmp_path):
     # was: internal error: FloatingPointError: remesh_relax: non-finite state after step 200
-    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.dt=0.05"])
+    # (to t_end = 10 s: 200 steps; a run to 0.1 s is 2 steps, now that the last chunk ends at t_end)
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [*REMESH_TINY, "dynamics.dt=0.05",
+                                                                      "dynamics.t_end=10.0", "dynamics.frames=[10.0]"])
     assert code == 3 and err.startswith("error: the explicit run became unstable: the state became non-finite"), err
 
 
@@ -146,3 +148,105 @@ def test_a_remesh_h_lower_allowing_too_many_nodes_is_an_input_error(capsys, tmp_
     code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", [
         *REMESH_TINY, "remesh.h_lower=1e-3", "remesh.const=1e-3", f"analysis={analysis}"])
     _assert_input_error(code, err, "remesh.h_lower", "would let the remeshed sheet have up to 4.62e+08 nodes")
+
+
+def test_a_relaxation_fallback_without_mass_is_a_reported_failure(capsys, tmp_path):
+    # was: internal error: ValueError: material 'wool-kang-yu (modified)' has mass_per_area = 0.0 kg/m^2 (the
+    # load steps failed and their relaxation fallback had no mass to move)
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", "material.weight=0.0", "loads.pressure=0.05",
+                                                 "solver.max_iterations=1", "solver.max_load_steps=3"])
+    assert code == 3 and "internal error" not in err, err
+    assert "no dynamic relaxation: the material's areal weight is 0 N/m^2" in err, err
+
+
+def test_a_collapsed_relaxation_step_is_a_convergence_error():
+    # was: ValueError from step_count (4.5e8 explicit steps of 1.9e-7 s) out of solve_static through the API
+    from rftstatic import api
+    from rftstatic.errors import ConvergenceError
+    from rftstatic.solvers.static import StaticOptions, solve_static
+
+    model, _ = api.build_model(api.load_scene("sphere-30", ["mesh.nodes=[3,14]"]))
+    with pytest.raises(ConvergenceError, match="relaxation route's segment limit"):
+        solve_static(model, options=StaticOptions(start="relax", perturbation=1e4, progress=False))
+
+
+def test_a_collapsed_explicit_step_is_a_step_limit_error():
+    import numpy as np
+
+    from rftstatic.errors import StepLimitError
+    from rftstatic.solvers.explicit import step_count
+
+    for dt in (0.0, np.nan, -1.0, np.inf):
+        with pytest.raises(StepLimitError, match="not a positive finite number"):
+            step_count(1.0, dt)
+    with pytest.raises(StepLimitError, match=r"more than the limit of 10 \(dynamics.max_steps\)"):
+        step_count(1.0, 0.01, 10)
+
+
+def test_a_relaxation_that_cannot_come_to_rest_stops_at_its_default_step_limit(capsys, tmp_path):
+    import json
+    import time
+
+    # was: a default limit of 10^7 steps: a tiny undamped relaxation to t_end = 1e4 s ran for about 5 minutes
+    t0 = time.perf_counter()
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "analysis=relax", "dynamics.t_end=1e4",
+                                                   "dynamics.alpha=0.0", "dynamics.frames=[]"])
+    assert code == 3 and "did not come to rest within dynamics.max_steps = 50000 explicit steps" in err, err
+    assert time.perf_counter() - t0 < 20
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["steps"] == 50000 and summary["stopped_by"] == "max_steps" and summary["converged"] is False
+
+
+def test_the_default_step_limit_grows_with_the_nodes_along_a_side():
+    from rftstatic.solvers.explicit import MAX_STEPS, default_max_steps
+
+    assert default_max_steps(25) == 50_000 and default_max_steps(41 * 41) == 410_000
+    assert default_max_steps(1e15) == MAX_STEPS
+
+
+def test_a_dynamic_run_beyond_the_default_step_limit_is_refused(capsys, tmp_path):
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[7,7]", "dynamics.t_end=1e4", "dynamics.frames=[]"])
+    _assert_input_error(code, err, "dynamics.t_end", "by default 10,000 x sqrt(nodes) = 70000 for 49 nodes")
+
+
+
+def test_an_unloaded_relaxation_is_at_rest(capsys, tmp_path):
+    import json
+
+    # was: never at rest (the rest test needed a peak kinetic energy and a load to measure the force by)
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "analysis=relax", "loads.gravity=false",
+                                                   "dynamics.t_end=1.0", "dynamics.frames=[]"])
+    assert code == 0, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["at_rest"] and summary["steps"] <= 1
+
+
+def test_the_rest_test_of_a_perturbed_unloaded_sheet_measures_its_own_peak_force():
+    from rftstatic.solvers.relaxation import AtRest
+
+    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    assert rest(None, {"kinetic": 0.0, "residual": 0.0})  # no motion, no force: at rest
+    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    assert not rest(None, {"kinetic": 0.0, "residual": 1.0})  # a perturbed start
+    assert not rest(None, {"kinetic": 1.0, "residual": 0.5})
+    assert rest(None, {"kinetic": 1e-9, "residual": 1e-5})
+    loaded = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=1.0)
+    assert not loaded(None, {"kinetic": 0.0, "residual": 1.0})  # the first sample of a loaded sheet
+
+
+@pytest.mark.parametrize("key, value", [("top", "-1e300"), ("top", "1e300"), ("centre", "[1e300, 0.0]")])
+def test_an_obstacle_far_from_the_sheet_is_an_input_error(capsys, tmp_path, key, value):
+    # was: RuntimeWarning: overflow encountered in multiply (an internal error under the warning filter)
+    code, err = _run(capsys, tmp_path, "pedestal-square-20", ["mesh.nodes=[9,9]", f"obstacles.0.{key}={value}"])
+    _assert_input_error(code, err, f"obstacles.0.{key}", "more than 1000 sheet sizes (20000 scene length units)")
+
+
+def test_a_remeshed_relaxation_ends_at_t_end(capsys, tmp_path):
+    import json
+
+    # was: t = 0.58 s for t_end = 0.1 s (the stepper's whole chunk of 200 steps ran past t_end)
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", REMESH_TINY)
+    assert code == 3 and "did not come to rest by t_end = 0.1 s" in err, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["t"] == pytest.approx(0.1, rel=1e-9) and summary["t"] <= 0.1 * (1 + 1e-12)
+    assert summary["steps"] < 200

@@ -178,3 +178,22 @@ def test_fold_pattern_and_guide_options():
             static.StaticOptions(**bad)
     with pytest.raises(ValueError, match='start = "relax"'):
         static.StaticOptions(guide_folds=12, guide_weight=0.3)
+
+
+@pytest.mark.parametrize("key, value", [("seed", -1), ("seed", 1.5), ("seed", float("nan")), ("seed", True),
+                                        ("max_iterations", 0), ("max_load_steps", 2.0), ("max_continuations", -1),
+                                        ("reuse_factorisation", float("nan")), ("perturbation_folds", -2),
+                                        ("guide_folds", 0.5)])
+def test_static_options_refuse_bad_counts(key, value):
+    from rftstatic.solvers.newton import StaticOptions
+
+    with pytest.raises(ValueError, match=rf"solver\.{key} must be an integer >= \d, got {value!r}"):
+        StaticOptions(**{key: value})
+
+
+@pytest.mark.parametrize("key", ["rtol", "etol", "intermediate_rtol", "initial_increment", "perturbation"])
+def test_static_options_refuse_nan(key):
+    from rftstatic.solvers.newton import StaticOptions
+
+    with pytest.raises(ValueError):
+        StaticOptions(**{key: float("nan")})
