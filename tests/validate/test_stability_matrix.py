@@ -42,7 +42,7 @@ def test_a_cell_runs_after_this_process_started_openmp_threads():
 
 
 def test_a_hung_cell_is_killed_and_named_in_its_verdict():
-    cell = st.Cell("test", "slow strip", "strip_cell", {"nx": 41, "ny": 9}, budget=1.0, tolerance=0.01)
+    cell = st.Cell("test", "slow strip", "strip_cell", {"nx": 401, "ny": 41}, budget=1.0, tolerance=0.01)
     t0 = time.perf_counter()
     rec = st.run_cell(cell)
     assert time.perf_counter() - t0 < 10 and rec["verdict"] == "FAIL"
