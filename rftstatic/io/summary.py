@@ -122,9 +122,10 @@ def self_intersection_summary(scene, model, U, *, states=()) -> dict:
     if last is None:
         out = {"applicable": False, "reason": "non-finite positions"}
     else:
-        out = {k: last[k] for k in ("pairs", "triangles", "area_fraction", "smallest_distance_pair")}
-        out.update(smallest_distance=last["smallest_distance"] / u.length, within=last["within"] / u.length,
-                   tol=last["tol"] / u.length)
+        out = {"pairs": last["pairs"], "triangles": last["triangles"], "area_fraction": last["area_fraction"],
+               "smallest_distance": last["smallest_distance"] / u.length,
+               "smallest_distance_pair": last["smallest_distance_pair"],
+               "within": last["within"] / u.length, "tol": last["tol"] / u.length}
     if len(states):
         times, pairs, dist, skipped = [], [], [], 0
         for t, V in states:
