@@ -182,6 +182,9 @@ def test_strip_pushed_through_itself():
     assert smallest_distance(x, tri)[0] == 0.0
     s = self_intersections(x, tri)
     assert s["pairs"] == len(pairs) and s["triangles"] == len(np.unique(pairs))
+    quick = self_intersections(x, tri, distance=False)              # crossings only
+    assert quick["pairs"] == s["pairs"] and quick["area_fraction"] == s["area_fraction"]
+    assert quick["smallest_distance"] is None and quick["smallest_distance_pair"] is None
     area = 0.5 * np.linalg.norm(np.cross(*(x[tri][:, 1:] - x[tri][:, :1]).transpose(1, 0, 2)), axis=1)
     assert s["area_fraction"] == pytest.approx(area[np.unique(pairs)].sum() / area.sum())
 
