@@ -210,14 +210,23 @@ class PairCache:
         """Forget the pairs (a new mesh)."""
         self._x = self._pairs = None
 
+    def _moved(self, x) -> float:
+        if self._x is None or self._x.shape != x.shape:
+            return np.inf
+        d = x - self._x
+        return float(np.sqrt(np.max(np.einsum("ni,ni->n", d, d), initial=0.0)))
+
     def pairs(self, prims: SheetPrimitives, x: np.ndarray, thickness: float) -> Pairs:
         """The pairs for positions ``x (N, 3)`` [m], rebuilt when needed."""
-        if self._x is not None and self._x.shape == x.shape:
-            d = x - self._x
-            moved = float(np.sqrt(np.max(np.einsum("ni,ni->n", d, d), initial=0.0)))
-            if moved <= 0.5 * self.margin:
-                return self._pairs
+        if self._moved(x) <= 0.5 * self.margin:
+            return self._pairs
         self._pairs = find_pairs(prims, x, thickness + self.margin)
         self._x = np.array(x, dtype=float, copy=True)
+        self._radius = thickness + self.margin
         self.builds += 1
         return self._pairs
+
+    def unlisted_distance(self, x: np.ndarray) -> float:
+        """A lower bound [m] of the distance at ``x (N, 3)`` of every pair not in the list (the list
+        radius less twice the largest motion since the build); call after :meth:`pairs`."""
+        return self._radius - 2.0 * self._moved(x)
