@@ -17,7 +17,8 @@ Outputs in the run folder, every number in the scene's units:
 * ``animation.gif`` (the sampled states, isometric view), ``energy.png`` (kinetic and potential
   energy against time);
 * ``summary.json``: counts, step and its estimate, steps, wall time, element-steps per second,
-  probe trajectories (t, x, y, z), time at rest, energies, flags;
+  probe trajectories (t, x, y, z), time at rest, energies, flags, the self-intersection check of the
+  final state and of every saved state (:func:`rftstatic.io.summary.self_intersection_summary`);
 * ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
   continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.checkpoint`).
 
@@ -35,7 +36,7 @@ import numpy as np
 from rftstatic.app.result import RunResult
 from rftstatic.errors import CheckpointError, StepLimitError
 from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
-from rftstatic.io.summary import summary_header
+from rftstatic.io.summary import self_intersection_summary, summary_header
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import dynamics_options, static_options
@@ -238,6 +239,7 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
     })
     if run.contact_nodes:
         summary["contact_nodes"] = run.contact_nodes
+    summary["self_intersections"] = self_intersection_summary(scene, model, run.U, states=run.frames)
     return summary
 
 

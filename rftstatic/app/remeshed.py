@@ -17,7 +17,8 @@ Outputs in the run folder, every number in the scene's units:
 * ``summary.json``: scene, element, route, final node and triangle counts, converged flag, wall
   time, the ``[remesh]`` settings, one record per mesh (cycle, time and step, reason, node and
   triangle counts, mesher quality, largest |kappa| h and |kappa| h^2, node-count change, wall time),
-  the drape measures of the final state (:func:`rftstatic.run.drape_summary`) and the probes;
+  the drape measures of the final state (:func:`rftstatic.run.drape_summary`), its self-intersection
+  check (:func:`rftstatic.io.summary.self_intersection_summary`) and the probes;
 * ``mesh_<k>_{top,iso}.png``: the deformed sheet with its mesh edges at each successive mesh
   (relax: the transferred state just after remesh k; static: the equilibrium on mesh k is only
   known for the last mesh, so the earlier ones are drawn flat in the top view), ``remesh.gif``
@@ -40,7 +41,7 @@ from rftstatic.contact.kinematic import contact_reaction_residual
 from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable, write_json
 from rftstatic.io.results import write_outputs
-from rftstatic.io.summary import drape_summary, probe_summary, summary_header
+from rftstatic.io.summary import drape_summary, probe_summary, self_intersection_summary, summary_header
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
 from rftstatic.remesh.static_driver import remesh_static
@@ -239,6 +240,7 @@ def summarize(scene, opts, solved) -> dict:
         "remeshes": len(records) - 1, "converged": solved["converged"], "wall_time_s": solved["wall_time_s"],
         "remesh": settings, "records": records,
         "max_relative_curvature": float(model.relative_curvature(U).max()),
+        "self_intersections": self_intersection_summary(scene, model, U),
     })
     if solved["route"] == "remesh_relax":
         d = solved["dynamics"]

@@ -22,7 +22,7 @@ from rftstatic.app.result import RunResult
 from rftstatic.errors import ConvergenceError
 from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_outputs
-from rftstatic.io.summary import drape_summary, probe_summary, summary_header
+from rftstatic.io.summary import drape_summary, probe_summary, self_intersection_summary, summary_header
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import static_options
 from rftstatic.solvers.static import solve_static
@@ -113,6 +113,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "energies": {k: v / u.energy for k, v in result.energies.items()},
         "probes": probe_summary(scene, model, extras["probes"], U),
         "max_relative_curvature": float(model.relative_curvature(U).max()),
+        "self_intersections": self_intersection_summary(scene, model, U),
     })
     if model.contact is not None:
         x = model.positions(U)

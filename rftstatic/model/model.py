@@ -5,7 +5,9 @@ stiffness K_b (Eq. 13), the membrane operator of RFT3 or RFT6, supports, the ext
 contact term. Its methods evaluate, for a displacement field ``U (N, 3)`` [m] and a load factor
 ``lam``, the total potential energy (method.md)
 
-    Pi(U) = E_b + E_m + E_c - lam P . U,
+    Pi(U) = E_b + E_m + E_c + E_s - lam P . U,
+
+``E_s`` the self-contact energy (:class:`rftstatic.contact.self_contact.law.SelfContact`, optional),
 
 its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
 The state is only ``U``; solvers are functions of (model, U).
@@ -104,6 +106,9 @@ class Model:
     supports : prescribed displacements (default: none)
     load : (N, 3) external nodal load at load factor 1 [N] (default: zero)
     contact : an object with ``energy(x)``, ``force(x)``, ``tangent_blocks(x)`` (penalty contact)
+    self_contact : the sheet's self-contact (an object with ``evaluate(x, tangent=, cache=)`` returning
+        energy, force ``(N, 3)`` and pair blocks ``(A, 12, 12)`` over ``nodes (A, 4)``, ``new_pairs()`` and
+        ``max_step_fraction(x, dx, cache=)``: :class:`rftstatic.contact.self_contact.law.SelfContact`), or None
     membrane : include the membrane energy (``False`` gives the linear Kirchhoff plate)
     load_terms : loads with a potential scaled by the load factor, e.g.
         :class:`rftstatic.loads.LeverMoment` (methods ``potential``, ``force``, ``tangent_blocks``,
@@ -113,7 +118,7 @@ class Model:
     """
 
     def __init__(self, mesh: TriMesh, material: Material, *, element="RFT6", supports=None, load=None,
-                 contact=None, membrane=True, load_terms=(), quiet=False):
+                 contact=None, membrane=True, load_terms=(), quiet=False, self_contact=None):
         if element not in ELEMENTS:
             raise ValueError(f'unknown element "{element}"; use one of {", ".join(ELEMENTS)}')
         self.mesh = mesh
@@ -124,6 +129,7 @@ class Model:
         if self.load.shape != (mesh.n_nodes, 3):
             raise ValueError(f"load must have shape ({mesh.n_nodes}, 3), got {self.load.shape}")
         self.contact = contact
+        self.self_contact = self_contact
         self.load_terms = list(load_terms)
         self.with_membrane = bool(membrane)
         self.fixed = self.supports.fixed_mask()
@@ -168,47 +174,57 @@ class Model:
 
     # --- energy and its derivatives -------------------------------------------------------------
     # ``candidates``: the solve's contact candidate list (a cache held in its State; results do not
-    # depend on it), or None to evaluate the contact at every node.
-    def energies(self, U, lam=1.0, *, candidates=None) -> dict:
-        """Parts of the total potential [J]: bending, membrane, contact, external work, total."""
+    # depend on it), or None to evaluate the contact at every node; ``pairs``: likewise the solve's
+    # self-contact pair cache (State.self_pairs), or None to find the pairs afresh.
+    def energies(self, U, lam=1.0, *, candidates=None, pairs=None) -> dict:
+        """Parts of the total potential [J]: bending, membrane, contact, self-contact, external work, total."""
         Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
         Em = self.membrane.energy(U, self.material.Dm) if self.with_membrane else 0.0
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
+        Es = (self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).energy
+              if self.self_contact is not None else 0.0)
         W = lam * float(np.einsum("ni,ni->", self.load, U))
         if self.load_terms:
             x = self.positions(U)
             W -= lam * sum(t.potential(x) for t in self.load_terms)
-        return {"bending": Eb, "membrane": Em, "contact": Ec, "external_work": W,
-                "total": Eb + Em + Ec - W}
+        return {"bending": Eb, "membrane": Em, "contact": Ec, "self_contact": Es, "external_work": W,
+                "total": Eb + Em + Ec + Es - W}
 
-    def potential(self, U, lam=1.0, *, candidates=None) -> float:
+    def potential(self, U, lam=1.0, *, candidates=None, pairs=None) -> float:
         """Total potential energy Pi(U) [J]."""
-        return self.energies(U, lam, candidates=candidates)["total"]
+        return self.energies(U, lam, candidates=candidates, pairs=pairs)["total"]
 
-    def internal_force(self, U, *, candidates=None) -> np.ndarray:
-        """Internal (bending + membrane + contact) force ``(N, 3)`` [N], the gradient of the stored energy."""
+    def internal_force(self, U, *, candidates=None, pairs=None) -> np.ndarray:
+        """Internal (bending + membrane + contact + self-contact) force ``(N, 3)`` [N], the gradient of
+        the stored energy."""
         f = self.Kb @ U
         if self.with_membrane:
             fe = self.membrane.element_forces(U, self.material.Dm)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             f += self.contact.force(self.positions(U), candidates=candidates)
+        if self.self_contact is not None:
+            f += self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).force
         return f
 
-    def residual(self, U, lam=1.0, *, candidates=None) -> np.ndarray:
+    def residual(self, U, lam=1.0, *, candidates=None, pairs=None) -> np.ndarray:
         """Out-of-balance force ``dPi/dU (N, 3)`` [N]; zero at equilibrium on the free dofs."""
-        r = self.internal_force(U, candidates=candidates) - lam * self.load
+        r = self.internal_force(U, candidates=candidates, pairs=pairs) - lam * self.load
         for term in self.load_terms:
             r += lam * term.force(self.positions(U))
         return r
 
-    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None, stress=None):
+    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None, stress=None, pairs=None):
         """Internal force ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m] at load factor ``lam``.
 
         ``psd=True`` drops compressive stress from the geometric stiffness (positive semi-definite
         membrane tangent); ``shift`` adds ``shift * I`` (Levenberg-Marquardt); ``stress (E, 3)``
         [N/m]: the membrane stress of the geometric stiffness (MIP Newton's mixed stress,
         :meth:`mixed_stress`) in place of :meth:`membrane_stress` (None: the exact Hessian).
+
+        Self-contact couples nodes outside the patch pattern: its PSD pair blocks are added as a second
+        sparse matrix (:meth:`_pair_matrix`), so the pattern of the result changes with the pairs in
+        contact (a sparse factorisation must redo its symbolic analysis then).
         """
         plan = self.plan
         data = self._bending_data.copy()
@@ -226,7 +242,32 @@ class Model:
             data += scatter_matrices(plan.positions(rows, cols), lam * blocks, plan.nnz)
         if shift:
             data += scatter_matrices(plan.diag_positions, shift * np.broadcast_to(np.eye(3), (self.mesh.n_nodes, 3, 3)), plan.nnz)
-        return f, plan.free_matrix(data)
+        K = plan.free_matrix(data)
+        if self.self_contact is not None:
+            ss = self.self_contact.evaluate(x, tangent=True, cache=pairs)
+            f += ss.force
+            if ss.n_active:
+                K = K + self._pair_matrix(ss.nodes, ss.blocks)
+                K.sort_indices()
+        return f, K
+
+    @cached_property
+    def _free_index(self) -> np.ndarray:
+        """(3N,) index of each dof among the free dofs, -1 for a prescribed one."""
+        idx = np.full(3 * self.mesh.n_nodes, -1, dtype=np.int64)
+        idx[self.plan.free_dofs] = np.arange(len(self.plan.free_dofs))
+        return idx
+
+    def _pair_matrix(self, nodes, blocks):
+        """CSR of the free dofs [N/m] summing pair blocks ``blocks (A, 12, 12)`` over ``nodes (A, 4)``."""
+        import scipy.sparse as sp
+
+        dof = self._free_index[(3 * nodes[:, :, None] + np.arange(3)).reshape(-1, 12)]  # (A, 12)
+        r = np.repeat(dof, 12, axis=1).ravel()
+        c = np.tile(dof, (1, 12)).ravel()
+        keep = (r >= 0) & (c >= 0)
+        n = len(self.plan.free_dofs)
+        return sp.csr_matrix((blocks.ravel()[keep], (r[keep], c[keep])), shape=(n, n))
 
     # --- post-processing ------------------------------------------------------------------------
     def curvature(self, U) -> np.ndarray:

@@ -25,6 +25,8 @@ class State:
     lam : load factor [-] (1 for dynamics: the full load acts from t = 0)
     candidates : contact candidate list (:class:`~rftstatic.contact.candidates.CandidateList`), a
         cache of the contact law (results never depend on it); None without penalty contact
+    self_pairs : self-contact pair cache (:class:`~rftstatic.contact.self_contact.broad_phase.PairCache`),
+        likewise a cache; None without self-contact
     contact_history : per-contact history carried from step to step (e.g. friction anchors), keyed
         by the contact law's name; empty for frictionless contact
     """
@@ -35,6 +37,7 @@ class State:
     step: int = 0
     lam: float = 1.0
     candidates: object | None = None
+    self_pairs: object | None = None
     contact_history: dict = field(default_factory=dict)
 
     @classmethod
@@ -47,7 +50,9 @@ class State:
             if arr.shape != (n, 3):
                 raise ValueError(f"{name} must have shape ({n}, 3) (nodes x xyz), got {arr.shape}")
         candidates = model.contact.new_candidates() if model.contact is not None else None
-        return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates)
+        sc = getattr(model, "self_contact", None)
+        pairs = sc.new_pairs() if sc is not None else None
+        return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates, self_pairs=pairs)
 
     @property
     def V_half(self) -> np.ndarray:

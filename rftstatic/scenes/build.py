@@ -367,6 +367,53 @@ def check_obstacle_positions(scene: Scene, mesh) -> None:
                                       "sheet")
 
 
+SELF_THICKNESS_M = 5e-4
+"""Default self-contact thickness [m] (0.05 cm) when the material gives none: within the 0.2-1 mm of
+woven fabrics and ARCSim's 1 mm repulsion thickness, and below half the 1 cm edges of the paper's
+drape meshes."""
+
+
+def build_self_contact(scene: Scene, mesh, material):
+    """The sheet's self-contact (:class:`~rftstatic.contact.self_contact.law.SelfContact`) when
+    ``contact.self = true``, else None. Thickness ``contact.self_thickness`` [scene length] (default
+    the material's thickness, else :data:`SELF_THICKNESS_M`); stiffness
+    :func:`~rftstatic.contact.self_contact.law.auto_stiffness` times ``contact.self_factor``."""
+    if not scene.get("contact.self", False):
+        return None
+    from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
+
+    u = scene.units.length
+    if scene.get("analysis", "static") != "static":
+        raise scene.error("contact.self", f"true: self-contact is implemented for the static analysis only, "
+                          f'not yet for analysis = "{scene.get("analysis")}"; remove it or use analysis = "static"')
+    given = scene.get("contact.self_thickness")
+    if given is None:
+        d = float(material.info.get("thickness", SELF_THICKNESS_M))
+        key, shown = "material.thickness" if "thickness" in material.info else "contact.self_thickness", d / u
+    else:
+        d, key, shown = float(given) * u, "contact.self_thickness", given
+    if not d > 0:
+        raise scene.error(key, f"{shown!r} is not a positive thickness; give a thickness > 0")
+    edges = mesh.topology.edges
+    smallest = float(np.linalg.norm(mesh.X[edges[:, 1]] - mesh.X[edges[:, 0]], axis=1).min())
+    if d > 0.5 * smallest:
+        raise scene.error(key, f"{shown!r} is above half the smallest edge of the mesh ({smallest / u:.4g} / 2 = "
+                          f"{0.5 * smallest / u:.4g}, scene length units): the self-contact would push apart "
+                          "neighbours that are not in contact; give a thinner thickness or a coarser mesh")
+    factor = scene.get("contact.self_factor", 1.0)
+    if not factor > 0:
+        raise scene.error("contact.self_factor", f"{factor!r} is not a positive multiplier; give a number > 0")
+    if not material.weight > 0:
+        raise scene.error("contact.self", "true needs material.weight > 0 (the self-contact stiffness is sized "
+                          "by the sheet's weight)")
+    k = auto_stiffness(weight=material.weight, node_area=float(mesh.node_area.mean()), thickness=d,
+                       factor=float(factor))
+    try:
+        return SelfContact(mesh, d, k)
+    except ValueError as exc:
+        raise scene.error(key, f"{shown!r}: {exc}") from None
+
+
 def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
     """Remove the in-plane rigid modes of a sheet on a frictionless support (method.md).
 
@@ -427,8 +474,9 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     if scene.get("analysis", "static") == "static":
         check_static_scene(scene, material, supports, load, obstacles)
     membrane = scene.get("solver.membrane", True)
+    self_contact = build_self_contact(scene, mesh, material)
     model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
-                  contact=contact, membrane=membrane, quiet=quiet)
+                  contact=contact, membrane=membrane, quiet=quiet, self_contact=self_contact)
     probes = {}
     u = scene.units.length
     for i, spec in enumerate(scene.get("probes", [])):

@@ -145,7 +145,11 @@ SCHEMA = {
         "factor": (NUM, "multiplier of the automatic penalty"),
         "hold_inplane": (bool, "hold the in-plane rigid modes of a sheet on a frictionless support"),
         "smoothing": (NUM, "width of the C2 penalty onset, in mean element sizes (default 0.05)"),
-    }, "penalty contact"),
+        "self": (bool, "self-contact of the sheet: its layers never pass through each other (default false)"),
+        "self_thickness": (NUM, "self-contact thickness [length] (default: material.thickness, else 0.05 cm); "
+                                "below half the smallest edge"),
+        "self_factor": (NUM, "multiplier of the automatic self-contact stiffness (default 1)"),
+    }, "penalty contact and self-contact"),
     "solver": ({
         "initial_increment": (NUM, ""), "min_increment": (NUM, ""), "max_increment": (NUM, ""),
         "max_iterations": (int, ""), "rtol": (NUM, ""), "intermediate_rtol": (NUM, ""), "etol": (NUM, ""),

@@ -100,11 +100,11 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
     for mode in sequence:
         shifts = [base] if mode != "shift" else None
         if mode == "shift":
-            _, K = model.tangent(U, psd=True, lam=lam, candidates=cand, stress=stress)
+            _, K = model.tangent(U, psd=True, lam=lam, candidates=cand, stress=stress, pairs=ws.pairs)
             scale = float(np.abs(K.diagonal()).mean())
             shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
         for shift in shifts:
-            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam, candidates=cand, stress=stress)
+            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam, candidates=cand, stress=stress, pairs=ws.pairs)
             ws.factorisations += 1
             try:
                 d = solver.solve(K, -r)
@@ -140,9 +140,24 @@ def roundoff_floor(model, U) -> float:
 def diagonal_scale(model, U, ws) -> float:
     """Mean diagonal of the tangent [N/m], computed once per solve (the scale of the LM damping)."""
     if ws.lm_scale is None:
-        _, K0 = model.tangent(U, psd=True, candidates=ws.candidates)
+        _, K0 = model.tangent(U, psd=True, candidates=ws.candidates, pairs=ws.pairs)
         ws.lm_scale = float(np.abs(K0.diagonal()).mean())
     return ws.lm_scale
+
+def self_contact_limited(model, U, step, ws):
+    """``step (N, 3)`` [m] scaled by the self-contact step bound (no pair of the sheet comes closer than
+    a fraction of its distance on the way, so none passes through another,
+    :meth:`~rftstatic.contact.self_contact.law.SelfContact.max_step_fraction`), and that factor (1
+    without self-contact)."""
+    sc = getattr(model, "self_contact", None)
+    if sc is None:
+        return step, 1.0
+    alpha = sc.max_step_fraction(model.positions(U), step, cache=ws.pairs)
+    if alpha < 1.0:
+        ws.modes["self-contact limited"] = ws.modes.get("self-contact limited", 0) + 1
+        step = alpha * step
+    return step, alpha
+
 
 def capped_step(model, d, max_step):
     """The free-dof step ``d`` as ``(N, 3)`` displacements [m], scaled so that no node moves more than

@@ -180,6 +180,18 @@ class CholmodSolver:
     def __init__(self):
         self._factor = None
         self._pattern = None
+        self.analyses = 0  # symbolic analyses done (one per sparsity pattern met)
+
+    def _same_pattern(self, K) -> bool:
+        """Whether ``K`` has the sparsity pattern of the analysed matrix. Compared entry by entry, not by
+        shape and nnz alone: self-contact (:meth:`rftstatic.model.model.Model.tangent`) adds blocks
+        outside the patch pattern, and two pair sets can give the same nnz in different places (the
+        old analysis would then not fit). Costs O(nnz), a few percent of a factorisation."""
+        if self._pattern is None:
+            return False
+        shape, indptr, indices = self._pattern
+        return (K.shape == shape and K.indptr.shape == indptr.shape and K.indices.shape == indices.shape
+                and np.array_equal(K.indptr, indptr) and np.array_equal(K.indices, indices))
 
     @classmethod
     def choose_mode(cls, n: int) -> tuple[str, str]:
@@ -223,12 +235,12 @@ class CholmodSolver:
         from sksparse.cholmod import CholmodNotPositiveDefiniteError, analyze
 
         A = K.T  # CSR of a symmetric matrix = its CSC transpose, no copy
-        pattern = (A.shape, A.nnz)
         with SerialOpenMP():
-            if self._factor is None or pattern != self._pattern:
+            if self._factor is None or not self._same_pattern(K):
                 mode, ordering = self.choose_mode(A.shape[0])
                 self._factor = analyze(A, mode=mode, ordering_method=ordering)
-                self._pattern = pattern
+                self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
+                self.analyses += 1
             try:
                 self._factor.cholesky_inplace(A)
             except CholmodNotPositiveDefiniteError as exc:

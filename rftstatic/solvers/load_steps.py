@@ -176,7 +176,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         result.tangent_modes = dict(modes)
         result.factorisations = ws.factorisations
         result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates)
+        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs)
         ws.state.U, ws.state.lam = result.U, result.lam
         result.state = ws.state
     return result
@@ -224,7 +224,7 @@ def _first_increment(model, U, opts, ws, target) -> float:
     if not np.any(P) or model.load_terms:
         return opts.initial_increment
     try:
-        _, K = model.tangent(U, psd=True, candidates=ws.candidates)
+        _, K = model.tangent(U, psd=True, candidates=ws.candidates, pairs=ws.pairs)
         du = np.zeros(3 * model.mesh.n_nodes)
         ws.factorisations += 1
         du[free] = ws.solver.solve(K, P)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction
+from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError
 
 MIXED_ITERATIONS = 12
@@ -39,7 +39,7 @@ def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
     cand, modes = ws.candidates, ws.modes
     U = U.copy()
     S = model.membrane_stress(U) if stress is None else np.array(stress, float)
-    r = model.residual(U, lam, candidates=cand).ravel()[free]
+    r = model.residual(U, lam, candidates=cand, pairs=ws.pairs).ravel()[free]
     rnorm = float(np.linalg.norm(r))
     if not np.isfinite(rnorm):
         return Iteration(False, U, 0, rnorm, "non-finite residual", scheme="mixed")
@@ -54,12 +54,14 @@ def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
                              scheme="mixed")
         stable = mode == "exact" if ws.solver.detects_indefinite else None
         step, cap = capped_step(model, d, max_step)
+        step, frac = self_contact_limited(model, U, step, ws)
+        cap *= frac
         if it == 1:
             test.load_work(U, step)
         S = model.mixed_stress(U, step)
         U = U + step
         hist.append({"residual": rnorm, "alpha": 1.0, "cap": cap, "mu": 0.0, "fresh": True, "mode": mode})
-        r = model.residual(U, lam, candidates=cand).ravel()[free]
+        r = model.residual(U, lam, candidates=cand, pairs=ws.pairs).ravel()[free]
         work = abs(float(step.ravel()[free] @ r))
         rnorm = float(np.linalg.norm(r))
         if not np.isfinite(rnorm):

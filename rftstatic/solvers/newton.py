@@ -36,7 +36,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from rftstatic.model.state import State
-from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction
+from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.mixed import mixed_iterations
 
@@ -243,6 +243,11 @@ class NewtonWorkspace:
     def candidates(self):
         return self.state.candidates
 
+    @property
+    def pairs(self):
+        """The solve's self-contact pair cache (None without self-contact)."""
+        return self.state.self_pairs
+
 
 def newton(model, U, lam, opts, ws, max_step, *, stress=None, scheme=None) -> Iteration:
     """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified).
@@ -267,8 +272,8 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
     free = model.free.ravel()
     U = U.copy()
-    Pi = model.potential(U, lam, candidates=cand)
-    r = (model.residual(U, lam, candidates=cand)).ravel()[free]
+    Pi = model.potential(U, lam, candidates=cand, pairs=ws.pairs)
+    r = (model.residual(U, lam, candidates=cand, pairs=ws.pairs)).ravel()[free]
     rnorm = float(np.linalg.norm(r))
     if not np.isfinite(rnorm):
         return Iteration(False, U, 0, rnorm, "non-finite residual")
@@ -307,7 +312,10 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
             dKd = -float(r @ d) - shift * float(d @ d)
         step, cap = capped_step(model, d, max_step)
         slope = float(r @ step.ravel()[free])
-        alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts, cand)
+        step, frac = self_contact_limited(model, U, step, ws)
+        cap *= frac
+        slope = float(r @ step.ravel()[free])
+        alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts, cand, ws.pairs)
         if alpha is None:
             return Iteration(False, U, it, rnorm, "line search found no decrease of the energy")
         U = U + alpha * step
@@ -330,12 +338,12 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
                 mu = max(4.0 * mu, 1e-6)
             elif rho > 0.75:
                 mu = mu / 3.0 if mu > 1e-9 else 0.0
-        r_new = model.residual(U, lam, candidates=cand).ravel()[free]
+        r_new = model.residual(U, lam, candidates=cand, pairs=ws.pairs).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r_new))
         if work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
             # (a good predictor makes the first step tiny; round-off must not stall the criterion)
-            parts = model.energies(U, lam, candidates=cand)
+            parts = model.energies(U, lam, candidates=cand, pairs=ws.pairs)
             work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))),
                         parts["bending"] + parts["membrane"], 1e-300)
             test.work_ref = work0
@@ -356,20 +364,20 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
                      descending=descending)
 
-def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, max_trials=12):
+def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, max_trials=12):
     """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""
     if not opts.line_search:
-        return 1.0, model.potential(U + step, lam, candidates=candidates)
-    parts = model.energies(U, lam, candidates=candidates)
+        return 1.0, model.potential(U + step, lam, candidates=candidates, pairs=pairs)
+    parts = model.energies(U, lam, candidates=candidates, pairs=pairs)
     scale = abs(parts["bending"]) + abs(parts["membrane"]) + abs(parts["contact"]) + abs(parts["external_work"])
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence
-        return 1.0, model.potential(U + step, lam, candidates=candidates)
+        return 1.0, model.potential(U + step, lam, candidates=candidates, pairs=pairs)
     roundoff = 1e-13 * scale
     alpha = 1.0
     for _ in range(max_trials):
-        Pi = model.potential(U + alpha * step, lam, candidates=candidates)
+        Pi = model.potential(U + alpha * step, lam, candidates=candidates, pairs=pairs)
         if np.isfinite(Pi) and Pi <= Pi0 + 1e-4 * alpha * slope + roundoff:
             return alpha, Pi
         # minimiser of the quadratic through Pi0, slope and Pi(alpha), safeguarded

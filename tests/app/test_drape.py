@@ -95,6 +95,17 @@ def test_drape_summary_reports_measures(tmp_path):
     assert np.all(np.abs(angles - np.array([45.0, 135.0, 225.0, 315.0])) < 10.0)
     assert s["max_penetration"] < 0.01 * 20 / 8 and s["converged"]
     assert s["perturbation_seed"] == 1
+    # the self-intersection check, in cm: the same as on the written state (deformed.vtu, cm)
+    import meshio
+
+    from rftstatic.post.measures.intersections import smallest_distance
+
+    si = s["self_intersections"]
+    assert si["pairs"] == si["triangles"] == 0 and si["area_fraction"] == 0.0 and si["seconds"] >= 0.0
+    m = meshio.read(out / "deformed.vtu")
+    d, pair = smallest_distance(m.points, m.cells_dict["triangle"])
+    assert si["smallest_distance"] == pytest.approx(d, rel=1e-9) and si["smallest_distance_pair"] == list(pair)
+    assert 0.5 < si["smallest_distance"] < 2.5 <= si["within"] < 3.0   # cm: the grid is 2.5 cm
 
 
 def test_a_sheet_smaller_than_the_pedestal_has_no_drape_coefficient(tmp_path):

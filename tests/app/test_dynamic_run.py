@@ -63,6 +63,11 @@ def test_tiny_hang_writes_well_formed_outputs(tmp_path):
             assert (out / name).stat().st_size > 0
     assert (out / "animation.gif").read_bytes()[:3] == b"GIF" and (out / "energy.png").stat().st_size > 0
     assert (out / "checkpoint.npz").exists()
+    # every saved state checked for self-intersection: a sheet falling for 0.05 s crosses nothing
+    si = s["self_intersections"]
+    assert si["saved_states"] == s["vtu_series"]["states"] == len(si["pairs_saved"]) and si["saved_skipped"] == 0
+    assert si["pairs"] == si["max_pairs_saved"] == 0 and 0.0 <= si["max_pairs_at"] <= 0.05
+    assert 0.0 < si["smallest_distance"] < si["within"] < 3.0   # cm
 
 
 def test_first_instants_are_a_damped_free_fall_and_energy_balances(tmp_path):

@@ -37,6 +37,8 @@ def test_relax_outputs_exist_and_are_well_formed(tiny_run):
     assert 0.5 <= on_disk["t"] < 1.5 and on_disk["remesh"]["h_lower"] == 2.5
     d = on_disk["drape"]
     assert 0 < d["drape_coefficient"] < 1 and d["boundary_radius_max"] < 15.0  # cm: the half diagonal is 14.1
+    si = on_disk["self_intersections"]
+    assert si["pairs"] >= 0 and 0.0 < si["smallest_distance"] < si["within"] < 10.0   # cm
     m = meshio.read(out / "deformed.vtu")
     assert len(m.points) == on_disk["nodes"] and m.cells[0].data.shape == (on_disk["elements"], 3)
     frames = on_disk["frames"]

@@ -21,9 +21,12 @@ Modules, one idea each:
   (|κ| is :func:`rftstatic.element.curvature.curvature_norm`);
 - :mod:`.summary`: :func:`~.summary.drape_measures`, all of them as plain values for
   ``summary.json``;
+- :mod:`.intersections`: the self-intersection check, independent of any contact law:
+  :func:`~.intersections.intersecting_pairs` (triangles sharing no node that pass through each
+  other) and :func:`~.intersections.smallest_distance` (between non-adjacent triangles);
 - :mod:`.triangles`: the input check and the half-edge keys the others share.
 
 Lengths are in the units of ``x`` (SI inside the package) and areas in their square.
-Everything is vectorised over triangles, edges and scan lines; only the choice among
-boundary loops (a handful) is a Python loop.
+Everything is vectorised over triangles, edges, scan lines and candidate pairs; only the choice
+among boundary loops (a handful) and among triangle size classes is a Python loop.
 """
