@@ -135,7 +135,8 @@ def _json(value) -> np.ndarray:
 def _mesh_arrays(meshes) -> dict:
     """The meshes as flat arrays: nodes (sum N_k, 2) [m], triangles (sum E_k, 3), their counts and labels."""
     return {"mesh_X": np.concatenate([m.X for m in meshes]), "mesh_tri": np.concatenate([m.tri for m in meshes]),
-            "mesh_nodes": np.array([m.n_nodes for m in meshes]), "mesh_elements": np.array([m.n_elements for m in meshes]),
+            "mesh_nodes": np.array([m.n_nodes for m in meshes]),
+            "mesh_elements": np.array([m.n_elements for m in meshes]),
             "mesh_meta": _json([{"z0": m.z0, "name": m.name, "info": m.info} for m in meshes])}
 
 
@@ -225,7 +226,8 @@ class RemeshCheckpointer:
         arrays = {**self._mesh_arrays(state.meshes), "U": np.array(state.U, dtype=float),
                   "V": np.array(state.V, dtype=float), "records": _records_json(state.records),
                   "relax": _json({k: getattr(state, k) for k in _RELAX_SCALARS})}
-        what = f"t = {state.t:.4g} s, step {state.steps}, mesh {len(state.meshes) - 1} ({state.meshes[-1].n_nodes} nodes)"
+        what = (f"t = {state.t:.4g} s, step {state.steps}, mesh {len(state.meshes) - 1} "
+                f"({state.meshes[-1].n_nodes} nodes)")
         self._pending = self._snapshot(phase, arrays, what)
         if phase != "chunk" or time.monotonic() - self._last >= self.every_seconds:
             self.flush()

@@ -211,6 +211,15 @@ class RemeshRelaxResult:
     skipped: int = 0
 
 
+def _initial_state(model, U0, V0) -> RelaxState:
+    """The state a remeshed relaxation starts from: U0, V0 (N, 3) [m, m/s] (default zero) on ``model``'s mesh."""
+    N = model.mesh.n_nodes
+    U = np.zeros((N, 3)) if U0 is None else np.array(U0, dtype=float)
+    V = np.zeros((N, 3)) if V0 is None else np.array(V0, dtype=float)
+    record = RemeshRecord(0, N, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})))
+    return RelaxState([model.mesh], U, V, t=0.0, steps=0, since=0, n_remesh=0, skipped=0, peak=0.0, records=[record])
+
+
 def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, mass_scale=RELAX_MASS_SCALE,
                  damping="fixed", every=None, kappa_h2_max=None, chunk=200, max_steps=100_000, max_remesh=50,
                  tol=0.05, tol_force=1e-4, tol_kinetic=1e-8, skip_settled=True, gradation=1.3, transfer="mesh",
@@ -280,21 +289,12 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
                                    damping=damping)
     if domain is None:
         domain = reference_domain(model.mesh)
-    N = model.mesh.n_nodes
     wall = time.perf_counter()
-    if restart is None:
-        U = np.zeros((N, 3)) if U0 is None else np.array(U0, dtype=float)
-        V = np.zeros((N, 3)) if V0 is None else np.array(V0, dtype=float)
-        t, steps, since, n_remesh, skipped = 0.0, 0, 0, 0, 0
-        peak = 0.0
-        records = [RemeshRecord(0, N, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})))]
-        meshes, done, converged = [model.mesh], False, False
-    else:
-        r = restart
-        U, V, t, steps, since, n_remesh, skipped = r.U.copy(), r.V.copy(), r.t, r.steps, r.since, r.n_remesh, r.skipped
-        peak, records, meshes, done, converged = r.peak, list(r.records), list(r.meshes), r.done, r.converged
-        if len(meshes) > 1:  # the initial model serves mesh 0
-            model, extras = make(meshes[-1])
+    r = _initial_state(model, U0, V0) if restart is None else restart
+    U, V, t, steps, since, n_remesh, skipped = r.U.copy(), r.V.copy(), r.t, r.steps, r.since, r.n_remesh, r.skipped
+    peak, records, meshes, done, converged = r.peak, list(r.records), list(r.meshes), r.done, r.converged
+    if len(meshes) > 1:  # a restart on a later mesh (the initial model serves mesh 0)
+        model, extras = make(meshes[-1])
     phase = None  # what the next snapshot is: None (the state just loaded or started), "chunk", "remesh"
 
     def save(phase):
