@@ -22,7 +22,10 @@ Outputs in the run folder, every number in the scene's units:
   (relax: the transferred state just after remesh k; static: the equilibrium on mesh k is only
   known for the last mesh, so the earlier ones are drawn flat in the top view), ``remesh.gif``
   (the isometric frames), ``nodes.png`` (node count against time or cycle);
-* ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.run.write_outputs`).
+* ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.run.write_outputs`);
+* ``checkpoint.npz`` (:mod:`rftstatic.remesh.checkpoint`): after every solved cycle (static), after every
+  remesh, at most every 10 s between remeshes and at the end (relax); ``--resume`` (:func:`resume_scene`)
+  continues from it to the meshes and state of the uninterrupted run.
 """
 
 from __future__ import annotations
