@@ -99,6 +99,9 @@ def test_an_interrupted_static_remesh_run_resumes_after_its_last_cycle(tmp_path,
     resumed = _run(scene, out, resume=True)
     _same_run(resumed, full)
     assert resumed.summary["checkpoint"]["resumed_from"] == {"phase": "cycle", "mesh": 0, "nodes": 105}
+    again = _run(scene, out, resume=True)  # from the last cycle's checkpoint: the model rebuilt on its saved mesh
+    _same_run(again, full)
+    assert again.summary["checkpoint"]["resumed_from"]["mesh"] == 1 and again.summary["checkpoint"]["writes"] == 0
 
 
 # ------------------------------------------------------------------------------------ remeshed relaxation
