@@ -53,7 +53,7 @@ def run(scene: Scene | str, out: str | Path | None = None, *, overrides=(), prog
 
 def resume(scene: Scene | str, out: str | Path | None = None, *, overrides=(), progress: bool = False,
            figures: bool = True) -> dict:
-    """Continue a run (static, dynamic or relax) from its checkpoint in ``out.partial`` or ``out``; return its
+    """Continue a run (static, dynamic, relax or remeshed) from its checkpoint in ``out.partial`` or ``out``; return its
     summary (:func:`rftstatic.app.registry.resume_scene`)."""
     if not isinstance(scene, Scene):
         scene = load_scene(str(scene), overrides)

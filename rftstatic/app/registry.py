@@ -101,14 +101,15 @@ def run_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
-    """Continue a run of ``scene`` (static, dynamic or relax) from its checkpoint; return its summary.
+    """Continue a run of ``scene`` (static, dynamic, relax or remeshed) from its checkpoint; return its summary.
 
     The checkpoint of an interrupted run is in ``<out_dir>.partial`` (:func:`run`); that run continues
     there and then replaces ``out_dir``. Without one, the run continues from ``out_dir/checkpoint.npz``
-    in place; a static scene with neither runs from the start (:func:`run`).
+    in place; a static or remeshed scene with neither runs from the start (:func:`run`).
     """
-    static = analysis_of(scene) == "static"
-    resume = importlib.import_module(ANALYSES["static" if static else "dynamic"]).resume_scene
+    name = analysis_of(scene)
+    static = name in ("static", "remeshed")  # these start afresh without a checkpoint
+    resume = importlib.import_module(ANALYSES[name]).resume_scene
     out = Path(out_dir)
     partial = out.with_name(out.name + PARTIAL)
     if (partial / "checkpoint.npz").exists():

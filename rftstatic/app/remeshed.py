@@ -23,7 +23,10 @@ Outputs in the run folder, every number in the scene's units:
   (relax: the transferred state just after remesh k; static: the equilibrium on mesh k is only
   known for the last mesh, so the earlier ones are drawn flat in the top view), ``remesh.gif``
   (the isometric frames), ``nodes.png`` (node count against time or cycle);
-* ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.run.write_outputs`).
+* ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.run.write_outputs`);
+* ``checkpoint.npz`` (:mod:`rftstatic.remesh.checkpoint`): after every solved cycle (static), after every
+  remesh, at most every 10 s between remeshes and at the end (relax); ``--resume`` (:func:`resume_scene`)
+  continues from it to the meshes and state of the uninterrupted run.
 """
 
 from __future__ import annotations
@@ -38,21 +41,25 @@ import numpy as np
 
 from rftstatic.app.result import RunResult
 from rftstatic.contact.kinematic import contact_reaction_residual
-from rftstatic.errors import InstabilityError, ParameterError
+from rftstatic.errors import CheckpointError, InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable, write_json
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import drape_summary, probe_summary, self_intersection_summary, summary_header
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
+from rftstatic.remesh.checkpoint import FIX, RemeshCheckpointer, load_remesh_checkpoint
 from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
 from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.scenes.build import MAX_MESH_NODES, build_model
 from rftstatic.scenes.options import REMESH_LENGTH_KEYS, dynamics_options, remesh_options, static_options
 from rftstatic.solvers.explicit import step_count
+from rftstatic.solvers.static_checkpoint import CHECKPOINT_SECONDS, remove_stale
 from rftstatic.solvers.timestep import stable_time_step
 
 log = logging.getLogger(__name__)
 
-__all__ = ["run", "run_remesh_scene", "solve_remesh_scene", "summarize"]
+__all__ = ["run", "resume_scene", "run_remesh_scene", "solve_remesh_scene", "summarize", "checkpoint_header"]
+
+CHECKPOINT = "checkpoint.npz"
 
 SAFETY = 0.5
 """Safety factor on the critical explicit step of the remeshed relaxation (a new mesh starts moving)."""
@@ -63,16 +70,34 @@ class _TimeUp(Exception):
 
 
 class _Tracker:
-    """Wraps the explicit stepper: snapshots each new mesh (model, U, t, steps) and stops at t_end (the stepper
-    takes ``max_time``: its last chunk ends there)."""
+    """Wraps the explicit stepper: snapshots each new mesh (mesh, model, U, t, steps) and stops at t_end (the
+    stepper takes ``max_time``: its last chunk ends there)."""
 
     def __init__(self, advance, t_end):
         self.advance, self.t_end = advance, t_end
         self.t, self.steps, self.meshes, self.last = 0.0, 0, [], None
+        self._rebind = False
+
+    def state(self) -> tuple[dict, dict]:
+        """The checkpoint fields (time, steps, snapshot times and steps) and arrays (the snapshots' U)."""
+        fields = {"t": self.t, "steps": self.steps, "snap_t": [m["t"] for m in self.meshes],
+                  "snap_step": [m["step"] for m in self.meshes], **self.advance.state()}
+        return fields, {"snap_U": np.concatenate([m["U"] for m in self.meshes]) if self.meshes else np.zeros((0, 3))}
+
+    def restore(self, fields: dict, arrays: dict, meshes: list) -> None:
+        """Continue from :meth:`state` of a run whose driver had made ``meshes``."""
+        self.t, self.steps = float(fields["t"]), int(fields["steps"])
+        offsets = np.cumsum([0] + [m.n_nodes for m in meshes])
+        self.meshes = [{"mesh": meshes[k], "model": None, "U": arrays["snap_U"][offsets[k]:offsets[k + 1]].copy(),
+                        "t": t, "step": step} for k, (t, step) in enumerate(zip(fields["snap_t"], fields["snap_step"]))]
+        self._rebind = len(self.meshes) == len(meshes)  # the next call is on the last snapshot's mesh
+        self.advance.restore(fields, same_mesh=self._rebind)
 
     def __call__(self, model, U, V, n):
+        if self._rebind:
+            self.meshes[-1]["model"], self._rebind = model, False
         if not self.meshes or self.meshes[-1]["model"] is not model:
-            self.meshes.append({"model": model, "U": U.copy(), "t": self.t, "step": self.steps})
+            self.meshes.append({"mesh": model.mesh, "model": model, "U": U.copy(), "t": self.t, "step": self.steps})
         if self.t >= self.t_end * (1 - 1e-12):
             self.last = (model, U, V)
             raise _TimeUp
@@ -84,13 +109,48 @@ class _Tracker:
         return U, V, dt
 
 
-def run(scene, out: Path, *, progress=True, figures=True) -> RunResult:
-    """Run a scene that has a ``[remesh]`` table and write its outputs into ``out`` (module docstring)."""
+def run(scene, out: Path, *, progress=True, figures=True, resume=False,
+        checkpoint_seconds: float = CHECKPOINT_SECONDS) -> RunResult:
+    """Run a scene that has a ``[remesh]`` table and write its outputs into ``out`` (module docstring).
+
+    The run keeps ``out/checkpoint.npz`` (:mod:`rftstatic.remesh.checkpoint`): after every solved cycle of the
+    static route, after every remesh of the relaxation and between remeshes at most once per
+    ``checkpoint_seconds`` of wall time, and at the end. ``resume``: continue from it (a fresh run, logged, when
+    there is none; a :class:`~rftstatic.errors.CheckpointError` when it is corrupt or another scene's or
+    overrides').
+    """
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
     opts = remesh_options(scene)
-    solved = solve_remesh_scene(scene, opts)
+    path = out / CHECKPOINT
+    remove_stale(path)  # the temporary file of a write that a kill cut short
+    restart = None
+    if resume and path.exists():
+        restart = load_remesh_checkpoint(path, checkpoint_header(scene))
+        log.info("resuming the remeshed run from %s (%s)", path, restart.where)
+    elif resume:
+        log.warning("no checkpoint %s: running from the start", path)
+    saver = RemeshCheckpointer(path, checkpoint_header(scene), every_seconds=checkpoint_seconds)
+    with saver.on_interrupt():
+        solved = solve_remesh_scene(scene, opts, checkpoint=saver, restart=restart)
     summary = summarize(scene, opts, solved)
+    summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or restart else None, "writes": saver.writes,
+                             "write_time_s": saver.write_time,
+                             "resumed_from": None if restart is None else restart.where}
     _write(scene, solved, out, summary, figures=figures)
     return RunResult(to_jsonable(summary), solved["model"], solved["U"], solved["extras"], out)
+
+
+def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
+    """Continue the remeshed run of ``scene`` from ``out_dir/checkpoint.npz`` (``case NAME --resume``)."""
+    return run(scene, Path(out_dir), progress=progress, figures=figures, resume=True).summary
+
+
+def checkpoint_header(scene) -> dict:
+    """What a remeshed run's checkpoint is keyed to: the scene's name, analysis and its data after the ``--set``
+    overrides (but the ``[output]`` table, which does not change the run)."""
+    return {"scene": scene.name, "analysis": scene.get("analysis", "static"),
+            "data": {k: v for k, v in scene.data.items() if k != "output"}}
 
 
 def run_remesh_scene(scene, out, *, progress=True, figures=True) -> dict:
@@ -100,43 +160,48 @@ def run_remesh_scene(scene, out, *, progress=True, figures=True) -> dict:
     return run(scene, out, progress=progress, figures=figures).summary
 
 
-def solve_remesh_scene(scene, opts=None) -> dict:
+def solve_remesh_scene(scene, opts=None, *, checkpoint=None, restart=None) -> dict:
     """Run the remeshing route of ``scene``; return the final ``model``, ``U`` [m], ``extras``,
-    ``records``, ``converged``, ``meshes`` (the snapshots drawn as frames) and ``wall_time_s``."""
+    ``records``, ``converged``, ``meshes`` (the snapshots drawn as frames) and ``wall_time_s``.
+
+    ``checkpoint``: a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`; ``restart``: a
+    :class:`~rftstatic.remesh.checkpoint.RemeshRestart` to continue from."""
     opts = remesh_options(scene) if opts is None else opts
     analysis = scene.get("analysis", "static")
     t0 = time.perf_counter()
     if analysis not in ("static", "relax"):
         raise scene.error("analysis", f'"{analysis}" cannot be remeshed; use "static" or "relax" with [remesh]')
     try:
-        solved = (_static if analysis == "static" else _relax)(scene, opts)
+        solved = (_static if analysis == "static" else _relax)(scene, opts, checkpoint, restart)
     except ParameterError as exc:  # checked against the mesh: sizes larger than the sheet
         raise scene.error(f"remesh.{exc.key}", exc.detail) from None
     solved["wall_time_s"] = time.perf_counter() - t0
     return solved
 
 
-def _static(scene, opts) -> dict:
-    meshes = []
-
+def _static(scene, opts, checkpoint=None, restart=None) -> dict:
     def factory(mesh=None):
         model, extras = build_model(scene, mesh=mesh, quiet=mesh is not None)
         if mesh is None:
             _check_node_budget(scene, opts, model.mesh)
-        meshes.append({"model": model, "U": None, "t": 0.0, "step": 0})
         return model, extras
 
+    if restart is not None and restart.phase != "cycle":
+        raise CheckpointError(f"checkpoint {restart.path} is a remeshed relaxation's, this scene's route is static; "
+                              f"{FIX}")
     res = remesh_static(factory, const=opts.const, h_lower=opts.h_lower, h_upper=opts.h_upper,
                         max_cycles=opts.max_cycles, tol=opts.tol, kappa_h_max=opts.kappa_h_max,
                         gradation=opts.gradation, transfer=opts.transfer,
-                        options=static_options(scene, progress=False))
+                        options=static_options(scene, progress=False), checkpoint=checkpoint,
+                        restart=None if restart is None else restart.state)
+    meshes = [{"mesh": m, "U": None, "t": 0.0, "step": 0} for m in res.meshes]
     meshes[-1]["U"] = res.result.U
     return {"route": "remesh_static", "model": res.model, "extras": res.extras, "U": res.result.U,
             "records": res.records, "converged": bool(res.converged and res.result.converged),
             "meshes": meshes, "t": None, "steps": None, "skipped": 0}
 
 
-def _relax(scene, opts) -> dict:
+def _relax(scene, opts, checkpoint=None, restart=None) -> dict:
     d = dynamics_options(scene)
 
     def factory(mesh=None):
@@ -151,6 +216,13 @@ def _relax(scene, opts) -> dict:
     stepper = explicit_advance(alpha=d.alpha, mass_scale=d.mass_scale, dt=d.dt, safety=SAFETY,
                                obstacles=obstacles, damping=opts.damping)
     track = _Tracker(stepper, d.t_end)
+    if restart is not None:
+        if restart.phase == "cycle":
+            raise CheckpointError(f"checkpoint {restart.path} is a static remesh run's, this scene's route is the "
+                                  f"remeshed relaxation; {FIX}")
+        track.restore(restart.app, restart.app_arrays, restart.state.meshes)
+    if checkpoint is not None:
+        checkpoint.app = track.state
     first = [(model0, extras0)]
 
     def make(mesh=None):  # hand the already built initial model to the driver
@@ -164,7 +236,8 @@ def _relax(scene, opts) -> dict:
                            advance=track, mass_scale=d.mass_scale, every=opts.every,
                            kappa_h2_max=opts.kappa_h2_max, max_steps=max_steps, tol=opts.tol,
                            tol_force=d.force_tolerance, tol_kinetic=d.rest_tolerance,
-                           gradation=opts.gradation, transfer=opts.transfer, residual=residual)
+                           gradation=opts.gradation, transfer=opts.transfer, residual=residual,
+                           checkpoint=checkpoint, restart=None if restart is None else restart.state)
         model, U, records, converged, skipped = res.model, res.U, res.records, res.converged, res.skipped
         t, steps = res.t, res.steps
         stopped_by = "rest" if converged else "max_steps" if steps >= max_steps else "max_remesh"
@@ -179,9 +252,9 @@ def _relax(scene, opts) -> dict:
         model, U, _ = track.last
         records = []
         for k, m in enumerate(track.meshes):
-            mm = m["model"]
-            records.append(RemeshRecord(k, mm.mesh.n_nodes, mm.mesh.n_elements,
-                                        dict(mm.mesh.info.get("quality", {})), time=m["t"], step=m["step"],
+            mm = m["mesh"]
+            records.append(RemeshRecord(k, mm.n_nodes, mm.n_elements,
+                                        dict(mm.info.get("quality", {})), time=m["t"], step=m["step"],
                                         reason="initial" if k == 0 else "remesh"))
         kappa, records[-1].max_kappa_h, records[-1].max_kappa_h2 = _curvature_figures(model, U)
         records[-1].refinable_kappa_h, records[-1].refinable_kappa_h2 = refinable_maxima(
@@ -190,7 +263,7 @@ def _relax(scene, opts) -> dict:
         log.warning("remesh relax: t_end = %.4g s reached before the sheet came to rest on a settled mesh",
                     d.t_end)
     meshes = track.meshes
-    meshes.append({"model": model, "U": U, "t": t, "step": steps, "final": True})
+    meshes.append({"mesh": model.mesh, "model": model, "U": U, "t": t, "step": steps, "final": True})
     extras = extras0  # probes and obstacles are defined in reference coordinates: the same on every mesh
     return {"route": "remesh_relax", "model": model, "extras": extras, "U": U, "records": records,
             "converged": bool(converged), "meshes": meshes, "t": t, "steps": steps, "skipped": skipped,
@@ -278,20 +351,20 @@ def _frames(scene, run, out: Path) -> list:
     frames, lo, hi = [], None, None
     states = []
     for k, m in enumerate(run["meshes"]):
-        model = m["model"]
-        U = m["U"] if m["U"] is not None else np.zeros_like(model.X3)
-        x = (model.X3 + U) / u.length
-        states.append((k, m, model, x))
+        mesh = m["mesh"]
+        U = m["U"] if m["U"] is not None else np.zeros_like(mesh.X3)
+        x = (mesh.X3 + U) / u.length
+        states.append((k, m, mesh, x))
         lo = x.min(axis=0) if lo is None else np.minimum(lo, x.min(axis=0))
         hi = x.max(axis=0) if hi is None else np.maximum(hi, x.max(axis=0))
-    for k, m, model, x in states:
+    for k, m, mesh, x in states:
         label = "final" if m.get("final") else f"mesh {k}"
         when = (f"t = {m['t'] / u.time:.3g} s" if run["route"] == "remesh_relax" else
                 ("equilibrium" if m["U"] is not None else "flat reference"))
-        title = f"{scene.name}: {label}, {model.mesh.n_nodes} nodes, {when}"
+        title = f"{scene.name}: {label}, {mesh.n_nodes} nodes, {when}"
         name = f"mesh_{k:02d}" if not m.get("final") else "mesh_final"
-        files = plot_views(str(out / name), x, model.mesh.tri, views=("top", "iso"), title=title, length_unit=lu)
-        frames.append({"mesh": label, "nodes": model.mesh.n_nodes, "triangles": model.mesh.n_elements,
+        files = plot_views(str(out / name), x, mesh.tri, views=("top", "iso"), title=title, length_unit=lu)
+        frames.append({"mesh": label, "nodes": mesh.n_nodes, "triangles": mesh.n_elements,
                        "time": None if run["route"] != "remesh_relax" else m["t"] / u.time,
                        "files": {v: p.name for v, p in files.items()}})
     _gif(out / "remesh.gif", [out / f["files"]["iso"] for f in frames])

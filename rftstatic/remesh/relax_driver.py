@@ -24,6 +24,7 @@ from rftstatic.remesh.adapt import (
     refinable_maxima,
     transfer_state,
 )
+from rftstatic.remesh.checkpoint import RelaxState
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 
 log = logging.getLogger(__name__)
@@ -148,6 +149,17 @@ class ExplicitStepper:
         self.near = tuple(NearObstacle(ob, 0.0) for ob in obstacles)
         self.alphas = []
         self._model, self._dt = None, None  # the mesh the candidate lists and the step belong to
+        self._resumed_dt = None
+
+    def state(self) -> dict:
+        """What a checkpoint keeps: the damping of every chunk so far [1/s] and the present mesh's step [s]."""
+        return {"alphas": list(self.alphas), "dt": self._dt}
+
+    def restore(self, state: dict, *, same_mesh: bool) -> None:
+        """Continue from :meth:`state`; ``same_mesh``: the next call is on the mesh that ``state["dt"]`` was
+        estimated for (else the step is estimated afresh, as the uninterrupted run did on a new mesh)."""
+        self.alphas = [float(a) for a in state["alphas"]]
+        self._resumed_dt = state["dt"] if same_mesh else None
 
     def __call__(self, model, U, V, n_steps, *, max_time=None):
         """Advance ``n_steps`` steps, or fewer (the last one shortened) that end at ``max_time`` [s] when
@@ -158,7 +170,7 @@ class ExplicitStepper:
         if self._model is not model:
             for ob in self.near:  # candidates within a mean element size of the obstacle
                 ob.reset(float(model.mesh.element_size.mean()))
-            self._model, self._dt = model, None
+            self._model, self._dt, self._resumed_dt = model, self._resumed_dt, None
         step = self.dt
         if step is None:
             if self._dt is None:
@@ -199,10 +211,19 @@ class RemeshRelaxResult:
     skipped: int = 0
 
 
+def _initial_state(model, U0, V0) -> RelaxState:
+    """The state a remeshed relaxation starts from: U0, V0 (N, 3) [m, m/s] (default zero) on ``model``'s mesh."""
+    N = model.mesh.n_nodes
+    U = np.zeros((N, 3)) if U0 is None else np.array(U0, dtype=float)
+    V = np.zeros((N, 3)) if V0 is None else np.array(V0, dtype=float)
+    record = RemeshRecord(0, N, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})))
+    return RelaxState([model.mesh], U, V, t=0.0, steps=0, since=0, n_remesh=0, skipped=0, peak=0.0, records=[record])
+
+
 def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, mass_scale=RELAX_MASS_SCALE,
                  damping="fixed", every=None, kappa_h2_max=None, chunk=200, max_steps=100_000, max_remesh=50,
                  tol=0.05, tol_force=1e-4, tol_kinetic=1e-8, skip_settled=True, gradation=1.3, transfer="mesh",
-                 domain=None, U0=None, V0=None, residual=None) -> RemeshRelaxResult:
+                 domain=None, U0=None, V0=None, residual=None, checkpoint=None, restart=None) -> RemeshRelaxResult:
     """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6).
 
     The motion is advanced ``chunk`` steps at a time. After each chunk (step d) the mesh is
@@ -238,6 +259,12 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
     residual : ``residual(model, U) -> (N, 3)`` [N], the out-of-balance force of the rest test (default
         ``model.residual(U)``; with kinematic obstacles,
         :func:`rftstatic.contact.kinematic.contact_reaction_residual` takes their reaction off)
+    checkpoint : a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`, given the
+        :class:`~rftstatic.remesh.checkpoint.RelaxState` before every chunk (``"chunk"``, throttled; ``"remesh"``
+        after a remesh) and at the end (``"done"``)
+    restart : a :class:`~rftstatic.remesh.checkpoint.RelaxState` to continue from (a saved one; ``U0``, ``V0``
+        are then ignored). With an ``advance`` that keeps state of its own (the damping history, the stable step
+        of the mesh), the caller restores that too.
 
     Returns
     -------
@@ -262,15 +289,22 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
                                    damping=damping)
     if domain is None:
         domain = reference_domain(model.mesh)
-    N = model.mesh.n_nodes
-    U = np.zeros((N, 3)) if U0 is None else np.array(U0, dtype=float)
-    V = np.zeros((N, 3)) if V0 is None else np.array(V0, dtype=float)
-    t, steps, since, n_remesh, skipped = 0.0, 0, 0, 0, 0
-    peak = 0.0
     wall = time.perf_counter()
-    records = [RemeshRecord(0, N, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})))]
-    converged = False
-    while steps < max_steps:
+    r = _initial_state(model, U0, V0) if restart is None else restart
+    U, V, t, steps, since, n_remesh, skipped = r.U.copy(), r.V.copy(), r.t, r.steps, r.since, r.n_remesh, r.skipped
+    peak, records, meshes, done, converged = r.peak, list(r.records), list(r.meshes), r.done, r.converged
+    if len(meshes) > 1:  # a restart on a later mesh (the initial model serves mesh 0)
+        model, extras = make(meshes[-1])
+    phase = None  # what the next snapshot is: None (the state just loaded or started), "chunk", "remesh"
+
+    def save(phase):
+        checkpoint.relax(RelaxState(meshes, U, V, t, steps, since, n_remesh, skipped, peak, records, done=done,
+                                    converged=converged), phase=phase)
+
+    while steps < max_steps and not done:
+        if checkpoint is not None and phase is not None:
+            save(phase)  # every path through the loop ends here: the state the next chunk starts from
+        phase = "chunk"
         n = int(min(chunk, max_steps - steps))
         U, V, dt_adv = advance(model, U, V, n)
         if not (np.isfinite(U).all() and np.isfinite(V).all()):
@@ -293,8 +327,7 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
             continue
         if n_remesh >= max_remesh:
             if rest:
-                converged = False
-                break
+                done, converged = True, False
             continue
         new_mesh, _ = adapt_mesh(model.mesh, kappa, const=const, h_lower=h_lower, h_upper=h_upper,
                                  gradation=gradation, domain=domain)
@@ -304,8 +337,8 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         rec.node_change = abs(new_mesh.n_nodes - model.mesh.n_nodes) / model.mesh.n_nodes
         settled = rec.node_change < tol and (kappa_h2_max is None or rkh2 <= kappa_h2_max)
         if rest and settled:
-            converged = True
-            break
+            done, converged = True, True
+            continue
         if settled and skip_settled:
             since = 0
             skipped += 1
@@ -319,8 +352,13 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         rec.wall_time, wall = now - wall, now
         records.append(RemeshRecord(n_remesh, new_mesh.n_nodes, new_mesh.n_elements, new_mesh.info["quality"],
                                     time=t, step=steps, reason=reason))
+        meshes.append(new_mesh)
+        phase = "remesh"
         log.info("remesh_relax: t = %.4g s, step %d (%s): %d -> %d nodes, max |kappa| h %.3g",
                  t, steps, reason, rec.nodes, new_mesh.n_nodes, kh)
+    if checkpoint is not None and phase is not None:
+        done = True
+        save("done")
     rec = records[-1]
     if not np.isfinite(rec.max_kappa_h):
         kappa, rec.max_kappa_h, rec.max_kappa_h2 = _curvature_figures(model, U)

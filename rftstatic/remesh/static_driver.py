@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from rftstatic.remesh.adapt import (
     RemeshRecord,
@@ -20,6 +20,7 @@ from rftstatic.remesh.adapt import (
     refinable_maxima,
     transfer_state,
 )
+from rftstatic.remesh.checkpoint import StaticCycleState
 
 log = logging.getLogger(__name__)
 
@@ -35,6 +36,7 @@ class RemeshStaticResult:
     model, extras : the final model and its extras (probes, obstacles)
     records : one :class:`RemeshRecord` per mesh solved
     converged : the mesh stopped changing (and, if given, |kappa| h <= kappa_h_max) within ``max_cycles``
+    meshes : the :class:`~rftstatic.mesh.trimesh.TriMesh` of every record
     """
 
     result: object
@@ -42,6 +44,7 @@ class RemeshStaticResult:
     extras: dict
     records: list
     converged: bool
+    meshes: list = field(default_factory=list)
 
 
 def _continuation(options):
@@ -51,7 +54,8 @@ def _continuation(options):
 
 
 def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, kappa_h_max=None,
-                  gradation=1.3, transfer="mesh", options=None, domain=None) -> RemeshStaticResult:
+                  gradation=1.3, transfer="mesh", options=None, domain=None, checkpoint=None,
+                  restart=None) -> RemeshStaticResult:
     """Static solution with global adaptive remeshing (module docstring).
 
     Parameters
@@ -72,6 +76,10 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         defaults, without a progress bar); later solves start from the transferred state at
         full load (one load step) and fall back to the full load ramp from flat if that fails
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
+    checkpoint : a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`, given the
+        :class:`~rftstatic.remesh.checkpoint.StaticCycleState` after every solved cycle (None: no checkpoint)
+    restart : a :class:`~rftstatic.remesh.checkpoint.StaticCycleState` to continue from (a saved one);
+        the run then goes on as the uninterrupted one from the cycle after it
 
     Returns
     -------
@@ -97,11 +105,19 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
     _check_extent(model.mesh, const, h_lower, h_upper)
     if domain is None:
         domain = reference_domain(model.mesh)
-    result = solve_static(model, options=options)
-    records = [RemeshRecord(0, model.mesh.n_nodes, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})),
-                            solve=_static_figures(result, restarted=False))]
+    if restart is None:
+        result = solve_static(model, options=options)
+        records = [RemeshRecord(0, model.mesh.n_nodes, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})),
+                                solve=_static_figures(result, restarted=False))]
+        meshes, first = [model.mesh], 1
+        if checkpoint is not None:
+            checkpoint.cycle(StaticCycleState(0, meshes, result, records))
+    else:
+        result, records, meshes, first = restart.result, list(restart.records), list(restart.meshes), restart.cycle + 1
+        if restart.cycle > 0:  # the initial model serves cycle 0
+            model, extras = make(meshes[-1])
     converged = False
-    for cycle in range(1, int(max_cycles) + 1):
+    for cycle in range(first, int(max_cycles) + 1):
         kappa, kh, kh2 = _curvature_figures(model, result.U)
         rec = records[-1]
         rec.max_kappa_h, rec.max_kappa_h2 = kh, kh2
@@ -130,6 +146,9 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         model, extras = new_model, new_extras
         records.append(RemeshRecord(cycle, new_mesh.n_nodes, new_mesh.n_elements, new_mesh.info["quality"],
                                     reason="cycle", solve=_static_figures(result, restarted=restarted)))
+        meshes.append(new_mesh)
+        if checkpoint is not None:
+            checkpoint.cycle(StaticCycleState(cycle, meshes, result, records))
     rec = records[-1]
     if not converged:
         kappa, rec.max_kappa_h, rec.max_kappa_h2 = _curvature_figures(model, result.U)
@@ -137,7 +156,8 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         rec.wall_time = time.perf_counter() - t0
         log.warning("remesh_static: the mesh still changes after %d cycles (max |kappa| h %.3g)",
                     max_cycles, rec.max_kappa_h)
-    return RemeshStaticResult(result=result, model=model, extras=extras, records=records, converged=converged)
+    return RemeshStaticResult(result=result, model=model, extras=extras, records=records, converged=converged,
+                              meshes=meshes)
 
 
 def _static_figures(result, *, restarted):

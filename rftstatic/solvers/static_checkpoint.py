@@ -105,12 +105,14 @@ def _unfield(a) -> np.ndarray | None:
     return None if a.shape[0] == 0 else a.copy()
 
 
-def _result_arrays(prefix, result: StaticResult) -> dict:
+def result_arrays(prefix, result: StaticResult) -> dict:
+    """The arrays of a :class:`StaticResult` under keys starting with ``prefix`` (U (N, 3) [m], the rest as JSON)."""
     return {prefix + "U": _field(result.U),
             prefix + "result": _json({k: getattr(result, k) for k in _RESULT_FIELDS})}
 
 
-def _result_from(prefix, z) -> StaticResult:
+def result_from(prefix, z) -> StaticResult:
+    """The :class:`StaticResult` saved by :func:`result_arrays` in the open ``.npz`` ``z``."""
     return StaticResult(U=z[prefix + "U"].copy(), **json.loads(str(z[prefix + "result"])))
 
 
@@ -198,7 +200,7 @@ class StaticCheckpointer:
                                                                   "at_rest", "seed", "info")}),
                   "first": _json(None if first is None else str(first))}
         if first is not None and first.result is not None:
-            arrays.update(_result_arrays("first_", first.result))
+            arrays.update(result_arrays("first_", first.result))
         return arrays
 
     def route(self, route: RelaxRoute) -> None:
@@ -211,7 +213,7 @@ class StaticCheckpointer:
 
     def done(self, result: StaticResult) -> None:
         """Write the solve's result (not throttled)."""
-        self._write({**self._common("done"), **_result_arrays("", result)}, "the result")
+        self._write({**self._common("done"), **result_arrays("", result)}, "the result")
 
 
 class _SegmentSaver:
@@ -342,7 +344,7 @@ def _restart_from(path, z) -> StaticRestart:
     out = StaticRestart(path=path, phase=phase, factorisations=int(ws["factorisations"]), lm_scale=ws["lm_scale"],
                         load_terms=ws["load_terms"])
     if phase == "done":
-        out.result = _result_from("", z)
+        out.result = result_from("", z)
     elif phase == "load-steps":
         p = json.loads(str(z["path"]))
         result = StaticResult(U=z["U"].copy(), lam=p["lam"], converged=False, load_steps=p["load_steps"],
@@ -355,7 +357,7 @@ def _restart_from(path, z) -> StaticRestart:
         message = json.loads(str(z["first"]))
         first = None
         if message is not None:
-            first = ConvergenceError(message, _result_from("first_", z) if "first_U" in z.files else None)
+            first = ConvergenceError(message, result_from("first_", z) if "first_U" in z.files else None)
         out.route = RelaxRoute(U=_unfield(z["route_U"]), V=_unfield(z["route_V"]), first=first, **r)
     else:
         raise CheckpointError(f"checkpoint {path}: unknown phase {phase!r}; run without --resume")
