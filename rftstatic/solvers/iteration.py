@@ -28,6 +28,17 @@ class Iteration:
     scheme: str = "displacement"
 
 
+def unloaded_scales(model) -> tuple[float, float]:
+    """Force [N] and work [J] scales of the convergence test of an unloaded model: the norm of the
+    nodal weights ``|w A_n|`` that gravity would apply and their work over the mean element size
+    (1e-300 each for a weightless sheet, which leaves the round-off floor of the internal force)."""
+    weight = float(getattr(model.material, "weight", 0.0) or 0.0)
+    force = abs(weight) * float(np.linalg.norm(model.mesh.node_area))
+    if not force > 0 or not np.isfinite(force):
+        return 1e-300, 1e-300
+    return force, force * float(model.mesh.element_size.mean())
+
+
 class Criteria:
     """The convergence test of one Newton iteration at load factor ``lam`` (module docstring, 4).
 
@@ -35,7 +46,9 @@ class Criteria:
     (:func:`roundoff_floor`, evaluated only near convergence). Energy: the work of the residual on
     the last step ``|d . r_new| <= etol W`` with ``W = |lam| max(|P . U|, |P . dU_1|)``, the work of the
     applied load; both scales come from the loads alone, so the test does not tighten or loosen with
-    the membrane stiffness.
+    the membrane stiffness. With no load at all (an unloaded sheet, e.g. ``loads.gravity = false``)
+    the scales are those of the sheet's weight (:func:`unloaded_scales`), or the round-off floor of a
+    weightless one.
     """
 
     def __init__(self, model, lam, opts, U):
@@ -50,7 +63,9 @@ class Criteria:
         self.ref = max(np.linalg.norm(lam * P), 1e-6 * np.linalg.norm(P), 1e-300)
         self.atol = 0.0
         self.work_ref = 1e-300
-        self.unloaded = not np.any(P)  # no load: only the round-off of the internal force is left to test
+        self.unloaded = not np.any(P)
+        if self.unloaded:  # no load to scale by: the sheet's own weight, as if gravity acted (module docstring)
+            self.ref, self.work_ref = unloaded_scales(model)
 
     def load_work(self, U, step) -> None:
         """Raise the energy scale to the work of the load on ``U`` and on the first ``step`` [J]."""

@@ -250,3 +250,34 @@ def test_a_remeshed_relaxation_ends_at_t_end(capsys, tmp_path):
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["t"] == pytest.approx(0.1, rel=1e-9) and summary["t"] <= 0.1 * (1 + 1e-12)
     assert summary["steps"] < 200
+
+
+def test_an_unloaded_perturbed_sheet_on_a_pedestal_converges_by_load_steps(capsys, tmp_path):
+    import json
+
+    # was: exit 3, Newton stalled at |r| = 1.4e-9 N against the round-off floor (no load to scale the test by)
+    code, err = _run(capsys, tmp_path, "pedestal-square-20", ["mesh.nodes=[9,9]", "loads.gravity=false",
+                                                              "solver.start=load-steps"])
+    assert code == 0, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["converged"] and summary["self_intersections"]["pairs"] == 0
+    # the perturbed start relaxes back to a flat sheet (it floats where the penalty's onset left it, above the top)
+    assert summary["max_relative_curvature"] < 1e-4
+    heights = [p["deformed"][2] for p in summary["probes"].values()]
+    assert min(heights) >= 0.0 and max(heights) - min(heights) < 1e-4
+
+
+def test_the_convergence_scales_of_an_unloaded_model_are_its_weight():
+    import numpy as np
+
+    from rftstatic.bench.problems import strip_model
+    from rftstatic.solvers.iteration import unloaded_scales
+
+    model = strip_model(11, 3)
+    force, work = unloaded_scales(model)
+    expected = model.material.weight * np.linalg.norm(model.mesh.node_area)
+    assert force == pytest.approx(expected) and work == pytest.approx(expected * model.mesh.element_size.mean())
+    import dataclasses
+
+    model.material = dataclasses.replace(model.material, weight=0.0)
+    assert unloaded_scales(model) == (1e-300, 1e-300)
