@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rftstatic.contact.self_contact.distance import compiled_for
+from rftstatic.contact.self_contact import distance
 
 __all__ = ["Pairs", "SheetPrimitives", "find_pairs", "PairCache", "brute_force_pairs"]
 
@@ -150,7 +150,7 @@ def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.nda
     if not (np.isfinite(radius) and radius > 0):
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
     tri, edges = prims.tri, prims.edges
-    if compiled_for(len(tri) + len(edges)):
+    if distance.compiled_for(len(tri) + len(edges)):
         return _find_pairs_compiled(prims, x0, radius, x1)
     return _find_pairs_numpy(prims, x0, radius, x1)
 
