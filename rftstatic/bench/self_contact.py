@@ -63,8 +63,13 @@ def main(argv=None):
     ap.add_argument("--n", type=int, nargs="+", default=[81, 161])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--skip", nargs="*", default=[], help="parts to skip: build swept law ccd")
+    ap.add_argument("--numpy", action="store_true", help="the numpy path only (no compiled twins)")
     a = ap.parse_args(argv)
-    print(f"load average {os.getloadavg()}")
+    from rftstatic.contact.self_contact import distance, law_kernels
+
+    if a.numpy:
+        distance.compiled_for = lambda n: False
+    print(f"load average {os.getloadavg()}, {'numpy' if a.numpy else 'compiled where numba is installed'}")
     for n in a.n:
         mesh, X = crumpled(n)
         prims = SheetPrimitives.of_mesh(mesh)
@@ -86,7 +91,15 @@ def main(argv=None):
             t, st = best(lambda: sc.evaluate(X, tangent=False), a.repeat)
             print(f"{n}x{n} folded energy+force: {t:.3f} s, {st.n_active} active, min {st.min_distance / d:.3f} d")
             t, st = best(lambda: sc.evaluate(X, tangent=True), a.repeat)
-            print(f"{n}x{n} folded with PSD tangent: {t:.3f} s")
+            print(f"{n}x{n} folded with PSD tangent (law._psd): {t:.3f} s")
+            cache = sc.new_pairs()
+            sc.pairs(X, cache)
+            t, st = best(lambda: sc.evaluate(X, tangent=False, cache=cache), a.repeat)
+            print(f"{n}x{n} folded energy+force, cached pairs: {t:.3f} s")
+            t, st = best(lambda: sc.evaluate(X, tangent=True, cache=cache, project=False), a.repeat)
+            print(f"{n}x{n} folded with unprojected tangent, cached pairs: {t:.3f} s")
+            t, _ = best(lambda: law_kernels.psd_project(st.blocks), a.repeat)
+            print(f"{n}x{n} law_kernels.psd_project of {len(st.blocks)} blocks: {t:.3f} s")
         if "ccd" not in a.skip:
             cache = sc.new_pairs()
             sc.pairs(X, cache)
@@ -96,6 +109,13 @@ def main(argv=None):
             dx = 1e-2 * np.random.default_rng(3).standard_normal(X.shape)
             t, al = best(lambda: sc.max_step_fraction(X, dx, cache=cache), 1)
             print(f"{n}x{n} folded step bound, random 1 cm step: {t:.3f} s, alpha {al:.4f}")
+            npt, nee = sc._x4(X, cache.pairs(sc.prims, X, d))
+            for step in (1e-4, 1e-2):
+                dx = step * np.random.default_rng(2).standard_normal(X.shape)
+                t, al = best(lambda: min(law_kernels.additive_ccd(X[npt], dx[npt], 0, 0.2, 200),
+                                         law_kernels.additive_ccd(X[nee], dx[nee], 1, 0.2, 200)), a.repeat)
+                print(f"{n}x{n} law_kernels.additive_ccd, listed pairs, random {step * 1e3:g} mm step: "
+                      f"{t:.3f} s, alpha {al:.4f}")
 
 
 if __name__ == "__main__":

@@ -364,33 +364,42 @@ def psd_project_all(H, out):
         psd_project_one(H[a], out[a], B, R, U, M, V)
 
 
-def ccd_all(x4, dx4, kind, eta, max_rounds):
-    """Smallest safe time in [0, 1] over all pairs ``x4, dx4 (P, 4, 3)`` [m] of the additive continuous
-    collision detection (:mod:`.law`); ``kind`` 0 point-triangle (sides ``{0}``, ``{1, 2, 3}``),
-    1 edge-edge (``{0, 1}``, ``{2, 3}``). A pair stops once its time passes the smallest one found
-    (its time only grows), which leaves the minimum unchanged."""
+def ccd_all(x, dx, nodes, kind, eta, max_rounds):
+    """Smallest safe time in [0, 1] over all pairs ``nodes (P, 4)`` of positions ``x`` and step ``dx``
+    ``(N, 3)`` [m] of the additive continuous collision detection (:mod:`.law`); ``kind`` 0
+    point-triangle (sides ``{0}``, ``{1, 2, 3}``), 1 edge-edge (``{0, 1}``, ``{2, 3}``). A pair stops
+    once its time passes the smallest one found (its time only grows), which leaves the minimum
+    unchanged."""
     W = np.zeros(4)
     D = np.zeros((4, 2))
     act = np.zeros(2, dtype=np.bool_)
+    x4 = np.zeros((4, 3))
+    dx4 = np.zeros((4, 3))
     y = np.zeros((4, 3))
     na = 1 if kind == 0 else 2
     tmin = 1.0
-    for p in range(x4.shape[0]):
+    for p in range(nodes.shape[0]):
+        for k in range(4):
+            for i in range(3):
+                x4[k, i] = x[nodes[p, k], i]
+                dx4[k, i] = dx[nodes[p, k], i]
         ell2 = 0.0
         for a in range(na):
             for b in range(na, 4):
                 r = 0.0
                 for i in range(3):
-                    v = dx4[p, a, i] - dx4[p, b, i]
+                    v = dx4[a, i] - dx4[b, i]
                     r += v * v
                 ell2 = max(ell2, r)
         ell = np.sqrt(ell2)
+        if not ell > 0:
+            continue
         if kind == 0:
-            s0, _ = pt_classify(x4[p], W, D, act)
+            s0, _ = pt_classify(x4, W, D, act)
         else:
-            s0, _ = ee_classify(x4[p], W, D, act)
+            s0, _ = ee_classify(x4, W, D, act)
         d0 = np.sqrt(s0)
-        if not (ell > 0 and ell > (1.0 - eta) * d0):
+        if not ell > (1.0 - eta) * d0:
             continue
         g = eta * d0
         t = 0.0
@@ -405,7 +414,7 @@ def ccd_all(x4, dx4, kind, eta, max_rounds):
                 break
             for k in range(4):
                 for i in range(3):
-                    y[k, i] = x4[p, k, i] + t * dx4[p, k, i]
+                    y[k, i] = x4[k, i] + t * dx4[k, i]
             if kind == 0:
                 s, _ = pt_classify(y, W, D, act)
             else:

@@ -15,7 +15,7 @@ import numpy as np
 
 from rftstatic.contact.self_contact import distance
 
-__all__ = ["psd_project", "additive_ccd"]
+__all__ = ["psd_project", "additive_ccd", "additive_ccd_nodes"]
 
 _SIDES = (((0,), (1, 2, 3)), ((0, 1), (2, 3)))
 
@@ -48,8 +48,10 @@ def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rou
     if distance.compiled_for(len(x4)):
         from rftstatic.contact.self_contact._kernels_numba import ccd_all
 
-        return float(ccd_all(np.ascontiguousarray(x4, dtype=float), np.ascontiguousarray(dx4, dtype=float),
-                             kind, float(eta), int(max_rounds)))
+        P = len(x4)
+        return float(ccd_all(np.ascontiguousarray(x4, dtype=float).reshape(4 * P, 3),
+                             np.ascontiguousarray(dx4, dtype=float).reshape(4 * P, 3),
+                             np.arange(4 * P, dtype=np.int64).reshape(P, 4), kind, float(eta), int(max_rounds)))
     dist2 = distance.point_triangle_distance2 if kind == 0 else distance.edge_edge_distance2
     a, b = _SIDES[kind]
     rel = dx4[:, list(a)][:, :, None, :] - dx4[:, list(b)][:, None, :, :]
@@ -79,3 +81,19 @@ def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rou
         stuck = dcur[idx] - g[idx] <= 1e-3 * (d0[idx] - g[idx])
         live[idx[stuck]] = False
     return float(t.min())
+
+
+def additive_ccd_nodes(x: np.ndarray, dx: np.ndarray, nodes: np.ndarray, kind: int, eta: float,
+                       max_rounds: int) -> float:
+    """:func:`additive_ccd` of the pairs ``nodes (P, 4)`` of positions ``x (N, 3)`` [m] and step
+    ``dx (N, 3)`` [m], without gathering ``x[nodes]`` (the compiled loop reads the nodes itself: on the
+    824,000 swept pairs of a 1 cm step of the 81 x 81 fold the gather cost as much as the loop)."""
+    nodes = np.asarray(nodes, dtype=np.int64)
+    if not len(nodes):
+        return 1.0
+    if distance.compiled_for(len(nodes)):
+        from rftstatic.contact.self_contact._kernels_numba import ccd_all
+
+        return float(ccd_all(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(dx, dtype=float),
+                             np.ascontiguousarray(nodes), kind, float(eta), int(max_rounds)))
+    return additive_ccd(x[nodes], dx[nodes], kind, eta, max_rounds)

@@ -91,6 +91,11 @@ def test_additive_ccd_agrees(monkeypatch, kind, size):
     a, b = _both(monkeypatch, law_kernels.additive_ccd, x4, dx4, kind, 0.2, 200)
     assert 0.0 < a < 1.0 or size == 0.01
     assert b == pytest.approx(a, rel=1e-12)
+    nodes = rng.permutation(4 * len(x4)).reshape(-1, 4)  # the same pairs as nodes of a point cloud
+    x, dx = np.empty((4 * len(x4), 3)), np.empty((4 * len(x4), 3))
+    x[nodes], dx[nodes] = x4, dx4
+    c, e = _both(monkeypatch, law_kernels.additive_ccd_nodes, x, dx, nodes, kind, 0.2, 200)
+    assert c == a and e == pytest.approx(a, rel=1e-12)
 
 
 def test_broad_phase_agrees_on_a_folded_crumpled_sheet(monkeypatch):
