@@ -272,82 +272,86 @@ def jacobi_eigen(M, V, m):
 
 def psd_project_one(H, out, B, R, U, M, V):
     """``out (n, n)``: the symmetric part of ``H (n, n)`` with its negative eigenvalues set to 0 (module
-    docstring); ``B, R, U, M, V (n, n)`` are scratch."""
+    docstring); ``B, R, U, M, V (n, n)`` are scratch. Vectors are rows (``B`` is symmetric: its rows
+    span its range), so the inner loops run over contiguous memory."""
     n = H.shape[0]
     cmax = 0.0
     for i in range(n):
-        for j in range(n):
-            B[i, j] = 0.5 * (H[i, j] + H[j, i])
-    for j in range(n):
         c = 0.0
-        for i in range(n):
-            c += B[i, j] * B[i, j]
+        for j in range(n):
+            v = 0.5 * (H[i, j] + H[j, i])
+            B[i, j] = v
+            R[i, j] = v  # residual rows
+            c += v * v
         cmax = max(cmax, c)
     out[:, :] = 0.0
     if cmax == 0.0:
         return
     tol2 = RANK_TOL * RANK_TOL * cmax
-    R[:, :] = B  # residual columns
     m = 0
     while m < n:
         jbest, nbest = -1, tol2
         for j in range(n):
             c = 0.0
             for i in range(n):
-                c += R[i, j] * R[i, j]
+                c += R[j, i] * R[j, i]
             if c > nbest:
                 jbest, nbest = j, c
         if jbest < 0:
             break
         for i in range(n):
-            U[i, m] = R[i, jbest]
+            U[m, i] = R[jbest, i]
         for _ in range(2):  # Gram-Schmidt twice: orthogonal to round-off
             for b in range(m):
                 dot = 0.0
                 for i in range(n):
-                    dot += U[i, b] * U[i, m]
+                    dot += U[b, i] * U[m, i]
                 for i in range(n):
-                    U[i, m] -= dot * U[i, b]
+                    U[m, i] -= dot * U[b, i]
         nrm = 0.0
         for i in range(n):
-            nrm += U[i, m] * U[i, m]
-        nrm = np.sqrt(nrm)
+            nrm += U[m, i] * U[m, i]
+        nrm = 1.0 / np.sqrt(nrm)
         for i in range(n):
-            U[i, m] /= nrm
+            U[m, i] *= nrm
         for j in range(n):
             dot = 0.0
             for i in range(n):
-                dot += U[i, m] * R[i, j]
+                dot += U[m, i] * R[j, i]
             for i in range(n):
-                R[i, j] -= dot * U[i, m]
+                R[j, i] -= dot * U[m, i]
         m += 1
-    for a in range(m):  # M = U^T B U, B U kept in R
+    for a in range(m):  # M = U B U^T (basis as rows), B U^T kept in the rows of R
         for j in range(n):
             v = 0.0
             for i in range(n):
-                v += B[j, i] * U[i, a]
-            R[j, a] = v
+                v += B[j, i] * U[a, i]
+            R[a, j] = v
     for a in range(m):
         for b in range(a, m):
             v = 0.0
             for i in range(n):
-                v += U[i, a] * R[i, b]
+                v += U[a, i] * R[b, i]
             M[a, b] = v
             M[b, a] = v
     jacobi_eigen(M, V, m)
-    for c in range(m):  # eigenvectors in the full space, scaled by sqrt of the kept eigenvalues
+    k = 0
+    for c in range(m):  # kept eigenvectors in the full space, scaled by sqrt of their eigenvalues
         lam = M[c, c]
-        for i in range(n):
-            v = 0.0
-            if lam > 0:
-                for a in range(m):
-                    v += U[i, a] * V[a, c]
-            R[i, c] = v * np.sqrt(lam) if lam > 0 else 0.0
+        if lam > 0:
+            sq = np.sqrt(lam)
+            for i in range(n):
+                R[k, i] = 0.0
+            for a in range(m):
+                f = V[a, c] * sq
+                for i in range(n):
+                    R[k, i] += f * U[a, i]
+            k += 1
     for i in range(n):
         for j in range(i, n):
             v = 0.0
-            for c in range(m):
-                v += R[i, c] * R[j, c]
+            for c in range(k):
+                v += R[c, i] * R[c, j]
             out[i, j] = v
             out[j, i] = v
 
