@@ -7,27 +7,33 @@ swept test), a triangle or an edge the box of its nodes' boxes; triangles are in
 ``r``, edges by ``r / 2`` each, so that two primitives closer than ``r`` always have overlapping boxes
 (any axis on which the boxes are more than ``r`` apart separates the primitives by more than ``r``).
 Boxes are written into the cells of a grid of size ``c`` (the mean largest extent of the triangle
-boxes), cell keys sorted (``argsort``), and every pair of entries of the two kinds that share a cell
-is a candidate; candidates are kept if their boxes overlap, the node is not a vertex of the triangle
-(edges: they share no node), and deduplicated by ``np.unique`` on the pair key. No Python loop over
-primitives or pairs: a loop over the three axes only.
+boxes, swept ones for a swept test). Two paths, same pairs in the same order:
 
-Measured 2026-12-02 (2 cores shared with other jobs, so ranges; numpy; 0.8 m sheet, ``alternate``
-pattern, crumpled by random waves of 2 cm, r = d + margin = 0.5 mm + 2.5 mm, h = 1 cm;
-``/tmp``-style script: ``find_pairs`` best of 3):
+* compiled (numba installed, :func:`.distance.compiled_for`; loops in :mod:`.grid`): the entries of
+  one kind are counting-sorted by cell (or ``argsort``-ed on a sparse grid); every box of the other
+  kind visits its cells and keeps a listed box if the boxes overlap, share no node, and the cell is
+  the lowest common cell of the two (each pair once, no deduplication pass);
+* numpy: cell keys sorted (``argsort``), every pair of entries of the two kinds that share a cell a
+  candidate, kept as above and deduplicated by ``np.unique`` on the pair key (a loop over the three
+  axes only).
 
-=========  ======  =========  ============  ========  ========  ======================
-mesh       nodes   triangles  build [s]     PT pairs  EE pairs  swept 5-9 cm step [s]
-=========  ======  =========  ============  ========  ========  ======================
-81 x 81    6,561   12,800     0.17 - 0.38   12,800    31,229    0.9 - 1.8
-161 x 161  25,921  51,200     1.25 - 1.9    51,200    127,040   18 - 40
-=========  ======  =========  ============  ========  ========  ======================
+Measured 2026-12-02 (2 cores shared with other jobs, load average 2.6 - 3.1; 0.8 m sheet,
+``alternate`` pattern, crumpled by random waves of 2 cm, r = d + margin = 0.5 mm + 2.5 mm;
+``python -m rftstatic.bench.self_contact``, best of 3, ``--numpy`` for that path; "before" is the numpy
+code of commit c874a84, whose grid cell ignored the swept boxes):
+
+=========  =========  ==================================  ===================================
+mesh       triangles  build [s]: before, numpy, compiled  swept 7 cm step, r = 0.5 mm [s]
+=========  =========  ==================================  ===================================
+81 x 81    12,800     0.33, 0.17, 0.011                   23, 3.7, 0.09 (1.06 M pairs)
+161 x 161  51,200     1.90, 1.8, 0.055               -, 126, 1.2 (14.3 M pairs)
+=========  =========  ==================================  ===================================
 
 The candidates of a flat or gently crumpled sheet are its neighbours one ring of elements away
 (their boxes overlap, their distance is an element size); only pairs closer than the thickness enter
-the law. A swept test of a long step costs many times a build (tall boxes span many cells): the step
-bound of :mod:`.law` uses it only when the step's relative motion could bring an unlisted pair into
-contact.
+the law. A swept test of a long step costs several builds (tall boxes overlap many boxes: the smooth
+7 cm step of the 81 x 81 sheet lists 1.06 M pairs against 44,000): the step bound of :mod:`.law` uses
+it only when the step's relative motion could bring an unlisted pair into contact.
 """
 
 from __future__ import annotations

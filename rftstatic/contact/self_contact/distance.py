@@ -35,6 +35,13 @@ point-triangle pairs of their end points, which are smooth there.
 
 Shapes: pairs on the first axis, ``x4 (P, 4, 3)`` [m] -> ``s (P,)`` [m^2], gradient ``(P, 4, 3)``
 [m], Hessian ``(P, 12, 12)`` [-] (dof ``3 k + i``).
+
+Two paths: numpy (this module, all pairs at once) and compiled (numba, one loop over the pairs: the
+scalar kernels of :mod:`.kernels`, compiled by :mod:`._kernels_numba`), chosen by :func:`compiled_for`;
+they agree to round-off (closest-feature ties, e.g. exactly parallel edges, may pick another of the
+equally close points). Measured 2026-12-02 (2 cores shared, load average 3.0) on the 81 x 81 fold of
+:mod:`rftstatic.bench.self_contact`: squared distances of the 242,047 listed pairs 0.19 s numpy, 0.009 s
+compiled; gradients and Hessians of the 28,360 pairs closer than d 0.26 s and 0.010 s.
 """
 
 from __future__ import annotations
