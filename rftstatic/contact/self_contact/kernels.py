@@ -1,6 +1,6 @@
 """Self-contact kernels written once as scalar loops over pairs, for the compiled (numba) twins of
 :mod:`.distance` and of the law's PSD projection and step bound (:mod:`._kernels_numba` compiles a copy
-of every function here; nothing here is called uncompiled except by tests of tiny inputs).
+of every function here; the numpy paths are those of the calling modules).
 
 The formulas are those of :mod:`.distance` (closest feature, envelope-theorem Hessian) in the same
 order of operations, so the two paths agree to round-off; ``x (4, 3)`` is one pair's points
