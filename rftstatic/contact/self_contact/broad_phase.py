@@ -7,27 +7,33 @@ swept test), a triangle or an edge the box of its nodes' boxes; triangles are in
 ``r``, edges by ``r / 2`` each, so that two primitives closer than ``r`` always have overlapping boxes
 (any axis on which the boxes are more than ``r`` apart separates the primitives by more than ``r``).
 Boxes are written into the cells of a grid of size ``c`` (the mean largest extent of the triangle
-boxes), cell keys sorted (``argsort``), and every pair of entries of the two kinds that share a cell
-is a candidate; candidates are kept if their boxes overlap, the node is not a vertex of the triangle
-(edges: they share no node), and deduplicated by ``np.unique`` on the pair key. No Python loop over
-primitives or pairs: a loop over the three axes only.
+boxes, swept ones for a swept test). Two paths, same pairs in the same order:
 
-Measured 2026-12-02 (2 cores shared with other jobs, so ranges; numpy; 0.8 m sheet, ``alternate``
-pattern, crumpled by random waves of 2 cm, r = d + margin = 0.5 mm + 2.5 mm, h = 1 cm;
-``/tmp``-style script: ``find_pairs`` best of 3):
+* compiled (numba installed, :func:`.distance.compiled_for`; loops in :mod:`.grid`): the entries of
+  one kind are counting-sorted by cell (or ``argsort``-ed on a sparse grid); every box of the other
+  kind visits its cells and keeps a listed box if the boxes overlap, share no node, and the cell is
+  the lowest common cell of the two (each pair once, no deduplication pass);
+* numpy: cell keys sorted (``argsort``), every pair of entries of the two kinds that share a cell a
+  candidate, kept as above and deduplicated by ``np.unique`` on the pair key (a loop over the three
+  axes only).
 
-=========  ======  =========  ============  ========  ========  ======================
-mesh       nodes   triangles  build [s]     PT pairs  EE pairs  swept 5-9 cm step [s]
-=========  ======  =========  ============  ========  ========  ======================
-81 x 81    6,561   12,800     0.17 - 0.38   12,800    31,229    0.9 - 1.8
-161 x 161  25,921  51,200     1.25 - 1.9    51,200    127,040   18 - 40
-=========  ======  =========  ============  ========  ========  ======================
+Measured 2026-12-02 (2 cores shared with other jobs, load average 2.6 - 3.1; 0.8 m sheet,
+``alternate`` pattern, crumpled by random waves of 2 cm, r = d + margin = 0.5 mm + 2.5 mm;
+``python -m rftstatic.bench.self_contact``, best of 3, ``--numpy`` for that path; "before" is the numpy
+code of commit c874a84, whose grid cell ignored the swept boxes):
+
+=========  =========  ==================================  ===================================
+mesh       triangles  build [s]: before, numpy, compiled  swept 7 cm step, r = 0.5 mm [s]
+=========  =========  ==================================  ===================================
+81 x 81    12,800     0.33, 0.17, 0.011                   23, 3.7, 0.09 (1.06 M pairs)
+161 x 161  51,200     1.90, 1.8, 0.055               -, 126, 1.2 (14.3 M pairs)
+=========  =========  ==================================  ===================================
 
 The candidates of a flat or gently crumpled sheet are its neighbours one ring of elements away
 (their boxes overlap, their distance is an element size); only pairs closer than the thickness enter
-the law. A swept test of a long step costs many times a build (tall boxes span many cells): the step
-bound of :mod:`.law` uses it only when the step's relative motion could bring an unlisted pair into
-contact.
+the law. A swept test of a long step costs several builds (tall boxes overlap many boxes: the smooth
+7 cm step of the 81 x 81 sheet lists 1.06 M pairs against 44,000): the step bound of :mod:`.law` uses
+it only when the step's relative motion could bring an unlisted pair into contact.
 """
 
 from __future__ import annotations
@@ -35,6 +41,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from rftstatic.contact.self_contact import distance
 
 __all__ = ["Pairs", "SheetPrimitives", "find_pairs", "PairCache", "brute_force_pairs"]
 
@@ -147,15 +155,71 @@ def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.nda
         raise ValueError(f"x1 must have shape {x0.shape}, got {np.shape(x1)}")
     if not (np.isfinite(radius) and radius > 0):
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
+    tri, edges = prims.tri, prims.edges
+    if distance.compiled_for(len(tri) + len(edges)):
+        return _find_pairs_compiled(prims, x0, radius, x1)
+    return _find_pairs_numpy(prims, x0, radius, x1)
+
+
+def _boxes(prims, x0, radius, x1):
+    """Node, triangle and edge boxes ``(lo, hi)`` (module docstring) and the grid ``(origin, cell, dims)``."""
     lo_n, hi_n = _node_boxes(x0, x1)
     tri, edges = prims.tri, prims.edges
     lo_t, hi_t = lo_n[tri].min(axis=1) - radius, hi_n[tri].max(axis=1) + radius
     lo_e, hi_e = lo_n[edges].min(axis=1) - 0.5 * radius, hi_n[edges].max(axis=1) + 0.5 * radius
-    # cell size from the boxes at x0 (a swept box then spans more cells instead of coarsening the grid)
-    lo0, hi0 = x0[tri].min(axis=1), x0[tri].max(axis=1)
-    cell = float(np.mean(np.max(hi0 - lo0, axis=1))) + 2.0 * radius
+    cell = _cell_size(lo_t, hi_t)
     origin = lo_t.min(axis=0) - cell
     dims = np.floor((hi_t.max(axis=0) - origin) / cell).astype(np.int64) + 2
+    return (lo_n, hi_n), (lo_t, hi_t), (lo_e, hi_e), (origin, cell, dims)
+
+
+def _cell_size(lo_t, hi_t):
+    """Grid cell [m]: the mean largest extent of the (inflated, for a swept test swept) triangle boxes.
+    Cells much smaller than the boxes put every box into many cells: a swept test with cells from the
+    boxes at ``x0`` took 23 s for the 7 cm step of the 81 x 81 sheet (numpy), 7.7 s with these."""
+    return float(np.mean(np.max(hi_t - lo_t, axis=1)))
+
+
+def _cell_range(lo, hi, origin, cell):
+    return np.floor((lo - origin) / cell).astype(np.int64), np.floor((hi - origin) / cell).astype(np.int64)
+
+
+DENSE_CELLS = 8
+"""The compiled cell list keeps an array over every grid cell (a counting sort) when the grid has at
+most this many cells per box entry (or 65,536 in all), else it sorts the occupied cells."""
+
+
+def _find_pairs_compiled(prims, x0, radius, x1):
+    """:func:`find_pairs` by the compiled cell list (:mod:`.grid`)."""
+    from rftstatic.contact.self_contact._kernels_numba import boxes, cell_list, join
+
+    tri, edges = np.ascontiguousarray(prims.tri), np.ascontiguousarray(prims.edges)
+    nodes = np.arange(prims.n_nodes, dtype=np.int64)[:, None]
+    x0 = np.ascontiguousarray(x0)
+    x1 = np.zeros((0, 3)) if x1 is None else np.ascontiguousarray(x1, dtype=float)
+    box = {}
+    for name, prim, inflate in (("n", nodes, 0.0), ("t", tri, radius), ("e", edges, 0.5 * radius)):
+        lo, hi = np.empty((len(prim), 3)), np.empty((len(prim), 3))
+        boxes(x0, x1, prim, inflate, lo, hi)
+        box[name] = lo, hi
+    lo_t, hi_t = box["t"]
+    cell = _cell_size(lo_t, hi_t)
+    origin = lo_t.min(axis=0) - cell
+    dims = np.floor((hi_t.max(axis=0) - origin) / cell).astype(np.int64) + 2
+    c = {k: _cell_range(*v, origin, cell) for k, v in box.items()}
+    out = []
+    for a, b, na, nb_, same in (("n", "t", nodes, tri, False), ("e", "e", edges, edges, True)):
+        entries = int(np.prod(c[b][1] - c[b][0] + 1, axis=1).sum())
+        dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries, 1 << 16)
+        cl = cell_list(c[b][0], c[b][1], dims, dense)
+        out.append(join(c[a][0], c[a][1], *box[a], na, c[b][0], *box[b], nb_, *cl, dims, dense, same))
+    return Pairs(out[0], out[1])
+
+
+def _find_pairs_numpy(prims, x0, radius, x1):
+    """:func:`find_pairs` by numpy sorts and joins."""
+    (lo_n, hi_n), (lo_t, hi_t), (lo_e, hi_e), (origin, cell, dims) = _boxes(prims, x0, radius, x1)
+    tri, edges = prims.tri, prims.edges
     # point-triangle
     own_n, key_n = _cells(lo_n, hi_n, origin, cell, dims)
     own_t, key_t = _cells(lo_t, hi_t, origin, cell, dims)

@@ -8,6 +8,8 @@ from rftstatic.contact.self_contact.broad_phase import (PairCache, SheetPrimitiv
                                                         find_pairs)
 from rftstatic.mesh.trimesh import rectangle
 
+pytestmark = pytest.mark.usefixtures("backend")
+
 
 def crumpled(n, seed=0, amp=0.4):
     """An n x n sheet of side 1 [m] crumpled by random waves (amplitude ~amp) and folded over once."""

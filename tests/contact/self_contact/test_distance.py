@@ -7,6 +7,8 @@ import pytest
 from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distance2, point_triangle,
                                                      point_triangle_distance2)
 
+pytestmark = pytest.mark.usefixtures("backend")
+
 TRI = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 

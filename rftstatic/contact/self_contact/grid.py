@@ -1,0 +1,150 @@
+"""Cell-list loops of the broad phase, written once as scalar loops for the compiled (numba) twin of
+:func:`.broad_phase.find_pairs` (:mod:`._kernels_numba` compiles a copy of every function here).
+
+Boxes are given by their cell ranges ``c0, c1 (B, 3)`` (integers, inclusive) and their bounds
+``lo, hi (B, 3)`` [m]. :func:`cell_list` sorts the (box, cell) entries of one kind by cell key;
+:func:`join` then visits, for every box ``a`` of the other kind in order, the cells it covers and
+the boxes ``b`` listed there, and keeps ``(a, b)`` if the boxes overlap, share no node, and the cell
+is the lowest corner ``max(c0_a, c0_b)`` of their common cells, so that every pair is found once
+without a deduplication pass; the ``b`` of one ``a`` are sorted, so the pairs come out sorted.
+"""
+
+import numpy as np
+
+
+def boxes(x0, x1, prims, inflate, lo, hi):
+    """Fill ``lo, hi (B, 3)`` [m] with the boxes of primitives ``prims (B, m)`` (node indices): the
+    box of their nodes' positions ``x0`` (or paths ``x0 -> x1``; ``x1`` of shape ``(0, 3)``: none)
+    widened by ``inflate`` [m]."""
+    swept = x1.shape[0] > 0
+    for b in range(prims.shape[0]):
+        for i in range(3):
+            v = x0[prims[b, 0], i]
+            mn, mx = v, v
+            for k in range(prims.shape[1]):
+                v = x0[prims[b, k], i]
+                mn, mx = min(mn, v), max(mx, v)
+                if swept:
+                    v = x1[prims[b, k], i]
+                    mn, mx = min(mn, v), max(mx, v)
+            lo[b, i], hi[b, i] = mn - inflate, mx + inflate
+
+
+def cell_list(c0, c1, dims, dense):
+    """Entries of boxes ``c0, c1 (B, 3)`` by cell: ``ukey (U,)``, ``start (U + 1,)`` and the boxes
+    ``members (K,)`` (ascending within a cell), the entries of cell ``ukey[u]`` being
+    ``members[start[u]:start[u + 1]]``; key ``ix + dims[0] (iy + dims[1] iz)``. ``dense``: every cell
+    of the grid is listed (``U = prod(dims)``, ``ukey`` left empty, a counting sort); else only the
+    occupied ones, sorted (``argsort``)."""
+    B = c0.shape[0]
+    K = 0
+    for b in range(B):
+        K += (c1[b, 0] - c0[b, 0] + 1) * (c1[b, 1] - c0[b, 1] + 1) * (c1[b, 2] - c0[b, 2] + 1)
+    if dense:
+        C = dims[0] * dims[1] * dims[2]
+        start = np.zeros(C + 1, dtype=np.int64)
+        for b in range(B):
+            for iz in range(c0[b, 2], c1[b, 2] + 1):
+                for iy in range(c0[b, 1], c1[b, 1] + 1):
+                    for ix in range(c0[b, 0], c1[b, 0] + 1):
+                        start[ix + dims[0] * (iy + dims[1] * iz) + 1] += 1
+        for c in range(C):
+            start[c + 1] += start[c]
+        fill = start[:C].copy()
+        members = np.empty(K, dtype=np.int64)
+        for b in range(B):
+            for iz in range(c0[b, 2], c1[b, 2] + 1):
+                for iy in range(c0[b, 1], c1[b, 1] + 1):
+                    for ix in range(c0[b, 0], c1[b, 0] + 1):
+                        c = ix + dims[0] * (iy + dims[1] * iz)
+                        members[fill[c]] = b
+                        fill[c] += 1
+        return np.zeros(0, dtype=np.int64), start, members
+    key = np.empty(K, dtype=np.int64)
+    owner = np.empty(K, dtype=np.int64)
+    k = 0
+    for b in range(B):
+        for iz in range(c0[b, 2], c1[b, 2] + 1):
+            for iy in range(c0[b, 1], c1[b, 1] + 1):
+                for ix in range(c0[b, 0], c1[b, 0] + 1):
+                    key[k] = ix + dims[0] * (iy + dims[1] * iz)
+                    owner[k] = b
+                    k += 1
+    order = np.argsort(key, kind="mergesort")
+    members = owner[order]
+    skey = key[order]
+    U = 0
+    for k in range(K):
+        if k == 0 or skey[k] != skey[k - 1]:
+            U += 1
+    ukey = np.empty(U, dtype=np.int64)
+    start = np.empty(U + 1, dtype=np.int64)
+    u = 0
+    for k in range(K):
+        if k == 0 or skey[k] != skey[k - 1]:
+            ukey[u] = skey[k]
+            start[u] = k
+            u += 1
+    start[U] = K
+    return ukey, start, members
+
+
+def _grow(out, n):
+    if n < out.shape[0]:
+        return out
+    bigger = np.empty((2 * out.shape[0] + 16, 2), dtype=np.int64)
+    bigger[:n] = out[:n]
+    return bigger
+
+
+def join(c0a, c1a, lo_a, hi_a, nodes_a, c0b, lo_b, hi_b, nodes_b, ukey, start, members, dims, dense, same):
+    """Pairs ``(a, b) (Q, 2)``, sorted, of boxes ``a`` (cell ranges ``c0a, c1a``, bounds ``lo_a, hi_a``,
+    nodes ``nodes_a (A, m)``) and ``b`` (the :func:`cell_list` of ``c0b``; bounds, ``nodes_b (B, n)``)
+    that overlap and share no node; ``same``: both are one kind, only ``a < b``."""
+    out = np.empty((4 * c0a.shape[0] + 16, 2), dtype=np.int64)
+    found = np.empty(64, dtype=np.int64)
+    n = 0
+    for a in range(c0a.shape[0]):
+        nf = 0
+        for iz in range(c0a[a, 2], c1a[a, 2] + 1):
+            for iy in range(c0a[a, 1], c1a[a, 1] + 1):
+                for ix in range(c0a[a, 0], c1a[a, 0] + 1):
+                    key = ix + dims[0] * (iy + dims[1] * iz)
+                    if dense:
+                        u = key
+                    else:
+                        u = np.searchsorted(ukey, key)
+                        if u == ukey.shape[0] or ukey[u] != key:
+                            continue
+                    for k in range(start[u], start[u + 1]):
+                        b = members[k]
+                        if same and b <= a:
+                            continue
+                        if (max(c0a[a, 0], c0b[b, 0]) != ix or max(c0a[a, 1], c0b[b, 1]) != iy
+                                or max(c0a[a, 2], c0b[b, 2]) != iz):
+                            continue  # reported in the lowest common cell
+                        if not (lo_a[a, 0] <= hi_b[b, 0] and lo_b[b, 0] <= hi_a[a, 0]
+                                and lo_a[a, 1] <= hi_b[b, 1] and lo_b[b, 1] <= hi_a[a, 1]
+                                and lo_a[a, 2] <= hi_b[b, 2] and lo_b[b, 2] <= hi_a[a, 2]):
+                            continue
+                        shared = False
+                        for i in range(nodes_a.shape[1]):
+                            for j in range(nodes_b.shape[1]):
+                                if nodes_a[a, i] == nodes_b[b, j]:
+                                    shared = True
+                        if shared:
+                            continue
+                        if nf == found.shape[0]:
+                            more = np.empty(2 * nf, dtype=np.int64)
+                            more[:nf] = found[:nf]
+                            found = more
+                        found[nf] = b
+                        nf += 1
+        if nf:
+            found[:nf].sort()
+            for f in range(nf):
+                out = _grow(out, n)
+                out[n, 0] = a
+                out[n, 1] = found[f]
+                n += 1
+    return out[:n].copy()

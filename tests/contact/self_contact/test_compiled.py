@@ -1,0 +1,111 @@
+"""The compiled (numba) twins of the self-contact loops agree with the numpy path to round-off: the
+distances, gradients, Hessians and features of random pairs of every closest-feature type, the PSD
+projection of the law's blocks and of random symmetric matrices, the additive CCD, and the broad phase."""
+
+import numpy as np
+import pytest
+
+from rftstatic.contact.self_contact import distance, law_kernels
+from rftstatic.contact.self_contact.broad_phase import SheetPrimitives, find_pairs
+
+pytest.importorskip("numba")
+
+
+def _on(monkeypatch, compiled):
+    monkeypatch.setattr(distance, "compiled_for", lambda n: compiled)
+
+
+def _both(monkeypatch, f, *args, **kw):
+    _on(monkeypatch, False)
+    a = f(*args, **kw)
+    _on(monkeypatch, True)
+    return a, f(*args, **kw)
+
+
+def _random_pairs(kind, n=3000, seed=0):
+    """Random pairs, a sixth of the edge pairs (anti-)parallel, so that every feature occurs."""
+    rng = np.random.default_rng(seed)
+    x4 = rng.standard_normal((n, 4, 3))
+    if kind == "ee":
+        m = n // 6
+        d = rng.standard_normal((m, 3))
+        x4[:m, 1] = x4[:m, 0] + d
+        x4[:m, 3] = x4[:m, 2] + rng.choice([-1.0, 0.5, 2.0], size=(m, 1)) * d
+    return x4
+
+
+@pytest.mark.parametrize("kind", ["pt", "ee"])
+def test_distances_and_derivatives_agree(monkeypatch, kind):
+    f = distance.point_triangle if kind == "pt" else distance.edge_edge
+    f2 = distance.point_triangle_distance2 if kind == "pt" else distance.edge_edge_distance2
+    x4 = _random_pairs(kind)
+    (s, g, H, code), (s_c, g_c, H_c, code_c) = _both(monkeypatch, f, x4)
+    assert np.bincount(code, minlength=3).min() > 50  # every feature, many times
+    np.testing.assert_array_equal(code_c, code)
+    np.testing.assert_allclose(s_c, s, rtol=1e-12, atol=1e-14)
+    # exactly parallel edges have ties of closest points (distance unique, gradient not): left out
+    smooth = slice(len(x4) // 6, None) if kind == "ee" else slice(None)
+    g, H, g_c, H_c = g[smooth], H[smooth], g_c[smooth], H_c[smooth]
+    np.testing.assert_allclose(g_c, g, rtol=1e-11, atol=1e-13)
+    scale = np.abs(H).max(axis=(1, 2), keepdims=True)
+    np.testing.assert_allclose(H_c / scale, H / scale, rtol=0, atol=1e-11)
+    a, b = _both(monkeypatch, f2, x4)
+    np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-14)
+    (_, _, none, _), (_, g2, none2, _) = _both(monkeypatch, f, x4, hessian=False)
+    assert none is None and none2 is None
+    np.testing.assert_allclose(g2[smooth], g_c, rtol=0, atol=0)
+
+
+def _law_blocks(seed=0):
+    """Law-like blocks ``c1 gg^T + c2 H`` of random pairs of both kinds, ``c2`` of either sign."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for kind, f in (("pt", distance.point_triangle), ("ee", distance.edge_edge)):
+        s, g, H, _ = f(_random_pairs(kind, 1000, seed))
+        g = g.reshape(-1, 12)
+        c1, c2 = rng.uniform(0, 2, (2, len(s), 1, 1)) * [[[[1.0]]], [[[-1.0]]]]
+        out.append(c1 * np.einsum("pm,pn->pmn", g, g) + c2 * rng.choice([-1.0, 1.0], (len(s), 1, 1)) * H)
+    return np.concatenate(out)
+
+
+def test_psd_projection_agrees(monkeypatch):
+    rng = np.random.default_rng(1)
+    full = rng.standard_normal((200, 12, 12))
+    low = rng.standard_normal((200, 12, 4))
+    sign = np.where(np.arange(4) % 2, -1.0, 1.0)
+    blocks = [_law_blocks(), full + full.transpose(0, 2, 1), np.einsum("pik,k,pjk->pij", low, sign, low),
+              np.zeros((3, 12, 12))]
+    for B in blocks:
+        a, b = _both(monkeypatch, law_kernels.psd_project, B)
+        scale = np.abs(B).max(axis=(1, 2), keepdims=True) + 1e-300
+        np.testing.assert_allclose(b / scale, a / scale, rtol=0, atol=1e-12)
+        assert np.linalg.eigvalsh(b).min() >= -1e-12 * scale.max()
+
+
+@pytest.mark.parametrize("kind", [0, 1])
+@pytest.mark.parametrize("size", [0.01, 0.3, 3.0])
+def test_additive_ccd_agrees(monkeypatch, kind, size):
+    rng = np.random.default_rng(2)
+    x4 = _random_pairs("pt" if kind == 0 else "ee", 2000, seed=3)
+    dx4 = size * rng.standard_normal(x4.shape)
+    a, b = _both(monkeypatch, law_kernels.additive_ccd, x4, dx4, kind, 0.2, 200)
+    assert 0.0 < a < 1.0 or size == 0.01
+    assert b == pytest.approx(a, rel=1e-12)
+    nodes = rng.permutation(4 * len(x4)).reshape(-1, 4)  # the same pairs as nodes of a point cloud
+    x, dx = np.empty((4 * len(x4), 3)), np.empty((4 * len(x4), 3))
+    x[nodes], dx[nodes] = x4, dx4
+    c, e = _both(monkeypatch, law_kernels.additive_ccd_nodes, x, dx, nodes, kind, 0.2, 200)
+    assert c == a and e == pytest.approx(a, rel=1e-12)
+
+
+def test_broad_phase_agrees_on_a_folded_crumpled_sheet(monkeypatch):
+    from rftstatic.bench.self_contact import crumpled, smooth_step
+
+    mesh, X = crumpled(31)
+    X[X[:, 0] > 0.4, 2] += 0.004
+    prims = SheetPrimitives.of_mesh(mesh)
+    for r, X1 in ((3e-3, None), (5e-3, None), (5e-4, X + smooth_step(X, 0.05))):
+        a, b = _both(monkeypatch, find_pairs, prims, X, r, X1)
+        assert len(a.pt) and len(a.ee)
+        np.testing.assert_array_equal(b.pt, a.pt)
+        np.testing.assert_array_equal(b.ee, a.ee)
