@@ -144,3 +144,20 @@ def test_near_pair_cache_keeps_every_pair_within_the_radius():
     q = len(cache.npt)
     assert np.all(np.sqrt(point_triangle_distance2(y[cache.npt])) >= lb[:q] - 1e-15)
     assert np.all(np.sqrt(edge_edge_distance2(y[cache.nee])) >= lb[q:] - 1e-15)
+
+
+def test_dynamic_scene_with_self_contact_reports_its_counters(tmp_path):
+    """contact.self = true runs in a dynamic scene (it was a SceneError) and summary.json states the
+    pair counts and costs next to the crossing check of every saved state."""
+    from rftstatic.app.registry import run_scene
+    from rftstatic.scenes.schema import load_scene
+
+    scene = load_scene("hang-20", ["mesh.nodes=[9, 9]", "dynamics.t_end=0.05", "dynamics.samples=4",
+                                   "dynamics.frames=[0.0, 0.05]", "contact.self=true"])
+    s = run_scene(scene, tmp_path / "out", progress=False, figures=False)
+    sc = s["self_contact"]
+    assert sc["rebuilds"] >= 1 and sc["filter_steps"] == s["steps"]
+    assert sc["thickness"] == pytest.approx(0.05)  # cm
+    for key in ("pairs", "max_pairs", "broad_phase_s", "force_s", "filter_s", "impulses", "ccd_limited"):
+        assert key in sc
+    assert s["self_intersections"]["pairs"] == 0 and max(s["self_intersections"]["pairs_saved"]) == 0
