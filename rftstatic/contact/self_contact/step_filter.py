@@ -39,6 +39,14 @@ distances stay positive and no pair passes through another (straight-line steps;
 projection after the step is not part of the path). The kinetic energy the filter removes is returned
 (the explicit loop adds it to ``contact_loss``).
 
+Measured 2026-12-02 (2 shared cores, other jobs running, so upper figures), pedestal-square-80 with
+``contact.self = true`` (81 x 81, d = 0.05 cm, margin 0.28 cm): its relaxation (28,302 explicit steps)
+rebuilt the list 513 times, 0.35 s each (179 s: :func:`~.broad_phase.find_pairs` of ~54,000 box pairs
+plus the exact-distance cut to 571 near pairs); the force on the near pairs 23 s over 23,532 calls
+(~1 ms); the filter 269 s including the rebuilds it triggered, i.e. ~3 ms a step of per-pair tests
+(16,794 steps ran them, none needed an impulse; the early exit when nothing approaches too fast was
+added after that run). On a flat sheet (no near pairs) the force and filter add only O(N) tests.
+
 Shapes: ``x, v (N, 3)`` [m], [m/s]; ``minv (N, 3)`` [1/kg]; pairs ``(P, 4)`` node rows.
 """
 
@@ -153,6 +161,8 @@ class StepFilter:
         delta = np.sqrt(np.einsum("pi,pi->p", r, r))
         n = r / np.where(delta > 0, delta, 1.0)[:, None]
         bound = -self.approach * delta / dt
+        if not np.any(np.einsum("pk,pki,pi->p", w, v[nodes], n) < bound):  # nothing approaches too fast
+            return
         minv = self.minv.ravel()
         rows = w[:, :, None] * n[:, None, :]  # (P, 4, 3): d v_n / d v
         dof = (3 * nodes[:, :, None] + np.arange(3)).reshape(-1, 12)
