@@ -36,7 +36,7 @@ import numpy as np
 from rftstatic.app.result import RunResult
 from rftstatic.errors import CheckpointError, StepLimitError
 from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
-from rftstatic.io.summary import self_intersection_summary, summary_header
+from rftstatic.io.summary import self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import dynamics_options, static_options
@@ -240,6 +240,8 @@ def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_fr
     if run.contact_nodes:
         summary["contact_nodes"] = run.contact_nodes
     summary["self_intersections"] = self_intersection_summary(scene, model, run.U, states=run.frames)
+    if getattr(model, "self_contact", None) is not None:
+        summary["self_contact"] = self_contact_summary(scene, model)
     return summary
 
 

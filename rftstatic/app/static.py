@@ -22,7 +22,7 @@ from rftstatic.app.result import RunResult
 from rftstatic.errors import ConvergenceError
 from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_outputs
-from rftstatic.io.summary import drape_summary, probe_summary, self_intersection_summary, summary_header
+from rftstatic.io.summary import drape_summary, probe_summary, self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import static_options
 from rftstatic.solvers.static import solve_static
@@ -115,6 +115,8 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "max_relative_curvature": float(model.relative_curvature(U).max()),
         "self_intersections": self_intersection_summary(scene, model, U),
     })
+    if model.self_contact is not None:
+        summary["self_contact"] = self_contact_summary(scene, model)
     if model.contact is not None:
         x = model.positions(U)
         summary["max_penetration"] = model.contact.max_penetration(x) / u.length

@@ -5,7 +5,9 @@ out for speed: the constant bending stiffness (Eq. 13) as one scalar CSR product
 membrane forces of the kernels of :mod:`rftstatic.element.kernels` (the same code as the static
 force and tangent: strain-point gradients, averaged Green strain of Eq. 14, ``S = D^m eps`` of
 Eq. 15, ``f_a = A/Q sum_q F_q S g_qa``), summed into the nodes. A penalty contact term of the model
-(``model.contact``), if any, is added as in the static solver.
+(``model.contact``), if any, is added as in the static solver, and so is its self-contact
+(``model.self_contact``: the gradient of the same energy, evaluated on the near pairs of the solve's
+pair cache only, :meth:`rftstatic.contact.self_contact.law.SelfContact.near_force`).
 
 Two back ends run that code: ``"numba"`` (compiled, one pass over the elements and the CSR rows of
 K_b, :func:`rftstatic.element.kernels.internal_force`) and ``"numpy"`` (the same element kernels
@@ -59,6 +61,7 @@ class ForceKernel:
         self.Dm = np.ascontiguousarray(model.material.Dm, dtype=float)
         self.with_membrane = model.with_membrane
         self.contact = model.contact
+        self.self_contact = getattr(model, "self_contact", None)
         self.X3 = model.X3
         mem = model.membrane
         E, Q, A, _ = mem.G.shape
@@ -92,11 +95,12 @@ class ForceKernel:
             self._tuner = ThreadTuner(self._run_threads) if tune else None
             self._nb_parallel = internal_force_parallel
 
-    def __call__(self, U: np.ndarray, *, energy: bool = False, candidates=None):
+    def __call__(self, U: np.ndarray, *, energy: bool = False, candidates=None, pairs=None):
         """Internal force ``(N, 3)`` [N]; with ``energy=True`` also the stored energy [J].
 
-        The stored energy is bending + membrane + penalty contact (:meth:`Model.energies`);
-        ``candidates`` is the solve's contact candidate list (a cache; None: every node).
+        The stored energy is bending + membrane + penalty contact + self-contact (:meth:`Model.energies`);
+        ``candidates`` is the solve's contact candidate list (a cache; None: every node), ``pairs`` its
+        self-contact pair cache (``State.self_pairs``; None: a fresh broad phase).
         """
         U = np.ascontiguousarray(U, dtype=float)
         if self.backend == "numba":
@@ -128,4 +132,11 @@ class ForceKernel:
             f += self.contact.force(x, candidates=candidates)
             if energy:
                 W += self.contact.energy(x, candidates=candidates)
+        if self.self_contact is not None:
+            fs = self.self_contact.near_force(self.X3 + U, pairs, energy=energy)
+            if energy:
+                f += fs[0]
+                W += fs[1]
+            else:
+                f += fs
         return (f, W) if energy else f

@@ -94,6 +94,22 @@ def probe_summary(scene, model, probes: dict, U) -> dict:
             for name, p in probe_positions(model, probes, U).items()}
 
 
+def self_contact_summary(scene, model) -> dict | None:
+    """The self-contact's settings and counters (:class:`~rftstatic.contact.self_contact.near_pairs.SelfContactStats`,
+    summed over the run's solves), lengths in scene units; None without self-contact. ``pairs``: the near
+    pairs (within thickness + margin) of the last broad phase, ``max_pairs`` the most of any;
+    ``broad_phase_s`` the builds' wall time, ``force_s`` that of the energy/force/tangent evaluations,
+    ``filter_s`` that of the explicit step filter."""
+    sc = getattr(model, "self_contact", None)
+    if sc is None:
+        return None
+    u = scene.units
+    out = {"thickness": sc.thickness / u.length, "margin": sc.margin / u.length,
+           "stiffness": sc.stiffness / (u.force / u.length)}
+    out.update(sc.stats.as_dict())
+    return out
+
+
 def self_intersection_summary(scene, model, U, *, states=()) -> dict:
     """Self-intersection check (:func:`~rftstatic.post.measures.intersections.self_intersections`) of
     the state ``U (N, 3)`` [m] of ``model``, lengths in the scene's unit.

@@ -383,9 +383,9 @@ def build_self_contact(scene: Scene, mesh, material):
     from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
 
     u = scene.units.length
-    if scene.get("analysis", "static") != "static":
-        raise scene.error("contact.self", f"true: self-contact is implemented for the static analysis only, "
-                          f'not yet for analysis = "{scene.get("analysis")}"; remove it or use analysis = "static"')
+    if scene.get("analysis", "static") != "static" and scene.get("remesh") is not None:
+        raise scene.error("contact.self", "true: self-contact is not yet implemented for a remeshed explicit run "
+                          '(analysis = "relax" with [remesh]); remove it or the [remesh] table')
     given = scene.get("contact.self_thickness")
     if given is None:
         d = float(material.info.get("thickness", SELF_THICKNESS_M))

@@ -265,6 +265,13 @@ class _Loop:
         self.P = np.array(model.load if load is None else load, dtype=float)
         self.probes, self.frame_times = probes, frame_times
         self.minv = self.free / self.mass[:, None]  # (N, 3) inverse mass, zero on supported dofs
+        sc = getattr(model, "self_contact", None)
+        if sc is not None:
+            from rftstatic.contact.self_contact.step_filter import StepFilter
+
+            self.self_filter = StepFilter(sc, self.minv)
+        else:
+            self.self_filter = None
         self.n_contact = 0
         self.interrupted = False  # set by Ctrl-C (:class:`_StopOnInterrupt`); checked after every step
 
@@ -276,7 +283,7 @@ class _Loop:
         self.hist = {k: [] for k in HISTORY_KEYS}
         self.probe_hist, self.frames = [], []
         if start_consistent:
-            f = self.kernel(state.U, candidates=state.candidates)
+            f = self.kernel(state.U, candidates=state.candidates, pairs=state.self_pairs)
             a0 = (self.P - f) / self.mass[:, None] - self.alpha * state.V
             state.V = state.V - 0.5 * dt * a0 * self.free
 
@@ -310,9 +317,9 @@ class _Loop:
             sample = step % sample_every == 0
             checked = sample or step % check_every == 0
             if checked:
-                f, W = self.kernel(U, energy=True, candidates=state.candidates)
+                f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs)
             else:
-                f = self.kernel(U, candidates=state.candidates)
+                f = self.kernel(U, candidates=state.candidates, pairs=state.self_pairs)
             self._frames_due(t, U)
             # Eq. 20-21, with the damping force lagged half a step
             np.subtract(P, f, out=f)
@@ -332,6 +339,8 @@ class _Loop:
                         state.U, state.V, state.t, state.step = U, V, t, step
                         stopped = bool(callback(state, rec))
             V, Vnew = Vnew, V
+            if self.self_filter is not None:  # no pair of the sheet passes through another on this step
+                acc["contact"] += self.self_filter(state.self_pairs, self.model.X3 + U, V, dt)
             # Eq. 22
             U += dt * V
             if self.obstacles:
@@ -364,7 +373,7 @@ class _Loop:
     def final_sample(self, state, check):
         """The history sample (and any frame due) at the end state."""
         t, U, V, dt = state.t, state.U, state.V, self.dt
-        f, W = self.kernel(U, energy=True, candidates=state.candidates)
+        f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs)
         self._frames_due(t, U)
         g = (self.P - f) * self.minv * dt
         Vend = V * (1.0 - self.alpha * dt) + g

@@ -54,6 +54,7 @@ phase (tall boxes) and took 20 s: the Newton step cap keeps such steps rare near
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,6 +62,7 @@ import numpy as np
 from rftstatic.contact.self_contact.broad_phase import PairCache, Pairs, SheetPrimitives, find_pairs
 from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distance2, point_triangle,
                                                      point_triangle_distance2)
+from rftstatic.contact.self_contact.near_pairs import NearPairCache, SelfContactStats, pair_nodes
 
 __all__ = ["SelfContact", "SelfContactState", "auto_stiffness"]
 
@@ -153,6 +155,7 @@ class SelfContact:
         self.stiffness = float(stiffness)
         self.min_fraction = float(min_fraction)
         self.margin = float(margin) if margin is not None else max(2.0 * thickness, 0.25 * float(length.mean()))
+        self.stats = SelfContactStats()
         ref = self.evaluate(X, tangent=False)
         if ref.n_active:
             raise ValueError(f"the flat reference mesh has {ref.n_active} self-contact pairs closer than the "
@@ -163,9 +166,10 @@ class SelfContact:
     def n_nodes(self) -> int:
         return self.prims.n_nodes
 
-    def new_pairs(self) -> PairCache:
-        """A fresh pair cache for a solve (kept in :attr:`rftstatic.model.state.State.self_pairs`)."""
-        return PairCache(self.margin)
+    def new_pairs(self) -> NearPairCache:
+        """A fresh pair cache for a solve (kept in :attr:`rftstatic.model.state.State.self_pairs`): the
+        pairs within ``d + margin`` by exact distance (:mod:`.near_pairs`), counted in :attr:`stats`."""
+        return NearPairCache(self.margin, self.stats)
 
     def pairs(self, x, cache: PairCache | None = None) -> Pairs:
         """Pairs within ``d + margin`` of ``x (N, 3)`` [m] (from ``cache`` when still valid)."""
@@ -174,10 +178,8 @@ class SelfContact:
         return find_pairs(self.prims, x, self.thickness + self.margin)
 
     def _x4(self, x, pairs: Pairs):
-        """Nodes ``(P, 4)`` and points ``(P, 4, 3)`` of the point-triangle, then edge-edge, pairs."""
-        npt = np.concatenate([pairs.pt[:, :1], self.prims.tri[pairs.pt[:, 1]]], axis=1)
-        nee = self.prims.edges[pairs.ee].reshape(-1, 4)
-        return npt, nee
+        """Nodes ``(Q, 4)`` of the point-triangle and ``(R, 4)`` of the edge-edge pairs."""
+        return pair_nodes(self.prims, pairs)
 
     def _check_x(self, x):
         x = np.asarray(x, dtype=float)
@@ -187,12 +189,24 @@ class SelfContact:
 
     def evaluate(self, x, *, tangent: bool = True, cache: PairCache | None = None,
                  project: bool = True) -> SelfContactState:
-        """Energy, force and pair blocks at positions ``x (N, 3)`` [m]; ``project``: the blocks
-        projected to PSD (False: the exact Hessian blocks, for tests)."""
+        """Energy, force and pair blocks at positions ``x (N, 3)`` [m] over the pairs within ``d + margin``
+        (:meth:`pairs`); ``project``: the blocks projected to PSD (False: the exact Hessian blocks, for tests)."""
         x = self._check_x(x)
-        d, k = self.thickness, self.stiffness
         pairs = self.pairs(x, cache)
-        npt, nee = self._x4(x, pairs)
+        if isinstance(cache, NearPairCache):
+            npt, nee = cache.npt, cache.nee
+        else:
+            npt, nee = self._x4(x, pairs)
+        return self.evaluate_pairs(x, npt, nee, tangent=tangent, project=project)
+
+    def evaluate_pairs(self, x, npt, nee, *, tangent: bool = True, project: bool = True) -> SelfContactState:
+        """The law (module docstring) summed over the given pairs: ``npt (Q, 4)`` point-triangle rows
+        (node, triangle), ``nee (R, 4)`` edge-edge rows (edge, edge), at ``x (N, 3)`` [m]. The one source
+        of the energy ``sum k / (3 d) (d - delta)^3`` [J], its gradient ``(N, 3)`` [N] and the pair blocks,
+        for the static solver (:meth:`evaluate`) and the explicit one
+        (:meth:`near_force`)."""
+        t0 = time.perf_counter()
+        d, k = self.thickness, self.stiffness
         s_pt = point_triangle_distance2(x[npt]) if len(npt) else np.zeros(0)
         s_ee = edge_edge_distance2(x[nee]) if len(nee) else np.zeros(0)
         smin = min(float(s_pt.min(initial=np.inf)), float(s_ee.min(initial=np.inf)))
@@ -208,6 +222,7 @@ class SelfContact:
             dist.append(np.sqrt(s2))
         force = np.zeros((self.n_nodes, 3))
         if not nodes_list:
+            self._count(t0)
             return SelfContactState(0.0, force, np.zeros((0, 4), np.int64),
                                     np.zeros((0, 12, 12)) if tangent else None, float(np.sqrt(smin)), 0)
         nodes = np.concatenate(nodes_list)
@@ -227,7 +242,32 @@ class SelfContact:
             blocks = e2[:, None, None] * np.einsum("am,an->amn", gd, gd) + e1[:, None, None] * hd
             if project:
                 blocks = _psd(blocks)
+        self._count(t0)
         return SelfContactState(energy, force, nodes, blocks, float(np.sqrt(smin)), len(nodes))
+
+    def _count(self, t0):
+        self.stats.force_s += time.perf_counter() - t0
+        self.stats.force_calls += 1
+
+    def near_force(self, x, cache: NearPairCache | None, *, energy: bool = False):
+        """The force ``(N, 3)`` [N] (gradient of ``E_s``) at ``x (N, 3)`` [m] and, with ``energy``, ``E_s`` [J],
+        for the explicit solver: only the near pairs of ``cache`` (the solve's :class:`NearPairCache`; None:
+        a fresh broad phase) whose lower bound (Eq. 1 of :mod:`.near_pairs`) is below the thickness are
+        evaluated, and none when even the smallest bound is above it (an O(N) test)."""
+        x = self._check_x(x)
+        if cache is None:
+            st = self.evaluate(x, tangent=False)
+            return (st.force, st.energy) if energy else st.force
+        cache.pairs(self.prims, x, self.thickness)
+        m = cache.motion(x)
+        d = self.thickness
+        if cache.min_dist - 2.0 * float(m.max(initial=0.0)) >= d:
+            f = np.zeros_like(x)
+            return (f, 0.0) if energy else f
+        live = cache.lower_bounds(m) < d
+        q = len(cache.npt)
+        st = self.evaluate_pairs(x, cache.npt[live[:q]], cache.nee[live[q:]], tangent=False)
+        return (st.force, st.energy) if energy else st.force
 
     def energy(self, x, *, cache: PairCache | None = None) -> float:
         """E_s [J] at ``x (N, 3)`` [m]."""
