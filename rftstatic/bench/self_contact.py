@@ -64,19 +64,13 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--skip", nargs="*", default=[], help="parts to skip: build swept law ccd")
     ap.add_argument("--numpy", action="store_true", help="the numpy path only (no compiled twins)")
-    ap.add_argument("--wired", action="store_true",
-                    help="the law's PSD projection and CCD replaced by their law_kernels twins")
     a = ap.parse_args(argv)
-    from rftstatic.contact.self_contact import distance, law, law_kernels
+    from rftstatic.contact.self_contact import distance, law_kernels
 
     if a.numpy:
         distance.compiled_for = lambda n: False
-    if a.wired:
-        law._psd = law_kernels.psd_project
-        law._additive_ccd = lambda x4, dx4, dist2, eta, rounds, sides: law_kernels.additive_ccd(
-            x4, dx4, 0 if len(sides[0]) == 1 else 1, eta, rounds)
     print(f"load average {os.getloadavg()}, {'numpy' if a.numpy else 'compiled where numba is installed'}"
-          f"{', law wired to law_kernels' if a.wired else ''}")
+          )
     for n in a.n:
         mesh, X = crumpled(n)
         prims = SheetPrimitives.of_mesh(mesh)
@@ -98,7 +92,7 @@ def main(argv=None):
             t, st = best(lambda: sc.evaluate(X, tangent=False), a.repeat)
             print(f"{n}x{n} folded energy+force: {t:.3f} s, {st.n_active} active, min {st.min_distance / d:.3f} d")
             t, st = best(lambda: sc.evaluate(X, tangent=True), a.repeat)
-            print(f"{n}x{n} folded with PSD tangent (law._psd): {t:.3f} s")
+            print(f"{n}x{n} folded with PSD tangent (law_kernels.psd_project): {t:.3f} s")
             cache = sc.new_pairs()
             sc.pairs(X, cache)
             t, st = best(lambda: sc.evaluate(X, tangent=False, cache=cache), a.repeat)

@@ -62,6 +62,7 @@ import numpy as np
 from rftstatic.contact.self_contact.broad_phase import PairCache, Pairs, SheetPrimitives, find_pairs
 from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distance2, point_triangle,
                                                      point_triangle_distance2)
+from rftstatic.contact.self_contact.law_kernels import additive_ccd_nodes, psd_project
 from rftstatic.contact.self_contact.near_pairs import NearPairCache, SelfContactStats, pair_nodes
 
 __all__ = ["SelfContact", "SelfContactState", "auto_stiffness"]
@@ -110,15 +111,6 @@ def auto_stiffness(*, weight: float, node_area: float, thickness: float, pressur
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
     return float(factor * 4.0 * pressure_factor * weight * node_area / thickness)
-
-
-def _psd(H):
-    """Project symmetric ``(A, n, n)`` matrices onto the PSD cone (eigenvalues clamped at 0)."""
-    if not len(H):
-        return H
-    H = 0.5 * (H + H.transpose(0, 2, 1))
-    lam, Q = np.linalg.eigh(H)
-    return np.einsum("aij,aj,akj->aik", Q, np.maximum(lam, 0.0), Q)
 
 
 class SelfContact:
@@ -241,7 +233,7 @@ class SelfContact:
             hd = Hs / (2.0 * delta[:, None, None]) - np.einsum("am,an->amn", gs, gs) / (4.0 * delta[:, None, None] ** 3)
             blocks = e2[:, None, None] * np.einsum("am,an->amn", gd, gd) + e1[:, None, None] * hd
             if project:
-                blocks = _psd(blocks)
+                blocks = psd_project(blocks)
         self._count(t0)
         return SelfContactState(energy, force, nodes, blocks, float(np.sqrt(smin)), len(nodes))
 
@@ -316,40 +308,6 @@ class SelfContact:
             swept = find_pairs(self.prims, x, d, x + dx)
             s_pt, s_ee = self._x4(x, swept)
             npt, nee = np.concatenate([npt, s_pt]), np.concatenate([nee, s_ee])
-        t_pt = _additive_ccd(x[npt], dx[npt], point_triangle_distance2, eta, max_rounds, ((0,), (1, 2, 3)))
-        t_ee = _additive_ccd(x[nee], dx[nee], edge_edge_distance2, eta, max_rounds, ((0, 1), (2, 3)))
+        t_pt = additive_ccd_nodes(x, dx, npt, 0, eta, max_rounds)
+        t_ee = additive_ccd_nodes(x, dx, nee, 1, eta, max_rounds)
         return float(min(1.0, t_pt, t_ee))
-
-
-def _additive_ccd(x4, dx4, dist2, eta, max_rounds, sides) -> float:
-    """Smallest safe time in [0, 1] over pairs ``x4, dx4 (P, 4, 3)`` (module docstring); 1 if none."""
-    if not len(x4):
-        return 1.0
-    a, b = sides
-    rel = dx4[:, list(a)][:, :, None, :] - dx4[:, list(b)][:, None, :, :]
-    ell = np.sqrt(np.max(np.einsum("pabi,pabi->pab", rel, rel), axis=(1, 2)))  # (P,) relative speed bound
-    d0 = np.sqrt(dist2(x4))
-    keep = (ell > 0) & (ell * 1.0 > (1.0 - eta) * d0)  # the others cannot reach eta d0 by t = 1
-    if not np.any(keep):
-        return 1.0
-    x4, dx4, ell, d0 = x4[keep], dx4[keep], ell[keep], d0[keep]
-    g = eta * d0
-    t = np.zeros(len(d0))
-    dcur = d0.copy()
-    live = np.ones(len(d0), dtype=bool)
-    for _ in range(max_rounds):
-        tau = (dcur[live] - g[live]) / ell[live]
-        tn = t[live] + tau
-        done = tn >= 1.0
-        idx = np.flatnonzero(live)
-        t[idx[done]] = 1.0
-        live[idx[done]] = False
-        idx, tn = idx[~done], tn[~done]
-        if not len(idx):
-            break
-        t[idx] = tn
-        dcur[idx] = np.sqrt(dist2(x4[idx] + tn[:, None, None] * dx4[idx]))
-        # close to the target: the pair is about to reach eta d0; keep the time reached
-        stuck = dcur[idx] - g[idx] <= 1e-3 * (d0[idx] - g[idx])
-        live[idx[stuck]] = False
-    return float(t.min())

@@ -57,9 +57,8 @@ import time
 import numpy as np
 
 from rftstatic.contact.self_contact.broad_phase import find_pairs
-from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distance2, point_triangle,
-                                                     point_triangle_distance2)
-from rftstatic.contact.self_contact.law import _additive_ccd
+from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
+from rftstatic.contact.self_contact.law_kernels import additive_ccd_nodes
 from rftstatic.contact.self_contact.near_pairs import NearPairCache, pair_nodes
 
 __all__ = ["APPROACH", "StepFilter"]
@@ -228,8 +227,8 @@ class StepFilter:
         if swept:  # the swept pairs are not in the list: check them all
             pt_rows = np.concatenate([pt_rows, nodes_checked[is_pt_checked]])
             ee_rows = np.concatenate([ee_rows, nodes_checked[~is_pt_checked]])
-        t_pt = _additive_ccd(x[pt_rows], dx[pt_rows], point_triangle_distance2, self.eta, 200, ((0,), (1, 2, 3)))
-        t_ee = _additive_ccd(x[ee_rows], dx[ee_rows], edge_edge_distance2, self.eta, 200, ((0, 1), (2, 3)))
+        t_pt = additive_ccd_nodes(x, dx, pt_rows, 0, self.eta, 200)
+        t_ee = additive_ccd_nodes(x, dx, ee_rows, 1, self.eta, 200)
         t = min(1.0, t_pt, t_ee)
         if t < 1.0:
             v *= t
