@@ -47,6 +47,38 @@ def charge_numpy(seconds: float) -> None:
     _numpy_seconds[0] += seconds
 
 
+def numpy_budget_spent() -> bool:
+    """Whether the numpy twins chosen by "auto" back ends have used up :data:`NUMPY_BUDGET_S` in this process."""
+    return _numpy_seconds[0] > NUMPY_BUDGET_S
+
+
+def charged_numpy(loaded):
+    """Decorator: the wall time of a call of the wrapped function counts against the numpy budget
+    (:func:`charge_numpy`) when ``loaded()`` (whether the compiled twins are in this process) is false
+    before and after the call, i.e. when it ran the numpy twin. Nested charged calls count once."""
+    import functools
+    import time
+
+    def wrap(f):
+        @functools.wraps(f)
+        def charged(*args, **kwargs):
+            if _depth[0] or loaded():
+                return f(*args, **kwargs)
+            _depth[0] += 1
+            t0 = time.perf_counter()
+            try:
+                return f(*args, **kwargs)
+            finally:
+                _depth[0] -= 1
+                if not loaded():
+                    charge_numpy(time.perf_counter() - t0)
+        return charged
+    return wrap
+
+
+_depth = [0]
+
+
 def static_kernels_compiled(n_elements: int) -> bool:
     """Whether the static membrane kernels of a mesh of ``n_elements`` run compiled ("auto" back end):
     numba installed, and the mesh large enough to repay loading it (:data:`STATIC_COMPILED_MIN_ELEMENTS`),

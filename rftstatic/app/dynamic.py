@@ -52,6 +52,19 @@ log = logging.getLogger(__name__)
 CHECKPOINT = "checkpoint.npz"
 
 
+MIN_DT_SHARE = 1e-9
+"""Smallest ``dynamics.dt`` as a share of the stable step estimate: below it a step moves the sheet by
+round-off only (at dt = 5e-324 s the velocity update underflowed to zero and the rest test saw a sheet at
+rest), and an explicit run could not reach any time of interest within the step limit."""
+
+
+def checkpoint_steps(every: float, dt: float) -> int:
+    """Explicit steps between checkpoints: ``every`` [s] of simulated time at step ``dt`` [s], at least 1
+    (a subnormal ``dt`` makes the ratio overflow: then every 10^12 steps, i.e. only at the end)."""
+    ratio = every / dt
+    return max(1, int(round(min(ratio, 1e12)))) if np.isfinite(ratio) else 10**12
+
+
 def run(scene, out: Path, *, progress=True, figures=True, resume=False) -> RunResult:
     """Build ``scene``'s model (obstacles acting kinematically) and run it (:func:`run_dynamic_scene`)."""
     model, extras = build_model(scene)
@@ -133,7 +146,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         hist_r = np.asarray(data["history"]["residual"], float)
         rest.peak_residual = float(hist_r.max()) if hist_r.size else 0.0
         dt = data["dt"]
-        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
+        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, dt))
         resumed_from = data["t"]
         try:
             run = resume_run(ckpt_path, model, obstacles=obstacles, callback=watch, checkpoint=ckpt,
@@ -148,9 +161,13 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         dt = o.dt if o.dt is not None else estimate.dt
         if dt > estimate.dt * (1 + 1e-3):
             log.warning("dynamics.dt = %.4g s exceeds the stable estimate %.4g s", dt, estimate.dt)
+        if dt < MIN_DT_SHARE * estimate.dt:  # the velocity update dt M^-1 (P - F) would lose the force to round-off
+            raise scene.error("dynamics.dt", f"{dt / scene.units.time:.4g} is below {MIN_DT_SHARE:g} of the stable step "
+                              f"estimate {estimate.dt / scene.units.time:.4g} (scene time units): the steps would not "
+                              "move the sheet; give a dt near the estimate or leave dynamics.dt out")
         horizon = _horizon(scene, analysis, t_end, dt, limit, _limit_name(o, model.mesh.n_nodes))
         dt = horizon / step_count(horizon, dt, limit)
-        ckpt = Checkpointer(ckpt_path, every_steps=max(1, int(round(o.checkpoint_every / dt))))
+        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, dt))
         run = run_explicit(model, t_end=horizon, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
                            obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(), callback=watch,
                            checkpoint=ckpt, progress=progress, rest_tol=o.rest_tolerance, backend=backend,

@@ -704,6 +704,9 @@ def check_scene(data: dict, workdir: Path, label: str = "") -> tuple[str, float]
 def workdirs(tmp_path_factory):
     """A fresh folder per example; the first use loads (or compiles) the kernels outside the bound."""
     root = tmp_path_factory.mktemp("scenes")
+    from rftstatic.contact.self_contact.law_kernels import load_compiled
+
+    load_compiled()  # the self-contact twins that a long tiny run switches to (their first compile: ~30 s)
     for name in ("hang-20", "strip", "pedestal-square-20"):  # the explicit, static and relax routes
         extra = ["dynamics.t_end=0.01", "dynamics.frames=[0.01]"] if name == "hang-20" else []
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):

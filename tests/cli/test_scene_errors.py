@@ -281,3 +281,17 @@ def test_the_convergence_scales_of_an_unloaded_model_are_its_weight():
 
     model.material = dataclasses.replace(model.material, weight=0.0)
     assert unloaded_scales(model) == (1e-300, 1e-300)
+
+
+def test_a_subnormal_time_step_is_an_input_error(capsys, tmp_path):
+    # was: an OverflowError (checkpoint_every / dt), then a relaxation "at rest" after one step whose
+    # velocity update had underflowed to zero
+    code, err = _run(capsys, tmp_path, "pedestal-square-40", ["mesh.nodes=[14,3]", "analysis=relax", "dynamics.dt=5e-324",
+                                                               "dynamics.t_end=0.01"])
+    assert code == 2 and "dynamics.dt" in err and "stable step" in err, err
+
+
+def test_checkpoint_steps_of_a_tiny_step_do_not_overflow():
+    from rftstatic.app.dynamic import checkpoint_steps
+
+    assert checkpoint_steps(0.2, 1e-3) == 200 and checkpoint_steps(0.2, 5e-324) == 10**12 and checkpoint_steps(1e-9, 1.0) == 1

@@ -50,7 +50,7 @@ import sys
 
 import numpy as np
 
-from rftstatic.compiled import numba_available
+from rftstatic.compiled import charged_numpy, numba_available, numpy_budget_spent
 from rftstatic.contact.self_contact.kernels import PARALLEL_TOL
 
 __all__ = [
@@ -75,8 +75,19 @@ _COMPILED = "rftstatic.contact.self_contact._kernels_numba"
 
 def compiled_for(n: int) -> bool:
     """Whether the self-contact loops over ``n`` pairs or boxes run compiled: numba installed and
-    either ``n >= COMPILED_MIN_PAIRS`` or the compiled twins already loaded in this process."""
-    return numba_available() and (n >= COMPILED_MIN_PAIRS or _COMPILED in sys.modules)
+    either ``n >= COMPILED_MIN_PAIRS``, the compiled twins already loaded in this process, or the numpy
+    twins having used up the process's budget (:func:`rftstatic.compiled.numpy_budget_spent`, the
+    ski-rental rule: a long explicit run of a tiny sheet calls them ~10 times a step)."""
+    return numba_available() and (n >= COMPILED_MIN_PAIRS or compiled_loaded() or numpy_budget_spent())
+
+
+def compiled_loaded() -> bool:
+    """Whether the compiled self-contact twins are loaded in this process."""
+    return _COMPILED in sys.modules
+
+
+numpy_charged = charged_numpy(compiled_loaded)
+"""Decorator of the self-contact functions with a numpy twin: their numpy time counts against the budget."""
 
 
 def _compiled_derivatives(x4, kind, hessian):
@@ -249,6 +260,7 @@ def pair_derivatives(x4, W, D, act, *, hessian=True):
     return s, grad, H
 
 
+@numpy_charged
 def point_triangle(x4, *, hessian=True):
     """Point-triangle squared distance, gradient, Hessian and closest feature.
 
@@ -272,6 +284,7 @@ def point_triangle(x4, *, hessian=True):
     return s, g, H, code
 
 
+@numpy_charged
 def edge_edge(x4, *, hessian=True):
     """Edge-edge (segment-segment) squared distance, gradient, Hessian and closest feature.
 
@@ -295,6 +308,7 @@ def edge_edge(x4, *, hessian=True):
     return s, g, H, code
 
 
+@numpy_charged
 def point_triangle_distance2(x4) -> np.ndarray:
     """Point-triangle squared distance ``(P,)`` [m^2] only (the continuous-collision loop's call)."""
     x4 = _check(x4, "point_triangle_distance2")
@@ -303,6 +317,7 @@ def point_triangle_distance2(x4) -> np.ndarray:
     return _pt_classify(x4)[3]
 
 
+@numpy_charged
 def edge_edge_distance2(x4) -> np.ndarray:
     """Edge-edge squared distance ``(P,)`` [m^2] only."""
     x4 = _check(x4, "edge_edge_distance2")

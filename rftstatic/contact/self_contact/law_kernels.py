@@ -24,6 +24,7 @@ __all__ = ["psd_project", "additive_ccd", "additive_ccd_nodes"]
 _SIDES = (((0,), (1, 2, 3)), ((0, 1), (2, 3)))
 
 
+@distance.numpy_charged
 def psd_project(H: np.ndarray) -> np.ndarray:
     """Symmetric ``(A, n, n)`` matrices projected onto the PSD cone (eigenvalues clamped at 0).
 
@@ -42,6 +43,7 @@ def psd_project(H: np.ndarray) -> np.ndarray:
     return np.einsum("aij,aj,akj->aik", Q, np.maximum(lam, 0.0), Q)
 
 
+@distance.numpy_charged
 def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rounds: int) -> float:
     """Smallest safe time in [0, 1] over pairs ``x4, dx4 (P, 4, 3)`` [m] (``kind`` 0 point-triangle,
     1 edge-edge): the first time any pair comes within ``eta`` of its starting distance, found by
@@ -101,3 +103,40 @@ def additive_ccd_nodes(x: np.ndarray, dx: np.ndarray, nodes: np.ndarray, kind: i
         return float(ccd_all(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(dx, dtype=float),
                              np.ascontiguousarray(nodes), kind, float(eta), int(max_rounds)))
     return additive_ccd(x[nodes], dx[nodes], kind, eta, max_rounds)
+
+
+def load_compiled() -> bool:
+    """Load the compiled self-contact twins now (numba compiles them on their first use in a checkout,
+    about half a minute, then loads them from its cache in about a second) by running each once on a
+    sheet folded onto itself; False when numba is not installed. For callers that time what follows
+    (a study, the property test's per-scene bound), so that the one-time compile falls outside."""
+    from rftstatic.compiled import numba_available
+    from rftstatic.contact.self_contact.broad_phase import SheetPrimitives, find_pairs
+    from rftstatic.mesh.trimesh import rectangle
+
+    if not numba_available():
+        return False
+    mesh = rectangle(2.0, 1.0, 5, 3)
+    x = mesh.X3.copy()
+    fold = x[:, 0] > 1.0
+    x[fold, 0], x[fold, 2] = 2.0 - x[fold, 0], 0.1  # the right half laid over the left one
+    dx = np.zeros_like(x)
+    dx[fold, 2] = -0.2  # and pushed through it
+    saved = distance.compiled_for
+    distance.compiled_for = lambda n: True
+    try:
+        pairs = find_pairs(SheetPrimitives.of_mesh(mesh), x, 0.2)
+        find_pairs(SheetPrimitives.of_mesh(mesh), x, 0.2, x + dx)
+        tri, edges = mesh.tri, mesh.topology.edges
+        npt = np.column_stack([pairs.pt[:, 0], tri[pairs.pt[:, 1]]]).astype(np.int64)
+        nee = np.column_stack([edges[pairs.ee[:, 0]], edges[pairs.ee[:, 1]]]).astype(np.int64)
+        for kind, nodes, full, d2 in ((0, npt, distance.point_triangle, distance.point_triangle_distance2),
+                                      (1, nee, distance.edge_edge, distance.edge_edge_distance2)):
+            H = full(x[nodes], hessian=True)[2]
+            d2(x[nodes])
+            psd_project(H)
+            additive_ccd(x[nodes], dx[nodes], kind, 0.2, 10)
+            additive_ccd_nodes(x, dx, nodes, kind, 0.2, 10)
+    finally:
+        distance.compiled_for = saved
+    return True

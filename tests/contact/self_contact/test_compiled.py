@@ -109,3 +109,24 @@ def test_broad_phase_agrees_on_a_folded_crumpled_sheet(monkeypatch):
         assert len(a.pt) and len(a.ee)
         np.testing.assert_array_equal(b.pt, a.pt)
         np.testing.assert_array_equal(b.ee, a.ee)
+
+
+def test_load_compiled_loads_the_twins_and_the_budget_switches_to_them(monkeypatch):
+    import sys
+
+    from rftstatic import compiled
+    from rftstatic.contact.self_contact import distance, law_kernels
+
+    if not compiled.numba_available():
+        assert law_kernels.load_compiled() is False
+        return
+    assert law_kernels.load_compiled() and distance.compiled_loaded()
+    # the ski-rental rule: with the twins not loaded, small calls go compiled once the numpy budget is spent
+    monkeypatch.delitem(sys.modules, "rftstatic.contact.self_contact._kernels_numba")
+    monkeypatch.setattr(compiled, "_numpy_seconds", [0.0])
+    assert not distance.compiled_for(10)
+    x4 = np.random.default_rng(1).normal(size=(50, 4, 3))
+    distance.point_triangle(x4)
+    assert 0.0 < compiled._numpy_seconds[0] < compiled.NUMPY_BUDGET_S  # the numpy twin's time was charged
+    compiled._numpy_seconds[0] = 2 * compiled.NUMPY_BUDGET_S
+    assert distance.compiled_for(10)
