@@ -73,7 +73,7 @@ def run_case(name: str, overrides: list[str]) -> dict:
 
         x = model.positions(U)
         sc = model.self_contact
-        costs["broad_phase_build_s"] = _median_time(lambda: find_pairs(x, model.mesh.tri, sc.thickness + sc.margin))
+        costs["broad_phase_build_s"] = _median_time(lambda: find_pairs(sc.prims, x, sc.thickness + sc.margin))
     return {"summary": summary, "run_s": run_s, "costs": costs}
 
 
