@@ -44,7 +44,8 @@ from rftstatic.contact.kinematic import contact_reaction_residual
 from rftstatic.errors import CheckpointError, InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable, write_json
 from rftstatic.io.results import write_outputs
-from rftstatic.io.summary import drape_summary, probe_summary, self_intersection_summary, summary_header
+from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_summary, self_intersection_summary,
+                                   summary_header)
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.remesh.checkpoint import FIX, RemeshCheckpointer, load_remesh_checkpoint
 from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
@@ -315,6 +316,8 @@ def summarize(scene, opts, solved) -> dict:
         "max_relative_curvature": float(model.relative_curvature(U).max()),
         "self_intersections": self_intersection_summary(scene, model, U),
     })
+    if model.self_contact is not None:  # the counters of the last mesh's model (each remesh builds its own)
+        summary["self_contact"] = self_contact_summary(scene, model)
     if solved["route"] == "remesh_relax":
         d = solved["dynamics"]
         summary.update(t=solved["t"] / u.time, steps=solved["steps"], skipped_remeshes=solved["skipped"],

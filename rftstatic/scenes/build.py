@@ -373,6 +373,11 @@ woven fabrics and ARCSim's 1 mm repulsion thickness, and below half the 1 cm edg
 drape meshes."""
 
 
+REMESH_THICKNESS_SHARE = 0.25
+"""Largest self-contact thickness of a remeshed run, as a share of ``remesh.h_lower``: the advancing-front
+meshes' shortest edges are about half the target size, and the thickness must stay below half of those."""
+
+
 def build_self_contact(scene: Scene, mesh, material):
     """The sheet's self-contact (:class:`~rftstatic.contact.self_contact.law.SelfContact`) when
     ``contact.self = true``, else None. Thickness ``contact.self_thickness`` [scene length] (default
@@ -383,9 +388,6 @@ def build_self_contact(scene: Scene, mesh, material):
     from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
 
     u = scene.units.length
-    if scene.get("analysis", "static") != "static" and scene.get("remesh") is not None:
-        raise scene.error("contact.self", "true: self-contact is not yet implemented for a remeshed explicit run "
-                          '(analysis = "relax" with [remesh]); remove it or the [remesh] table')
     given = scene.get("contact.self_thickness")
     if given is None:
         d = float(material.info.get("thickness", SELF_THICKNESS_M))
@@ -396,6 +398,11 @@ def build_self_contact(scene: Scene, mesh, material):
         raise scene.error(key, f"{shown!r} is not a positive thickness; give a thickness > 0")
     edges = mesh.topology.edges
     smallest = float(np.linalg.norm(mesh.X[edges[:, 1]] - mesh.X[edges[:, 0]], axis=1).min())
+    h_lower = scene.get("remesh.h_lower") if scene.get("remesh") is not None else None
+    if isinstance(h_lower, (int, float)) and d > REMESH_THICKNESS_SHARE * h_lower * u:
+        raise scene.error(key, f"{shown!r} is above {REMESH_THICKNESS_SHARE:g} of remesh.h_lower = {h_lower:g} (scene length "
+                          "units): the remeshed meshes' shortest edges (about half h_lower) must stay above twice the "
+                          "thickness; give a thinner thickness or a larger remesh.h_lower")
     if d > 0.5 * smallest:
         raise scene.error(key, f"{shown!r} is above half the smallest edge of the mesh ({smallest / u:.4g} / 2 = "
                           f"{0.5 * smallest / u:.4g}, scene length units): the self-contact would push apart "

@@ -185,3 +185,14 @@ def test_bench_scene_in_a_fresh_process_and_its_report(tmp_path):
     text = (tmp_path / "bench_remesh.md").read_text()
     assert "| square uniform | 2000 | 3800 |" in text and "remesh-pedestal-square-20" in text
     assert json.loads((tmp_path / "bench_remesh.json").read_text())["scenes"][0]["nodes"] == r["nodes"]
+
+
+def test_a_remeshed_relaxation_with_self_contact_rebuilds_its_pairs_on_every_mesh(tmp_path):
+    # each remesh builds a model with its own self-contact (pairs rebuilt on the new mesh); the summary
+    # keeps the last mesh's counters and the independent crossing check
+    scene = load_scene("remesh-pedestal-square-20", ["contact.self=true", "remesh.h_lower=1.0", "remesh.h_upper=3.0",
+                                                     "dynamics.t_end=2.0"])
+    s = run_remesh_scene(scene, tmp_path, progress=False, figures=False)
+    assert s["remeshes"] >= 1 and s["self_intersections"]["pairs"] == 0
+    sc = s["self_contact"]
+    assert sc["thickness"] == pytest.approx(0.05) and sc["rebuilds"] >= 0 and sc["filter_steps"] > 0  # it acted on the last mesh

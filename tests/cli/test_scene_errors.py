@@ -295,3 +295,8 @@ def test_checkpoint_steps_of_a_tiny_step_do_not_overflow():
     from rftstatic.app.dynamic import checkpoint_steps
 
     assert checkpoint_steps(0.2, 1e-3) == 200 and checkpoint_steps(0.2, 5e-324) == 10**12 and checkpoint_steps(1e-9, 1.0) == 1
+
+
+def test_a_self_contact_thickness_above_a_quarter_of_h_lower_is_an_input_error(capsys, tmp_path):
+    code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", ["contact.self=true", "contact.self_thickness=0.2"])
+    assert code == 2 and "contact.self_thickness" in err and "remesh.h_lower" in err, err
