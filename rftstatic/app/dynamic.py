@@ -161,11 +161,11 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         dt = o.dt if o.dt is not None else estimate.dt
         if dt > estimate.dt * (1 + 1e-3):
             log.warning("dynamics.dt = %.4g s exceeds the stable estimate %.4g s", dt, estimate.dt)
+        horizon = _horizon(scene, analysis, t_end, dt, limit, _limit_name(o, model.mesh.n_nodes))
         if dt < MIN_DT_SHARE * estimate.dt:  # the velocity update dt M^-1 (P - F) would lose the force to round-off
             raise scene.error("dynamics.dt", f"{dt / scene.units.time:.4g} is below {MIN_DT_SHARE:g} of the stable step "
                               f"estimate {estimate.dt / scene.units.time:.4g} (scene time units): the steps would not "
                               "move the sheet; give a dt near the estimate or leave dynamics.dt out")
-        horizon = _horizon(scene, analysis, t_end, dt, limit, _limit_name(o, model.mesh.n_nodes))
         dt = horizon / step_count(horizon, dt, limit)
         ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, dt))
         run = run_explicit(model, t_end=horizon, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
