@@ -428,6 +428,9 @@ def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
         m = meshio.read(path)
     except Exception as exc:  # meshio raises many types; re-raise with the file name
         raise MeshError(f"{path}: meshio could not read it ({exc})") from exc
+    except SystemExit:  # meshio's VTU reader exits the interpreter on an empty or truncated file
+        raise MeshError(f"{path}: meshio could not read it (an empty or truncated file?); export the mesh "
+                        "again") from None
     tris = [c.data for c in m.cells if c.type == "triangle"]
     if not tris:
         kinds = sorted({c.type for c in m.cells})

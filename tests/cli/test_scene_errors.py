@@ -300,3 +300,12 @@ def test_checkpoint_steps_of_a_tiny_step_do_not_overflow():
 def test_a_self_contact_thickness_above_a_quarter_of_h_lower_is_an_input_error(capsys, tmp_path):
     code, err = _run(capsys, tmp_path, "remesh-pedestal-square-20", ["contact.self=true", "contact.self_thickness=0.2"])
     assert code == 2 and "contact.self_thickness" in err and "remesh.h_lower" in err, err
+
+
+@pytest.mark.parametrize("content", ["", "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n<Unstr"])
+def test_an_empty_or_truncated_vtu_is_an_input_error_naming_the_scene(capsys, tmp_path, content):
+    # was: exit 1 with meshio's own "Error: Couldn't read file ... as vtu" (its VTU reader calls sys.exit)
+    path = tmp_path / "sheet.vtu"
+    path.write_text(content)
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.kind=file", f"mesh.path={path}", "supports=[]"])
+    assert code == 2 and "strip.toml" in err and "mesh" in err and "sheet.vtu" in err, err
