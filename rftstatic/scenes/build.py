@@ -14,6 +14,7 @@ from rftstatic import material as mat
 from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.scenes.schema import Scene
+from rftstatic.scenes.self_contact import build_self_contact
 from rftstatic.units import unit_system
 
 MESH_KEYS = {
@@ -365,60 +366,6 @@ def check_obstacle_positions(scene: Scene, mesh) -> None:
                                       f"{MAX_OBSTACLE_DISTANCE:g} sheet sizes ({bound:g} scene length units) from the "
                                       f"sheet (centre {axis} = {centre['xyz'.index(axis)]:g}); give a position near the "
                                       "sheet")
-
-
-SELF_THICKNESS_M = 5e-4
-"""Default self-contact thickness [m] (0.05 cm) when the material gives none: within the 0.2-1 mm of
-woven fabrics and ARCSim's 1 mm repulsion thickness, and below half the 1 cm edges of the paper's
-drape meshes."""
-
-
-REMESH_THICKNESS_SHARE = 0.25
-"""Largest self-contact thickness of a remeshed run, as a share of ``remesh.h_lower``: the advancing-front
-meshes' shortest edges are about half the target size, and the thickness must stay below half of those."""
-
-
-def build_self_contact(scene: Scene, mesh, material):
-    """The sheet's self-contact (:class:`~rftstatic.contact.self_contact.law.SelfContact`) when
-    ``contact.self = true``, else None. Thickness ``contact.self_thickness`` [scene length] (default
-    the material's thickness, else :data:`SELF_THICKNESS_M`); stiffness
-    :func:`~rftstatic.contact.self_contact.law.auto_stiffness` times ``contact.self_factor``."""
-    if not scene.get("contact.self", False):
-        return None
-    from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
-
-    u = scene.units.length
-    given = scene.get("contact.self_thickness")
-    if given is None:
-        d = float(material.info.get("thickness", SELF_THICKNESS_M))
-        key, shown = "material.thickness" if "thickness" in material.info else "contact.self_thickness", d / u
-    else:
-        d, key, shown = float(given) * u, "contact.self_thickness", given
-    if not d > 0:
-        raise scene.error(key, f"{shown!r} is not a positive thickness; give a thickness > 0")
-    edges = mesh.topology.edges
-    smallest = float(np.linalg.norm(mesh.X[edges[:, 1]] - mesh.X[edges[:, 0]], axis=1).min())
-    h_lower = scene.get("remesh.h_lower") if scene.get("remesh") is not None else None
-    if isinstance(h_lower, (int, float)) and d > REMESH_THICKNESS_SHARE * h_lower * u:
-        raise scene.error(key, f"{shown!r} is above {REMESH_THICKNESS_SHARE:g} of remesh.h_lower = {h_lower:g} (scene length "
-                          "units): the remeshed meshes' shortest edges (about half h_lower) must stay above twice the "
-                          "thickness; give a thinner thickness or a larger remesh.h_lower")
-    if d > 0.5 * smallest:
-        raise scene.error(key, f"{shown!r} is above half the smallest edge of the mesh ({smallest / u:.4g} / 2 = "
-                          f"{0.5 * smallest / u:.4g}, scene length units): the self-contact would push apart "
-                          "neighbours that are not in contact; give a thinner thickness or a coarser mesh")
-    factor = scene.get("contact.self_factor", 1.0)
-    if not factor > 0:
-        raise scene.error("contact.self_factor", f"{factor!r} is not a positive multiplier; give a number > 0")
-    if not material.weight > 0:
-        raise scene.error("contact.self", "true needs material.weight > 0 (the self-contact stiffness is sized "
-                          "by the sheet's weight)")
-    k = auto_stiffness(weight=material.weight, node_area=float(mesh.node_area.mean()), thickness=d,
-                       factor=float(factor))
-    try:
-        return SelfContact(mesh, d, k)
-    except ValueError as exc:
-        raise scene.error(key, f"{shown!r}: {exc}") from None
 
 
 def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
