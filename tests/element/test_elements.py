@@ -228,3 +228,25 @@ def test_bad_material_is_reported():
         material.fabric(C_warp=1.0, C_weft=1.0, C_shear=1.0, C12=5.0, B_warp=1, B_weft=1, B_twist=1, weight=0)
     with pytest.raises(ValueError, match="nu"):
         material.isotropic_shell(E=1.0, nu=0.7, thickness=1.0)
+
+
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+@pytest.mark.parametrize("psd", [False, True])
+@pytest.mark.parametrize("carried", [False, True])
+def test_numpy_tangent_agrees_with_the_compiled_kernel(element, psd, carried):
+    # the numpy twin writes the element tangent as whole-array products; the compiled kernel loops
+    pytest.importorskip("numba")
+    import rftstatic.element._kernels_numba as compiled
+    from rftstatic.bench.problems import strip_model
+    from rftstatic.element import kernels
+
+    model = strip_model(11, 5, element=element)
+    op = model.membrane
+    rng = np.random.default_rng(3)
+    U = 0.05 * rng.normal(size=(model.mesh.n_nodes, 3))
+    E, A = op.nodes.shape
+    S = rng.normal(size=(E, 3)) if carried else np.zeros((0, 3))
+    fe1, ke1 = kernels.tangents_numpy(op.G_last, op.nodes, op.area, model.material.Dm, U, psd, S if carried else None)
+    fe2, ke2 = np.empty((E, A, 3)), np.empty((E, A, 3, A, 3))
+    compiled.membrane_tangents(op.nodes, np.ascontiguousarray(op.G), op.area, model.material.Dm, U, psd, S, fe2, ke2)
+    assert np.abs(ke1 - ke2).max() <= 1e-13 * np.abs(ke2).max() and np.array_equal(fe1, fe2)
