@@ -106,6 +106,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "route": result.route,
         "relax": result.relax,
         "stable_minimum": result.stable,
+        "self_contact_stiffenings": getattr(result, "self_contact_stiffenings", 0),
         "perturbation_seed": result.seed,
         "residual": result.residual / u.force,
         "wall_time_s": result.wall_time,

@@ -65,21 +65,72 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         if restart.phase == "done":
             return _check_stability(model, restart.result, opts)
         if restart.route is not None:
-            return _check_stability(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint,
-                                                              route=restart.route, segment=restart.segment), opts)
+            return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint,
+                                                     route=restart.route, segment=restart.segment), opts, ws)
     elif opts.start == "relax":
-        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint), opts)
+        return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint), opts, ws)
     try:
-        return _check_stability(model, solve_load_steps(
+        return _finish(model, solve_load_steps(
             model, U0=U0, options=opts, callback=callback, workspace=ws,
             checkpoint=None if checkpoint is None else checkpoint.load_step,
-            resume=None if restart is None else restart.load_path), opts)
+            resume=None if restart is None else restart.load_path), opts, ws)
     except ConvergenceError as exc:
         if not opts.relax_fallback or model.load_terms or not np.any(model.load):
             raise
         log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
-        return _check_stability(model, _relax_then_newton(model, opts, callback, ws, first=exc,
-                                                          checkpoint=checkpoint), opts)
+        return _finish(model, _relax_then_newton(model, opts, callback, ws, first=exc, checkpoint=checkpoint),
+                       opts, ws)
+
+
+SELF_CONTACT_STIFFENINGS = 3
+"""Most times the self-contact stiffness is raised (x :data:`SELF_CONTACT_STIFFENING`) after a converged
+solve whose smallest pair distance is below half the thickness, each followed by Newton from that state."""
+
+SELF_CONTACT_MIN_GAP = 0.5
+"""Smallest pair distance of a converged self-contact equilibrium, as a share of the thickness d, below
+which the stiffness is raised (issue "Self-contact": >= 0.5 d)."""
+
+SELF_CONTACT_STIFFENING = 8.0
+"""Factor on the self-contact stiffness per raise: the cubic penalty's push at a given gap grows with it,
+so a gap of 0.05 d under the automatic stiffness opens to about d/2 after two raises."""
+
+
+def _stiffen_self_contact(model, result, opts, ws):
+    """Continuation on the self-contact stiffness (as IPC adapts its barrier stiffness): while the
+    converged state has a pair closer than :data:`SELF_CONTACT_MIN_GAP` times the thickness d (folds pinched harder than the automatic
+    stiffness's design load, ten times the sheet's weight), raise the stiffness and converge again from
+    that state (its steps bounded by the collision test, so no pair crosses on the way). The model's law
+    keeps the raised stiffness (its summary reports it); ``result.self_contact_stiffenings`` counts them."""
+    sc = getattr(model, "self_contact", None)
+    result.self_contact_stiffenings = 0
+    if sc is None or not result.converged:
+        return result
+    polish = replace(opts.from_state(relax_fallback=False), max_continuations=0)
+    for _ in range(SELF_CONTACT_STIFFENINGS):
+        gap = sc.min_distance(model.positions(result.U))
+        if not gap < SELF_CONTACT_MIN_GAP * sc.thickness:
+            break
+        sc.stiffness *= SELF_CONTACT_STIFFENING
+        log.info("self-contact: a pair %.3g d apart; stiffness x %g, Newton again", gap / sc.thickness,
+                 SELF_CONTACT_STIFFENING)
+        try:
+            res = solve_load_steps(model, U0=result.U, options=polish, workspace=ws)
+        except ConvergenceError as exc:
+            sc.stiffness /= SELF_CONTACT_STIFFENING
+            log.warning("self-contact: Newton with the raised stiffness did not converge (%s); the equilibrium "
+                        "of the last stiffness stands", exc)
+            break
+        result.self_contact_stiffenings += 1
+        result.U, result.residual, result.energies = res.U, res.residual, res.energies
+        result.iterations += res.iterations
+        result.factorisations += res.factorisations
+        result.load_steps = list(result.load_steps) + list(res.load_steps)
+    return result
+
+
+def _finish(model, result, opts, ws):
+    """The self-contact continuation (:func:`_stiffen_self_contact`), then the stability check."""
+    return _check_stability(model, _stiffen_self_contact(model, result, opts, ws), opts)
 
 
 def _check_stability(model, result, opts):
