@@ -24,10 +24,7 @@ file with a :class:`~rftstatic.errors.CheckpointError` that names the file, the 
 from __future__ import annotations
 
 import json
-import logging
-import time
 import zipfile
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,11 +32,10 @@ import numpy as np
 
 from rftstatic.errors import CheckpointError
 from rftstatic.remesh.adapt import RemeshRecord
-from rftstatic.solvers.checkpoint import save_atomic
+from rftstatic.solvers.checkpoint import ThrottledWriter
 from rftstatic.solvers.newton import StaticResult
 from rftstatic.solvers.static_checkpoint import CHECKPOINT_SECONDS, result_arrays, result_from
 
-log = logging.getLogger(__name__)
 
 __all__ = ["FORMAT", "StaticCycleState", "RelaxState", "RemeshCheckpointer", "RemeshRestart",
            "load_remesh_checkpoint"]
@@ -153,7 +149,7 @@ def _records_json(records) -> np.ndarray:
     return _json([r.as_dict() for r in records])
 
 
-class RemeshCheckpointer:
+class RemeshCheckpointer(ThrottledWriter):
     """Saves a remeshed run to ``path`` (module docstring); given to the drivers as ``checkpoint``.
 
     Parameters
@@ -168,14 +164,12 @@ class RemeshCheckpointer:
     writes, write_time : files written and the wall time spent writing them [s]; saved : what the last holds
     """
 
+    run = "the remeshed run"
+
     def __init__(self, path, header: dict, *, every_seconds: float = CHECKPOINT_SECONDS, app=None):
-        self.path = Path(path)
+        super().__init__(path, every_seconds)
         self.header = json.loads(json.dumps(header, default=_plain))
-        self.every_seconds = float(every_seconds)
         self.app = app
-        self.writes, self.write_time, self.saved = 0, 0.0, ""
-        self._pending = None
-        self._last = time.monotonic()
         self._meshes = (0, {})  # the mesh arrays of the first k meshes (a run's meshes only grow)
 
     def _mesh_arrays(self, meshes) -> dict:
@@ -188,31 +182,6 @@ class RemeshCheckpointer:
         arrays = {"remesh_format": np.array(FORMAT), "header": _json(self.header), "phase": np.array(phase),
                   "app": _json(fields), **{"app_" + k: np.asarray(v) for k, v in extra.items()}, **arrays}
         return arrays, what
-
-    def _write(self, arrays, what) -> None:
-        t = time.perf_counter()
-        save_atomic(self.path, arrays)
-        self.write_time += time.perf_counter() - t
-        self.writes += 1
-        self.saved, self._pending, self._last = what, None, time.monotonic()
-        log.info("checkpoint (%s) -> %s", what, self.path)
-
-    def flush(self) -> None:
-        """Write the snapshot kept back by the throttle, if any."""
-        if self._pending is not None:
-            self._write(*self._pending)
-
-    @contextmanager
-    def on_interrupt(self):
-        """A KeyboardInterrupt inside writes the last snapshot kept back before it goes on."""
-        try:
-            yield self
-        except KeyboardInterrupt:
-            self.flush()
-            if self.writes:
-                log.warning("interrupted: the remeshed run is saved in %s (%s); continue it with --resume",
-                            self.path, self.saved)
-            raise
 
     def cycle(self, state: StaticCycleState) -> None:
         """After a solved cycle of the static route (always written)."""
@@ -229,7 +198,7 @@ class RemeshCheckpointer:
         what = (f"t = {state.t:.4g} s, step {state.steps}, mesh {len(state.meshes) - 1} "
                 f"({state.meshes[-1].n_nodes} nodes)")
         self._pending = self._snapshot(phase, arrays, what)
-        if phase != "chunk" or time.monotonic() - self._last >= self.every_seconds:
+        if phase != "chunk" or self.due():
             self.flush()
 
 

@@ -18,6 +18,7 @@ import os
 import tempfile
 import time
 import zipfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +62,57 @@ def save_atomic(path, arrays: dict) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+class ThrottledWriter:
+    """A checkpoint file written atomically (:func:`save_atomic`) at most every ``every_seconds`` of wall
+    time, the snapshot kept back by the throttle written by :meth:`flush` and on a Ctrl-C
+    (:meth:`on_interrupt`). The base of the static and the remeshed checkpointers; ``run`` names the run
+    in the interrupt message (e.g. ``"the static solve"``).
+
+    Attributes
+    ----------
+    writes : files written; write_time : wall time spent writing them [s]
+    saved : what the last write holds (e.g. ``"load factor 0.42"``), for messages
+    """
+
+    run = "the run"
+
+    def __init__(self, path, every_seconds: float):
+        self.path = Path(path)
+        self.every_seconds = float(every_seconds)
+        self.writes, self.write_time, self.saved = 0, 0.0, ""
+        self._pending = None
+        self._last = time.monotonic()
+
+    def due(self, step=None) -> bool:
+        """Whether ``every_seconds`` have passed since the last write (``step`` unused: the explicit loop's call)."""
+        return time.monotonic() - self._last >= self.every_seconds
+
+    def _write(self, arrays, what) -> None:
+        t = time.perf_counter()
+        save_atomic(self.path, arrays)
+        self.write_time += time.perf_counter() - t
+        self.writes += 1
+        self.saved, self._pending, self._last = what, None, time.monotonic()
+        log.info("checkpoint (%s) -> %s", what, self.path)
+
+    def flush(self) -> None:
+        """Write the snapshot kept back by the throttle, if any."""
+        if self._pending is not None:
+            self._write(*self._pending)
+
+    @contextmanager
+    def on_interrupt(self):
+        """A KeyboardInterrupt inside writes the last snapshot kept back before it goes on."""
+        try:
+            yield self
+        except KeyboardInterrupt:
+            self.flush()
+            if self.writes:
+                log.warning("interrupted: %s is saved in %s (%s); continue it with --resume", self.run, self.path,
+                            self.saved)
+            raise
 
 
 class Checkpointer:

@@ -31,22 +31,18 @@ from __future__ import annotations
 
 import hashlib
 import json
-import logging
-import time
 import zipfile
-from contextlib import contextmanager
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
 from rftstatic.errors import CheckpointError, ConvergenceError
-from rftstatic.solvers.checkpoint import load_checkpoint, model_fingerprint, save_atomic, state_arrays
+from rftstatic.solvers.checkpoint import ThrottledWriter, load_checkpoint, model_fingerprint, state_arrays
 from rftstatic.solvers.load_steps import LoadPath
 from rftstatic.solvers.newton import StaticResult
 from rftstatic.solvers.static import RelaxRoute
 
-log = logging.getLogger(__name__)
 
 FORMAT = 1
 """Version of the static checkpoint layout (key ``static_format``)."""
@@ -116,7 +112,7 @@ def result_from(prefix, z) -> StaticResult:
     return StaticResult(U=z[prefix + "U"].copy(), **json.loads(str(z[prefix + "result"])))
 
 
-class StaticCheckpointer:
+class StaticCheckpointer(ThrottledWriter):
     """Saves a static solve to ``path`` (module docstring); given to :func:`solve_static` as ``checkpoint``.
 
     Parameters
@@ -134,20 +130,14 @@ class StaticCheckpointer:
         its factorisation count and damping scale are saved)
     """
 
+    run = "the static solve"
+
     def __init__(self, path, model, options, *, scene: str = "", every_seconds: float = CHECKPOINT_SECONDS):
-        self.path = Path(path)
-        self.every_seconds = float(every_seconds)
+        super().__init__(path, every_seconds)
         self.header = {"scene": scene, "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements,
                        "element": model.element, "model": static_fingerprint(model), "options": options_spec(options)}
         self.model = model
         self.workspace = None
-        self.writes, self.write_time, self.saved = 0, 0.0, ""
-        self._pending = None
-        self._last = time.monotonic()
-
-    def due(self, step=None) -> bool:
-        """Whether ``every_seconds`` have passed since the last write (``step`` unused: the explicit loop's call)."""
-        return time.monotonic() - self._last >= self.every_seconds
 
     def _common(self, phase) -> dict:
         ws = self.workspace
@@ -155,31 +145,6 @@ class StaticCheckpointer:
         return {"static_format": np.array(FORMAT), "static_header": _json(self.header), "phase": np.array(phase),
                 "workspace": _json({"factorisations": 0 if ws is None else ws.factorisations,
                                     "lm_scale": None if ws is None else ws.lm_scale, "load_terms": branches})}
-
-    def _write(self, arrays, what) -> None:
-        t = time.perf_counter()
-        save_atomic(self.path, arrays)
-        self.write_time += time.perf_counter() - t
-        self.writes += 1
-        self.saved, self._pending, self._last = what, None, time.monotonic()
-        log.info("checkpoint (%s) -> %s", what, self.path)
-
-    def flush(self) -> None:
-        """Write the snapshot kept back by the throttle, if any."""
-        if self._pending is not None:
-            self._write(*self._pending)
-
-    @contextmanager
-    def on_interrupt(self):
-        """A KeyboardInterrupt inside writes the last snapshot kept back before it goes on."""
-        try:
-            yield self
-        except KeyboardInterrupt:
-            self.flush()
-            if self.writes:
-                log.warning("interrupted: the static solve is saved in %s (%s); continue it with --resume",
-                            self.path, self.saved)
-            raise
 
     def load_step(self, path: LoadPath) -> None:
         """After a converged increment: keep the load path, write it when due and at full load."""
