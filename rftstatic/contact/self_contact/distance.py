@@ -276,12 +276,7 @@ def point_triangle(x4, *, hessian=True):
     hess : (P, 12, 12) ``d^2 s/dX^2`` [-], or None
     feature : (P,) int8, 0 face, 1 edge, 2 vertex (:data:`FEATURES`)
     """
-    x4 = _check(x4, "point_triangle")
-    if compiled_for(len(x4)):
-        return _compiled_derivatives(x4, 0, hessian)
-    W, D, act, _, code = _pt_classify(x4)
-    s, g, H = pair_derivatives(x4, W, D, act, hessian=hessian)
-    return s, g, H, code
+    return _derivatives(x4, 0, hessian, "point_triangle")
 
 
 @numpy_charged
@@ -300,10 +295,15 @@ def edge_edge(x4, *, hessian=True):
     hess : (P, 12, 12) ``d^2 s/dX^2`` [-], or None
     feature : (P,) int8, 0 interior-interior, 1 end point-edge, 2 end point-end point
     """
-    x4 = _check(x4, "edge_edge")
+    return _derivatives(x4, 1, hessian, "edge_edge")
+
+
+def _derivatives(x4, kind: int, hessian: bool, who: str):
+    """:func:`point_triangle` (``kind`` 0) or :func:`edge_edge` (1): compiled, or classified and derived in numpy."""
+    x4 = _check(x4, who)
     if compiled_for(len(x4)):
-        return _compiled_derivatives(x4, 1, hessian)
-    W, D, act, _, code = _ee_classify(x4)
+        return _compiled_derivatives(x4, kind, hessian)
+    W, D, act, _, code = (_pt_classify if kind == 0 else _ee_classify)(x4)
     s, g, H = pair_derivatives(x4, W, D, act, hessian=hessian)
     return s, g, H, code
 

@@ -221,21 +221,6 @@ def triangle_distances(x: np.ndarray, tri: np.ndarray, pairs: np.ndarray, *, tol
     return _pair_distance(P, Q, _crossing(P, Q, tol))
 
 
-def _positions(x: np.ndarray, tri: np.ndarray, who: str) -> np.ndarray:
-    if x.shape[1] != 3:
-        raise ValueError(f"{who}: x.shape = {x.shape}, expected (N, 3) positions in space")
-    if not np.isfinite(x).all():
-        raise ValueError(f"{who}: x holds {int((~np.isfinite(x)).sum())} non-finite value(s)")
-    return x[tri]
-
-
-def _tolerance(tol, p, who: str) -> float:
-    tol = TOL * _mean_edge(p) if tol is None else float(tol)
-    if not tol >= 0.0:
-        raise ValueError(f"{who}: tol = {tol!r}, expected a length >= 0")
-    return tol
-
-
 def intersecting_pairs(x: np.ndarray, tri: np.ndarray, *, tol: float | None = None) -> np.ndarray:
     """All pairs of triangles that share no node and intersect (an edge of one crosses the other).
 
