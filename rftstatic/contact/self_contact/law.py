@@ -250,8 +250,7 @@ class SelfContact:
         if cache is None:
             st = self.evaluate(x, tangent=False)
             return (st.force, st.energy) if energy else st.force
-        cache.pairs(self.prims, x, self.thickness)
-        m = cache.motion(x)
+        m = cache.current(self.prims, x, self.thickness)
         d = self.thickness
         if cache.min_dist - 2.0 * float(m.max(initial=0.0)) >= d:
             f = np.zeros_like(x)

@@ -122,6 +122,18 @@ class NearPairCache(PairCache):
             return self._pairs
         return self.rebuild(prims, x, thickness)
 
+    def current(self, prims: SheetPrimitives, x: np.ndarray, thickness: float) -> np.ndarray:
+        """The list made valid for ``x (N, 3)`` [m] (rebuilt when needed, as :meth:`pairs`) and the
+        translation-free motion ``(N,)`` [m] since its build (:meth:`motion`), computed once."""
+        if self._x is None or self._x.shape != x.shape:
+            self.rebuild(prims, x, thickness)
+            return np.zeros(len(x))
+        m = self.motion(x)
+        if float(m.max(initial=0.0)) > 0.5 * self.margin:
+            self.rebuild(prims, x, thickness)
+            return np.zeros(len(x))
+        return m
+
     def rebuild(self, prims: SheetPrimitives, x: np.ndarray, thickness: float) -> Pairs:
         """Build the list at ``x (N, 3)`` [m] now."""
         t0 = time.perf_counter()

@@ -109,9 +109,8 @@ class StepFilter:
     def _filter(self, sc, cache, x, v, dt, stats) -> float:
         if self._quick_pass(cache, v, dt):
             return 0.0
-        removed = self._full(sc, cache, x, v, dt, stats)
-        m = cache.motion(x)  # exact, from the (possibly new) build, for the quick passes that follow
-        self._bound = (cache, cache.builds, float(m.max(initial=0.0)), _largest(v) * dt)
+        removed, m_max = self._full(sc, cache, x, v, dt, stats)
+        self._bound = (cache, cache.builds, m_max, _largest(v) * dt)  # for the quick passes that follow
         return removed
 
     def _quick_pass(self, cache, v, dt) -> bool:
@@ -137,12 +136,12 @@ class StepFilter:
         self._bound = (cache, cache.builds, b[2], total)
         return True
 
-    def _full(self, sc, cache, x, v, dt, stats) -> float:
+    def _full(self, sc, cache, x, v, dt, stats) -> tuple[float, float]:
+        """Tests 1-4 (module docstring); the kinetic energy removed [J] and the largest motion since the build [m]."""
         d, half = sc.thickness, 0.5 * cache.margin
-        cache.pairs(sc.prims, x, d)
+        m = cache.current(sc.prims, x, d)
         dx = dt * v
         spread = _spread(dx)
-        m = cache.motion(x)
         if max(float(m.max(initial=0.0)), float(cache.motion(x + dx).max(initial=0.0))) > half:
             cache.rebuild(sc.prims, x, d)  # 1. the list must cover the whole step
             m = np.zeros(len(x))
@@ -150,10 +149,11 @@ class StepFilter:
         if float(spread.max(initial=0.0)) > half:
             stats.swept += 1
             extra = find_pairs(sc.prims, x, d, x + dx)
-        lb_min = cache.min_dist - 2.0 * float(m.max(initial=0.0))
+        m_max = float(m.max(initial=0.0))
+        lb_min = cache.min_dist - 2.0 * m_max
         beta = 1.0 - self.approach
         if extra is None and 2.0 * float(spread.max(initial=0.0)) <= beta * lb_min:  # 2. quick test
-            return 0.0
+            return 0.0, m_max
         lb = cache.lower_bounds(m)
         pick = 2.0 * spread[cache.nodes].max(axis=1) > beta * lb
         nodes, is_pt = cache.nodes[pick], np.flatnonzero(pick) < len(cache.npt)
@@ -162,12 +162,12 @@ class StepFilter:
             nodes = np.concatenate([nodes, spt, see])
             is_pt = np.concatenate([is_pt, np.ones(len(spt), bool), np.zeros(len(see), bool)])
         if not len(nodes):
-            return 0.0
+            return 0.0, m_max
         stats.filter_work_steps += 1
         k_before = self._kinetic(v)
         self._impulses(x, v, dt, nodes, is_pt, stats)
         self._fail_safe(cache, x, v, dt, m, nodes, is_pt, extra is not None, stats)
-        return k_before - self._kinetic(v)
+        return k_before - self._kinetic(v), m_max
 
     def _kinetic(self, v):
         with np.errstate(divide="ignore"):
