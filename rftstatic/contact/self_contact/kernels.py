@@ -428,3 +428,30 @@ def ccd_all(x, dx, nodes, kind, eta, max_rounds):
                 break
         tmin = min(tmin, t)
     return tmin
+
+
+def midrange_motion(a, b, s, c, out):
+    """Translation-free motion (Eq. 1 of :mod:`.near_pairs`) of ``w = a + s b - c`` (``a, b, c (N, 3)``
+    [m], ``s`` a scalar): ``out[k] = |w_k - m|`` ``(N,)`` [m] with ``m`` the midrange of ``w`` over the
+    nodes; returns ``max_k out[k]`` (0 for no node). Two passes over the nodes, no temporary array:
+    the motion since a build (``a = x``, ``s = 0``, ``c = x_build``), at the end of a step
+    (``b = dx``, ``s = 1``) or a step's own spread (``a = dx``, ``c = 0``)."""
+    n = a.shape[0]
+    lo = np.full(3, np.inf)
+    hi = np.full(3, -np.inf)
+    for k in range(n):
+        for i in range(3):
+            w = a[k, i] + s * b[k, i] - c[k, i]
+            lo[i] = min(lo[i], w)
+            hi[i] = max(hi[i], w)
+    mid = 0.5 * (lo + hi)
+    big = 0.0
+    for k in range(n):
+        r = 0.0
+        for i in range(3):
+            w = a[k, i] + s * b[k, i] - c[k, i] - mid[i]
+            r += w * w
+        r = np.sqrt(r)
+        out[k] = r
+        big = max(big, r)
+    return big

@@ -250,9 +250,9 @@ class SelfContact:
         if cache is None:
             st = self.evaluate(x, tangent=False)
             return (st.force, st.energy) if energy else st.force
-        m = cache.current(self.prims, x, self.thickness)
+        m, m_max = cache.current(self.prims, x, self.thickness)
         d = self.thickness
-        if cache.min_dist - 2.0 * float(m.max(initial=0.0)) >= d:
+        if cache.min_dist - 2.0 * m_max >= d:
             f = np.zeros_like(x)
             return (f, 0.0) if energy else f
         live = cache.lower_bounds(m) < d

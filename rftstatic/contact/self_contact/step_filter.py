@@ -59,7 +59,7 @@ import numpy as np
 from rftstatic.contact.self_contact.broad_phase import find_pairs
 from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
 from rftstatic.contact.self_contact.law_kernels import additive_ccd_nodes
-from rftstatic.contact.self_contact.near_pairs import NearPairCache, pair_nodes
+from rftstatic.contact.self_contact.near_pairs import NearPairCache, pair_nodes, translation_free_motion
 
 __all__ = ["APPROACH", "StepFilter"]
 
@@ -93,6 +93,7 @@ class StepFilter:
             raise ValueError(f"approach must be in (0, {1.0 - sc.min_fraction:g}), got {approach!r}")
         self.sc, self.minv, self.approach, self.sweeps = sc, np.asarray(minv, float), float(approach), int(sweeps)
         self.eta = sc.min_fraction
+        self._zeros = None
         self._bound = None  # (cache, its build count, motion at the last full test [m], sum of steps since [m])
 
     def __call__(self, cache: NearPairCache, x: np.ndarray, v: np.ndarray, dt: float) -> float:
@@ -139,20 +140,19 @@ class StepFilter:
     def _full(self, sc, cache, x, v, dt, stats) -> tuple[float, float]:
         """Tests 1-4 (module docstring); the kinetic energy removed [J] and the largest motion since the build [m]."""
         d, half = sc.thickness, 0.5 * cache.margin
-        m = cache.current(sc.prims, x, d)
+        m, m_max = cache.current(sc.prims, x, d)  # m_max <= margin / 2 now
         dx = dt * v
-        spread = _spread(dx)
-        if max(float(m.max(initial=0.0)), float(cache.motion(x + dx).max(initial=0.0))) > half:
+        spread, spread_max = translation_free_motion(dx, self._zero(dx))
+        if cache.motion(x, dx)[1] > half:
             cache.rebuild(sc.prims, x, d)  # 1. the list must cover the whole step
-            m = np.zeros(len(x))
+            m, m_max = np.zeros(len(x)), 0.0
         extra = None
-        if float(spread.max(initial=0.0)) > half:
+        if spread_max > half:
             stats.swept += 1
             extra = find_pairs(sc.prims, x, d, x + dx)
-        m_max = float(m.max(initial=0.0))
         lb_min = cache.min_dist - 2.0 * m_max
         beta = 1.0 - self.approach
-        if extra is None and 2.0 * float(spread.max(initial=0.0)) <= beta * lb_min:  # 2. quick test
+        if extra is None and 2.0 * spread_max <= beta * lb_min:  # 2. quick test
             return 0.0, m_max
         lb = cache.lower_bounds(m)
         pick = 2.0 * spread[cache.nodes].max(axis=1) > beta * lb
@@ -168,6 +168,12 @@ class StepFilter:
         self._impulses(x, v, dt, nodes, is_pt, stats)
         self._fail_safe(cache, x, v, dt, m, nodes, is_pt, extra is not None, stats)
         return k_before - self._kinetic(v), m_max
+
+    def _zero(self, like):
+        """A zero array shaped as ``like (N, 3)`` (kept: the spread of a step is its motion from 0)."""
+        if self._zeros is None or self._zeros.shape != like.shape:
+            self._zeros = np.zeros_like(like)
+        return self._zeros
 
     def _kinetic(self, v):
         with np.errstate(divide="ignore"):
@@ -249,7 +255,7 @@ class StepFilter:
     def _fail_safe(self, cache, x, v, dt, m, nodes_checked, is_pt_checked, swept, stats):
         """4. Additive CCD on the pairs that the per-pair test picks for the filtered step."""
         dx = dt * v
-        spread = _spread(dx)
+        spread = translation_free_motion(dx, self._zero(dx))[0]
         beta = 1.0 - self.eta
         lb = cache.lower_bounds(m)
         pick = 2.0 * spread[cache.nodes].max(axis=1) > beta * lb
@@ -271,10 +277,3 @@ class StepFilter:
 def _largest(v) -> float:
     """``max_k |v_k|`` of ``v (N, 3)``."""
     return float(np.sqrt(np.einsum("ni,ni->n", v, v).max(initial=0.0)))
-
-
-def _spread(dx):
-    """``|dx_k - c| (N,)``, ``c`` the midrange of ``dx (N, 3)``."""
-    c = 0.5 * (dx.max(axis=0) + dx.min(axis=0))
-    w = dx - c
-    return np.sqrt(np.einsum("ni,ni->n", w, w))

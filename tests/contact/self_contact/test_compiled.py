@@ -130,3 +130,20 @@ def test_load_compiled_loads_the_twins_and_the_budget_switches_to_them(monkeypat
     assert 0.0 < compiled._numpy_seconds[0] < compiled.NUMPY_BUDGET_S  # the numpy twin's time was charged
     compiled._numpy_seconds[0] = 2 * compiled.NUMPY_BUDGET_S
     assert distance.compiled_for(10)
+
+
+@pytest.mark.parametrize("s", [0.0, 1.0])
+def test_translation_free_motion_agrees_and_ignores_translation(monkeypatch, s):
+    from rftstatic.contact.self_contact.near_pairs import translation_free_motion
+
+    rng = np.random.default_rng(5)
+    x0 = rng.standard_normal((1500, 3))
+    x, dx = x0 + 0.01 * rng.standard_normal(x0.shape), 0.01 * rng.standard_normal(x0.shape)
+    (ma, ba), (mb, bb) = _both(monkeypatch, translation_free_motion, x, x0, b=dx, s=s)
+    np.testing.assert_allclose(mb, ma, rtol=1e-13, atol=1e-16)
+    assert bb == pytest.approx(ba, rel=1e-13) and ba == ma.max()
+    shifted = translation_free_motion(x + np.array([3.0, -2.0, 7.0]), x0, b=dx, s=s)[0]  # a translation
+    np.testing.assert_allclose(shifted, ma, atol=1e-12)
+    u = x + s * dx - x0
+    c = 0.5 * (u.max(axis=0) + u.min(axis=0))
+    np.testing.assert_allclose(ma, np.linalg.norm(u - c, axis=1), rtol=1e-13)

@@ -140,7 +140,7 @@ def test_near_pair_cache_keeps_every_pair_within_the_radius():
     before = cache.builds
     cache.pairs(sc.prims, y, D)
     assert cache.builds == before
-    lb = cache.lower_bounds(cache.motion(y))
+    lb = cache.lower_bounds(cache.motion(y)[0])
     q = len(cache.npt)
     assert np.all(np.sqrt(point_triangle_distance2(y[cache.npt])) >= lb[:q] - 1e-15)
     assert np.all(np.sqrt(edge_edge_distance2(y[cache.nee])) >= lb[q:] - 1e-15)
