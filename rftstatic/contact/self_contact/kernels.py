@@ -368,10 +368,11 @@ def psd_project_all(H, out):
         psd_project_one(H[a], out[a], B, R, U, M, V)
 
 
-def ccd_all(x, dx, nodes, kind, eta, max_rounds):
+def ccd_all(x, dx, nodes, kind, eta, max_rounds, floor):
     """Smallest safe time in [0, 1] over all pairs ``nodes (P, 4)`` of positions ``x`` and step ``dx``
     ``(N, 3)`` [m] of the additive continuous collision detection (:mod:`.law`); ``kind`` 0
-    point-triangle (sides ``{0}``, ``{1, 2, 3}``), 1 edge-edge (``{0, 1}``, ``{2, 3}``). A pair stops
+    point-triangle (sides ``{0}``, ``{1, 2, 3}``), 1 edge-edge (``{0, 1}``, ``{2, 3}``). A pair's
+    target distance is ``g = eta d0``, raised to ``floor`` [m] when it starts above it. A pair stops
     once its time passes the smallest one found (its time only grows), which leaves the minimum
     unchanged."""
     W = np.zeros(4)
@@ -403,9 +404,11 @@ def ccd_all(x, dx, nodes, kind, eta, max_rounds):
         else:
             s0, _ = ee_classify(x4, W, D, act)
         d0 = np.sqrt(s0)
-        if not ell > (1.0 - eta) * d0:
-            continue
         g = eta * d0
+        if d0 > floor:
+            g = max(g, floor)
+        if not ell > d0 - g:
+            continue
         t = 0.0
         dcur = d0
         for _ in range(max_rounds):

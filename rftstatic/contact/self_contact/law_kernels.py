@@ -44,11 +44,13 @@ def psd_project(H: np.ndarray) -> np.ndarray:
 
 
 @distance.numpy_charged
-def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rounds: int) -> float:
+def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rounds: int,
+                 floor: float = 0.0) -> float:
     """Smallest safe time in [0, 1] over pairs ``x4, dx4 (P, 4, 3)`` [m] (``kind`` 0 point-triangle,
-    1 edge-edge): the first time any pair comes within ``eta`` of its starting distance, found by
-    advancing each pair by ``(delta - eta delta_0) / l`` (``l`` its relative speed bound) for at most
-    ``max_rounds`` rounds; 1 if none (:mod:`.law`)."""
+    1 edge-edge): the first time any pair comes within its target ``g`` (``eta`` times its starting
+    distance ``delta_0``, raised to ``floor`` [m] for a pair that starts above it), found by advancing
+    each pair by ``(delta - g) / l`` (``l`` its relative speed bound) for at most ``max_rounds`` rounds;
+    1 if none (:mod:`.law`)."""
     if not len(x4):
         return 1.0
     if distance.compiled_for(len(x4)):
@@ -57,17 +59,18 @@ def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rou
         P = len(x4)
         return float(ccd_all(np.ascontiguousarray(x4, dtype=float).reshape(4 * P, 3),
                              np.ascontiguousarray(dx4, dtype=float).reshape(4 * P, 3),
-                             np.arange(4 * P, dtype=np.int64).reshape(P, 4), kind, float(eta), int(max_rounds)))
+                             np.arange(4 * P, dtype=np.int64).reshape(P, 4), kind, float(eta), int(max_rounds),
+                             float(floor)))
     dist2 = distance.point_triangle_distance2 if kind == 0 else distance.edge_edge_distance2
     a, b = _SIDES[kind]
     rel = dx4[:, list(a)][:, :, None, :] - dx4[:, list(b)][:, None, :, :]
     ell = np.sqrt(np.max(np.einsum("pabi,pabi->pab", rel, rel), axis=(1, 2)))  # (P,) relative speed bound
     d0 = np.sqrt(dist2(x4))
-    keep = (ell > 0) & (ell * 1.0 > (1.0 - eta) * d0)  # the others cannot reach eta d0 by t = 1
+    g = np.where(d0 > floor, np.maximum(eta * d0, floor), eta * d0)
+    keep = (ell > 0) & (ell * 1.0 > d0 - g)  # the others cannot reach g by t = 1
     if not np.any(keep):
         return 1.0
-    x4, dx4, ell, d0 = x4[keep], dx4[keep], ell[keep], d0[keep]
-    g = eta * d0
+    x4, dx4, ell, d0, g = x4[keep], dx4[keep], ell[keep], d0[keep], g[keep]
     t = np.zeros(len(d0))
     dcur = d0.copy()
     live = np.ones(len(d0), dtype=bool)
@@ -90,7 +93,7 @@ def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rou
 
 
 def additive_ccd_nodes(x: np.ndarray, dx: np.ndarray, nodes: np.ndarray, kind: int, eta: float,
-                       max_rounds: int) -> float:
+                       max_rounds: int, floor: float = 0.0) -> float:
     """:func:`additive_ccd` of the pairs ``nodes (P, 4)`` of positions ``x (N, 3)`` [m] and step
     ``dx (N, 3)`` [m], without gathering ``x[nodes]`` (the compiled loop reads the nodes itself: on the
     824,000 swept pairs of a 1 cm step of the 81 x 81 fold the gather cost as much as the loop)."""
@@ -101,8 +104,8 @@ def additive_ccd_nodes(x: np.ndarray, dx: np.ndarray, nodes: np.ndarray, kind: i
         from rftstatic.contact.self_contact._kernels_numba import ccd_all
 
         return float(ccd_all(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(dx, dtype=float),
-                             np.ascontiguousarray(nodes), kind, float(eta), int(max_rounds)))
-    return additive_ccd(x[nodes], dx[nodes], kind, eta, max_rounds)
+                             np.ascontiguousarray(nodes), kind, float(eta), int(max_rounds), float(floor)))
+    return additive_ccd(x[nodes], dx[nodes], kind, eta, max_rounds, floor)
 
 
 def load_compiled() -> bool:

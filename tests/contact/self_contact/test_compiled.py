@@ -147,3 +147,20 @@ def test_translation_free_motion_agrees_and_ignores_translation(monkeypatch, s):
     u = x + s * dx - x0
     c = 0.5 * (u.max(axis=0) + u.min(axis=0))
     np.testing.assert_allclose(ma, np.linalg.norm(u - c, axis=1), rtol=1e-13)
+
+
+@pytest.mark.parametrize("kind", [0, 1])
+def test_additive_ccd_with_a_floor_agrees_and_stops_at_the_floor(monkeypatch, kind):
+    rng = np.random.default_rng(4)
+    x4 = _random_pairs("pt" if kind == 0 else "ee", 500, seed=6)
+    dx4 = 0.3 * rng.standard_normal(x4.shape)
+    dist2 = distance.point_triangle_distance2 if kind == 0 else distance.edge_edge_distance2
+    floor = float(np.median(np.sqrt(dist2(x4))))
+    a, b = _both(monkeypatch, law_kernels.additive_ccd, x4, dx4, kind, 0.2, 200, floor)
+    assert b == pytest.approx(a, rel=1e-12)
+    assert a <= law_kernels.additive_ccd(x4, dx4, kind, 0.2, 200)  # a floor only shortens the step
+    d0 = np.sqrt(dist2(x4))
+    for t in np.linspace(0.0, a, 21):  # on the allowed part of the path no pair that began above the floor goes below it
+        d = np.sqrt(dist2(x4 + t * dx4))
+        assert np.all(d[d0 > floor] >= floor * (1 - 1e-9))
+        assert np.all(d >= 0.2 * d0 * (1 - 1e-9))

@@ -47,7 +47,7 @@ def test_a_fast_layer_does_not_pass_through_the_folded_strip(mass_scale):
         x = model.positions(U)
         assert len(intersecting_pairs(x, tri)) == 0, f"crossing at t = {t:.4f} s"
         closest = min(closest, smallest_distance(x, tri)[0])
-    assert 0 < closest < D  # the layer came down onto the strip, and stayed apart
+    assert 0.5 * D <= closest < D  # the layer came down onto the strip, and stayed apart by half the thickness
     stats = model.self_contact.stats
     assert stats.impulses > 0 and stats.filter_work_steps > 0
     assert np.isfinite(run.history["total"]).all()
@@ -112,6 +112,12 @@ def test_velocity_filter_conserves_momentum_and_meets_its_bound():
         assert np.all(np.sqrt(s_pt) >= sc.min_fraction * cache.dist_pt * (1 - 1e-9))
         assert np.all(np.sqrt(s_ee) >= sc.min_fraction * cache.dist_ee * (1 - 1e-9))
     assert cache.stats.impulses > 0 and cache.stats.ccd_limited == 0  # the impulses did it, not the fail-safe
+    # and the gap floor: pairs that started above it end the step above half the thickness
+    y = x + dt * w
+    for rows, d0, dist2 in ((cache.npt, cache.dist_pt, point_triangle_distance2),
+                            (cache.nee, cache.dist_ee, edge_edge_distance2)):
+        above = d0 > filt.gap_floor
+        assert above.any() and np.all(np.sqrt(dist2(y[rows[above]])) >= 0.5 * D)
     # the unfiltered step does bring pairs through each other: some pair's distance passes through ~0
     closest = min(float(np.sqrt(point_triangle_distance2((x + t * dt * v)[cache.npt])).min())
                   for t in np.linspace(0, 1, 101))
