@@ -16,7 +16,7 @@ from rftstatic.contact.self_contact import grid, kernels
 
 _INLINE = {kernels: ("segment_param", "pt_classify", "ee_classify", "pair_derivatives"), grid: ("_grow",)}
 _LOOPS = {kernels: ("distances_all", "derivatives_all", "jacobi_eigen", "psd_project_one", "psd_project_all",
-                    "ccd_all", "midrange_motion"),
+                    "ccd_all", "midrange_motion", "distances_by_index"),
           grid: ("boxes", "cell_list", "join")}
 
 
@@ -42,6 +42,7 @@ derivatives_all = _scopes[kernels]["derivatives_all"]
 psd_project_all = _scopes[kernels]["psd_project_all"]
 ccd_all = _scopes[kernels]["ccd_all"]
 midrange_motion = _scopes[kernels]["midrange_motion"]
+distances_by_index = _scopes[kernels]["distances_by_index"]
 boxes = _scopes[grid]["boxes"]
 cell_list = _scopes[grid]["cell_list"]
 join = _scopes[grid]["join"]

@@ -458,3 +458,30 @@ def midrange_motion(a, b, s, c, out):
         out[k] = r
         big = max(big, r)
     return big
+
+
+def distances_by_index(x, pairs, tri, edges, kind, s):
+    """Squared distances ``s (P,)`` [m^2] of the broad phase's pairs ``pairs (P, 2)`` read from positions
+    ``x (N, 3)`` [m] without gathering them first: kind 0 (node, triangle of ``tri (T, 3)``), kind 1
+    (edge, edge of ``edges (M, 2)``). The near-pair cut of every list build (:mod:`.near_pairs`)."""
+    W = np.zeros(4)
+    D = np.zeros((4, 2))
+    act = np.zeros(2, dtype=np.bool_)
+    x4 = np.zeros((4, 3))
+    for p in range(pairs.shape[0]):
+        a, b = pairs[p, 0], pairs[p, 1]
+        for i in range(3):
+            if kind == 0:
+                x4[0, i] = x[a, i]
+                x4[1, i] = x[tri[b, 0], i]
+                x4[2, i] = x[tri[b, 1], i]
+                x4[3, i] = x[tri[b, 2], i]
+            else:
+                x4[0, i] = x[edges[a, 0], i]
+                x4[1, i] = x[edges[a, 1], i]
+                x4[2, i] = x[edges[b, 0], i]
+                x4[3, i] = x[edges[b, 1], i]
+        if kind == 0:
+            s[p], _ = pt_classify(x4, W, D, act)
+        else:
+            s[p], _ = ee_classify(x4, W, D, act)

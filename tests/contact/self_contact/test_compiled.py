@@ -164,3 +164,16 @@ def test_additive_ccd_with_a_floor_agrees_and_stops_at_the_floor(monkeypatch, ki
         d = np.sqrt(dist2(x4 + t * dx4))
         assert np.all(d[d0 > floor] >= floor * (1 - 1e-9))
         assert np.all(d >= 0.2 * d0 * (1 - 1e-9))
+
+
+def test_near_pair_distances_by_index_agree(monkeypatch):
+    from rftstatic.bench.self_contact import crumpled
+    from rftstatic.contact.self_contact.near_pairs import _distances
+
+    mesh, X = crumpled(31)
+    prims = SheetPrimitives.of_mesh(mesh)
+    pairs = find_pairs(prims, X, 5e-3)
+    (pa, ea), (pb, eb) = _both(monkeypatch, _distances, prims, X, pairs)
+    assert len(pa) == len(pairs.pt) and len(eb) == len(pairs.ee) and len(pa) and len(ea)
+    np.testing.assert_allclose(pb, pa, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(eb, ea, rtol=1e-12, atol=1e-15)
