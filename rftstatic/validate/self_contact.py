@@ -24,6 +24,7 @@ the contact force is reported against one evaluation of the element (bending + m
 from __future__ import annotations
 
 import json
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -108,7 +109,8 @@ def _record(run) -> dict:
     return {"converged": s.get("converged"), "stable": s.get("stable_minimum"), "pairs": si.get("pairs"),
             "max_pairs_saved": si.get("max_pairs_saved"), "smallest_distance": si.get("smallest_distance"),
             "dc": drape.get("drape_coefficient"), "folds": drape.get("fold_count"),
-            "energy": (s.get("energies") or {}).get("total"), "wall_s": run.wall_s,
+            "energy": (s.get("energies") or {}).get("total"), "wall_s": run.wall_s, "cpu_s": run.cpu_s,
+            "load": os.getloadavg()[0],
             "thickness": sc.get("thickness"), "broad_phase_s": sc.get("broad_phase_s"), "force_s": sc.get("force_s"),
             "rebuilds": sc.get("rebuilds"), "near_pairs": sc.get("max_pairs"),
             "costs": run.result.get("costs", {}), "analysis": s.get("analysis"), "nodes": s.get("nodes")}
@@ -176,21 +178,25 @@ def _f(v, fmt):
 
 
 def _table(rows) -> str:
-    head = ("| scene | layers meet | self | converged | stable | crossing pairs (max saved) | smallest distance [cm] "
-            "| DC | folds | energy [gf cm] | wall [s] | ratio | verdict |\n|" + "---|" * 13 + "\n")
+    head = ("Wall time is what the tolerance is about; the child's CPU time (user + system) and the machine's load "
+            "average at its end stand beside it, since on a shared machine the wall time moves with the other jobs' "
+            "load.\n\n| scene | layers meet | self | converged | stable | crossing pairs (max saved) | smallest distance [cm] "
+            "| DC | folds | energy [gf cm] | wall [s] | ratio | CPU [s] (ratio) | load | verdict |\n|" + "---|" * 15 + "\n")
     lines = []
     for r in rows:
         for key in ("off", "on"):
             x = r[key]
             if "failed" in x:
                 lines.append(f"| {r['case']} | {'yes' if r['touching'] else 'no'} | {key} | failed: {x['failed'][:80]} |"
-                             + " |" * 9)
+                             + " |" * 11)
                 continue
             ratio = (r["on"]["wall_s"] / r["off"]["wall_s"]) if key == "on" and "failed" not in r["off"] else None
+            cpu = f"{x['cpu_s']:.1f}" + (f" ({x['cpu_s'] / r['off']['cpu_s']:.2f})" if ratio is not None else "")
             saved = f" ({x['max_pairs_saved']})" if x.get("max_pairs_saved") is not None else ""
             lines.append(f"| {r['case']} | {'yes' if r['touching'] else 'no'} | {key} | {x['converged']} | {x['stable']} | "
                          f"{x['pairs']}{saved} | {_f(x['smallest_distance'], '.3g')} | {_f(x['dc'], '.4f')} | "
-                         f"{_f(x['folds'], 'd')} | {_f(x['energy'], '.2f')} | {x['wall_s']:.1f} | {_f(ratio, '.2f')} | "
+                         f"{_f(x['folds'], 'd')} | {_f(x['energy'], '.2f')} | {x['wall_s']:.1f} | {_f(ratio, '.2f')} | {cpu} | "
+                         f"{x['load']:.1f} | "
                          f"{r['verdict'] if key == 'on' else ''} |")
     return head + "\n".join(lines) + "\n"
 
