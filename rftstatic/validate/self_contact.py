@@ -215,7 +215,7 @@ def _cost_table(rows) -> str:
         c = x["costs"]
         el, bp = c.get("element_force_s"), c.get("broad_phase_build_s")
         lines.append(f"| {r['case']} | {x['nodes']} | {_f(el and 1e3 * el, '.2f')} | {_f(bp and 1e3 * bp, '.1f')} | "
-                     f"{_f(bp / el if el and bp else None, '.0f')} | {_f(x['rebuilds'], 'd')} | "
+                     f"{_f(bp / el if el and bp else None, '.2f')} | {_f(x['rebuilds'], 'd')} | "
                      f"{_f(x['broad_phase_s'], '.2f')} | {_f(x['force_s'], '.2f')} | {_f(x['near_pairs'], 'd')} | "
                      f"{x['wall_s']:.1f} |")
     return head + "\n".join(lines) + "\n"
