@@ -168,6 +168,7 @@ BENCHES = {
     "mesher": _lazy("bench.mesher", lambda m: m.main([])),  # triangles per second
     "drape": _lazy("bench.drape", lambda m: m.main([])),  # static drape scenes, each in a fresh process
     "remesh": _lazy("bench.remesh", lambda m: m.main([])),  # mesher sizes and the remeshed scenes
+    "study": _lazy("bench.study", lambda m: m.main([])),  # points per minute of a sweep on 1 and 2 Dask workers
 }
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -170,6 +171,7 @@ def weak_warnings(sens: dict) -> list[str]:
 def run_fit(scene: str, free_texts, target_texts, *, sets=(), out=None, scheduler=None, workers=None,
             figures=False, max_evaluations=100, argv=None) -> dict:
     """The ``fit`` command (module docstring); returns what ``fit.json`` holds."""
+    t0 = time.perf_counter()
     base = load_base(scene, sets)
     free = parse_free(free_texts)
     targets = parse_targets(target_texts, base)
@@ -195,10 +197,12 @@ def run_fit(scene: str, free_texts, target_texts, *, sets=(), out=None, schedule
               "relative_mismatch": {m: (achieved[m] - t) / abs(t) if t else achieved[m] - t for m, t in targets.items()},
               "success": bool(res.success), "message": res.message, "objective": 0.5 * float(res.fun @ res.fun),
               "evaluations": len(ev.history), "points": len(store.rows), "points_run": ev.points_run,
-              "sensitivity": sens, "warnings": warnings, "history": ev.history, "engine": info}
+              "sensitivity": sens, "warnings": warnings, "history": ev.history, "engine": info,
+              "wall_time_s": time.perf_counter() - t0}
     write_json(out / "fit.json", result)
     record_run(out, {"kind": "fit", "command": argv, "scene": base.name, "sets": list(sets),
-                     "free": result["free"], "targets": targets}, {**info, "points_run": ev.points_run})
+                     "free": result["free"], "targets": targets},
+               {**info, "points_run": ev.points_run, "wall_time_s": result["wall_time_s"]})
     _report(result, out)
     return result
 
@@ -210,7 +214,7 @@ def _report(result: dict, out: Path) -> None:
         print(f"  {m}: target {t:.6g}, fitted {result['achieved'][m]:.6g} "
               f"({100 * result['relative_mismatch'][m]:+.3g} %); d log / d log: "
               + ", ".join(f"{k} {s:+.3f}" for k, s in result["sensitivity"][m].items() if s is not None))
-    print(f"{result['evaluations']} evaluations, {result['points_run']} points run ({result['points']} kept); "
-          f"{out}/fit.json", flush=True)
+    print(f"{result['evaluations']} evaluations, {result['points_run']} points run ({result['points']} kept) in "
+          f"{result['wall_time_s']:.1f} s; {out}/fit.json", flush=True)
     for line in result["warnings"]:
         print(f"warning: {line}", file=sys.stderr)

@@ -11,6 +11,7 @@ not import Dask. Then it draws each measure against each varied key (:mod:`rftst
 from __future__ import annotations
 
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -56,6 +57,7 @@ def load_base(scene: str, sets) -> object:
 def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, scheduler=None, workers=None,
               figures=False, plots=True, retry_failed=False, argv=None) -> Store:
     """The ``sweep`` command (module docstring); returns the study's :class:`Store`."""
+    t0 = time.perf_counter()
     base = load_base(scene, sets)
     space = parse_vary(vary, samples)
     for key, values in space.grid.items():  # each key alone first: the error names its --vary argument
@@ -80,7 +82,7 @@ def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, sche
     record_run(out, {"kind": "sweep", "command": argv, "scene": base.name, "sets": list(sets),
                      "varied": space.keys, "samples": samples, "seed": seed, "points": len(specs),
                      "measures": study.measures},
-               {**info, "points_run": len(todo)})
+               {**info, "points_run": len(todo), "wall_time_s": time.perf_counter() - t0})
     if plots:
         from rftstatic.study.plots import plot_study
 
