@@ -50,6 +50,7 @@ def main(argv=None) -> int:
     v.add_argument("--out", default=None)
 
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # what a study records in study.json
     verbose = getattr(args, "verbose", False)
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
@@ -101,14 +102,14 @@ def _study_command(args) -> int:
 
         store = run_sweep(args.scene, args.vary, samples=args.samples, seed=args.seed, sets=args.set, out=args.out,
                           scheduler=args.scheduler, workers=args.workers, figures=args.figures,
-                          plots=not args.no_plots, retry_failed=args.retry_failed, argv=sys.argv[1:])
+                          plots=not args.no_plots, retry_failed=args.retry_failed, argv=args.argv)
         failed = sum(r.get("status") == "failed" for r in store.rows.values())
         return EXIT["done"] if not failed else EXIT["goal"]
     from rftstatic.study.fit import run_fit
 
     result = run_fit(args.scene, args.free, args.target, sets=args.set, out=args.out, scheduler=args.scheduler,
                      workers=args.workers, figures=args.figures, max_evaluations=args.max_evaluations,
-                     argv=sys.argv[1:])
+                     argv=args.argv)
     return EXIT["done"] if result["success"] else EXIT["goal"]
 
 
