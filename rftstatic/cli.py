@@ -100,10 +100,10 @@ def _study_command(args) -> int:
     if args.command == "sweep":
         from rftstatic.study.sweep import run_sweep
 
-        store = run_sweep(args.scene, args.vary, samples=args.samples, seed=args.seed, sets=args.set, out=args.out,
+        rows = run_sweep(args.scene, args.vary, samples=args.samples, seed=args.seed, sets=args.set, out=args.out,
                           scheduler=args.scheduler, workers=args.workers, figures=args.figures,
                           plots=not args.no_plots, retry_failed=args.retry_failed, argv=args.argv)
-        failed = sum(r.get("status") == "failed" for r in store.rows.values())
+        failed = sum(r.get("status") == "failed" for r in rows)
         return EXIT["done"] if not failed else EXIT["goal"]
     from rftstatic.study.fit import run_fit
 

@@ -17,9 +17,10 @@ def _numeric(values) -> bool:
     return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
 
 
-def plot_study(store, keys: list[str], measures: list[str], folder: Path) -> list[Path]:
-    """Draw every measure that has values against the numeric varied ``keys``; return the files."""
-    rows = [r for r in store.rows.values() if r.get("status") != "failed"]
+def plot_study(rows: list[dict], keys: list[str], measures: list[str], folder: Path) -> list[Path]:
+    """Draw every measure that has values in ``rows`` (the study's points; failed ones are left out) against
+    the numeric varied ``keys``; return the files."""
+    rows = [r for r in rows if r.get("status") != "failed"]
     keys = [k for k in keys if rows and _numeric([r.get(k) for r in rows])]
     if not rows or not keys:
         return []
@@ -68,5 +69,6 @@ def _map(ax, X, y, keys, m) -> None:
             pass
     sc = ax.scatter(X[:, 0], X[:, 1], c=y, cmap="viridis", edgecolors="k", s=30)
     plt.colorbar(sc, ax=ax, label=m)
+    ax.margins(0.05)
     ax.set_xlabel(keys[0])
     ax.set_ylabel(keys[1])

@@ -55,8 +55,8 @@ def load_base(scene: str, sets) -> object:
 
 
 def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, scheduler=None, workers=None,
-              figures=False, plots=True, retry_failed=False, argv=None) -> Store:
-    """The ``sweep`` command (module docstring); returns the study's :class:`Store`."""
+              figures=False, plots=True, retry_failed=False, argv=None) -> list[dict]:
+    """The ``sweep`` command (module docstring); returns the rows of its points, in their order."""
     t0 = time.perf_counter()
     base = load_base(scene, sets)
     space = parse_vary(vary, samples)
@@ -83,12 +83,13 @@ def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, sche
                      "varied": space.keys, "samples": samples, "seed": seed, "points": len(specs),
                      "measures": study.measures},
                {**info, "points_run": len(todo), "wall_time_s": time.perf_counter() - t0})
+    rows = [store.rows[s["key"]] for s in specs]  # this study's points (the table may hold earlier code's rows)
     if plots:
         from rftstatic.study.plots import plot_study
 
-        plot_study(store, space.keys, study.measures, out / "plots")
-    _report(store, [s["key"] for s in specs])
-    return store
+        plot_study(rows, space.keys, study.measures, out / "plots")
+    _report(rows, store.path)
+    return rows
 
 
 def _check_key(scene, sets, key, value) -> None:
@@ -98,11 +99,10 @@ def _check_key(scene, sets, key, value) -> None:
         raise StudyError(f"--vary {format_override(key, value)}: {exc}") from None
 
 
-def _report(store: Store, keys) -> None:
-    rows = [store.rows[k] for k in keys if k in store.rows]
+def _report(rows: list[dict], path: Path) -> None:
     counts = {s: sum(r.get("status") == s for r in rows) for s in ("ok", "not converged", "failed")}
     print(f"{len(rows)} points: {counts['ok']} converged, {counts['not converged']} not converged, "
-          f"{counts['failed']} failed; {store.path}", flush=True)
+          f"{counts['failed']} failed; {path}", flush=True)
     for r in rows:
         if r.get("status") == "failed":
             print(f"  failed {r['key']}: {r.get('error')}", file=sys.stderr)
