@@ -192,3 +192,15 @@ def test_fit_recovers_the_bending_rigidity_from_the_tip_drop(tmp_path, capsys):
     stdout = capsys.readouterr().out
     assert "Dask" not in stdout and len(_rows(out)) == n
     assert json.loads((out / "fit.json").read_text())["points_run"] == 0
+
+
+def test_a_failed_point_is_a_row_with_its_error_and_can_be_retried(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    argv = ["sweep", "strip", "--vary", "mesh.nodes=[9,3],[1,3]", "--out", str(out), "--workers", "1", "--no-plots"]
+    assert cli.main(argv) == cli.EXIT["goal"]  # the study ran; one of its points failed
+    rows = {r["mesh.nodes"]: r for r in _rows(out)}
+    assert rows["[9, 3]"]["status"] == "ok"
+    assert rows["[1, 3]"]["status"] == "failed" and "at least 2 x 2 nodes" in rows["[1, 3]"]["error"]
+    assert "failed" in capsys.readouterr().err
+    assert cli.main([*argv, "--retry-failed"]) == cli.EXIT["goal"]
+    assert "1 to run" in capsys.readouterr().out  # only the failed point ran again
