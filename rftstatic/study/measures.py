@@ -60,7 +60,7 @@ def check_measure(path: str, scene, arg: str = "--target") -> None:
         raise StudyError(f'{arg} "{path}": unknown MEASURE path: {problem}')
 
 
-def measure(summary: dict, path: str) -> float | None:
+def measure(summary: dict, path: str) -> float | int | None:
     """The value of MEASURE ``path`` in ``summary`` (None when the run has none, e.g. no drape)."""
     parts = path.split(".")
     if parts[0] == "probes" and len(parts) == 3:
@@ -75,7 +75,9 @@ def measure(summary: dict, path: str) -> float | None:
         node = node[part]
     if isinstance(node, bool):
         return float(node)
-    return float(node) if isinstance(node, (int, float)) else None
+    if isinstance(node, int):  # a count (fold_count, newton_iterations) stays an integer in results.csv
+        return node
+    return float(node) if isinstance(node, float) else None
 
 
 def clamped_edge_x(summary: dict) -> float:

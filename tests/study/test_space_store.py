@@ -55,7 +55,7 @@ def test_measures_from_a_summary_and_peirce_bending_length():
                "drape": {"drape_coefficient": 0.61, "fold_count": 7}, "newton_iterations": 30,
                "resolved_scene": {"supports": [{"kind": "clamped", "box": [0, 0, -0.5, 0.5]}]}}
     assert measures.measure(summary, "probes.tip.y") == 0.1
-    assert measures.measure(summary, "drape.fold_count") == 7.0
+    assert measures.measure(summary, "drape.fold_count") == 7
     assert measures.measure(summary, "probes.other.x") is None
     assert measures.measure(summary, "cantilever.bending_length") == pytest.approx(0.5093 * l, rel=1e-3)
     scene = api.load_scene("strip")
@@ -115,3 +115,16 @@ def test_the_package_and_the_case_command_do_not_import_dask(tmp_path):
     root = str(Path(api.__file__).resolve().parents[1])
     subprocess.run([sys.executable, "-c", code, str(tmp_path / "s")], check=True, cwd=tmp_path, capture_output=True,
                    env={**__import__("os").environ, "PYTHONPATH": root})
+
+
+def test_plots_draw_numeric_and_category_keys_and_skip_failed_points(tmp_path):
+    from rftstatic.study.plots import plot_study
+
+    rows = [{"status": "ok", "material.B_warp": b, "element": e, "mesh.nodes": [9, 3], "probes.tip.z": -4 - b}
+            for b in (0.05, 0.1) for e in ("RFT3", "RFT6")]
+    rows.append({"status": "failed", "material.B_warp": 0.2, "element": "RFT3", "mesh.nodes": [9, 3]})
+    one = plot_study(rows, ["element"], ["probes.tip.z", "drape.drape_coefficient"], tmp_path / "one")
+    two = plot_study(rows, ["material.B_warp", "element"], ["probes.tip.z"], tmp_path / "two")
+    three = plot_study(rows, ["material.B_warp", "element", "mesh.nodes"], ["probes.tip.z"], tmp_path / "three")
+    assert [p.name for p in one + two + three] == ["probes.tip.z.png"] * 3  # no drape on a strip: no plot
+    assert all(p.stat().st_size > 1000 for p in one + two + three)
