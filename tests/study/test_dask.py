@@ -204,3 +204,18 @@ def test_a_failed_point_is_a_row_with_its_error_and_can_be_retried(tmp_path, cap
     assert "failed" in capsys.readouterr().err
     assert cli.main([*argv, "--retry-failed"]) == cli.EXIT["goal"]
     assert "1 to run" in capsys.readouterr().out  # only the failed point ran again
+
+
+def test_local_workers_run_on_one_thread_without_the_nanny_malloc_setting():
+    import os as os_
+
+    from rftstatic.study.runner import Engine
+
+    engine = Engine(None, 1)
+    try:
+        client = engine.client()
+        env = list(client.run(lambda: {k: os_.environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "NUMBA_NUM_THREADS",
+                                                                          "OMP_NUM_THREADS")}).values())[0]
+    finally:
+        engine.close()
+    assert env == {"MALLOC_TRIM_THRESHOLD_": None, "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
