@@ -1,8 +1,10 @@
-"""Command line: ``python -m rftstatic {case, list, bench, validate}``, on the Python API (:mod:`rftstatic.api`).
+"""Command line: ``python -m rftstatic {case, list, sweep, fit, bench, validate}``, on the Python API
+(:mod:`rftstatic.api`) and the studies on Dask (:mod:`rftstatic.study`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
 not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs
-cannot be written; 130 interrupted; 1 an internal error, printed as one line (``-v``: the traceback).
+cannot be written (``sweep``/``fit``: 2 also for a bad ``--vary``/``--free``/``--target`` or an
+unreachable ``--scheduler``; 3 a fit whose evaluation failed); 130 interrupted; 1 an internal error, printed as one line (``-v``: the traceback).
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ def main(argv=None) -> int:
     p.add_argument("--resume", action="store_true", help="continue a run (static, dynamic, relax) from its last checkpoint")
 
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
+    _study_parsers(sub, common)
 
     b = sub.add_parser("bench", parents=[common], help="print wall time and peak memory of the benchmarks")
     b.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
@@ -47,19 +50,67 @@ def main(argv=None) -> int:
     v.add_argument("--out", default=None)
 
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # what a study records in study.json
     verbose = getattr(args, "verbose", False)
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         return _command(args)
     except KeyboardInterrupt:
-        print("interrupted (the run resumes from its last checkpoint with --resume)", file=sys.stderr)
+        if args.command in ("sweep", "fit"):
+            print("interrupted: the finished points are kept in results.csv; run the same command again to "
+                  "continue", file=sys.stderr)
+        else:
+            print("interrupted (the run resumes from its last checkpoint with --resume)", file=sys.stderr)
         return EXIT["interrupted"]
     except Exception as exc:  # noqa: BLE001 - the one place an unexpected error is reported
         if verbose:
             raise
         print(f"internal error: {type(exc).__name__}: {exc} (run with -v for the traceback)", file=sys.stderr)
         return EXIT["internal"]
+
+
+def _study_parsers(sub, common) -> None:
+    """The ``sweep`` and ``fit`` sub-commands (:mod:`rftstatic.study`)."""
+    shared = argparse.ArgumentParser(add_help=False)
+    shared.add_argument("scene", help="cases/NAME.toml or a path to a .toml file")
+    shared.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a scene key for every point, as for case")
+    shared.add_argument("--out", default=None, help="study folder (default out/sweep-NAME, out/fit-NAME)")
+    shared.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                        help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: a LocalCluster)")
+    shared.add_argument("--workers", type=int, default=None, metavar="N",
+                        help="LocalCluster worker processes (default: the cores); with --scheduler: wait for N")
+    shared.add_argument("--figures", action="store_true", help="each point writes its PNG views (off: faster)")
+    s = sub.add_parser("sweep", parents=[common, shared], help="run a scene over a grid or a Latin hypercube of keys")
+    s.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2|LO:HI[:log]",
+                   help="values of a scene key (a grid), or a range sampled with --samples")
+    s.add_argument("--samples", type=int, default=None, metavar="N", help="Latin-hypercube samples of the ranges")
+    s.add_argument("--seed", type=int, default=0, help="seed of the Latin hypercube (default 0)")
+    s.add_argument("--no-plots", action="store_true", help="skip the measure-against-key plots")
+    s.add_argument("--retry-failed", action="store_true", help="run the failed points again")
+    f = sub.add_parser("fit", parents=[common, shared], help="fit scene keys to measured values")
+    f.add_argument("--free", action="append", default=[], metavar="KEY=LO:HI", help="a key to fit, within bounds")
+    f.add_argument("--target", action="append", default=[], metavar="MEASURE=VALUE",
+                   help="a measured value: probes.NAME.x|y|z, drape.drape_coefficient, cantilever.bending_length, ...")
+    f.add_argument("--max-evaluations", type=int, default=100, help="most evaluations of the optimiser")
+
+
+def _study_command(args) -> int:
+    if args.command == "sweep":
+        from rftstatic.study.sweep import run_sweep
+
+        rows = run_sweep(args.scene, args.vary, samples=args.samples, seed=args.seed, sets=args.set, out=args.out,
+                          scheduler=args.scheduler, workers=args.workers, figures=args.figures,
+                          plots=not args.no_plots, retry_failed=args.retry_failed, argv=args.argv)
+        failed = sum(r.get("status") == "failed" for r in rows)
+        return EXIT["done"] if not failed else EXIT["goal"]
+    from rftstatic.study.fit import run_fit
+
+    result = run_fit(args.scene, args.free, args.target, sets=args.set, out=args.out, scheduler=args.scheduler,
+                     workers=args.workers, figures=args.figures, max_evaluations=args.max_evaluations,
+                     argv=args.argv)
+    return EXIT["done"] if result["success"] else EXIT["goal"]
 
 
 def _goal_missed(summary: dict) -> str:
@@ -106,6 +157,18 @@ def _command(args) -> int:
                       file=sys.stderr)
                 return EXIT["goal"]
             return EXIT["done"]
+        if args.command in ("sweep", "fit"):
+            from rftstatic.study.fit import FitFailed
+            from rftstatic.study.space import StudyError
+
+            try:
+                return _study_command(args)
+            except StudyError as exc:
+                print(f"error: {exc}", file=sys.stderr)
+                return EXIT["input"]
+            except FitFailed as exc:
+                print(f"error: {exc}", file=sys.stderr)
+                return EXIT["goal"]
         if args.command == "bench":
             from rftstatic.bench.main import main as bench_main
 

@@ -169,6 +169,7 @@ BENCHES = {
     "drape": _lazy("bench.drape", lambda m: m.main([])),  # static drape scenes, each in a fresh process
     "remesh": _lazy("bench.remesh", lambda m: m.main([])),  # mesher sizes and the remeshed scenes
     "self-contact": _lazy("bench.self_contact_scenes", lambda m: m.main([])),  # run time with / without it
+    "study": _lazy("bench.study", lambda m: m.main([])),  # points per minute of a sweep on 1 and 2 Dask workers
 }
 
 

@@ -1,0 +1,202 @@
+"""The Dask side of a study: a client on a LocalCluster or on a scheduler given by address, started
+only when a point has to run, and batches of points run on it with a progress line.
+
+Engines:
+
+- ``local`` (default): ``distributed.LocalCluster`` of N worker *processes* (spawned by Dask's nanny,
+  never forked) with one thread each and :data:`~rftstatic.study.worker.THREAD_VARIABLES` set to 1 in
+  their environment, so that N workers use N cores; no dashboard, no set-up;
+- ``scheduler``: ``--scheduler tcp://HOST:PORT``, any running Dask scheduler (``dask scheduler`` and
+  ``dask worker ADDRESS --nthreads 1``, or a deployment of dask-jobqueue, dask-kubernetes, ...). The
+  connection gives up after :data:`CONNECT_TIMEOUT_S`, the wait for workers after
+  :data:`WORKER_TIMEOUT_S`: a wrong address is an input error (exit 2), never a hang. The workers
+  write into the study folder, which they must share with the driver (one machine, or a shared file
+  system); the rows come back to the driver through Dask.
+
+A point that raises on its worker is a failed row (:func:`~rftstatic.study.worker.run_point` catches
+everything); a worker that dies under a point (Dask retries it on another worker, 3 times by default)
+gives a failed row with Dask's error.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+import time
+
+from rftstatic.study.space import StudyError
+
+CONNECT_TIMEOUT_S = 10.0
+"""Longest wait for a scheduler to answer [s]."""
+WORKER_TIMEOUT_S = 60.0
+"""Longest wait for the first worker to join a scheduler [s]."""
+
+
+def _dask_level() -> int:
+    """Dask's log level: WARNING, or INFO when rftstatic logs at INFO (``-v``)."""
+    return logging.INFO if logging.getLogger().getEffectiveLevel() <= logging.INFO else logging.WARNING
+
+
+def _quiet() -> None:
+    """Dask's INFO lines (workers joining, connections) only with ``-v``."""
+    logging.getLogger("distributed").setLevel(_dask_level())
+
+
+MALLOC_TRIM = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+"""Dask's nanny starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536``, which also turns off glibc's
+dynamic mmap threshold, so every array above 128 kB is a fresh mmap whose pages fault in again: the
+strip at 51 x 11 solved 35 % slower with it (6 points, 4.0-4.1 s against 5.4-5.7 s, in-process). The
+LocalCluster's workers start without it (this key set to None); ``dask worker`` processes of an
+external cluster get it unless their configuration unsets it (README)."""
+
+
+class StudyProgress:
+    """``label: D/N done, R running, F failed, T s`` on stderr: redrawn on a terminal, else a line at
+    every tenth of the way (a batch of at most 3 points: at its end only). R: the points on workers,
+    min(workers, points not done), as each worker runs one point at a time."""
+
+    def __init__(self, total: int, label: str, workers: int, stream=None):
+        self.total, self.label, self.workers = total, label, max(1, workers)
+        self.stream = stream or sys.stderr
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.done = self.failed = 0
+        self._t0 = time.perf_counter()
+        self._next = 0.1
+
+    def line(self) -> str:
+        running = min(self.workers, self.total - self.done)
+        return (f"{self.label}: {self.done}/{self.total} done, {running} running, {self.failed} failed, "
+                f"{time.perf_counter() - self._t0:.1f} s")
+
+    def update(self, row: dict) -> None:
+        self.done += 1
+        self.failed += row.get("status") == "failed"
+        if self.tty:
+            self.stream.write("\r" + self.line() + " " * 8)
+            self.stream.flush()
+        elif self.done == self.total or (self.total > 3 and self.done >= self._next * self.total):
+            print(self.line(), file=self.stream, flush=True)
+            while self._next * self.total <= self.done:
+                self._next += 0.1
+
+    def close(self) -> None:
+        if self.tty:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+class Engine:
+    """A Dask client, created on first use (:meth:`client`), closed by :meth:`close`.
+
+    Parameters
+    ----------
+    scheduler : address of a running scheduler (``tcp://HOST:PORT``), or None for a LocalCluster
+    workers : LocalCluster: its number of worker processes (default: the machine's cores); with a
+        scheduler: how many workers to wait for before starting (default 1)
+    """
+
+    def __init__(self, scheduler: str | None = None, workers: int | None = None, *,
+                 connect_timeout: float | None = None, worker_timeout: float | None = None):
+        if workers is not None and workers < 1:
+            raise StudyError(f"--workers {workers}: must be >= 1")
+        self.scheduler, self.workers = scheduler, workers
+        self.connect_timeout = CONNECT_TIMEOUT_S if connect_timeout is None else connect_timeout
+        self.worker_timeout = WORKER_TIMEOUT_S if worker_timeout is None else worker_timeout
+        self._client = self._cluster = None
+
+    @property
+    def started(self) -> bool:
+        return self._client is not None
+
+    def client(self):
+        if self._client is None:
+            self._client = self._connect() if self.scheduler else self._local()
+            info = self.info()
+            print(f"Dask {info['engine']} scheduler {info['address']}, {len(info['workers'])} workers",
+                  flush=True)
+        return self._client
+
+    def _local(self):
+        import os
+
+        from distributed import Client, LocalCluster
+
+        from rftstatic.study.worker import worker_environment
+
+        import dask
+
+        n = self.workers or os.cpu_count() or 1
+        _quiet()
+        env = {**worker_environment(), "DASK_LOGGING__DISTRIBUTED": logging.getLevelName(_dask_level()).lower()}
+        with dask.config.set({MALLOC_TRIM: None}):  # read when each nanny is made
+            self._cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                         scheduler_kwargs={"dashboard": False}, silence_logs=_dask_level(), env=env)
+        return Client(self._cluster)
+
+    def _connect(self):
+        from distributed import Client
+
+        address = self.scheduler
+        _quiet()
+        try:
+            client = Client(address, timeout=self.connect_timeout)
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            raise StudyError(f"--scheduler {address}: no Dask scheduler answered within {self.connect_timeout:g} s "
+                             f"({type(exc).__name__}: {' '.join(str(exc).split())[:160]}); start one with "
+                             "`dask scheduler` and give the address it prints") from None
+        try:
+            client.wait_for_workers(self.workers or 1, timeout=self.worker_timeout)
+        except TimeoutError:
+            client.close()
+            raise StudyError(f"--scheduler {address}: fewer than {self.workers or 1} workers joined within "
+                             f"{self.worker_timeout:g} s; start them with `dask worker {address} --nthreads 1`") \
+                from None
+        return client
+
+    def info(self) -> dict:
+        """``engine`` (local / scheduler / none), scheduler ``address`` and ``workers`` (address -> threads)."""
+        if self._client is None:
+            return {"engine": "none", "address": None, "workers": {}}
+        sinfo = self._client.scheduler_info()
+        workers = {a: w.get("nthreads") for a, w in sinfo.get("workers", {}).items()}
+        return {"engine": "scheduler" if self.scheduler else "local", "address": sinfo.get("address"),
+                "workers": workers}
+
+    def run(self, specs: list[dict], on_row, *, label: str = "points") -> list[dict]:
+        """Run ``specs`` (:func:`~rftstatic.study.worker.run_point`); call ``on_row(row)`` as each finishes
+        (in completion order); return the rows in the order of ``specs``."""
+        if not specs:
+            return []
+        from distributed import as_completed
+
+        from rftstatic.study.worker import run_point
+
+        client = self.client()
+        progress = StudyProgress(len(specs), label, len(self.info()["workers"]))
+        futures = {client.submit(run_point, spec, key=f"rftstatic-point-{spec['key']}", pure=False): spec
+                   for spec in specs}
+        rows = {}
+        try:
+            for future in as_completed(futures):
+                spec = futures[future]
+                try:
+                    row = future.result()
+                except Exception as exc:  # noqa: BLE001 - a worker died under the point: a failed row
+                    row = {"key": spec["key"], **spec["values"], "status": "failed", "folder": f"points/{spec['key']}",
+                           "error": f"{type(exc).__name__}: {' '.join(str(exc).split())[:400]}"}
+                rows[spec["key"]] = row
+                on_row(row)
+                progress.update(row)
+        finally:
+            progress.close()
+            for future in futures:
+                if not future.done():
+                    future.cancel()
+        return [rows[spec["key"]] for spec in specs]
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+        self._client = self._cluster = None

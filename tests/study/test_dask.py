@@ -1,0 +1,221 @@
+"""Studies on Dask, on the strip with 9 x 3 nodes (0.1-0.5 s a point): a sweep on a 2-worker
+LocalCluster, the same sweep on a scheduler and two workers started as separate processes, a driver
+killed mid-sweep and resumed, and a fit that recovers the strip's bending rigidity from its tip drop."""
+
+import csv
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from rftstatic import api, cli
+from rftstatic.study.worker import worker_environment
+
+pytest.importorskip("distributed")
+
+ROOT = Path(api.__file__).resolve().parents[1]
+COARSE = "mesh.nodes=[9,3]"
+B_TRUE = 0.083  # wool-kang-yu B_warp [gf cm]
+
+
+def _env():
+    env = {**os.environ, **worker_environment()}
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
+    return env
+
+
+def _rows(out: Path) -> list[dict]:
+    with open(out / "results.csv", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _stop(proc) -> None:
+    if proc.poll() is None:
+        for sig in (signal.SIGTERM, signal.SIGKILL):
+            try:
+                os.killpg(proc.pid, sig)
+            except ProcessLookupError:
+                return
+            try:
+                proc.wait(5)
+                return
+            except subprocess.TimeoutExpired:
+                continue
+
+
+@pytest.fixture
+def processes():
+    """Started subprocesses (each in its own session), stopped with their process groups at the end."""
+    started = []
+    yield started
+    for proc in reversed(started):
+        _stop(proc)
+
+
+def _sweep(out, *extra):
+    return ["sweep", "strip", "--set", COARSE, "--vary", "material.B_warp=0.05,0.12",
+            "--vary", "material.B_weft=0.04,0.09", "--out", str(out), *extra]
+
+
+def test_sweep_on_a_local_cluster_then_nothing_to_run(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    assert cli.main(_sweep(out, "--workers", "2")) == 0
+    stdout = capsys.readouterr().out
+    assert "Dask local scheduler tcp://" in stdout
+    rows = _rows(out)
+    assert len(rows) == 4 and {r["status"] for r in rows} == {"ok"}
+    by_b = {}
+    for r in rows:
+        assert (out / r["folder"] / "summary.json").exists() and (out / r["folder"] / "deformed.vtu").exists()
+        by_b.setdefault(float(r["material.B_warp"]), []).append(float(r["probes.tip.z"]))
+    assert max(by_b[0.12]) > min(by_b[0.05])  # a stiffer warp: the tip drops less
+    # B_weft acts across the strip: its tip drop changes by less than 1e-3 of the warp's effect
+    assert abs(by_b[0.05][0] - by_b[0.05][1]) < 1e-3 * abs(by_b[0.05][0] - by_b[0.12][0]) + 1e-4
+    study = json.loads((out / "study.json").read_text())
+    assert study["runs"][-1]["engine"] == "local" and len(study["runs"][-1]["workers"]) == 2
+    assert (out / "plots" / "probes.tip.z.png").exists()
+    assert cli.main(_sweep(out, "--workers", "2")) == 0  # finished: no cluster, nothing re-run
+    stdout = capsys.readouterr().out
+    assert "0 to run" in stdout and "Dask" not in stdout
+    assert json.loads((out / "study.json").read_text())["runs"][-1] == {
+        **json.loads((out / "study.json").read_text())["runs"][-1], "engine": "none", "points_run": 0}
+
+
+def test_sweep_on_an_external_scheduler_and_workers(tmp_path, processes, capsys):
+    from distributed import Client
+
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    logs = tmp_path / "logs"
+    logs.mkdir()
+
+    def start(name, *args):
+        with open(logs / f"{name}.log", "wb") as log:
+            processes.append(subprocess.Popen([sys.executable, "-m", "dask", *args], stdout=log, stderr=log,
+                                              env=_env(), cwd=tmp_path, start_new_session=True))
+
+    start("scheduler", "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard")
+    for i in range(2):
+        start(f"worker{i}", "worker", address, "--nthreads", "1", "--nworkers", "1", "--no-dashboard",
+              "--name", f"external-{i}", "--local-directory", str(tmp_path / f"w{i}"))
+    deadline = time.monotonic() + 60
+    while True:  # the scheduler takes a moment to listen
+        try:
+            with Client(address, timeout=5) as client:
+                client.wait_for_workers(2, timeout=60)
+                workers = set(client.scheduler_info()["workers"])
+            break
+        except OSError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.5)
+    out = tmp_path / "sweep"
+    assert cli.main(_sweep(out, "--scheduler", address, "--workers", "2")) == 0
+    assert f"Dask scheduler scheduler {address}" in capsys.readouterr().out
+    rows = _rows(out)
+    assert len(rows) == 4 and {r["status"] for r in rows} == {"ok"}
+    assert {r["worker"] for r in rows} <= workers  # the external workers ran every point
+    run = json.loads((out / "study.json").read_text())["runs"][-1]
+    assert run["engine"] == "scheduler" and run["address"] == address and set(run["workers"]) == workers
+
+
+def test_unreachable_scheduler_is_an_input_error(tmp_path, capsys):
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    t0 = time.monotonic()
+    from rftstatic.study import runner
+
+    old, runner.CONNECT_TIMEOUT_S = runner.CONNECT_TIMEOUT_S, 2.0
+    try:
+        code = cli.main(_sweep(tmp_path / "s", "--scheduler", address))
+    finally:
+        runner.CONNECT_TIMEOUT_S = old
+    assert code == cli.EXIT["input"] and time.monotonic() - t0 < 30
+    err = capsys.readouterr().err
+    assert f"--scheduler {address}: no Dask scheduler answered" in err
+
+
+def test_killed_driver_loses_no_finished_point(tmp_path, processes, capsys):
+    out = tmp_path / "sweep"
+    values = ",".join(f"{0.05 + 0.01 * i:.2f}" for i in range(8))
+    argv = ["sweep", "strip", "--set", COARSE, "--vary", f"material.B_warp={values}", "--out", str(out),
+            "--workers", "1", "--no-plots"]
+    proc = subprocess.Popen([sys.executable, "-m", "rftstatic", *argv], env=_env(), cwd=tmp_path,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    processes.append(proc)
+    deadline = time.monotonic() + 90
+    while not ((out / "results.csv").exists() and len(_rows(out)) >= 2):
+        assert proc.poll() is None and time.monotonic() < deadline, "the driver ended before two points"
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)  # the driver, its scheduler and its worker
+    proc.wait(10)
+    before = {r["key"]: r for r in _rows(out)}
+    assert 2 <= len(before) < 8
+    stamps = {k: (out / "points" / k / "summary.json").stat().st_mtime_ns for k in before}
+    assert cli.main(argv[:-2] + ["2", "--no-plots"]) == 0
+    rows = {r["key"]: r for r in _rows(out)}
+    assert len(rows) == 8 and {r["status"] for r in rows.values()} == {"ok"}
+    for k, r in before.items():  # kept as they were, not run again
+        assert rows[k]["wall_time_s"] == r["wall_time_s"] and rows[k]["worker"] == r["worker"]
+        assert (out / "points" / k / "summary.json").stat().st_mtime_ns == stamps[k]
+    run = json.loads((out / "study.json").read_text())["runs"][-1]
+    assert run["points_run"] <= 8 - len(before)
+
+
+def test_fit_recovers_the_bending_rigidity_from_the_tip_drop(tmp_path, capsys):
+    synthetic = api.run("strip", tmp_path / "truth", overrides=[COARSE, f"material.B_warp={B_TRUE}"], figures=False)
+    drop = synthetic.summary["probes"]["tip"]["deformed"][2]
+    out = tmp_path / "fit"
+    argv = ["fit", "strip", "--set", COARSE, "--free", "material.B_warp=0.03:0.3", "--target",
+            f"probes.tip.z={drop!r}", "--out", str(out), "--workers", "2"]
+    assert cli.main(argv) == 0
+    captured = capsys.readouterr()
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["fitted"]["material.B_warp"] == pytest.approx(B_TRUE, rel=1e-4)
+    assert fit["history"][0]["objective"] > fit["history"][-1]["objective"]
+    s = fit["sensitivity"]["probes.tip.z"]["material.B_warp"]
+    assert -0.2 < s < -0.05  # the drop hardly moves: 0.1 % per 1 % of B, ...
+    assert "barely depends on material.B_warp" in captured.err  # ... and the fit says so
+    n = len(_rows(out))
+    assert cli.main(argv) == 0  # a repeated fit replays from results.csv: nothing runs, no cluster
+    stdout = capsys.readouterr().out
+    assert "Dask" not in stdout and len(_rows(out)) == n
+    assert json.loads((out / "fit.json").read_text())["points_run"] == 0
+
+
+def test_a_failed_point_is_a_row_with_its_error_and_can_be_retried(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    argv = ["sweep", "strip", "--vary", "mesh.nodes=[9,3],[1,3]", "--out", str(out), "--workers", "1", "--no-plots"]
+    assert cli.main(argv) == cli.EXIT["goal"]  # the study ran; one of its points failed
+    rows = {r["mesh.nodes"]: r for r in _rows(out)}
+    assert rows["[9, 3]"]["status"] == "ok"
+    assert rows["[1, 3]"]["status"] == "failed" and "at least 2 x 2 nodes" in rows["[1, 3]"]["error"]
+    assert "failed" in capsys.readouterr().err
+    assert cli.main([*argv, "--retry-failed"]) == cli.EXIT["goal"]
+    assert "1 to run" in capsys.readouterr().out  # only the failed point ran again
+
+
+def test_local_workers_run_on_one_thread_without_the_nanny_malloc_setting():
+    import os as os_
+
+    from rftstatic.study.runner import Engine
+
+    engine = Engine(None, 1)
+    try:
+        client = engine.client()
+        env = list(client.run(lambda: {k: os_.environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "NUMBA_NUM_THREADS",
+                                                                          "OMP_NUM_THREADS")}).values())[0]
+    finally:
+        engine.close()
+    assert env == {"MALLOC_TRIM_THRESHOLD_": None, "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}

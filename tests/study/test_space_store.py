@@ -1,0 +1,130 @@
+"""The study's pieces without Dask: parameter space, Latin hypercube, MEASURE paths, the results table,
+and the command line's input errors (status 2, one line naming the argument)."""
+
+import json
+from pathlib import Path
+import math
+
+import numpy as np
+import pytest
+
+from rftstatic import api, cli
+from rftstatic.scenes.schema import parse_override
+from rftstatic.study import measures, space, store
+
+
+def test_latin_hypercube_has_one_sample_in_each_stratum_and_is_reproducible():
+    u = space.latin_hypercube(3, 16, seed=4)
+    assert u.shape == (16, 3)
+    for j in range(3):
+        assert sorted(np.floor(u[:, j] * 16).astype(int)) == list(range(16))
+    assert np.array_equal(u, space.latin_hypercube(3, 16, seed=4))
+    assert not np.array_equal(u, space.latin_hypercube(3, 16, seed=5))
+
+
+def test_grid_times_hypercube_and_log_range():
+    s = space.parse_vary(["element=RFT3,RFT6", "mesh.nodes=[9,3],[13,3]", "material.B_warp=0.01:1:log"], 5)
+    pts = s.points(5, seed=0)
+    assert len(pts) == 2 * 2 * 5
+    assert {tuple(p["mesh.nodes"]) for p in pts} == {(9, 3), (13, 3)}
+    b = sorted({p["material.B_warp"] for p in pts})
+    assert len(b) == 5 and all(0.01 <= v <= 1 for v in b)
+    # log-uniform strata: one sample per decade-fifth
+    assert sorted(np.floor((np.log10(b) + 2) / 2 * 5).astype(int)) == list(range(5))
+
+
+def test_override_text_round_trips_through_set_parser():
+    for key, value in [("a.b", 0.1 + 0.2), ("a", 1e-300), ("a", "RFT3"), ("a", [9, 3]), ("a", True), ("a", 7)]:
+        assert parse_override(space.format_override(key, value)) == (key, value)
+
+
+@pytest.mark.parametrize("text, word", [("material.B_warp", "KEY=VALUES"), ("material.B_warp=2:1", "LO < HI"),
+                                        ("material.B_warp=a:b", "not numbers"), ("x=-1:1:log", "LO > 0"),
+                                        ("x=1:2:lin", "LO:HI or LO:HI:log")])
+def test_malformed_vary_is_refused_naming_it(text, word):
+    with pytest.raises(space.StudyError, match=word) as err:
+        space.parse_vary([text], 4)
+    assert "--vary" in str(err.value)
+
+
+def test_measures_from_a_summary_and_peirce_bending_length():
+    theta = math.radians(41.5)  # Peirce's angle: the bending length is half the overhang
+    l = 5.0
+    summary = {"probes": {"tip": {"reference": [l, 0, 0], "deformed": [l * math.cos(theta) * 0.9, 0.1,
+                                                                        -l * math.sin(theta) * 0.9]}},
+               "drape": {"drape_coefficient": 0.61, "fold_count": 7}, "newton_iterations": 30,
+               "resolved_scene": {"supports": [{"kind": "clamped", "box": [0, 0, -0.5, 0.5]}]}}
+    assert measures.measure(summary, "probes.tip.y") == 0.1
+    assert measures.measure(summary, "drape.fold_count") == 7
+    assert measures.measure(summary, "probes.other.x") is None
+    assert measures.measure(summary, "cantilever.bending_length") == pytest.approx(0.5093 * l, rel=1e-3)
+    scene = api.load_scene("strip")
+    measures.check_measure("probes.tip.z", scene)
+    for bad in ("probes.tip.w", "probes.end.x", "drape.folds", "tip"):
+        with pytest.raises(space.StudyError, match="unknown MEASURE path"):
+            measures.check_measure(bad, scene)
+
+
+def test_store_rewrites_the_table_and_recovers_rows_from_point_folders(tmp_path):
+    s = store.Store(tmp_path, ["mesh.nodes", "probes.tip.z"])
+    s.add({"key": "a" * 16, "status": "ok", "mesh.nodes": [9, 3], "probes.tip.z": -4.3818048362912, "converged": True})
+    s.add({"key": "b" * 16, "status": "failed", "mesh.nodes": [13, 3], "error": "ValueError: x, y"})
+    folder = s.folder("c" * 16)
+    folder.mkdir(parents=True)
+    (folder / "point.json").write_text(json.dumps({"key": "c" * 16, "status": "ok", "probes.tip.z": -1.0}))
+    again = store.Store(tmp_path, ["mesh.nodes", "probes.tip.z", "probes.tip.x"])
+    assert again.rows["a" * 16]["mesh.nodes"] == [9, 3]
+    assert again.rows["a" * 16]["probes.tip.z"] == -4.3818048362912
+    assert again.rows["b" * 16]["error"] == "ValueError: x, y"
+    assert again.done("b" * 16) and not again.done("b" * 16, retry_failed=True)
+    assert not again.done("a" * 16, needs=["cantilever.bending_length"])
+    assert again.recover(["c" * 16, "d" * 16]) == 1
+    assert "c" * 16 in store.Store(tmp_path, []).rows
+
+
+def test_point_key_follows_the_resolved_scene():
+    a = store.point_key(api.load_scene("strip", ["material.B_warp=0.083"]))
+    assert a == store.point_key(api.load_scene("strip", ["material.B_warp=0.083"]))
+    assert a != store.point_key(api.load_scene("strip", ["material.B_warp=0.084"]))
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["sweep", "strip", "--vary", "material.B_wrap=0.05,0.1"], ["--vary material.B_wrap=0.05", "unknown key"]),
+    (["sweep", "strip", "--vary", "material.B_warp=0.1:0.05", "--samples", "3"], ["--vary", "LO < HI"]),
+    (["sweep", "strip", "--vary", "material.B_warp=0.05:0.1"], ["--samples"]),
+    (["fit", "strip", "--free", "material.B_warp=0.03:0.3", "--target", "probes.tap.z=-4"],
+     ["--target", "probes.tap.z", "unknown MEASURE path"]),
+    (["fit", "strip", "--free", "material.B_wrp=0.03:0.3", "--target", "probes.tip.z=-4"], ["--free", "B_wrp"]),
+    (["fit", "strip", "--free", "material.B_warp=0.3:0.03", "--target", "probes.tip.z=-4"], ["--free", "LO < HI"]),
+])
+def test_bad_study_arguments_exit_2_with_one_line(argv, words, tmp_path, capsys):
+    assert cli.main([*argv, "--out", str(tmp_path / "s")]) == cli.EXIT["input"]
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("error: ")
+    for w in words:
+        assert w in err
+
+
+def test_the_package_and_the_case_command_do_not_import_dask(tmp_path):
+    import subprocess
+    import sys
+
+    code = ("import sys; from rftstatic import cli; import rftstatic.api; "
+            "assert cli.main(['case', 'strip', '--set', 'mesh.nodes=[5,3]', '--no-figures', '--out', sys.argv[1]]) == 0; "
+            "bad = [m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')]; assert not bad, bad")
+    root = str(Path(api.__file__).resolve().parents[1])
+    subprocess.run([sys.executable, "-c", code, str(tmp_path / "s")], check=True, cwd=tmp_path, capture_output=True,
+                   env={**__import__("os").environ, "PYTHONPATH": root})
+
+
+def test_plots_draw_numeric_and_category_keys_and_skip_failed_points(tmp_path):
+    from rftstatic.study.plots import plot_study
+
+    rows = [{"status": "ok", "material.B_warp": b, "element": e, "mesh.nodes": [9, 3], "probes.tip.z": -4 - b}
+            for b in (0.05, 0.1) for e in ("RFT3", "RFT6")]
+    rows.append({"status": "failed", "material.B_warp": 0.2, "element": "RFT3", "mesh.nodes": [9, 3]})
+    one = plot_study(rows, ["element"], ["probes.tip.z", "drape.drape_coefficient"], tmp_path / "one")
+    two = plot_study(rows, ["material.B_warp", "element"], ["probes.tip.z"], tmp_path / "two")
+    three = plot_study(rows, ["material.B_warp", "element", "mesh.nodes"], ["probes.tip.z"], tmp_path / "three")
+    assert [p.name for p in one + two + three] == ["probes.tip.z.png"] * 3  # no drape on a strip: no plot
+    assert all(p.stat().st_size > 1000 for p in one + two + three)
