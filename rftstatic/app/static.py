@@ -122,5 +122,6 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         x = model.positions(U)
         summary["max_penetration"] = model.contact.max_penetration(x) / u.length
         summary["contact_nodes"] = int(model.contact.active(x).sum())
+    if model.contact is not None or extras.get("disc") is not None:
         summary["drape"] = drape_summary(scene, model, extras, U)
     return summary

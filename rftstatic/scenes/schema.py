@@ -18,6 +18,7 @@ from pathlib import Path
 
 from rftstatic.contact.obstacles import scene_schema as obstacle_schema
 from rftstatic.errors import SceneError
+from rftstatic.fabrics.lab import LAB_KEYS
 from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 
@@ -124,12 +125,16 @@ SCHEMA = {
         "weight": (NUM, "areal weight [force/area]"),
         "E": (NUM, "Young's modulus [force/area]"),
         "nu": (NUM, "Poisson ratio"),
-        "thickness": (NUM, "shell thickness [length]"),
-    }, "fabric or shell rigidities"),
+        "thickness": (NUM, "shell thickness, or a fabric's (self-contact default) [length]"),
+        **{k: (NUM, f"{meaning} [{unit}], lab units whatever the scene's (rftstatic.fabrics.lab)")
+           for k, (unit, meaning) in LAB_KEYS.items()},
+    }, "fabric or shell rigidities; fabric lab data (KES-F kes_*, FAST fast_*)"),
     "supports": ([{
         "kind": (str, "clamped, pinned or fixed"),
         "box": (BOX, "[xmin, xmax, ymin, ymax] in reference coordinates"),
         "at": (PointsXY(), "[x, y] or [[x, y], ...] reference points (nearest nodes)"),
+        "radius": (NUM, "the nodes within this distance of centre (a tester's clamping disc) [length]"),
+        "centre": (XY, "centre of the radius selector (default [0, 0])"),
         "components": (str, "for kind = fixed: which of x, y, z are held, e.g. 'xy'"),
     }], "prescribed (zero) displacements"),
     "loads": ({
