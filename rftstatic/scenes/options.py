@@ -202,5 +202,40 @@ def remesh_options(scene) -> RemeshOptions:
     return RemeshOptions(**{k: (v * u if k in REMESH_LENGTH_KEYS and v is not None else v) for k, v in r.items()})
 
 
-__all__ = ["static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
+@dataclass(frozen=True)
+class CantileverOptions:
+    """``[cantilever]`` of a cantilever-tester scene (Peirce; ASTM D1388, BS 3356).
+
+    Attributes
+    ----------
+    angle : the tester's plane below the horizontal [rad] (41.5 deg)
+    growth : overhang factor per step while the tip is above the plane [-]
+    tolerance : relative change of the overhang at which the root find stops [-]
+    max_solves : most static solves (growth steps and root-find steps together)
+    """
+
+    angle: float = float(np.radians(41.5))
+    growth: float = 1.15
+    tolerance: float = 1e-7
+    max_solves: int = 60
+
+
+def cantilever_options(scene) -> CantileverOptions:
+    """The scene's ``[cantilever]`` table checked, angles in radians."""
+    c = dict(scene.get("cantilever", {}))
+    if "angle" in c and not 1.0 <= c["angle"] <= 80.0:
+        raise scene.error("cantilever.angle", f"{c['angle']!r} must lie in [1, 80] deg (the tester's plane below "
+                          "the horizontal: 41.5 in ASTM D1388 and BS 3356)")
+    if "growth" in c and not 1.0 < c["growth"] <= 2.0:
+        raise scene.error("cantilever.growth", f"{c['growth']!r} must lie in (1, 2] (overhang factor per step)")
+    if "tolerance" in c and not 1e-12 <= c["tolerance"] <= 1e-2:
+        raise scene.error("cantilever.tolerance", f"{c['tolerance']!r} must lie in [1e-12, 1e-2]")
+    if "max_solves" in c and not c["max_solves"] >= 3:
+        raise scene.error("cantilever.max_solves", f"{c['max_solves']!r} must be an integer >= 3")
+    if "angle" in c:
+        c["angle"] = float(np.radians(c["angle"]))
+    return CantileverOptions(**c)
+
+
+__all__ = ["cantilever_options", "CantileverOptions", "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
            "DYNAMICS_DEFAULTS", "SceneError"]

@@ -48,7 +48,8 @@ def clamp_disc(X3: np.ndarray, tri: np.ndarray, nodes: np.ndarray, centre) -> Di
     inside = np.zeros(len(X3), bool)
     inside[nodes] = True
     p = X3[tri[inside[tri].all(axis=1)]][:, :, :2]
-    covered = 0.5 * np.abs(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])).sum()
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    covered = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()
     c = np.array([centre[0], centre[1], float(X3[ring, 2].mean())])
     a, b = X3[ring], X3[np.roll(ring, -1)]
     fill = np.stack([np.broadcast_to(c, a.shape), a, b], axis=1)
