@@ -36,6 +36,7 @@ def static_options(scene, *, progress=True) -> StaticOptions:
     """
     s = dict(scene.get("solver", {}))
     s.pop("membrane", None)
+    s.pop("seeds", None)
     u = scene.units.length
     for key in _STATIC_LENGTH_KEYS:
         if key in s:
@@ -220,6 +221,20 @@ class CantileverOptions:
     max_solves: int = 60
 
 
+def seed_count(scene) -> int:
+    """``solver.seeds``: how many seeded starts a static drape runs (a lab's specimens), checked; 1 by default.
+    More than one needs a seeded start (``solver.perturbation`` > 0)."""
+    n = scene.get("solver.seeds", 1)
+    if not (isinstance(n, int) and 1 <= n <= 100):
+        raise scene.error("solver.seeds", f"{n!r} must be an integer in [1, 100] (seeded starts, one per specimen)")
+    if n > 1 and not scene.get("solver.perturbation", 0.0) > 0:
+        raise scene.error("solver.seeds", f"{n} seeded starts need a seeded lift: give solver.perturbation > 0 "
+                          "(e.g. 0.01 element sizes), or every start is the same")
+    if n > 1 and scene.get("analysis", "static") != "static":
+        raise scene.error("solver.seeds", f"{n!r}: seeded starts are run by the static analysis only")
+    return n
+
+
 def cantilever_options(scene) -> CantileverOptions:
     """The scene's ``[cantilever]`` table checked, angles in radians."""
     c = dict(scene.get("cantilever", {}))
@@ -237,5 +252,5 @@ def cantilever_options(scene) -> CantileverOptions:
     return CantileverOptions(**c)
 
 
-__all__ = ["cantilever_options", "CantileverOptions", "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
+__all__ = ["seed_count", "cantilever_options", "CantileverOptions", "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
            "DYNAMICS_DEFAULTS", "SceneError"]

@@ -166,6 +166,8 @@ SCHEMA = {
         "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
         "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
+        "seeds": (int, "static drape: run this many seeded starts (seed, seed + 1, ...), as a lab tests several "
+                       "specimens; the summary reports their mean, range and fold counts"),
         "perturbation_folds": (int, "0: random modes; n: an n-fold lift about the sheet's centre"),
         "guide_folds": (int, "relax route: n-fold modulation of the weight in the first stage (0: none)"),
         "guide_weight": (NUM, "relative amplitude of that modulation, in [0, 1)"),
