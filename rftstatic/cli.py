@@ -1,4 +1,4 @@
-"""Command line: ``python -m rftstatic {case, list, bench, validate}``, on the Python API (:mod:`rftstatic.api`).
+"""Command line: ``python -m rftstatic {case, list, fabrics, bench, validate}``, on the Python API (:mod:`rftstatic.api`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
 not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs
@@ -37,6 +37,7 @@ def main(argv=None) -> int:
     p.add_argument("--resume", action="store_true", help="continue a run (static, dynamic, relax) from its last checkpoint")
 
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
+    sub.add_parser("fabrics", parents=[common], help="list the fabric library with bending lengths and sources")
 
     b = sub.add_parser("bench", parents=[common], help="print wall time and peak memory of the benchmarks")
     b.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
@@ -85,6 +86,12 @@ def _command(args) -> int:
         if args.command == "list":
             for name, title in api.list_scenes():
                 print(f"{name:32s} {title}")
+            return 0
+        if args.command == "fabrics":
+            print(f"{'preset':18s} {'B warp/weft [gf cm]':>20s} {'W [gf/cm2]':>11s} {'c warp/weft [cm]':>17s}  source")
+            for f in api.list_fabrics():
+                print(f"{f['name']:18s} {f['B_warp']:>9.4g} / {f['B_weft']:<8.4g} {f['weight']:>11.4g} "
+                      f"{f['c_warp']:>7.4g} / {f['c_weft']:<7.4g}  {f['source']}")
             return 0
         if args.command == "case":
             scene = api.load_scene(args.name, args.set)

@@ -125,3 +125,19 @@ def material_summary(scene, material: mat.Material) -> dict:
     if "lab" in material.info:
         out["lab"] = material.info["lab"]
     return out
+
+
+def list_fabrics() -> list[dict]:
+    """Every library fabric as built for a scene in cm-gf-s: name, bending rigidities B [gf cm] and bending
+    lengths c = (B/W)^(1/3) [cm] along warp and weft, weight [gf/cm^2], description and source."""
+    from rftstatic.scenes.schema import scene_from_dict
+
+    rows = []
+    for name, fab in FABRICS.items():
+        scene = scene_from_dict({"units": "cm-gf-s", "material": {"preset": name}})
+        m = material_summary(scene, build_material(scene))
+        rows.append({"name": name, "B_warp": m["B_warp"], "B_weft": m["B_weft"], "weight": m["weight"],
+                     "c_warp": m["bending_length_warp"], "c_weft": m["bending_length_weft"],
+                     "published_units": fab.units, "description": fab.description, "source": fab.source,
+                     "measured_dc": dict(fab.measured_dc)})
+    return rows

@@ -109,3 +109,11 @@ def test_library_bending_lengths():
         assert c["warp"]["c"] == pytest.approx(0.01 * (0.083 / 0.019) ** (1 / 3), rel=1e-12)
         assert c["weft"]["c"] == pytest.approx(0.01 * (0.063 / 0.019) ** (1 / 3), rel=1e-12)
     assert all(f.source for f in FABRICS.values())
+
+
+def test_fabrics_command_lists_the_library(capsys):
+    from rftstatic.cli import main
+
+    assert main(["fabrics"]) == 0
+    out = capsys.readouterr().out
+    assert "wool-kang-yu" in out and "1.635 / 1.491" in out and "Kang" in out
