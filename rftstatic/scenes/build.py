@@ -143,7 +143,7 @@ def select_nodes(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
     u = scene.units.length
     given = [k for k in ("box", "at", "radius") if k in spec]
     if len(given) > 1:
-        raise scene.error(f"{key}.{given[1]}", f"give one of box, at or radius, not {' and '.join(given)}")
+        raise scene.error(f"{key}.{given[1]}", f"give box, at or radius (one of them), not {' and '.join(given)}")
     if "radius" in spec:
         return _within_radius(scene, mesh, spec, key)
     if "box" in spec:

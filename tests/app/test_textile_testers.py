@@ -42,7 +42,7 @@ def test_bias_strip_lies_between_the_narrow_strip_and_the_plate(tmp_path):
 @pytest.mark.parametrize("sets, key, fragment", [
     (["supports.0.radius=16.0"], "supports.0.radius", "holds the whole specimen"),
     (["supports.0.radius=-1.0"], "supports.0.radius", "must be > 0"),
-    (["supports.0.box=[0,1,0,1]"], "supports.0.radius", "give one of box, at or radius"),
+    (["supports.0.box=[0,1,0,1]"], "supports.0.radius", "give box, at or radius (one of them)"),
 ])
 def test_clamping_disc_errors_name_key_and_value(sets, key, fragment):
     scene = api.load_scene("cusick-30", sets)
