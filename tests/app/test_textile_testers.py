@@ -60,3 +60,39 @@ def test_clamping_disc_areas():
     polygon = 0.5 * n * 0.09**2 * math.sin(2 * math.pi / n)
     assert disc.area == pytest.approx(polygon, rel=1e-9) and disc.open_area == pytest.approx(polygon, rel=1e-9)
     assert np.isin(model.supports.clamped, np.flatnonzero(np.isclose(np.hypot(*model.mesh.X.T), 0.09))).all()
+
+
+def test_cusick_dc_falls_as_the_specimen_grows(tmp_path):
+    """Coarse meshes (1 cm rings, 80 nodes): the wool's DC falls from the 24 to the 36 cm specimen; every
+    drape coefficient obeys its definition and the percentage is 100 x the fraction."""
+    dc = []
+    for size, rings in ((24, 4), (30, 7), (36, 10)):
+        s = api.run(api.load_scene(f"cusick-{size}", [f"mesh.nodes=[{rings},80]"]), tmp_path / str(size),
+                    figures=False).summary
+        d = s["drape"]
+        assert s["converged"] and s["stable_minimum"]
+        a_d, a_s = d["disc"]["area"], d["disc"]["specimen_area"]
+        assert d["drape_coefficient"] == pytest.approx((d["shadow_area"] - a_d) / (a_s - a_d), rel=1e-12)
+        assert d["drape_coefficient_percent"] == pytest.approx(100 * d["drape_coefficient"])
+        assert a_s == pytest.approx(math.pi * (size / 2) ** 2, rel=5e-3) and a_d == pytest.approx(math.pi * 81, rel=5e-3)
+        assert len(d["hem_profile"]["r"]) == 360 and 9.0 < min(d["hem_profile"]["r"]) <= max(d["hem_profile"]["r"]) < size / 2
+        assert d["fold_count"] == len(d["fold_angles_deg"]) >= 3
+        dc.append(d["drape_coefficient"])
+    assert dc[0] > dc[1] > dc[2] > 0
+
+
+def test_seeded_specimens_report_mean_and_range(tmp_path):
+    s = api.run(api.load_scene("cusick-24", ["mesh.nodes=[4,80]", "solver.seeds=2"]), tmp_path / "s",
+                figures=False).summary
+    g = s["seeds"]
+    dcs = [r["drape_coefficient_percent"] for r in g["specimens"]]
+    assert g["count"] == g["solved"] == 2 and dcs[0] == pytest.approx(s["drape"]["drape_coefficient_percent"])
+    assert g["drape_coefficient_percent_min"] <= g["drape_coefficient_percent_mean"] <= g["drape_coefficient_percent_max"]
+    assert g["drape_coefficient_percent_mean"] == pytest.approx(np.mean(dcs))
+
+
+def test_seeds_need_a_seeded_lift():
+    with pytest.raises(SceneError, match="solver.seeds: 3 seeded starts need a seeded lift"):
+        from rftstatic.scenes.options import seed_count
+
+        seed_count(api.load_scene("cusick-30", ["solver.seeds=3", "solver.perturbation=0.0"]))
