@@ -19,7 +19,7 @@ from rftstatic.scenes.self_contact import build_self_contact
 
 MESH_KEYS = {
     "rectangle": {"size", "nodes", "origin", "pattern"},
-    "polar": {"radius", "inner_radius", "nodes", "centre", "pattern"},
+    "polar": {"radius", "inner_radius", "nodes", "centre", "pattern", "grading"},
     "square-polar": {"radius", "inner_radius", "nodes", "centre", "pattern"},
     "file": {"path"},
     "unstructured": {"h", "size", "origin", "radius", "centre"},
@@ -68,7 +68,8 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
             if "radius" not in m:
                 raise scene.error("mesh.radius", f"a {kind} mesh needs its radius")
             return meshmod.polar(m["radius"] * u, nr, nc, r_inner=m.get("inner_radius", 0.0) * u,
-                                 centre=(cx * u, cy * u), pattern=m.get("pattern", "alternate"), z0=z0)
+                                 centre=(cx * u, cy * u), pattern=m.get("pattern", "alternate"), z0=z0,
+                                 grading=m.get("grading", 1.0))
         if kind == "file":
             if "path" not in m:
                 raise scene.error("mesh.path", "a file mesh needs the path of the mesh file")

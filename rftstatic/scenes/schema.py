@@ -112,6 +112,7 @@ SCHEMA = {
         "pattern": (str, "diagonal pattern: right, left, alternate, union-jack"),
         "radius": (NUM, "outer radius (polar) or half side (square-polar)"),
         "inner_radius": (NUM, "inner radius of an annulus"),
+        "grading": (NUM, "polar: outermost ring spacing / innermost (1: uniform)"),
         "path": (str, "mesh file read with meshio (relative to the scene file)"),
         "h": (NUM, "target element size of an unstructured mesh"),
         "z": (NUM, "height of the flat reference plane"),
