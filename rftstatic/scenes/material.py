@@ -76,6 +76,8 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
                           name=label)
     if "thickness" in si:
         material.info["thickness"] = si["thickness"]
+    for q, rec in record.items():
+        rec["si"] = si[q]
     if record:
         material.info["lab"] = record
     return material
@@ -123,7 +125,10 @@ def material_summary(scene, material: mat.Material) -> dict:
     out["Dm_global"] = (np.asarray(material.Dm) / u.line_force).tolist()
     out["Db_global"] = (np.asarray(material.Db) / u.moment).tolist()
     if "lab" in material.info:
-        out["lab"] = material.info["lab"]
+        kinds = {**mat._FABRIC_KINDS, "thickness": "length"}
+        out["lab"] = {q: {**{k: v for k, v in rec.items() if k != "si"},
+                          "converted": u.from_si(rec["si"], kinds[q]), "converted_units": u.name}
+                      for q, rec in material.info["lab"].items()}
     return out
 
 

@@ -117,3 +117,12 @@ def test_fabrics_command_lists_the_library(capsys):
     assert main(["fabrics"]) == 0
     out = capsys.readouterr().out
     assert "wool-kang-yu" in out and "1.635 / 1.491" in out and "Kang" in out
+
+
+def test_summary_records_the_converted_values():
+    from rftstatic.scenes.material import material_summary
+
+    scene = scene_from_dict({"units": "cm-gf-s", "material": WOOL_KES})
+    rec = material_summary(scene, build_material(scene))["lab"]
+    assert rec["C_shear"]["converted"] == pytest.approx(41.8, rel=1e-12) and rec["C_shear"]["from"] == "kes_G"
+    assert rec["weight"]["converted"] == pytest.approx(0.019, rel=1e-12) and rec["weight"]["unit"] == "mg/cm^2"
