@@ -22,8 +22,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 from rftstatic import api
 from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures
 
@@ -146,15 +144,30 @@ def _dc_vs_group(result, tmp, out, factors):
                             + "\n\nc = sqrt(c_warp c_weft); scaling all bending rigidities by f scales c by f^(1/3). "
                               "At a fixed specimen/disc ratio the DC is a function of R_disc/c (and of the weaker "
                               "groups C/B R^2 and the anisotropy): a limper fabric (larger R_disc/c) drapes lower."))
+    for label, points in curves.items():
+        for group, dc, row in points:
+            result.rows.append(row)
     if out is not None:
-        from rftstatic.io.charts import plot_load_deflection
+        result.figures.append(_plot_group(out, curves))
 
-        name = "textile_tests_dc_vs_group.png"
-        plot_load_deflection(out / name, {k: (np.array([p[1] for p in v]), np.array([p[0] for p in v]))
-                                          for k, v in curves.items()},
-                             xlabel="drape coefficient [%]", ylabel="R_disc / c",
-                             title="Cusick drape coefficient against disc radius / bending length")
-        result.figures.append(name)
+
+def _plot_group(out, curves) -> str:
+    """DC [%] against R_disc / c, one marker series per specimen size."""
+    from rftstatic.io.figure import new_figure, save_png, set_title
+
+    fig = new_figure()
+    ax = fig.add_subplot()
+    for k, (label, points) in enumerate(curves.items()):
+        ax.plot([p[0] for p in points], [p[1] for p in points], marker="osd"[k % 3], ls="-", color=f"C{k}",
+                label=label)
+    ax.set_xlabel("R_disc / c  (c = sqrt(c_warp c_weft), the bending length)")
+    ax.set_ylabel("drape coefficient [%]")
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.legend(loc="best", fontsize="small")
+    set_title(ax, "Cusick drape coefficient against disc radius / bending length (wool, its bending rigidities scaled)")
+    name = "textile_tests_dc_vs_group.png"
+    save_png(fig, out / name)
+    return name
 
 
 def _group_row(s, label, size, t, lines):
@@ -162,7 +175,10 @@ def _group_row(s, label, size, t, lines):
     c = math.sqrt(m["bending_length_warp"] * m["bending_length_weft"])
     lines.append(f"| {label} | {size} | {m['bending_length_warp']:.3f} / {m['bending_length_weft']:.3f} | "
                  f"{9.0 / c:.3f} | {d['drape_coefficient_percent']:.2f} | {d['fold_count']} | {t:.1f} |")
-    return 9.0 / c, d["drape_coefficient_percent"]
+    row = {"case": f"DC vs R_disc/c: {label}, {size} cm", "element": "RFT6", "mesh": "default", "nodes": s["nodes"],
+           "value": [9.0 / c, d["drape_coefficient"]], "reference": None, "error": float("nan"), "wall_time_s": t,
+           "iterations": s["newton_iterations"]}
+    return 9.0 / c, d["drape_coefficient_percent"], row
 
 
 def run(quick: bool = False, *, out=None) -> BenchmarkResult:
