@@ -22,9 +22,10 @@ from rftstatic.app.registry import run as _run
 from rftstatic.app.result import RunResult
 from rftstatic.errors import ConvergenceError, InstabilityError, SceneError
 from rftstatic.scenes.build import build_model
+from rftstatic.scenes.material import list_fabrics
 from rftstatic.scenes.schema import Scene, list_scenes, load_scene, scene_from_dict
 
-__all__ = ["load_scene", "scene_from_dict", "list_scenes", "build_model", "run", "resume", "analysis_of",
+__all__ = ["load_scene", "scene_from_dict", "list_scenes", "list_fabrics", "build_model", "run", "resume", "analysis_of",
            "ANALYSES", "RunResult", "Scene", "SceneError", "ConvergenceError", "InstabilityError"]
 
 

@@ -1,4 +1,4 @@
-"""Command line: ``python -m rftstatic {case, list, sweep, fit, bench, validate}``, on the Python API
+"""Command line: ``python -m rftstatic {case, list, fabrics, sweep, fit, bench, validate}``, on the Python API
 (:mod:`rftstatic.api`) and the studies on Dask (:mod:`rftstatic.study`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
@@ -39,6 +39,7 @@ def main(argv=None) -> int:
     p.add_argument("--resume", action="store_true", help="continue a run (static, dynamic, relax) from its last checkpoint")
 
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
+    sub.add_parser("fabrics", parents=[common], help="list the fabric library with bending lengths and sources")
     _study_parsers(sub, common)
 
     b = sub.add_parser("bench", parents=[common], help="print wall time and peak memory of the benchmarks")
@@ -137,6 +138,12 @@ def _command(args) -> int:
             for name, title in api.list_scenes():
                 print(f"{name:32s} {title}")
             return 0
+        if args.command == "fabrics":
+            print(f"{'preset':18s} {'B warp/weft [gf cm]':>20s} {'W [gf/cm2]':>11s} {'c warp/weft [cm]':>17s}  source")
+            for f in api.list_fabrics():
+                print(f"{f['name']:18s} {f['B_warp']:>9.4g} / {f['B_weft']:<8.4g} {f['weight']:>11.4g} "
+                      f"{f['c_warp']:>7.4g} / {f['c_weft']:<7.4g}  {f['source']}")
+            return 0
         if args.command == "case":
             scene = api.load_scene(args.name, args.set)
             out = Path(args.out) if args.out else Path("out") / scene.name
@@ -146,10 +153,19 @@ def _command(args) -> int:
                 summary = api.run(scene, out, progress=True, figures=not args.no_figures).summary
             keys = ("scene", "element", "nodes", "converged", "load_steps", "newton_iterations", "wall_time_s",
                     "probes")
-            if summary.get("analysis", "static") != "static":  # trajectories are too long to print
+            if summary.get("analysis") == "cantilever":
+                keys = ("scene", "element", "nodes", "converged", "wall_time_s")
+            elif summary.get("analysis", "static") != "static":  # trajectories are too long to print
                 keys = ("scene", "element", "nodes", "analysis", "dt", "steps", "wall_time_s",
                         "element_steps_per_second", "time_at_rest", "at_rest", "converged")
             brief = {k: summary.get(k) for k in keys}
+            if "cantilever" in summary:  # the tester's reading, without the solves
+                brief["cantilever"] = {k: v for k, v in summary["cantilever"].items() if k != "solves"}
+            if isinstance(summary.get("drape"), dict) and "drape_coefficient_percent" in summary["drape"]:
+                brief["drape"] = {k: summary["drape"].get(k) for k in ("drape_coefficient_percent", "fold_count",
+                                                                       "fold_angles_deg")}
+            if "seeds" in summary:
+                brief["seeds"] = {k: v for k, v in summary["seeds"].items() if k != "specimens"}
             print(json.dumps(brief, indent=1, default=str))
             print(f"outputs written to {out}/")
             if summary.get("converged") is False:  # the run ended, short of its goal

@@ -389,7 +389,7 @@ def _gif(path: Path, pngs: list) -> None:
 
 
 def _node_plot(scene, summary, out: Path) -> None:
-    from rftstatic.io.figure import new_figure, save_png
+    from rftstatic.io.figure import new_figure, save_png, set_title
 
     recs = summary["records"]
     relax = summary["route"] == "remesh_relax"
@@ -403,6 +403,6 @@ def _node_plot(scene, summary, out: Path) -> None:
     ax.set_xlabel(f"time [{scene.units.name.split('-')[-1] if '-' in scene.units.name else 's'}]" if relax
                   else "remesh cycle")
     ax.set_ylabel("nodes")
-    ax.set_title(f"{scene.name}: node count ({summary['element']})")
+    set_title(ax, f"{scene.name}: node count ({summary['element']})")
     ax.grid(alpha=0.3)
     save_png(fig, out / "nodes.png")

@@ -24,7 +24,8 @@ from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import drape_summary, probe_summary, self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.scenes.build import build_model
-from rftstatic.scenes.options import static_options
+from rftstatic.app.specimens import seeded_specimens
+from rftstatic.scenes.options import seed_count, static_options
 from rftstatic.solvers.static import solve_static
 from rftstatic.solvers.static_checkpoint import (
     CHECKPOINT_SECONDS,
@@ -53,6 +54,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     model, extras = build_model(scene)
     build_time = time.perf_counter() - t0
     opts = static_options(scene, progress=progress)
+    seeds = seed_count(scene)
     path = out / CHECKPOINT
     remove_stale(path)
     restart = None
@@ -71,6 +73,8 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         if result is None:
             raise
     summary = static_summary(scene, model, extras, result, build_time)
+    if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
+        summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds)
     summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or restart else None, "writes": saver.writes,
                              "write_time_s": saver.write_time,
                              "resumed_from": None if restart is None else restart.where}
@@ -122,5 +126,6 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         x = model.positions(U)
         summary["max_penetration"] = model.contact.max_penetration(x) / u.length
         summary["contact_nodes"] = int(model.contact.active(x).sum())
+    if model.contact is not None or extras.get("disc") is not None:
         summary["drape"] = drape_summary(scene, model, extras, U)
     return summary

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic.io.figure import DPI, axis_labels, figsize_2d, new_figure, set_2d_limits
+from rftstatic.io.figure import DPI, axis_labels, figsize_2d, new_figure, set_2d_limits, set_title
 from rftstatic.io.files import atomic_write
 from rftstatic.io.surface import AXES_2D, CAMERA, add_surface_2d, add_surface_3d, check_mesh, set_3d_limits
 
@@ -53,7 +53,7 @@ def animate(path: str | os.PathLike, frames: Sequence[np.ndarray], tri: np.ndarr
         ax = fig.add_subplot()
         set_2d_limits(ax, lo[[i, j]], hi[[i, j]])
         axis_labels(ax, ("xyz"[i], "xyz"[j]), length_unit)
-    ax.set_title(f"{title}: t = 0" if title else "t = 0")
+    set_title(ax, f"{title}: t = 0" if title else "t = 0")
     fig.get_layout_engine().execute(fig)
     fig.set_layout_engine("none")  # lay out once, then keep it fixed: the frames must not jitter
     writer = PillowWriter(fps=fps)
@@ -67,6 +67,6 @@ def animate(path: str | os.PathLike, frames: Sequence[np.ndarray], tri: np.ndarr
             else:
                 coll, _ = add_surface_2d(ax, x, tri, view)
             head = f"{title}: " if title else ""
-            ax.set_title(f"{head}t = {float(t):.3g} {time_unit}".strip())
+            set_title(ax, f"{head}t = {float(t):.3g} {time_unit}".strip())
             writer.grab_frame()
     return Path(path)

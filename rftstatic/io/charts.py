@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from rftstatic.io.figure import as_curve, axis_labels, new_figure, save_png, set_2d_limits
+from rftstatic.io.figure import as_curve, axis_labels, new_figure, save_png, set_2d_limits, set_title
 
 __all__ = ["plot_boundary_overlay", "plot_convergence", "plot_history", "plot_load_deflection",
            "plot_side_profiles"]
@@ -69,7 +69,7 @@ def plot_boundary_overlay(path: str | os.PathLike, curves: Mapping[str, np.ndarr
     set_2d_limits(ax, allp.min(axis=0), allp.max(axis=0))
     axis_labels(ax, ("x", "y"), length_unit)
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small")  # the middle holds the obstacle
-    ax.set_title(title)
+    set_title(ax, title)
     return save_png(fig, path)
 
 
@@ -104,7 +104,7 @@ def plot_side_profiles(path: str | os.PathLike, curves: Mapping[str, np.ndarray]
     axis_labels(ax, ("x", "z"), length_unit)
     ax.legend(loc="best", fontsize="small")
     ax.grid(True, lw=0.3, alpha=0.5)
-    ax.set_title(title)
+    set_title(ax, title)
     return save_png(fig, path)
 
 
@@ -200,7 +200,7 @@ def plot_convergence(path: str | os.PathLike, series: Mapping[str, tuple[np.ndar
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.legend(loc="best", fontsize="small")
-    ax.set_title(title)
+    set_title(ax, title)
     return save_png(fig, path), slopes
 
 
@@ -231,7 +231,7 @@ def plot_history(path: str | os.PathLike, t: np.ndarray, series: Mapping[str, np
     ax.set_ylabel(ylabel)
     if series:
         ax.legend(loc="best", fontsize="small")
-    ax.set_title(title)
+    set_title(ax, title)
     return save_png(fig, path)
 
 
@@ -261,5 +261,5 @@ def plot_load_deflection(path: str | os.PathLike, curves: Mapping[str, tuple[np.
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.legend(loc="best", fontsize="small")
-    ax.set_title(title)
+    set_title(ax, title)
     return save_png(fig, path)

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from rftstatic.io.figure import set_title
+
 __all__ = ["boundary_distance", "boundary_xy", "obstacle_drawers", "plot_side_by_side"]
 
 
@@ -143,9 +145,39 @@ def plot_side_by_side(path, drapes: dict, *, title: str, obstacles_draw=None, le
                 ax.set_aspect("equal")
                 ax.set_xlabel(f"x [{length_unit}]")
                 ax.set_ylabel(f"y [{length_unit}]")
-            ax.set_title(f"{lb} ({view})", fontsize="small")
-    fig.suptitle(title)
+            set_title(ax, f"{lb} ({view})", fontsize="small")
+    set_title(fig, title, figure_title=True)
     fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=fig.axes, shrink=0.6, label="|kappa| h")
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def plot_shadow(path, x: np.ndarray, tri: np.ndarray, *, fill: np.ndarray, centre, specimen_radius: float,
+                disc_radius: float, title: str, unit: str = ""):
+    """The drape tester's photograph: the shadow of the draped specimen seen from above (the union of the
+    projected triangles, black), the disc (grey) and the flat specimen's and disc's outlines (dashed).
+
+    Parameters
+    ----------
+    x : (N, 3) draped positions [scene length]; tri : (E, 3) triangles
+    fill : (F, 3, 3) the clamping disc as triangles [scene length] (:class:`~rftstatic.post.measures.disc.Disc`)
+    centre : (2,) the disc's centre; specimen_radius, disc_radius : [scene length]
+    """
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import Circle
+
+    from rftstatic.io.figure import axis_labels, new_figure, save_png, set_2d_limits
+
+    fig = new_figure((5.6, 6.0))
+    ax = fig.add_subplot()
+    ax.add_collection(PolyCollection(np.asarray(x)[np.asarray(tri)][:, :, :2], facecolors="0.08", edgecolors="0.08",
+                                     linewidths=0.3))
+    ax.add_collection(PolyCollection(np.asarray(fill)[:, :, :2], facecolors="0.55", edgecolors="0.55", linewidths=0.3))
+    for r, style in ((specimen_radius, "--"), (disc_radius, ":")):
+        ax.add_patch(Circle(tuple(np.asarray(centre)[:2]), r, fill=False, linestyle=style, color="tab:red", lw=1.0))
+    c = np.asarray(centre, float)[:2]
+    set_2d_limits(ax, c - specimen_radius, c + specimen_radius)
+    axis_labels(ax, ("x (warp)", "y (weft)"), unit)
+    set_title(ax, title)
+    return save_png(fig, path)

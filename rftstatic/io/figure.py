@@ -22,7 +22,7 @@ import numpy as np
 from rftstatic.io.files import atomic_write
 
 __all__ = ["DPI", "as_curve", "axis_labels", "figsize_2d", "new_figure", "padded_limits", "save_png",
-           "set_2d_limits"]
+           "set_2d_limits", "set_title", "wrap_title"]
 
 DPI = 120
 """Resolution of every PNG and GIF frame [dots per inch]."""
@@ -88,3 +88,42 @@ def axis_labels(ax, names, unit):
     ax.set_ylabel(names[1] + suffix)
     if len(names) == 3:
         ax.set_zlabel(names[2] + suffix)
+
+
+TITLE_CHAR_WIDTH = 0.55
+"""Mean width of a title character over its font size (DejaVu Sans, mixed text; measured 0.52-0.58)."""
+
+
+def wrap_title(text: str, width_inch: float, fontsize_pt: float, *, max_lines: int = 3) -> str:
+    """``text`` broken into lines that fit ``width_inch`` at ``fontsize_pt`` (at most ``max_lines``; a longer
+    title is cut with an ellipsis), so that no title runs off the figure's edges."""
+    import textwrap
+
+    chars = max(int(width_inch * 72.0 / (TITLE_CHAR_WIDTH * fontsize_pt)), 20)
+    out = []
+    for part in str(text).split("\n"):
+        out += textwrap.wrap(part, chars, break_long_words=True, break_on_hyphens=False) or [""]
+    if len(out) > max_lines:
+        out = out[:max_lines]
+        out[-1] = out[-1][: max(chars - 3, 1)].rstrip() + "..."
+    return "\n".join(out)
+
+
+def set_title(ax, text: str, *, fontsize=None, figure_title: bool = False):
+    """Set the title of ``ax`` (or the figure's suptitle, ``figure_title``), wrapped to the width it has:
+    the figure's for a suptitle or a figure's only plot (whose title becomes the figure's), else the axes'
+    (:func:`wrap_title`)."""
+    import matplotlib
+    from matplotlib.font_manager import FontProperties
+
+    fig = ax if figure_title else ax.figure
+    key = "figure.titlesize" if figure_title else "axes.titlesize"
+    size = FontProperties(size=fontsize if fontsize is not None else matplotlib.rcParams[key]).get_size_in_points()
+    plots = [a for a in fig.axes if not hasattr(a, "_colorbar")]
+    # a lone plot's title is the figure's, centred on the figure and as wide: an equal-aspect view is often far
+    # narrower than its title, and a colour bar moves it off the centre
+    whole = figure_title or len(plots) <= 1
+    width = fig.get_figwidth() * (0.95 if whole else ax.get_position().width)
+    kw = {} if fontsize is None else {"fontsize": fontsize}
+    text = wrap_title(text, max(width, 1.0), size)
+    return fig.suptitle(text, **kw) if whole else ax.set_title(text, **kw)

@@ -26,3 +26,21 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
         plot_views(str(out / "view"), model.positions(U) / u, model.mesh.tri, views=views, title=title,
                    color_by=cell["relative_curvature"], color_label="|kappa| h",
                    obstacles_draw=obstacle_drawers(extras.get("obstacles", ()), u))
+        drape = summary.get("drape") or {}
+        if extras.get("disc") is not None and drape.get("drape_coefficient") is not None:
+            _shadow(scene, model, extras["disc"], U, out, drape)
+
+
+def _shadow(scene, model, disc, U, out: Path, drape: dict) -> None:
+    """``shadow_top.png``: the Cusick tester's view of the draped specimen (its shadow from above)."""
+    import numpy as np
+
+    from rftstatic.io.drape_figures import plot_shadow
+
+    u = scene.units.length
+    r = np.hypot(*(model.mesh.X - disc.centre).T)
+    title = (f"{scene.get('title', scene.name)}: drape coefficient {drape['drape_coefficient_percent']:.1f}%, "
+             f"{drape['fold_count']} folds ({model.element}, {model.mesh.n_nodes} nodes)")
+    plot_shadow(out / "shadow_top.png", model.positions(U) / u, model.mesh.tri, fill=disc.fill / u,
+                centre=disc.centre / u, specimen_radius=float(r.max()) / u,
+                disc_radius=float(np.sqrt(disc.area / np.pi)) / u, title=title, unit=scene.units.name.split("-")[0])

@@ -20,6 +20,7 @@ from rftstatic.post.measures.intersections import self_intersections
 from rftstatic.post.measures.summary import drape_measures
 from rftstatic.post.probes import probe_positions
 from rftstatic.provenance import peak_memory_mb, software
+from rftstatic.scenes.material import material_summary
 
 log = logging.getLogger(__name__)
 
@@ -43,6 +44,7 @@ def summary_header(scene, model, analysis: str) -> dict:
         "warnings": list(model.warnings),
         "peak_memory_mb": peak_memory_mb(),
         "resolved_scene": copy.deepcopy(scene.data),
+        "material": material_summary(scene, model.material),
     }
 
 
@@ -53,11 +55,14 @@ def drape_summary(scene, model, extras, U) -> dict:
     obstacles = extras["obstacles"]
     disc_area, centre = obstacles[0].footprint() if obstacles else (None, np.zeros(2))
     sheet_area = float(model.mesh.area.sum())
+    disc = extras.get("disc") if not obstacles else None
+    if disc is not None:  # a tester's clamping disc: the specimen includes the part the mesh leaves open
+        disc_area, centre, sheet_area = disc.area, disc.centre, sheet_area + disc.open_area
     reason = None
     if disc_area is not None and not sheet_area > disc_area:
         reason = (f"the sheet ({sheet_area / u**2:.4g} square units) is not larger than the obstacle's footprint "
                   f"({disc_area / u**2:.4g}): no drape coefficient")
-    elif model.mesh.locate(np.asarray(centre, float)[None, :2])[0][0] < 0:
+    elif disc is None and model.mesh.locate(np.asarray(centre, float)[None, :2])[0][0] < 0:
         reason = (f"the obstacle's centre {np.round(np.asarray(centre) / u, 6).tolist()} is not under the sheet: "
                   "the drape measures (coefficient, folds about the centre) do not apply")
     elif not outline_surrounds(x, boundary_loop(model.mesh.tri, x), centre):
@@ -67,9 +72,14 @@ def drape_summary(scene, model, extras, U) -> dict:
     if reason is not None:
         log.warning("drape measures skipped: %s", reason)
         return {"applicable": False, "reason": reason}
-    m = drape_measures(x, model.mesh.tri, sheet_area=float(model.mesh.area.sum()), disc_area=disc_area,
-                       centre=centre, curvature=model.curvature(U), h=model.mesh.element_size)
-    return _scale_lengths(m, u)
+    m = drape_measures(x, model.mesh.tri, sheet_area=sheet_area, disc_area=disc_area, centre=centre,
+                       curvature=model.curvature(U), h=model.mesh.element_size,
+                       fill=None if disc is None else disc.fill, profile=disc is not None)
+    m = _scale_lengths(m, u)
+    if disc is not None:
+        m["disc"] = {"area": disc.area / u**2, "specimen_area": sheet_area / u**2,
+                     "centre": (np.asarray(disc.centre) / u).tolist()}
+    return m
 
 
 _LENGTH_KEYS = ("boundary_radius_min", "boundary_radius_mean", "boundary_radius_max", "max_dihedral_at",
@@ -81,6 +91,9 @@ def _scale_lengths(m: dict, u: float) -> dict:
     out = dict(m)
     if "shadow_area" in out:
         out["shadow_area"] = out["shadow_area"] / u**2
+    if "hem_profile" in out:
+        out["hem_profile"] = {"theta_deg": out["hem_profile"]["theta_deg"],
+                              "r": (np.asarray(out["hem_profile"]["r"]) / u).tolist()}
     for key in _LENGTH_KEYS:
         if key in out and out[key] is not None:
             out[key] = (np.asarray(out[key], float) / u).tolist()

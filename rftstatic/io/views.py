@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from rftstatic.io.figure import axis_labels, figsize_2d, new_figure, save_png, set_2d_limits
+from rftstatic.io.figure import axis_labels, figsize_2d, new_figure, save_png, set_2d_limits, set_title
 from rftstatic.io.surface import AXES_2D, CAMERA, add_surface_2d, add_surface_3d, check_mesh, set_3d_limits
 
 __all__ = ["plot_views"]
@@ -90,6 +90,6 @@ def plot_views(path_prefix: str | os.PathLike, x: np.ndarray, tri: np.ndarray, *
             axis_labels(ax, ("xyz"[i], "xyz"[j]), length_unit)
         if mappable is not None:
             fig.colorbar(mappable, ax=ax, shrink=0.7, pad=0.12 if view == "iso" else 0.02, label=color_label)
-        ax.set_title(label)
+        set_title(ax, label)
         out[view] = save_png(fig, f"{os.fspath(path_prefix)}_{view}.png")
     return out

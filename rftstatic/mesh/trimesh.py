@@ -300,7 +300,7 @@ def rectangle(lx, ly, nx, ny, *, origin=(0.0, 0.0), pattern="right", z0=0.0) -> 
 
 
 def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern="alternate",
-          z0=0.0) -> TriMesh:
+          z0=0.0, grading=1.0) -> TriMesh:
     """Polar mesh of a disc or annulus (a square sheet meshed in rings is :func:`square_polar`).
 
     Parameters
@@ -310,8 +310,13 @@ def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern=
     n_circ : nodes around each ring
     r_inner : inner radius [m]; 0 gives a disc with a centre node (fan of triangles around it)
     pattern : diagonal of each quadrilateral: ``"right"``, ``"left"`` or ``"alternate"``.
+    grading : outermost ring spacing over the innermost (geometric progression; 1: uniform rings). Below 1
+        the rings crowd towards the outer edge, above 1 towards the centre (a clamped inner ring: the bend
+        at a drape tester's disc edge).
     """
     n_radial, n_circ = int(n_radial), int(n_circ)
+    if not (np.isfinite(grading) and 0.05 <= grading <= 20.0):
+        raise MeshError(f"polar mesh grading = {grading!r}: give the outer/inner ring spacing ratio in [0.05, 20]")
     if n_radial < 2 or n_circ < 3:
         raise MeshError(f"a polar mesh needs n_radial >= 2 and n_circ >= 3, got {n_radial}, {n_circ}")
     if not (0 <= r_inner < r_outer):
@@ -321,7 +326,8 @@ def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern=
     theta = 2 * np.pi * np.arange(n_circ) / n_circ
     direction = np.column_stack([np.cos(theta), np.sin(theta)])
     disc = r_inner == 0.0
-    rings = np.linspace(r_inner, r_outer, n_radial)
+    steps = float(grading) ** (np.arange(n_radial - 1) / max(n_radial - 2, 1))
+    rings = r_inner + (r_outer - r_inner) * np.concatenate([[0.0], np.cumsum(steps) / steps.sum()])
     first = 1 if disc else 0
     X_rings = (rings[first:, None, None] * direction[None]).reshape(-1, 2)
     X = np.vstack([np.zeros((1, 2)), X_rings]) if disc else X_rings
@@ -347,7 +353,8 @@ def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern=
         fan = np.stack([np.zeros(n_circ, int), 1 + c, 1 + (c + 1) % n_circ], 1)
         tri = np.vstack([fan, tri])
     kind = "disc" if disc else "annulus"
-    info = {"generator": kind, "r_outer": r_outer, "r_inner": r_inner, "nodes_radial_circ": [n_radial, n_circ]}
+    info = {"generator": kind, "r_outer": r_outer, "r_inner": r_inner, "nodes_radial_circ": [n_radial, n_circ],
+            "grading": float(grading)}
     return TriMesh(X, tri, z0=z0, name=f"{kind} {n_radial}x{n_circ}", info=info)
 
 

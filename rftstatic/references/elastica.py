@@ -45,7 +45,7 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_bvp
 
-__all__ = ["ElasticaSolution", "ElasticaError", "heavy_elastica", "alpha_of"]
+__all__ = ["ElasticaSolution", "ElasticaError", "heavy_elastica", "alpha_of", "chord_angle", "alpha_at_chord_angle"]
 
 _ALPHA_START = 1.0   # the linear-beam guess converges directly up to here
 _STEP = 2.0          # continuation factor on α
@@ -280,3 +280,26 @@ def heavy_elastica(alpha: float, *, beta: float = 0.0, tol: float = 1e-10,
         guess = _solve(alpha, beta, tol, guess, max_nodes)
         _CACHE[key] = guess
     return guess
+
+
+def chord_angle(alpha: float) -> float:
+    """Angle below the horizontal of the chord from the clamp to the tip of the heavy elastica [rad]: the
+    cantilever tester's reading (the tip on the plane through the platform edge at that angle)."""
+    s = heavy_elastica(alpha)
+    return float(math.atan2(-s.tip_z, s.tip_x))
+
+
+def alpha_at_chord_angle(angle: float, *, xtol: float = 1e-12) -> float:
+    """The gravity parameter alpha = w l^3 / EI at which the heavy elastica's chord meets the plane at
+    ``angle`` [rad] below the horizontal (Peirce's cantilever tester: 41.5 deg gives alpha = 8.0042, so that
+    the bending length c = (EI/w)^(1/3) = l alpha^(-1/3) is l/2 to 0.03 %: G = W (l/2)^3 reads the rigidity
+    0.052 % high; Peirce's closed form c = l (cos(theta/2) / (8 tan theta))^(1/3), an approximation, gives
+    c = 0.5093 l there, 5.7 % high in G)."""
+    from scipy.optimize import brentq
+
+    if not 0.0 < angle < 0.5 * math.pi:
+        raise ValueError(f"alpha_at_chord_angle: angle = {angle!r} rad; it must lie in (0, pi/2)")
+    lo, hi = 1e-3, 8.0
+    while chord_angle(hi) < angle:
+        lo, hi = hi, 2.0 * hi
+    return float(brentq(lambda a: chord_angle(a) - angle, lo, hi, xtol=xtol))

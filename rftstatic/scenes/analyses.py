@@ -12,7 +12,8 @@ ANALYSES = {
     "static": "rftstatic.app.static",  # static drape: load-scaled Newton and/or relaxation + Newton
     "dynamic": "rftstatic.app.dynamic",  # explicit central differences with mass damping (§2.4, §4.6)
     "relax": "rftstatic.app.dynamic",  # dynamic relaxation to rest (§6)
-    "remeshed": "rftstatic.app.remeshed",  # a scene with [remesh]: global adaptive remeshing (§5-6)
+    "remeshed": "rftstatic.app.remeshed",
+    "cantilever": "rftstatic.app.cantilever",  # Peirce's cantilever tester: the overhang at which the tip meets 41.5 deg  # a scene with [remesh]: global adaptive remeshing (§5-6)
 }
 """Analysis name -> module that runs it."""
 

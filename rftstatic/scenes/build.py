@@ -10,16 +10,16 @@ import math
 
 import numpy as np
 
-from rftstatic import material as mat
 from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
+from rftstatic.post.measures.disc import clamp_disc
+from rftstatic.scenes.material import build_material
 from rftstatic.scenes.schema import Scene
 from rftstatic.scenes.self_contact import build_self_contact
-from rftstatic.units import unit_system
 
 MESH_KEYS = {
     "rectangle": {"size", "nodes", "origin", "pattern"},
-    "polar": {"radius", "inner_radius", "nodes", "centre", "pattern"},
+    "polar": {"radius", "inner_radius", "nodes", "centre", "pattern", "grading"},
     "square-polar": {"radius", "inner_radius", "nodes", "centre", "pattern"},
     "file": {"path"},
     "unstructured": {"h", "size", "origin", "radius", "centre"},
@@ -68,7 +68,8 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
             if "radius" not in m:
                 raise scene.error("mesh.radius", f"a {kind} mesh needs its radius")
             return meshmod.polar(m["radius"] * u, nr, nc, r_inner=m.get("inner_radius", 0.0) * u,
-                                 centre=(cx * u, cy * u), pattern=m.get("pattern", "alternate"), z0=z0)
+                                 centre=(cx * u, cy * u), pattern=m.get("pattern", "alternate"), z0=z0,
+                                 grading=m.get("grading", 1.0))
         if kind == "file":
             if "path" not in m:
                 raise scene.error("mesh.path", "a file mesh needs the path of the mesh file")
@@ -138,63 +139,14 @@ def _pair(scene, key, value, kind=float):
     return kind(value[0]), kind(value[1])
 
 
-def build_material(scene: Scene) -> mat.Material:
-    m = dict(scene.get("material", {"preset": "wool-kang-yu"}))
-    units = scene.units
-    angle = m.pop("warp_angle", 0.0)
-    try:
-        if "preset" in m:
-            name = m.pop("preset")
-            if "kind" in m:
-                raise scene.error("material.kind", f'does not apply next to preset = "{name}" (a preset is a fabric '
-                                  "with its rigidities); remove kind, or the preset and give the rigidities")
-            foreign = sorted(set(m) - set(mat._FABRIC_KINDS))
-            if foreign:
-                raise scene.error(f"material.{foreign[0]}", f'does not apply next to preset = "{name}" (a fabric; '
-                                  f"it takes {', '.join(mat._FABRIC_KINDS)} and warp_angle); remove it, or the "
-                                  'preset and give kind = "isotropic" with E, nu and thickness')
-            # preset values are in the preset's own units; overrides in the scene's units
-            base = mat.preset(name, warp_angle_deg=angle)
-            if not m:
-                return base
-            _, values = mat.PRESETS[name]
-            pu = unit_system(mat.PRESETS[name][0])
-            merged = {k: v * pu.to_si(1.0, mat._FABRIC_KINDS[k]) / units.to_si(1.0, mat._FABRIC_KINDS[k])
-                      for k, v in values.items()}
-            merged.update(m)
-            return mat.fabric_from_units(merged, units, warp_angle_deg=angle, name=name + " (modified)")
-        kind = m.pop("kind", "fabric")
-        if kind == "isotropic":
-            for key in ("E", "nu", "thickness"):
-                if key not in m:
-                    raise scene.error(f"material.{key}", "an isotropic shell needs E, nu and thickness")
-            extra = set(m) - {"E", "nu", "thickness", "weight"}
-            if extra:
-                raise scene.error("material", f"keys {sorted(extra)} do not apply to an isotropic shell")
-            return mat.isotropic_shell(E=units.to_si(m["E"], "pressure"), nu=m["nu"],
-                                       thickness=units.to_si(m["thickness"], "length"),
-                                       weight=units.to_si(m.get("weight", 0.0), "pressure"))
-        if kind != "fabric":
-            raise scene.error("material.kind", f'"{kind}" is not a material kind; use fabric or isotropic')
-        needed = {"C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "B_twist", "weight"}
-        missing = needed - set(m)
-        if missing:
-            raise scene.error("material", f"a fabric needs {sorted(missing)} (or preset = \"wool-kang-yu\")")
-        bad = set(m) - set(mat._FABRIC_KINDS)
-        if bad:
-            raise scene.error("material", f"keys {sorted(bad)} do not apply to a fabric")
-        return mat.fabric_from_units(m, units, warp_angle_deg=angle)
-    except ValueError as exc:
-        if isinstance(exc, type(scene.error("", ""))):
-            raise
-        raise scene.error("material", str(exc)) from None
-
-
 def select_nodes(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
     """Nodes named by a ``box`` or ``at`` entry of a scene table (reference coordinates)."""
     u = scene.units.length
-    if "box" in spec and "at" in spec:
-        raise scene.error(f"{key}.at", "give box = [...] or at = [...], not both")
+    given = [k for k in ("box", "at", "radius") if k in spec]
+    if len(given) > 1:
+        raise scene.error(f"{key}.{given[1]}", f"give box, at or radius (one of them), not {' and '.join(given)}")
+    if "radius" in spec:
+        return _within_radius(scene, mesh, spec, key)
     if "box" in spec:
         box = spec["box"]
         if not (isinstance(box, list) and len(box) == 4):
@@ -211,6 +163,24 @@ def select_nodes(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
     if len(nodes) == 0:
         raise scene.error(f"{key}.box", f"{spec['box']} contains no node of the mesh; check the coordinates "
                           f"(scene units, reference configuration)")
+    return nodes
+
+
+def _within_radius(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
+    """Nodes within ``radius`` of ``centre`` (reference coordinates): a tester's clamping disc. Scene error
+    when the radius is not positive, holds no node, or holds them all (the specimen is not larger than the
+    disc)."""
+    u = scene.units.length
+    radius, centre = spec["radius"], spec.get("centre", [0.0, 0.0])
+    if not radius > 0:
+        raise scene.error(f"{key}.radius", f"{radius!r} must be > 0 (the clamping disc's radius, scene length units)")
+    r = np.linalg.norm(mesh.X - np.asarray(centre, float) * u, axis=1)
+    nodes = np.flatnonzero(r <= radius * u * (1.0 + 1e-9))
+    if len(nodes) == 0:
+        raise scene.error(f"{key}.radius", f"{radius!r} holds no node of the mesh within it about centre {centre}")
+    if len(nodes) == mesh.n_nodes:
+        raise scene.error(f"{key}.radius", f"{radius!r} holds the whole specimen (it reaches {r.max() / u:g} from "
+                          f"centre {centre}, scene length units): the specimen must be larger than the clamping disc")
     return nodes
 
 
@@ -412,7 +382,8 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     ``contact``: how the obstacles act, ``"penalty"`` (in the model's energy) or ``"kinematic"`` (by the
     explicit solver; the model has no contact term); default :func:`contact_law` of the scene's analysis.
     ``quiet``: the model's warnings at debug level (a remeshed run warns for its first mesh only).
-    ``extras``: ``{"obstacles": [...], "probes": {name: (2,) reference point [m]}}``.
+    ``extras``: ``{"obstacles": [...], "probes": {name: (2,) reference point [m]}, "disc": a tester's clamping
+    disc (:func:`clamping_disc`) or None}``.
     """
     mesh = build_mesh(scene) if mesh is None else mesh
     material = build_material(scene)
@@ -441,7 +412,18 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
                               "of its own")
         probes[spec["name"]] = np.asarray(spec["at"], float) * u
         check_on_sheet(scene, mesh, probes[spec["name"]][None, :], f"probes.{i}.at")
-    return model, {"obstacles": obstacles, "probes": probes}
+    return model, {"obstacles": obstacles, "probes": probes, "disc": clamping_disc(scene, mesh)}
+
+
+def clamping_disc(scene: Scene, mesh):
+    """The clamping disc of a drape tester (the first clamped ``[[supports]]`` with a ``radius``), as
+    :func:`~rftstatic.post.measures.disc.clamp_disc`; None without one."""
+    for i, spec in enumerate(scene.get("supports", [])):
+        if "radius" in spec and spec.get("kind", "pinned") == "clamped":
+            nodes = _within_radius(scene, mesh, spec, f"supports.{i}")
+            centre = np.asarray(spec.get("centre", [0.0, 0.0]), float) * scene.units.length
+            return clamp_disc(mesh.X3, mesh.tri, nodes, centre)
+    return None
 
 
 def model_factory(scene: Scene, *, contact: str | None = None):

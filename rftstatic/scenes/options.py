@@ -36,6 +36,7 @@ def static_options(scene, *, progress=True) -> StaticOptions:
     """
     s = dict(scene.get("solver", {}))
     s.pop("membrane", None)
+    s.pop("seeds", None)
     u = scene.units.length
     for key in _STATIC_LENGTH_KEYS:
         if key in s:
@@ -202,5 +203,54 @@ def remesh_options(scene) -> RemeshOptions:
     return RemeshOptions(**{k: (v * u if k in REMESH_LENGTH_KEYS and v is not None else v) for k, v in r.items()})
 
 
-__all__ = ["static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
+@dataclass(frozen=True)
+class CantileverOptions:
+    """``[cantilever]`` of a cantilever-tester scene (Peirce; ASTM D1388, BS 3356).
+
+    Attributes
+    ----------
+    angle : the tester's plane below the horizontal [rad] (41.5 deg)
+    growth : overhang factor per step while the tip is above the plane [-]
+    tolerance : relative change of the overhang at which the root find stops [-]
+    max_solves : most static solves (growth steps and root-find steps together)
+    """
+
+    angle: float = float(np.radians(41.5))
+    growth: float = 1.15
+    tolerance: float = 1e-7
+    max_solves: int = 60
+
+
+def seed_count(scene) -> int:
+    """``solver.seeds``: how many seeded starts a static drape runs (a lab's specimens), checked; 1 by default.
+    More than one needs a seeded start (``solver.perturbation`` > 0)."""
+    n = scene.get("solver.seeds", 1)
+    if not (isinstance(n, int) and 1 <= n <= 100):
+        raise scene.error("solver.seeds", f"{n!r} must be an integer in [1, 100] (seeded starts, one per specimen)")
+    if n > 1 and not scene.get("solver.perturbation", 0.0) > 0:
+        raise scene.error("solver.seeds", f"{n} seeded starts need a seeded lift: give solver.perturbation > 0 "
+                          "(e.g. 0.01 element sizes), or every start is the same")
+    if n > 1 and scene.get("analysis", "static") != "static":
+        raise scene.error("solver.seeds", f"{n!r}: seeded starts are run by the static analysis only")
+    return n
+
+
+def cantilever_options(scene) -> CantileverOptions:
+    """The scene's ``[cantilever]`` table checked, angles in radians."""
+    c = dict(scene.get("cantilever", {}))
+    if "angle" in c and not 1.0 <= c["angle"] <= 80.0:
+        raise scene.error("cantilever.angle", f"{c['angle']!r} must lie in [1, 80] deg (the tester's plane below "
+                          "the horizontal: 41.5 in ASTM D1388 and BS 3356)")
+    if "growth" in c and not 1.0 < c["growth"] <= 2.0:
+        raise scene.error("cantilever.growth", f"{c['growth']!r} must lie in (1, 2] (overhang factor per step)")
+    if "tolerance" in c and not 1e-12 <= c["tolerance"] <= 1e-2:
+        raise scene.error("cantilever.tolerance", f"{c['tolerance']!r} must lie in [1e-12, 1e-2]")
+    if "max_solves" in c and not c["max_solves"] >= 3:
+        raise scene.error("cantilever.max_solves", f"{c['max_solves']!r} must be an integer >= 3")
+    if "angle" in c:
+        c["angle"] = float(np.radians(c["angle"]))
+    return CantileverOptions(**c)
+
+
+__all__ = ["seed_count", "cantilever_options", "CantileverOptions", "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
            "DYNAMICS_DEFAULTS", "SceneError"]

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from rftstatic.contact.obstacles import scene_schema as obstacle_schema
 from rftstatic.errors import SceneError
+from rftstatic.fabrics.lab import LAB_KEYS
 from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 
@@ -111,6 +112,7 @@ SCHEMA = {
         "pattern": (str, "diagonal pattern: right, left, alternate, union-jack"),
         "radius": (NUM, "outer radius (polar) or half side (square-polar)"),
         "inner_radius": (NUM, "inner radius of an annulus"),
+        "grading": (NUM, "polar: outermost ring spacing / innermost (1: uniform)"),
         "path": (str, "mesh file read with meshio (relative to the scene file)"),
         "h": (NUM, "target element size of an unstructured mesh"),
         "z": (NUM, "height of the flat reference plane"),
@@ -124,12 +126,16 @@ SCHEMA = {
         "weight": (NUM, "areal weight [force/area]"),
         "E": (NUM, "Young's modulus [force/area]"),
         "nu": (NUM, "Poisson ratio"),
-        "thickness": (NUM, "shell thickness [length]"),
-    }, "fabric or shell rigidities"),
+        "thickness": (NUM, "shell thickness, or a fabric's (self-contact default) [length]"),
+        **{k: (NUM, f"{meaning} [{unit}], lab units whatever the scene's (rftstatic.fabrics.lab)")
+           for k, (unit, meaning) in LAB_KEYS.items()},
+    }, "fabric or shell rigidities; fabric lab data (KES-F kes_*, FAST fast_*)"),
     "supports": ([{
         "kind": (str, "clamped, pinned or fixed"),
         "box": (BOX, "[xmin, xmax, ymin, ymax] in reference coordinates"),
         "at": (PointsXY(), "[x, y] or [[x, y], ...] reference points (nearest nodes)"),
+        "radius": (NUM, "the nodes within this distance of centre (a tester's clamping disc) [length]"),
+        "centre": (XY, "centre of the radius selector (default [0, 0])"),
         "components": (str, "for kind = fixed: which of x, y, z are held, e.g. 'xy'"),
     }], "prescribed (zero) displacements"),
     "loads": ({
@@ -161,6 +167,8 @@ SCHEMA = {
         "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
         "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
+        "seeds": (int, "static drape: run this many seeded starts (seed, seed + 1, ...), as a lab tests several "
+                       "specimens; the summary reports their mean, range and fold counts"),
         "perturbation_folds": (int, "0: random modes; n: an n-fold lift about the sheet's centre"),
         "guide_folds": (int, "relax route: n-fold modulation of the weight in the first stage (0: none)"),
         "guide_weight": (NUM, "relative amplitude of that modulation, in [0, 1)"),
@@ -192,6 +200,12 @@ SCHEMA = {
         "damping": (str, "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's slowest "
                          "swing, at most dynamics.alpha)"),
     }, "global adaptive remeshing (§5)"),
+    "cantilever": ({
+        "angle": (NUM, "the tester's plane below the horizontal [deg] (41.5: ASTM D1388, BS 3356)"),
+        "growth": (NUM, "overhang factor per step while the tip is above the plane"),
+        "tolerance": (NUM, "relative change of the overhang at which the root find stops"),
+        "max_solves": (int, "most static solves"),
+    }, "cantilever bending tester (analysis = \"cantilever\"): the strip's mesh.size[0] is the first overhang"),
     "probes": ([{"name": (str, "probe name"), "at": (XY, "[x, y] reference point")}], "tracked points"),
     "output": ({
         "views": (ListOf(str, choices=("side", "top", "iso")), "PNG views: side, top, iso"),

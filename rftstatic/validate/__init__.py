@@ -7,6 +7,8 @@ Every benchmark is a module here with ``run(quick, *, out=None) -> BenchmarkResu
 - ``plates``: square Kirchhoff plates against Timoshenko/Navier (bending only, small load);
 - ``sze2004``: the large-deflection cantilevers and slit annular plate of Sze, Liu & Lo (2004);
 - ``hang20``: the explicit dynamics of §4.6 against fine-mesh and small-step runs;
+- ``textile_tests``: the cantilever tester recovers the given bending rigidity; the Cusick tester's DC and folds
+  against the mesh, the seed and the disc radius / bending length;
 - ``peers``: the plates with scikit-fem's Morley and Argyris triangles (optional extra ``peers``) and
   the published ABAQUS S4R meshes of Sze et al. (2004), error and time side by side.
 
@@ -40,6 +42,7 @@ BENCHMARKS = {
     "drape_sharp": "RFT3 vs RFT6 sharp-fold indicators on coarse meshes (§4.3, §4.5)",
     "drape_folds": "fold count on the round pedestal (§4.4, Fig. 10)",
     "self_contact": "self-contact: crossing pairs and smallest distance with and without it",
+    "textile_tests": "cantilever bending tester and Cusick drape tester (ASTM D1388, BS 3356, BS 5058)",
     "peers": "a general FE code (scikit-fem Morley/Argyris plates; cited ABAQUS S4R) next to RF triangles",
 }
 

@@ -27,6 +27,7 @@ import os
 
 import numpy as np
 
+from rftstatic.io.figure import set_title
 from rftstatic.validate.drape_common import (
     cache_root,
     copy_views,
@@ -251,7 +252,7 @@ def _energy_figure(out, branches) -> str:
     ax.xaxis.get_major_locator().set_params(integer=True)
     ax.set_xlabel("folds")
     ax.set_ylabel("energy above the lowest drape [gf cm]")
-    ax.set_title(f"{mesh_label(BRANCH_MESH)}, RFT6: stable drapes from different starts")
+    set_title(ax, f"{mesh_label(BRANCH_MESH)}, RFT6: stable drapes from different starts")
     ax.legend(fontsize="x-small", loc="lower right")
     path = out / "drape_folds_energy.png"
     fig.tight_layout()
@@ -283,7 +284,7 @@ def _profiles(out, recs, *, name="drape_folds_profiles.png",
     ax.set_ylabel("projected boundary radius r [cm]")
     ax.set_xlim(0, 360)
     ax.legend(fontsize="small")
-    ax.set_title(title)
+    set_title(ax, title)
     path = out / name
     fig.tight_layout()
     fig.savefig(path, dpi=110)

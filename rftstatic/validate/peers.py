@@ -400,7 +400,7 @@ def _figures(result, out) -> list[str]:
     """Error against wall time and against unknowns: one panel per plate case, every element in each."""
     from matplotlib.ticker import NullFormatter, NullLocator
 
-    from rftstatic.io.figure import new_figure, save_png
+    from rftstatic.io.figure import new_figure, save_png, set_title
 
     names = []
     styles = {"RFT3=RFT6": ("C0", "o"), f"Morley ({PEER})": ("C1", "s"), f"Argyris ({PEER})": ("C2", "d")}
@@ -428,11 +428,12 @@ def _figures(result, out) -> list[str]:
             ax.xaxis.set_minor_formatter(NullFormatter())
             ax.yaxis.set_minor_locator(NullLocator())  # up to ten decades: minor ticks cost seconds to lay out
             ax.grid(True, which="major", lw=0.3, alpha=0.5)
-            ax.set_title(case.replace("_", " "), fontsize="medium")
+            set_title(ax, case.replace("_", " "), fontsize="medium")
             ax.set_xlabel(xlabel)
             ax.set_ylabel("relative error of the centre deflection")
             ax.legend(fontsize="x-small", loc="best")
-        fig.suptitle(f"Square Kirchhoff plates vs Timoshenko: error vs {xlabel} (p: rate in h, resolved meshes)")
+        set_title(fig, f"Square Kirchhoff plates vs Timoshenko: error vs {xlabel} (p: rate in h, resolved meshes)",
+                  figure_title=True)
         path = out / f"peers_error_vs_{stem}.png"
         save_png(fig, path)
         names.append(path.name)

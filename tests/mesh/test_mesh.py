@@ -101,3 +101,13 @@ def test_mesh_files_that_are_not_a_clean_triangle_mesh_are_refused(tmp_path):
     meshio.write(path, meshio.Mesh(dup, [("triangle", np.array([[0, 1, 2], [0, 4, 3]]))]))
     with pytest.raises(mesh.MeshError, match="repeated"):
         mesh.read(path)
+
+
+def test_polar_grading_is_a_geometric_progression():
+    """grading = outermost / innermost ring spacing, the spacings a geometric progression between them."""
+    m = mesh.polar(15.0, 7, 16, r_inner=9.0, grading=4.0)
+    r = np.unique(np.round(np.hypot(*m.X.T), 9))
+    d = np.diff(r)
+    assert r[0] == 9.0 and r[-1] == 15.0 and len(r) == 7
+    assert d[-1] / d[0] == pytest.approx(4.0) and np.allclose(d[1:] / d[:-1], 4.0 ** 0.2)
+    assert (m.area > 0).all() and m.area.sum() < np.pi * (15.0**2 - 9.0**2)

@@ -1,0 +1,59 @@
+"""Several specimens of one drape test: the static drape solved from ``solver.seeds`` seeded starts.
+
+A drape tester's result scatters from specimen to specimen (the fold count above all: a drape has several
+stable equilibria, §6.2), so labs average several specimens (BS 5058 and ISO 9073-9 test three or more).
+The same scatter appears in the simulation when the seeded lift that tips the flat start off its
+bifurcation changes: :func:`seeded_specimens` solves the scene's model from seeds ``seed + 1, ...`` (the
+first specimen is the run itself) and reports every drape coefficient and fold count with their mean
+and range, in the scene's units.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import time
+
+import numpy as np
+
+from rftstatic.errors import ConvergenceError
+from rftstatic.io.summary import drape_summary
+from rftstatic.solvers.static import solve_static
+
+log = logging.getLogger(__name__)
+
+
+def seeded_specimens(scene, model, extras, opts, first: dict, n: int) -> dict:
+    """Solve ``model`` from ``n - 1`` further seeds after ``opts.seed`` and summarise all ``n`` drapes.
+
+    ``first``: the drape summary of the run's own solve (seed ``opts.seed``). A seed whose solve does not
+    converge is listed (``converged: false``) and left out of the statistics.
+    """
+    rows = [{"seed": opts.seed, "converged": True, **_row(first)}]
+    for k in range(1, n):
+        t0 = time.perf_counter()
+        seeded = dataclasses.replace(opts, seed=opts.seed + k, progress=False)
+        try:
+            res = solve_static(model, options=seeded)
+            ok = bool(res.converged)
+        except ConvergenceError as exc:
+            log.warning("seed %d: %s", seeded.seed, exc)
+            res, ok = exc.result, False
+        row = {"seed": seeded.seed, "converged": ok, "wall_time_s": time.perf_counter() - t0}
+        if ok:
+            row.update(_row(drape_summary(scene, model, extras, res.U)), stable_minimum=res.stable)
+        rows.append(row)
+    good = [r for r in rows if r["converged"] and r.get("drape_coefficient_percent") is not None]
+    dc = np.array([r["drape_coefficient_percent"] for r in good])
+    folds = [r["fold_count"] for r in good]
+    out = {"count": n, "solved": len(good), "specimens": rows, "fold_counts": folds}
+    if len(dc):
+        out.update(drape_coefficient_percent_mean=float(dc.mean()), drape_coefficient_percent_min=float(dc.min()),
+                   drape_coefficient_percent_max=float(dc.max()),
+                   drape_coefficient_percent_std=float(dc.std(ddof=1)) if len(dc) > 1 else 0.0,
+                   fold_count_mean=float(np.mean(folds)))
+    return out
+
+
+def _row(drape: dict) -> dict:
+    return {k: drape.get(k) for k in ("drape_coefficient_percent", "fold_count", "fold_angles_deg")}

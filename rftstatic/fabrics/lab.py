@@ -1,0 +1,211 @@
+"""Fabric data as textile laboratories report it (KES-F, FAST) converted to the model's rigidities.
+
+A ``[material]`` table may give, instead of (or mixed with, for *other* quantities) the model's
+rigidities ``C_warp, C_weft, C_shear, B_warp, B_weft, B_twist, weight``, the values a lab measures, in
+the units the instruments print, whatever the scene's ``units``:
+
+KES-F (Kawabata 1980; Kawabata & Niwa 1989), key ``kes_*``:
+
+=================  ==================  ===================================================================
+key                unit                conversion to the model (cm-gf-s; SI factors in :mod:`rftstatic.units`)
+=================  ==================  ===================================================================
+kes_B_warp/weft    gf cm^2/cm          B_warp/weft [gf cm] = B  (a bending rigidity per unit width: gf cm^2/cm
+                                       *is* gf cm, the paper's unit; 1 gf cm = 9.80665e-5 N m)
+kes_G              gf/(cm deg)         C_shear [gf/cm] = G * 180/pi  (per degree of shear angle -> per radian;
+                                       the shear angle is the engineering shear strain gamma = 2 e_xy)
+kes_EMT_warp/weft  %                   C [gf/cm] = Fm / (EMT/100): the secant at the test's maximum load Fm
+                                       (``kes_Fm``, default 500 gf/cm, the standard woven setting)
+kes_LT, kes_WT     -, gf cm/cm^2       without EMT: EMT/100 = 2 WT / (LT Fm)  (WT = LT Fm eps_m / 2), then as EMT
+kes_W              mg/cm^2             weight [gf/cm^2] = W / 1000  (mass per area under standard gravity)
+kes_T              mm                  thickness (self-contact default): T / 10 cm
+=================  ==================  ===================================================================
+
+FAST (SiroFAST: De Boos & Tester 1994, CSIRO report WT92.02), key ``fast_*``:
+
+=================  ==================  ===================================================================
+fast_B_warp/weft   uN m                B [N m] = B * 1e-6  (FAST's B = W c^3 per unit width, uN m = uN m^2/m)
+fast_E100_warp/weft  %                 C [N/m] = 98.0665 N/m / (E100/100): the secant at 100 gf/cm
+fast_G             N/m                 C_shear [N/m] = G  (FAST's G = 123 / EB5, already per radian)
+fast_W             g/m^2               weight [N/m^2] = W * 1e-3 * 9.80665
+fast_T             mm                  thickness (T2, at 2 gf/cm^2)
+=================  ==================  ===================================================================
+
+What the linear model drops: the bending and shear hysteresis (KES 2HB, 2HG, 2HG5), the nonlinear
+shear curve beyond the small angles where G is measured (0.5-5 deg), the tensile curve's nonlinearity
+(the secant at Fm replaces it: crimp interchange makes the initial modulus far lower, so a drape that
+stretches little is too stiff in tension; drape is insensitive to it while C >> B / h^2), the
+compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measured: Poisson coupling
+(C12 = B12 = 0) and the twisting rigidity, which defaults to ``B_twist = sqrt(B_warp B_weft) / 2`` (the
+orthotropic plate with zero Poisson ratio, M_xy = D (1 - nu)/2 * 2 k_xy; Kang & Yu's wool has 0.37 instead
+of 0.5 of the mean) unless the scene gives ``B_twist``.
+
+Range checks (:data:`RANGES`): a value outside them is almost surely a slip of unit or decimal point.
+They lie a factor 5-10 beyond the span of published data for apparel fabrics: Kawabata's (1980) charts
+for suitings (B about 0.04-0.25 gf cm^2/cm, G 0.3-2 gf/(cm deg), W 15-35 mg/cm^2, EMT 2-10 %); the paper's
+wool (B 0.083/0.063, G 0.73, W 19); FAST's control chart for tailorability (B 3-15 uN m, E100 1-7 %,
+G 20-150 N/m, W 150-400 g/m^2 for suitings). Wider fabrics (heavy denim, fine silk, nonwovens) remain
+inside the bounds; the bounds are deliberately loose.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rftstatic.errors import ParameterError
+from rftstatic.units import STANDARD_GRAVITY, unit_system
+
+__all__ = ["LAB_KEYS", "RANGES", "QUANTITY_KEYS", "lab_to_si", "sources_of", "default_twist"]
+
+GF = STANDARD_GRAVITY * 1e-3
+"""One gram-force [N]."""
+
+LAB_KEYS = {
+    "kes_B_warp": ("gf cm^2/cm", "KES-FB2 bending rigidity, warp (bending about the weft)"),
+    "kes_B_weft": ("gf cm^2/cm", "KES-FB2 bending rigidity, weft"),
+    "kes_G": ("gf/(cm deg)", "KES-FB1 shear rigidity"),
+    "kes_EMT_warp": ("%", "KES-FB1 extension at the maximum load Fm, warp"),
+    "kes_EMT_weft": ("%", "KES-FB1 extension at Fm, weft"),
+    "kes_LT_warp": ("-", "KES-FB1 tensile linearity, warp"),
+    "kes_LT_weft": ("-", "KES-FB1 tensile linearity, weft"),
+    "kes_WT_warp": ("gf cm/cm^2", "KES-FB1 tensile energy, warp"),
+    "kes_WT_weft": ("gf cm/cm^2", "KES-FB1 tensile energy, weft"),
+    "kes_Fm": ("gf/cm", "KES-FB1 maximum tensile load (default 500)"),
+    "kes_W": ("mg/cm^2", "KES mass per area"),
+    "kes_T": ("mm", "KES-FB3 thickness at 0.5 gf/cm^2"),
+    "fast_B_warp": ("uN m", "FAST-2 bending rigidity, warp"),
+    "fast_B_weft": ("uN m", "FAST-2 bending rigidity, weft"),
+    "fast_E100_warp": ("%", "FAST-3 extensibility at 100 gf/cm, warp"),
+    "fast_E100_weft": ("%", "FAST-3 extensibility at 100 gf/cm, weft"),
+    "fast_G": ("N/m", "FAST shear rigidity 123/EB5"),
+    "fast_W": ("g/m^2", "FAST mass per area"),
+    "fast_T": ("mm", "FAST-1 thickness T2"),
+}
+"""Lab keys of ``[material]``: (unit as printed by the instrument, meaning)."""
+
+RANGES = {
+    "kes_B_warp": (0.002, 5.0), "kes_B_weft": (0.002, 5.0), "kes_G": (0.02, 20.0),
+    "kes_EMT_warp": (0.2, 60.0), "kes_EMT_weft": (0.2, 60.0), "kes_LT_warp": (0.2, 1.5), "kes_LT_weft": (0.2, 1.5),
+    "kes_WT_warp": (0.5, 100.0), "kes_WT_weft": (0.5, 100.0), "kes_Fm": (5.0, 1000.0),
+    "kes_W": (1.0, 150.0), "kes_T": (0.05, 10.0),
+    "fast_B_warp": (0.2, 500.0), "fast_B_weft": (0.2, 500.0), "fast_E100_warp": (0.1, 60.0),
+    "fast_E100_weft": (0.1, 60.0), "fast_G": (2.0, 2000.0), "fast_W": (10.0, 1500.0), "fast_T": (0.05, 10.0),
+}
+"""Plausible bounds (inclusive) of each lab key, in its lab unit (module docstring)."""
+
+QUANTITY_KEYS = {
+    "B_warp": ("kes_B_warp", "fast_B_warp"),
+    "B_weft": ("kes_B_weft", "fast_B_weft"),
+    "C_shear": ("kes_G", "fast_G"),
+    "C_warp": ("kes_EMT_warp", "kes_WT_warp", "fast_E100_warp"),
+    "C_weft": ("kes_EMT_weft", "kes_WT_weft", "fast_E100_weft"),
+    "weight": ("kes_W", "fast_W"),
+    "thickness": ("kes_T", "fast_T"),
+}
+"""Model quantity -> the lab keys that give it (one source per quantity)."""
+
+_CM_GF = unit_system("cm-gf-s")
+
+
+def sources_of(values: dict) -> dict:
+    """``{quantity: [keys]}``: the keys of ``values`` that give each model quantity (the model key itself
+    and its lab keys), for the quantities given at all."""
+    out = {}
+    for q, lab in QUANTITY_KEYS.items():
+        keys = [k for k in (q, *lab) if k in values]
+        if q.startswith("C_w"):  # LT goes with WT: one source
+            keys = [k for k in keys if not k.startswith("kes_LT")]
+        if keys:
+            out[q] = keys
+    return out
+
+
+def check_ranges(values: dict) -> None:
+    """ParameterError(key, ...) for a lab value that is not a number inside :data:`RANGES`."""
+    for key, v in values.items():
+        if key not in RANGES:
+            continue
+        lo, hi = RANGES[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not lo <= v <= hi:
+            unit, meaning = LAB_KEYS[key]
+            raise ParameterError(key, f"{v!r} {unit} is outside the plausible range [{lo:g}, {hi:g}] {unit} of "
+                                 f"a {meaning} (rftstatic.fabrics.lab.RANGES, from published KES/FAST data); "
+                                 "check the unit and the decimal point")
+
+
+def _tensile(values: dict, d: str) -> tuple[float, dict] | None:
+    """Secant tensile rigidity [N/m] in direction ``d`` (warp/weft) from the lab keys, and its record."""
+    if f"kes_EMT_{d}" in values or f"kes_WT_{d}" in values:
+        fm = float(values.get("kes_Fm", 500.0))
+        if f"kes_EMT_{d}" in values:
+            strain = values[f"kes_EMT_{d}"] / 100.0
+            rule = f"secant at Fm = {fm:g} gf/cm: C = Fm / (EMT/100)"
+        else:
+            if f"kes_LT_{d}" not in values:
+                raise ParameterError(f"kes_WT_{d}", f"{values[f'kes_WT_{d}']!r}: the tensile energy needs "
+                                     f"kes_LT_{d} (linearity) or kes_EMT_{d} to give a strain")
+            strain = 2.0 * values[f"kes_WT_{d}"] / (values[f"kes_LT_{d}"] * fm)
+            rule = f"secant at Fm = {fm:g} gf/cm with EMT/100 = 2 WT / (LT Fm)"
+        return fm * GF / 1e-2 / strain, {"rule": rule, "strain_at_Fm": strain}
+    if f"fast_E100_{d}" in values:
+        strain = values[f"fast_E100_{d}"] / 100.0
+        return 100.0 * GF / 1e-2 / strain, {"rule": "secant at 100 gf/cm: C = 98.0665 N/m / (E100/100)",
+                                            "strain_at_100gf_per_cm": strain}
+    return None
+
+
+def default_twist(B_warp: float, B_weft: float) -> float:
+    """Twisting rigidity when no lab measures it: ``sqrt(B_warp B_weft) / 2`` (any consistent unit)."""
+    return 0.5 * math.sqrt(B_warp * B_weft)
+
+
+def lab_to_si(values: dict) -> tuple[dict, dict]:
+    """The model quantities the lab keys of ``values`` give, in SI, and a record of the conversion.
+
+    Parameters
+    ----------
+    values : dict
+        ``[material]`` entries; only the keys of :data:`LAB_KEYS` are read (each in its lab unit).
+
+    Returns
+    -------
+    si : dict
+        ``{quantity: value}`` for the quantities given: ``B_warp, B_weft`` [N m], ``C_shear, C_warp,
+        C_weft`` [N/m], ``weight`` [N/m^2], ``thickness`` [m].
+    record : dict
+        ``{quantity: {"from": key, "value": lab value, "unit": lab unit, "rule": ...}}``.
+
+    Raises
+    ------
+    ParameterError
+        A value outside :data:`RANGES` (key = the lab key).
+    """
+    lab = {k: v for k, v in values.items() if k in LAB_KEYS}
+    check_ranges(lab)
+    si, record = {}, {}
+
+    def put(q, key, value_si, rule, **extra):
+        si[q] = value_si
+        record[q] = {"from": key, "value": lab[key], "unit": LAB_KEYS[key][0], "rule": rule, **extra}
+
+    for d in ("warp", "weft"):
+        if f"kes_B_{d}" in lab:
+            put(f"B_{d}", f"kes_B_{d}", _CM_GF.to_si(lab[f"kes_B_{d}"], "moment"), "gf cm^2/cm = gf cm (per width)")
+        if f"fast_B_{d}" in lab:
+            put(f"B_{d}", f"fast_B_{d}", lab[f"fast_B_{d}"] * 1e-6, "uN m = 1e-6 N m (per width)")
+        tensile = _tensile(lab, d)
+        if tensile is not None:
+            key = next(k for k in (f"kes_EMT_{d}", f"kes_WT_{d}", f"fast_E100_{d}") if k in lab)
+            put(f"C_{d}", key, tensile[0], tensile[1].pop("rule"), **tensile[1])
+    if "kes_G" in lab:
+        put("C_shear", "kes_G", _CM_GF.to_si(lab["kes_G"] * 180.0 / math.pi, "line_force"),
+            "per degree -> per radian: C_shear = G * 180/pi")
+    if "fast_G" in lab:
+        put("C_shear", "fast_G", float(lab["fast_G"]), "N/m, per radian (123/EB5)")
+    if "kes_W" in lab:
+        put("weight", "kes_W", lab["kes_W"] * 1e-2 * STANDARD_GRAVITY, "mg/cm^2 = 1e-2 kg/m^2, times g")
+    if "fast_W" in lab:
+        put("weight", "fast_W", lab["fast_W"] * 1e-3 * STANDARD_GRAVITY, "g/m^2 = 1e-3 kg/m^2, times g")
+    for key in ("kes_T", "fast_T"):
+        if key in lab:
+            put("thickness", key, lab[key] * 1e-3, "mm")
+    return si, record

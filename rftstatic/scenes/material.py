@@ -1,0 +1,148 @@
+"""A scene's ``[material]`` table -> :class:`~rftstatic.material.Material` (SI), and its summary record.
+
+A fabric is given by a library preset (:data:`rftstatic.fabrics.library.FABRICS`), by the model's
+rigidities in the scene's units, by lab values (KES-F ``kes_*``, FAST ``fast_*``: :mod:`rftstatic.fabrics.lab`,
+each in its instrument's unit), or a mixture of them for *different* quantities. Two keys for the same
+quantity in one table (``B_warp`` and ``kes_B_warp``) are a scene error naming both; a key given next to a
+preset replaces the preset's value of that quantity, whatever form the preset gives it in
+(``--set material.C_warp=900`` on the wool; ``--set material.kes_B_warp=0.1``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rftstatic import material as mat
+from rftstatic.errors import ParameterError
+from rftstatic.fabrics.lab import LAB_KEYS, QUANTITY_KEYS, default_twist, lab_to_si, sources_of
+from rftstatic.fabrics.library import FABRICS, bending_lengths
+from rftstatic.units import UnitSystem, unit_system
+
+__all__ = ["build_material", "material_summary", "FABRIC_KEYS"]
+
+FABRIC_KEYS = set(mat._FABRIC_KINDS) | {"thickness"} | set(LAB_KEYS)
+"""Keys of a fabric ``[material]`` table besides ``preset``, ``kind`` and ``warp_angle``."""
+
+_REQUIRED = ("C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "weight")
+
+
+def _to_si(values: dict, units: UnitSystem) -> tuple[dict, dict]:
+    """SI quantities and the lab record of one set of fabric ``values`` (model keys in ``units``)."""
+    for q, keys in sources_of(values).items():
+        if len(keys) > 1:
+            shown = " and ".join(f"{k} = {values[k]!r}" for k in keys)
+            raise ParameterError(keys[1], f"{shown} both give {q}; give one of them")
+    si, record = lab_to_si(values)
+    for key, kind in mat._FABRIC_KINDS.items():
+        if key in values:
+            si[key] = units.to_si(float(values[key]), kind)
+    if "thickness" in values:
+        si["thickness"] = units.to_si(float(values["thickness"]), "length")
+    return si, record
+
+
+def _fabric(scene, m: dict, angle: float) -> mat.Material:
+    name = m.pop("preset", None)
+    foreign = sorted(set(m) - FABRIC_KEYS - {"kind"})
+    if foreign:
+        where = f'next to preset = "{name}" (a fabric' if name else "to a fabric ("
+        raise scene.error(f"material.{foreign[0]}", f"does not apply {where}; it takes {', '.join(sorted(FABRIC_KEYS))} "
+                          'and warp_angle); remove it, or give kind = "isotropic" with E, nu and thickness')
+    if name is not None and "kind" in m:
+        raise scene.error("material.kind", f'does not apply next to preset = "{name}" (a preset is a fabric '
+                          "with its rigidities); remove kind, or the preset and give the rigidities")
+    m.pop("kind", None)
+    si, record = {}, {}
+    if name is not None:
+        if name not in FABRICS:
+            raise scene.error("material.preset", f'"{name}" is not a fabric of the library; known: '
+                              f'{", ".join(FABRICS)} (python -m rftstatic fabrics lists them)')
+        fab = FABRICS[name]
+        si, record = _to_si(fab.values, unit_system(fab.units))
+    own_si, own_record = _to_si(m, scene.units)
+    for q in own_si:  # a scene key replaces the preset's value of its quantity, whatever its form
+        record.pop(q, None)
+    si.update(own_si)
+    record.update(own_record)
+    missing = [q for q in _REQUIRED if q not in si]
+    if missing:
+        options = ", ".join(f"{q} (or {' / '.join(QUANTITY_KEYS[q])})" for q in missing)
+        raise scene.error("material", f"a fabric needs {options}; or a preset (python -m rftstatic fabrics)")
+    if "B_twist" not in si:
+        si["B_twist"] = default_twist(si["B_warp"], si["B_weft"])
+        record["B_twist"] = {"rule": "sqrt(B_warp B_weft) / 2 (not measured: orthotropic plate, zero Poisson ratio)"}
+    label = (name or "fabric") + (" (modified)" if name and m else "")
+    material = mat.fabric(**{k: si[k] for k in mat._FABRIC_KINDS if k in si}, warp_angle=np.radians(angle),
+                          name=label)
+    if "thickness" in si:
+        material.info["thickness"] = si["thickness"]
+    for q, rec in record.items():
+        rec["si"] = si[q]
+    if record:
+        material.info["lab"] = record
+    return material
+
+
+def build_material(scene) -> mat.Material:
+    """The scene's material in SI (module docstring); scene errors name the key and value."""
+    m = dict(scene.get("material", {"preset": "wool-kang-yu"}))
+    units = scene.units
+    angle = m.pop("warp_angle", 0.0)
+    try:
+        if m.get("kind", "fabric") == "isotropic" and "preset" not in m:
+            m.pop("kind")
+            for key in ("E", "nu", "thickness"):
+                if key not in m:
+                    raise scene.error(f"material.{key}", "an isotropic shell needs E, nu and thickness")
+            extra = set(m) - {"E", "nu", "thickness", "weight"}
+            if extra:
+                raise scene.error("material", f"keys {sorted(extra)} do not apply to an isotropic shell")
+            return mat.isotropic_shell(E=units.to_si(m["E"], "pressure"), nu=m["nu"],
+                                       thickness=units.to_si(m["thickness"], "length"),
+                                       weight=units.to_si(m.get("weight", 0.0), "pressure"))
+        if m.get("kind", "fabric") not in ("fabric", "isotropic"):
+            raise scene.error("material.kind", f'"{m["kind"]}" is not a material kind; use fabric or isotropic')
+        return _fabric(scene, m, angle)
+    except ParameterError as exc:
+        raise scene.error(f"material.{exc.key}", exc.detail) from None
+    except ValueError as exc:
+        if isinstance(exc, type(scene.error("", ""))):
+            raise
+        raise scene.error("material", str(exc)) from None
+
+
+def material_summary(scene, material: mat.Material) -> dict:
+    """The material as run, in the scene's units: the rigidities in the fabric's own axes, the bending
+    lengths, the warp angle and, for lab input, how each value was converted (``lab``)."""
+    u = scene.units
+    out = {"name": material.name, "warp_angle_deg": material.info.get("warp_angle_deg", 0.0),
+           "weight": u.from_si(material.weight, "pressure")}
+    lengths = bending_lengths(material)
+    for d in ("warp", "weft"):
+        out[f"B_{d}"] = u.from_si(lengths[d]["B"], "moment")
+        c = lengths[d]["c"]
+        out[f"bending_length_{d}"] = None if c is None else u.from_si(c, "length")
+    out["Dm_global"] = (np.asarray(material.Dm) / u.line_force).tolist()
+    out["Db_global"] = (np.asarray(material.Db) / u.moment).tolist()
+    if "lab" in material.info:
+        kinds = {**mat._FABRIC_KINDS, "thickness": "length"}
+        out["lab"] = {q: {**{k: v for k, v in rec.items() if k != "si"},
+                          "converted": u.from_si(rec["si"], kinds[q]), "converted_units": u.name}
+                      for q, rec in material.info["lab"].items()}
+    return out
+
+
+def list_fabrics() -> list[dict]:
+    """Every library fabric as built for a scene in cm-gf-s: name, bending rigidities B [gf cm] and bending
+    lengths c = (B/W)^(1/3) [cm] along warp and weft, weight [gf/cm^2], description and source."""
+    from rftstatic.scenes.schema import scene_from_dict
+
+    rows = []
+    for name, fab in FABRICS.items():
+        scene = scene_from_dict({"units": "cm-gf-s", "material": {"preset": name}})
+        m = material_summary(scene, build_material(scene))
+        rows.append({"name": name, "B_warp": m["B_warp"], "B_weft": m["B_weft"], "weight": m["weight"],
+                     "c_warp": m["bending_length_warp"], "c_weft": m["bending_length_weft"],
+                     "published_units": fab.units, "description": fab.description, "source": fab.source,
+                     "measured_dc": dict(fab.measured_dc)})
+    return rows
