@@ -56,8 +56,10 @@ from rftstatic.scenes.schema import CASES_DIR, SCHEMA, ListOf, load_scene
 EXAMPLES = int(os.environ.get("RFTSTATIC_PROPERTY_EXAMPLES", "300"))
 """Generated scenes per run (measured: 46-75 s on a busy 2-core machine, 20 % of them reach a solver)."""
 
-BOUND_S = float(os.environ.get("RFTSTATIC_PROPERTY_BOUND_S", "20"))
-"""Longest a tiny scene may take, whatever its values [s]."""
+BOUND_S = float(os.environ.get("RFTSTATIC_PROPERTY_BOUND_S", "45"))
+"""Longest a tiny scene may take, whatever its values [s]: a hang detector, not a speed target. The slowest
+generated scene took 12.7-23 s on a 2-core machine shared with four other solvers (load 5), which a 20 s
+bound failed; an unloaded machine runs it in a few seconds."""
 
 MAX_NODES = 200
 """Nodes of the tiny meshes the scenes start from (fewer than this)."""
