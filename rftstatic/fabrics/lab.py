@@ -60,7 +60,9 @@ The FAST relations above (B in uN m, E100 at 100 gf/cm, G = 123/EB5 in N/m) are 
 Tester (1994), which could not be read here: unverified against the manual. A public note that
 summarises Kuijpers, Luible-Baer & Gong (2020), "The measurement of fabric properties for virtual
 simulation - a critical review", IEEE SA Industry Connections report STDVA24083 (its Table 2), gives the
-same definitions; only that report's title page could be read here.
+same definitions and KES-FB1's maximum load Fm = 500 gf/cm (50 for knits), the default of ``kes_Fm``; only
+that report's title page could be read here. The KES citations (Kawabata 1980; Kawabata & Niwa 1989) are
+likewise not checked against their text.
 """
 
 from __future__ import annotations
