@@ -40,11 +40,29 @@ orthotropic plate with zero Poisson ratio, M_xy = D (1 - nu)/2 * 2 k_xy; Kang & 
 of 0.5 of the mean) unless the scene gives ``B_twist``.
 
 Range checks (:data:`RANGES`): a value outside them is almost surely a slip of unit or decimal point.
-They lie a factor 5-10 beyond the span of published data for apparel fabrics: Kawabata's (1980) charts
-for suitings (B about 0.04-0.25 gf cm^2/cm, G 0.3-2 gf/(cm deg), W 15-35 mg/cm^2, EMT 2-10 %); the paper's
-wool (B 0.083/0.063, G 0.73, W 19); FAST's control chart for tailorability (B 3-15 uN m, E100 1-7 %,
-G 20-150 N/m, W 150-400 g/m^2 for suitings). Wider fabrics (heavy denim, fine silk, nonwovens) remain
-inside the bounds; the bounds are deliberately loose.
+What the bounds rest on (searched for through public material on 2026-12-02; nothing entered from memory):
+
+- bending rigidity and weight: the public data set of Feng, Huang, Xu & Wang (2022), "Learning-Based Bending
+  Stiffness Parameter Estimation by a Drape Tester", ACM Trans. Graph. 41(6) (SIGGRAPH Asia),
+  doi:10.1145/3550454.3555464, file ``dataset/dataset.csv`` of github.com/DrapeTester/ClothDrapeTester
+  (commit 24a980c): 618 real fabrics (251 distinct rows), cantilever-measured, columns "density[kg.m-2]"
+  and "linear warp/weft[SI*1e9]". Read as N m per width x 1e9 (dimensionally the modulus rho g L^3 / gamma
+  of the repository's ``GenerateModulusForSampling.m``; the paper itself was not read), they span
+  B 0.223-265.7 uN m (0.00227-2.71 gf cm^2/cm) and 15.3-870.3 g/m^2 (1.53-87.0 mg/cm^2). The bounds lie
+  a factor 4.5-7.5 beyond that span (tests/fabrics/test_lab.py checks the extremes are inside);
+- the paper's wool (B 0.083/0.063 gf cm, G 0.73 gf/(cm deg), W 19 mg/cm^2) is inside every bound;
+- UNVERIFIED (no table found through the tools; Kawabata's charts, the SiroFAST manual and its control
+  chart could not be read): the bounds of G, EMT, LT, WT, Fm, thickness, FAST E100 and G. They are kept
+  loose (two to three decades) and only catch gross slips; a fabric outside them is refused by name, so
+  widen a bound here (with its source) rather than bend a measured value.
+
+The FAST relations above (B in uN m, E100 at 100 gf/cm, G = 123/EB5 in N/m) are quoted after De Boos &
+Tester (1994), which could not be read here: unverified against the manual. A public note that
+summarises Kuijpers, Luible-Baer & Gong (2020), "The measurement of fabric properties for virtual
+simulation - a critical review", IEEE SA Industry Connections report STDVA24083 (its Table 2), gives the
+same definitions and KES-FB1's maximum load Fm = 500 gf/cm (50 for knits), the default of ``kes_Fm``; only
+that report's title page could be read here. The KES citations (Kawabata 1980; Kawabata & Niwa 1989) are
+likewise not checked against their text.
 """
 
 from __future__ import annotations
@@ -54,7 +72,7 @@ import math
 from rftstatic.errors import ParameterError
 from rftstatic.units import STANDARD_GRAVITY, unit_system
 
-__all__ = ["LAB_KEYS", "RANGES", "QUANTITY_KEYS", "lab_to_si", "sources_of", "default_twist"]
+__all__ = ["LAB_KEYS", "RANGES", "RANGE_EVIDENCE", "QUANTITY_KEYS", "lab_to_si", "sources_of", "default_twist"]
 
 GF = STANDARD_GRAVITY * 1e-3
 """One gram-force [N]."""
@@ -83,14 +101,22 @@ LAB_KEYS = {
 """Lab keys of ``[material]``: (unit as printed by the instrument, meaning)."""
 
 RANGES = {
-    "kes_B_warp": (0.002, 5.0), "kes_B_weft": (0.002, 5.0), "kes_G": (0.02, 20.0),
+    "kes_B_warp": (0.0005, 20.0), "kes_B_weft": (0.0005, 20.0), "kes_G": (0.02, 20.0),
     "kes_EMT_warp": (0.2, 60.0), "kes_EMT_weft": (0.2, 60.0), "kes_LT_warp": (0.2, 1.5), "kes_LT_weft": (0.2, 1.5),
     "kes_WT_warp": (0.5, 100.0), "kes_WT_weft": (0.5, 100.0), "kes_Fm": (5.0, 1000.0),
-    "kes_W": (1.0, 150.0), "kes_T": (0.05, 10.0),
-    "fast_B_warp": (0.2, 500.0), "fast_B_weft": (0.2, 500.0), "fast_E100_warp": (0.1, 60.0),
-    "fast_E100_weft": (0.1, 60.0), "fast_G": (2.0, 2000.0), "fast_W": (10.0, 1500.0), "fast_T": (0.05, 10.0),
+    "kes_W": (0.3, 500.0), "kes_T": (0.05, 10.0),
+    "fast_B_warp": (0.05, 2000.0), "fast_B_weft": (0.05, 2000.0), "fast_E100_warp": (0.1, 60.0),
+    "fast_E100_weft": (0.1, 60.0), "fast_G": (2.0, 2000.0), "fast_W": (3.0, 5000.0), "fast_T": (0.05, 10.0),
 }
-"""Plausible bounds (inclusive) of each lab key, in its lab unit (module docstring)."""
+"""Plausible bounds (inclusive) of each lab key, in its lab unit (module docstring: B and W from a public
+618-fabric data set; the others unverified and loose)."""
+
+RANGE_EVIDENCE = {
+    "source": "Feng, Huang, Xu & Wang (2022), ACM TOG 41(6), doi:10.1145/3550454.3555464; "
+              "github.com/DrapeTester/ClothDrapeTester dataset/dataset.csv (commit 24a980c), 618 fabrics",
+    "B_uNm": (0.223, 265.7254), "W_g_per_m2": (15.3, 870.3),
+}
+"""The measured span the B and W bounds were set against (module docstring)."""
 
 QUANTITY_KEYS = {
     "B_warp": ("kes_B_warp", "fast_B_warp"),
@@ -128,7 +154,8 @@ def check_ranges(values: dict) -> None:
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not lo <= v <= hi:
             unit, meaning = LAB_KEYS[key]
             raise ParameterError(key, f"{v!r} {unit} is outside the plausible range [{lo:g}, {hi:g}] {unit} of "
-                                 f"a {meaning} (rftstatic.fabrics.lab.RANGES, from published KES/FAST data); "
+                                 f"a {meaning} (rftstatic.fabrics.lab.RANGES: B and W set against a measured "
+                                 "618-fabric data set, the others loose and unverified); "
                                  "check the unit and the decimal point")
 
 

@@ -205,7 +205,12 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
 
 MEASURED_NOTE = (
     "Not done: no fabric in the library (rftstatic.fabrics.library) has both published mechanical data and a "
-    "published Cusick DC. Kang & Yu (1995) give the wool's rigidities but no drape-tester reading we could trace; "
-    "the studies that pair KES-F data with Cusick DC (e.g. Hu & Chan 1998, Text. Res. J. 68(1) 57-64; Kenkare et "
-    "al. 2008, J. Text. Inst. 99(3)) could not be read here for their tables, and no value is entered from memory. "
-    "A fabric enters the library with its source table (Fabric.measured_dc), and this section then compares.")
+    "published Cusick DC. Kang & Yu (1995) give the wool's rigidities but no drape-tester reading. A search of "
+    "public copies (2026-12-02) found the studies that pair KES-F or FAST data with a Cusick DC by title and "
+    "abstract only, their tables out of reach: Hu & Chan (1998), Text. Res. J. 68(1) 57-64; Kenkare et al. (2008), "
+    "J. Text. Inst., doi:10.1080/00405000701489222; Jeong & Phillips (1998), J. Text. Inst. 89(1) 70-79; Kuijpers "
+    "(2017), MPhil thesis, Manchester; Sanad et al. (2013), J. Fiber Bioeng. Inform. 6(1). The public measured data "
+    "sets found (Feng et al. 2022, 618 fabrics: density and cantilever bending only; Wang et al. 2011, ten fabrics "
+    "in ARCSim's format) give no Cusick DC. No value is entered from memory. A fabric enters the library with its "
+    "source table (Fabric.measured_dc with the specimen and disc sizes), and this section then compares "
+    "(README, Fabric data in lab units).")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rftstatic.errors import ParameterError, SceneError
-from rftstatic.fabrics.lab import lab_to_si
+from rftstatic.fabrics.lab import RANGE_EVIDENCE, RANGES, lab_to_si
 from rftstatic.fabrics.library import FABRICS, bending_lengths
 from rftstatic.scenes.material import build_material
 from rftstatic.scenes.schema import load_scene, scene_from_dict
@@ -51,6 +51,21 @@ def test_out_of_range_lab_values_are_refused(key, value):
     with pytest.raises(ParameterError) as err:
         lab_to_si({key: value})
     assert err.value.key == key and repr(value) in err.value.detail
+
+
+def test_bounds_of_b_and_w_hold_the_measured_data_set_with_margin():
+    """The B and W bounds against the span of Feng et al.'s (2022) 618 cantilever-measured fabrics
+    (RANGE_EVIDENCE): each extreme is inside, and the bound lies a factor >= 4 beyond it."""
+    b_lo, b_hi = RANGE_EVIDENCE["B_uNm"]
+    w_lo, w_hi = RANGE_EVIDENCE["W_g_per_m2"]
+    to_kes_b = 1e-6 / GF_CM_MOMENT                  # uN m -> gf cm^2/cm (1 gf cm = 98.0665 uN m)
+    spans = {"fast_B_warp": (b_lo, b_hi), "kes_B_weft": (b_lo * to_kes_b, b_hi * to_kes_b),
+             "fast_W": (w_lo, w_hi), "kes_W": (w_lo / 10.0, w_hi / 10.0)}   # 1 mg/cm^2 = 10 g/m^2
+    for key, (lo, hi) in spans.items():
+        lab_to_si({key: lo})
+        lab_to_si({key: hi})
+        assert RANGES[key][0] * 4 <= lo and RANGES[key][1] >= 4 * hi, key
+    assert b_lo * to_kes_b == pytest.approx(0.002274, rel=1e-3)
 
 
 def _material(table, units="cm-gf-s"):
