@@ -82,6 +82,8 @@ def _study_parsers(sub, common) -> None:
     shared.add_argument("--workers", type=int, default=None, metavar="N",
                         help="LocalCluster worker processes (default: the cores); with --scheduler: wait for N")
     shared.add_argument("--figures", action="store_true", help="each point writes its PNG views (off: faster)")
+    shared.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                        help="a point running longer is a failed row and its worker is restarted (default: no limit)")
     s = sub.add_parser("sweep", parents=[common, shared], help="run a scene over a grid or a Latin hypercube of keys")
     s.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2|LO:HI[:log]",
                    help="values of a scene key (a grid), or a range sampled with --samples")
@@ -102,7 +104,8 @@ def _study_command(args) -> int:
 
         rows = run_sweep(args.scene, args.vary, samples=args.samples, seed=args.seed, sets=args.set, out=args.out,
                           scheduler=args.scheduler, workers=args.workers, figures=args.figures,
-                          plots=not args.no_plots, retry_failed=args.retry_failed, argv=args.argv)
+                          plots=not args.no_plots, retry_failed=args.retry_failed, timeout=args.timeout,
+                          argv=args.argv)
         failed = sum(r.get("status") == "failed" for r in rows)
         return EXIT["done"] if not failed else EXIT["goal"]
     from rftstatic.study.fit import run_fit

@@ -219,3 +219,28 @@ def test_local_workers_run_on_one_thread_without_the_nanny_malloc_setting():
     finally:
         engine.close()
     assert env == {"MALLOC_TRIM_THRESHOLD_": None, "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+def test_a_point_over_the_timeout_is_a_failed_row_and_its_worker_is_restarted(tmp_path, capsys):
+    # 201 x 41 nodes take well over 2 s (3.3 s at 101 x 21 on the idle machine); 9 x 3 about 0.1-0.7 s
+    out = tmp_path / "sweep"
+    argv = ["sweep", "strip", "--vary", "mesh.nodes=[201,41],[9,3]", "--out", str(out), "--workers", "1",
+            "--no-plots", "--timeout", "2"]
+    t0 = time.monotonic()
+    assert cli.main(argv) == cli.EXIT["goal"]  # the study ran to its end; one point failed
+    assert time.monotonic() - t0 < 60
+    rows = {r["mesh.nodes"]: r for r in _rows(out)}
+    slow, fast = rows["[201, 41]"], rows["[9, 3]"]
+    assert slow["status"] == "failed"
+    assert slow["error"] == "timed out after 2 s (--timeout; its worker was restarted)"
+    assert 2 <= float(slow["wall_time_s"]) < 10
+    assert fast["status"] == "ok"  # the study went on, on the restarted worker
+    assert fast["worker"] != slow["worker"]  # the one worker process was replaced (a new address)
+    assert not list((out / "points").glob("*.started"))
+    assert "timed out after 2 s" in capsys.readouterr().err
+
+
+def test_timeout_must_be_positive(tmp_path, capsys):
+    assert cli.main(["sweep", "strip", "--vary", "material.B_warp=0.05", "--out", str(tmp_path / "s"),
+                     "--timeout", "0"]) == cli.EXIT["input"]
+    assert "--timeout 0: must be > 0 seconds" in capsys.readouterr().err
