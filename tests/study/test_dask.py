@@ -186,12 +186,45 @@ def test_fit_recovers_the_bending_rigidity_from_the_tip_drop(tmp_path, capsys):
     assert fit["history"][0]["objective"] > fit["history"][-1]["objective"]
     s = fit["sensitivity"]["probes.tip.z"]["material.B_warp"]
     assert -0.2 < s < -0.05  # the drop hardly moves: 0.1 % per 1 % of B, ...
-    assert "barely depends on material.B_warp" in captured.err  # ... and the fit says so
+    assert "material.B_warp is barely identifiable" in captured.err  # ... and the fit says so
+    assert fit["identifiability"]["amplification"]["material.B_warp"] == pytest.approx(1 / abs(s))
     n = len(_rows(out))
     assert cli.main(argv) == 0  # a repeated fit replays from results.csv: nothing runs, no cluster
     stdout = capsys.readouterr().out
     assert "Dask" not in stdout and len(_rows(out)) == n
     assert json.loads((out / "fit.json").read_text())["points_run"] == 0
+
+
+def test_fit_over_two_runs_recovers_b_warp_and_b_weft_from_two_bending_lengths(tmp_path, capsys):
+    # a warp strip and a weft strip (warp at 90 deg: B_weft bends it), each its cantilever bending length
+    truth = {"material.B_warp": 0.083, "material.B_weft": 0.06}
+    sets = [COARSE, *(f"{k}={v}" for k, v in truth.items())]
+    measured = {label: api.run("strip", tmp_path / label, overrides=[*sets, *extra], figures=False).summary
+                for label, extra in (("warp", []), ("weft", ["material.warp_angle=90"]))}
+    from rftstatic.study.measures import bending_length
+
+    c = {label: bending_length(s) for label, s in measured.items()}
+    assert c["warp"] > 1.05 * c["weft"]  # the weft strip is the softer one
+    out = tmp_path / "fit"
+    argv = ["fit", "strip", "--set", COARSE, "--run", "warp:", "--run", "weft:material.warp_angle=90",
+            "--free", "material.B_warp=0.03:0.3", "--free", "material.B_weft=0.03:0.3",
+            "--target", f"warp:cantilever.bending_length={c['warp']!r}",
+            "--target", f"weft:cantilever.bending_length={c['weft']!r}", "--out", str(out), "--workers", "2"]
+    assert cli.main(argv) == 0
+    captured = capsys.readouterr()
+    fit = json.loads((out / "fit.json").read_text())
+    for k, v in truth.items():
+        assert fit["fitted"][k] == pytest.approx(v, rel=1e-2)
+    assert fit["runs"] == {"warp": [], "weft": ["material.warp_angle=90"]}
+    assert set(fit["targets"]) == {"warp:cantilever.bending_length", "weft:cantilever.bending_length"}
+    S = fit["identifiability"]["matrix"]  # each strip's bending length depends on its own rigidity only
+    assert 0.2 < S[0][0] < 0.4 and 0.2 < S[1][1] < 0.4 and abs(S[0][1]) < 0.01 and abs(S[1][0]) < 0.01
+    assert fit["identifiability"]["condition_number"] < 1.1 and fit["warnings"] == []
+    assert "warning" not in captured.err
+    rows = _rows(out)
+    assert {r["run"] for r in rows} == {"warp", "weft"} and {r["status"] for r in rows} == {"ok"}
+    # every evaluation ran both strips: each run has as many points
+    assert sum(r["run"] == "warp" for r in rows) == sum(r["run"] == "weft" for r in rows)
 
 
 def test_a_failed_point_is_a_row_with_its_error_and_can_be_retried(tmp_path, capsys):

@@ -96,6 +96,18 @@ def test_point_key_follows_the_resolved_scene():
      ["--target", "probes.tap.z", "unknown MEASURE path"]),
     (["fit", "strip", "--free", "material.B_wrp=0.03:0.3", "--target", "probes.tip.z=-4"], ["--free", "B_wrp"]),
     (["fit", "strip", "--free", "material.B_warp=0.3:0.03", "--target", "probes.tip.z=-4"], ["--free", "LO < HI"]),
+    (["fit", "strip", "--run", "warp:", "--run", "weft:material.warp_angle=90", "--free", "material.B_warp=0.03:0.3",
+      "--target", "probes.tip.z=-4"], ["--target", "name one of the runs (warp, weft)"]),
+    (["fit", "strip", "--run", "warp:", "--run", "weft:material.warp_angle=90", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4"], ["--run weft: no --target names it"]),
+    (["fit", "strip", "--run", "warp:material.B_warp=0.1", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4"], ["--run", "is a --free key"]),
+    (["fit", "strip", "--run", "weft:material.warp_angel=90", "--free", "material.B_warp=0.03:0.3",
+      "--target", "weft:probes.tip.z=-4"], ["--run weft:material.warp_angel=90", "warp_angel"]),
+    (["fit", "strip", "--run", "warp", "--free", "material.B_warp=0.03:0.3", "--target", "warp:probes.tip.z=-4"],
+     ["--run", "expected LABEL:"]),
+    (["fit", "strip", "--free", "material.B_warp=0.03:0.3", "--target", "weft:probes.tip.z=-4"],
+     ["there is no --run weft"]),
 ])
 def test_bad_study_arguments_exit_2_with_one_line(argv, words, tmp_path, capsys):
     assert cli.main([*argv, "--out", str(tmp_path / "s")]) == cli.EXIT["input"]
@@ -103,6 +115,43 @@ def test_bad_study_arguments_exit_2_with_one_line(argv, words, tmp_path, capsys)
     assert err.count("\n") == 0 and err.startswith("error: ")
     for w in words:
         assert w in err
+
+
+def test_run_overrides_split_at_commas_outside_brackets():
+    from rftstatic.study.fit import Run, parse_runs
+
+    free = space.parse_free(["material.B_warp=0.03:0.3"])
+    assert parse_runs([], free) == [Run(None)]
+    assert parse_runs(["warp:", "fine:mesh.nodes=[17,5], material.warp_angle=90"], free) == [
+        Run("warp", ()), Run("fine", ("mesh.nodes=[17,5]", "material.warp_angle=90"))]
+
+
+def test_identifiability_of_a_sensitivity_matrix():
+    from rftstatic.study import identify
+
+    keys = ["B_warp", "B_weft"]
+    good = identify.analyse({"warp:c": {"B_warp": 0.28, "B_weft": 0.0}, "weft:c": {"B_warp": 0.0, "B_weft": 0.28}},
+                            keys)
+    assert good["condition_number"] == pytest.approx(1.0)
+    assert good["amplification"] == pytest.approx({"B_warp": 1 / 0.28, "B_weft": 1 / 0.28})
+    assert identify.warnings(good) == []
+    # the tip drop: 0.1 % per 1 % of B, a 1 % error becomes 10 % in B
+    weak = identify.analyse({"z": {"B_warp": -0.1}}, ["B_warp"])
+    (line,) = identify.warnings(weak)
+    assert line.startswith("B_warp is barely identifiable from the targets") and "~10 %" in line
+    # two measures of the warp strip hardly see B_weft: near-singular, B_weft amplified
+    same = identify.analyse({"warp:x": {"B_warp": 0.65, "B_weft": 0.002}, "warp:z": {"B_warp": -0.1, "B_weft": 0.0}},
+                            keys)
+    lines = identify.warnings(same)
+    assert len(lines) == 3 and "near-singular" in lines[0] and "log B_weft" in lines[0]
+    # an exact solve of the 2 x 2 system passes z's error to B_warp through the tiny B_weft column
+    assert lines[1].startswith("B_warp is barely identifiable") and lines[2].startswith("B_weft is barely identifiable")
+    assert same["amplification"]["B_weft"] > 100
+    assert same["weakest_combination"]["B_weft"] == pytest.approx(1.0, abs=0.01)
+    # fewer targets than keys
+    under = identify.analyse({"c": {"B_warp": 0.28, "B_weft": 0.1}}, keys)
+    assert under["condition_number"] is None
+    assert "1 target(s) cannot identify 2 free keys" in identify.warnings(under)[0]
 
 
 def test_the_package_and_the_case_command_do_not_import_dask(tmp_path):
