@@ -58,6 +58,17 @@ def test_measures_from_a_summary_and_peirce_bending_length():
     assert measures.measure(summary, "drape.fold_count") == 7
     assert measures.measure(summary, "probes.other.x") is None
     assert measures.measure(summary, "cantilever.bending_length") == pytest.approx(0.5093 * l, rel=1e-3)
+    # a cantilever tester's own reading wins over the one derived from the tip (colleague's analysis)
+    tester = {**summary, "cantilever": {"bending_length": 1.7, "overhang": 3.4}}
+    assert measures.measure(tester, "cantilever.bending_length") == 1.7
+    assert measures.measure(tester, "cantilever.overhang") == 3.4
+    measures.check_measure("cantilever.overhang", {"analysis": "cantilever", "probes": []})
+    measures.check_measure("cantilever.bending_length", {"analysis": "cantilever"})
+    for bad in ("cantilever.overhang", "cantilever"):
+        with pytest.raises(space.StudyError, match="cantilever"):
+            measures.check_measure(bad, {"analysis": "static", "probes": [{"name": "tip"}]})
+    with pytest.raises(space.StudyError, match='probe named "tip"'):
+        measures.check_measure("cantilever.bending_length", {"analysis": "static", "probes": []})
     scene = api.load_scene("strip")
     measures.check_measure("probes.tip.z", scene)
     for bad in ("probes.tip.w", "probes.end.x", "drape.folds", "tip"):
