@@ -19,8 +19,8 @@ gives a failed row with Dask's error. With a ``timeout`` (``--timeout SECONDS``)
 that long after it started (its ``points/KEY.started`` file appeared; time queued does not count) is a
 failed row ``timed out after N s``: its task is cancelled and its worker restarted by its nanny (a
 process stuck in compiled code is killed), so the study goes on. Dask cannot stop one task of a running
-process otherwise; a worker without a nanny (``dask worker --no-nanny``) cannot be restarted and keeps
-running the point to its end (the row says so).
+process otherwise; a worker without a nanny (``dask worker --no-nanny``) cannot be restarted (the row's
+error says so) and may go on running the point.
 """
 
 from __future__ import annotations
