@@ -259,9 +259,7 @@ def test_a_point_over_the_timeout_is_a_failed_row_and_its_worker_is_restarted(tm
     out = tmp_path / "sweep"
     argv = ["sweep", "strip", "--vary", "mesh.nodes=[201,41],[9,3]", "--out", str(out), "--workers", "1",
             "--no-plots", "--timeout", "2"]
-    t0 = time.monotonic()
     assert cli.main(argv) == cli.EXIT["goal"]  # the study ran to its end; one point failed
-    assert time.monotonic() - t0 < 60
     rows = {r["mesh.nodes"]: r for r in _rows(out)}
     slow, fast = rows["[201, 41]"], rows["[9, 3]"]
     assert slow["status"] == "failed"
