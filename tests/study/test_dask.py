@@ -225,6 +225,10 @@ def test_fit_over_two_runs_recovers_b_warp_and_b_weft_from_two_bending_lengths(t
     assert {r["run"] for r in rows} == {"warp", "weft"} and {r["status"] for r in rows} == {"ok"}
     # every evaluation ran both strips: each run has as many points
     assert sum(r["run"] == "warp" for r in rows) == sum(r["run"] == "weft" for r in rows)
+    assert cli.main(argv) == 0  # replayed from results.csv: no cluster, nothing run, the same answer
+    assert "Dask" not in capsys.readouterr().out
+    again = json.loads((out / "fit.json").read_text())
+    assert again["points_run"] == 0 and again["fitted"] == fit["fitted"]
 
 
 def test_a_failed_point_is_a_row_with_its_error_and_can_be_retried(tmp_path, capsys):
