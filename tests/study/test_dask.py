@@ -1,6 +1,8 @@
 """Studies on Dask, on the strip with 9 x 3 nodes (0.1-0.5 s a point): a sweep on a 2-worker
-LocalCluster, the same sweep on a scheduler and two workers started as separate processes, a driver
-killed mid-sweep and resumed, and a fit that recovers the strip's bending rigidity from its tip drop."""
+LocalCluster, the same sweep on a scheduler and two workers started as separate processes (and a point
+over --timeout there), a driver killed mid-sweep and resumed, a fit that recovers the strip's bending
+rigidity from its tip drop, a fit over a warp and a weft strip that recovers B_warp and B_weft, and a
+point over --timeout on a LocalCluster (201 x 41 nodes)."""
 
 import csv
 import json
@@ -129,6 +131,16 @@ def test_sweep_on_an_external_scheduler_and_workers(tmp_path, processes, capsys)
     assert {r["worker"] for r in rows} <= workers  # the external workers ran every point
     run = json.loads((out / "study.json").read_text())["runs"][-1]
     assert run["engine"] == "scheduler" and run["address"] == address and set(run["workers"]) == workers
+    # --timeout on the external workers: the overdue point's worker is restarted by its nanny
+    slow = tmp_path / "slow"
+    assert cli.main(["sweep", "strip", "--vary", "mesh.nodes=[201,41],[9,3]", "--out", str(slow), "--no-plots",
+                     "--scheduler", address, "--timeout", "2"]) == cli.EXIT["goal"]
+    rows = {r["mesh.nodes"]: r for r in _rows(slow)}
+    assert rows["[201, 41]"]["error"] == "timed out after 2 s (--timeout; its worker was restarted)"
+    assert rows["[201, 41]"]["worker"] in workers and rows["[9, 3]"]["status"] == "ok"
+    with Client(address, timeout=5) as client:
+        client.wait_for_workers(2, timeout=60)  # the restarted worker joined again, under a new address
+        assert rows["[201, 41]"]["worker"] not in client.scheduler_info()["workers"]
 
 
 def test_unreachable_scheduler_is_an_input_error(tmp_path, capsys):
