@@ -157,7 +157,7 @@ class Evaluator:
             if s["key"] not in seen and not self.store.done(s["key"], needs=needs):
                 todo.append(s)
                 seen.add(s["key"])
-        self.engine.run(todo, self.store.add, label=label)
+        self.engine.run(todo, self.store.add, label=label, brief=True)
         self.points_run += len(todo)
         out = []
         for i in range(len(points)):

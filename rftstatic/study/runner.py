@@ -63,11 +63,11 @@ external cluster get it unless their configuration unsets it (README)."""
 
 class StudyProgress:
     """``label: D/N done, R running, F failed, T s`` on stderr: redrawn on a terminal, else a line at
-    every tenth of the way (a batch of at most 3 points: at its end only). R: the points on workers,
-    min(workers, points not done), as each worker runs one point at a time."""
+    every tenth of the way (a batch of at most 3 points, or any batch when ``brief``: at its end only).
+    R: the points on workers, min(workers, points not done), as each worker runs one point at a time."""
 
-    def __init__(self, total: int, label: str, workers: int, stream=None):
-        self.total, self.label, self.workers = total, label, max(1, workers)
+    def __init__(self, total: int, label: str, workers: int, stream=None, brief: bool = False):
+        self.total, self.label, self.workers, self.brief = total, label, max(1, workers), brief
         self.stream = stream or sys.stderr
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.done = self.failed = 0
@@ -85,7 +85,7 @@ class StudyProgress:
         if self.tty:
             self.stream.write("\r" + self.line() + " " * 8)
             self.stream.flush()
-        elif self.done == self.total or (self.total > 3 and self.done >= self._next * self.total):
+        elif self.done == self.total or (self.total > 3 and not self.brief and self.done >= self._next * self.total):
             print(self.line(), file=self.stream, flush=True)
             while self._next * self.total <= self.done:
                 self._next += 0.1
@@ -175,9 +175,10 @@ class Engine:
         return {"engine": "scheduler" if self.scheduler else "local", "address": sinfo.get("address"),
                 "workers": workers}
 
-    def run(self, specs: list[dict], on_row, *, label: str = "points") -> list[dict]:
+    def run(self, specs: list[dict], on_row, *, label: str = "points", brief: bool = False) -> list[dict]:
         """Run ``specs`` (:func:`~rftstatic.study.worker.run_point`); call ``on_row(row)`` as each finishes
-        (in completion order); return the rows in the order of ``specs``."""
+        (in completion order); return the rows in the order of ``specs``. ``brief``: off a terminal, one
+        progress line at the end (a fit's batches, many and short)."""
         if not specs:
             return []
         from distributed import as_completed
@@ -185,7 +186,7 @@ class Engine:
         from rftstatic.study.worker import run_point
 
         client = self.client()
-        progress = StudyProgress(len(specs), label, len(self.info()["workers"]))
+        progress = StudyProgress(len(specs), label, len(self.info()["workers"]), brief=brief)
         if self.timeout is not None:
             for spec in specs:  # a marker left by a killed driver's attempt would start the clock too early
                 _remove(started_marker(spec["folder"]))

@@ -188,3 +188,19 @@ def test_plots_draw_numeric_and_category_keys_and_skip_failed_points(tmp_path):
     three = plot_study(rows, ["material.B_warp", "element", "mesh.nodes"], ["probes.tip.z"], tmp_path / "three")
     assert [p.name for p in one + two + three] == ["probes.tip.z.png"] * 3  # no drape on a strip: no plot
     assert all(p.stat().st_size > 1000 for p in one + two + three)
+
+
+def test_progress_lines_off_a_terminal_every_tenth_or_once_when_brief():
+    import io
+
+    from rftstatic.study.runner import StudyProgress
+
+    for brief, expected in ((False, 6), (True, 1)):
+        stream = io.StringIO()
+        progress = StudyProgress(6, "fit evaluation 1", 2, stream=stream, brief=brief)
+        for i in range(6):
+            progress.update({"status": "failed" if i == 2 else "ok"})
+        progress.close()
+        lines = stream.getvalue().splitlines()
+        assert len(lines) == expected
+        assert lines[-1].startswith("fit evaluation 1: 6/6 done, 0 running, 1 failed")
