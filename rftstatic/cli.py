@@ -92,9 +92,9 @@ def _study_parsers(sub, common) -> None:
     s.add_argument("--no-plots", action="store_true", help="skip the measure-against-key plots")
     s.add_argument("--retry-failed", action="store_true", help="run the failed points again")
     f = sub.add_parser("fit", parents=[common, shared], help="fit scene keys to measured values")
-    f.add_argument("--run", action="append", default=[], metavar="LABEL:[KEY=VALUE,...]",
-                   help="a run of the scene with its own overrides (repeat: one fit over several runs, e.g. "
-                        "--run warp: --run weft:material.warp_angle=90); targets then name it, LABEL:MEASURE=VALUE")
+    f.add_argument("--run", action="append", default=[], metavar="LABEL[@SCENE]:[KEY=VALUE,...]",
+                   help="a run of the scene (or of SCENE) with its own overrides (repeat: one fit over several runs, "
+                        "e.g. --run warp: --run weft:material.warp_angle=90); targets then name it, LABEL:MEASURE=VALUE")
     f.add_argument("--free", action="append", default=[], metavar="KEY=LO:HI", help="a key to fit, within bounds")
     f.add_argument("--target", action="append", default=[], metavar="[LABEL:]MEASURE=VALUE",
                    help="a measured value: probes.NAME.x|y|z, drape.drape_coefficient, cantilever.bending_length, ...")

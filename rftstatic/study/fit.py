@@ -1,10 +1,10 @@
-"""``python -m rftstatic fit SCENE [--run LABEL:KEY=VALUE,...] --free KEY=LO:HI [...] --target
+"""``python -m rftstatic fit SCENE [--run LABEL[@SCENE]:KEY=VALUE,...] --free KEY=LO:HI [...] --target
 [LABEL:]MEASURE=VALUE [...]``: fabric parameters from measurements, of one run or of several.
 
 A fit has one or more *runs* of the scene: without ``--run``, the scene itself (targets ``MEASURE=VALUE``);
-with ``--run LABEL:OVERRIDES`` (repeated), one run per label, each the scene with the study's ``--set``
-and then its own overrides (``--run warp:`` none, ``--run weft:material.warp_angle=90``; several
-``KEY=VALUE`` separated by commas), each target naming its run (``--target weft:probes.tip.z=-4.5``).
+with ``--run LABEL[@SCENE]:OVERRIDES`` (repeated), one run per label, each the scene (or its own SCENE,
+e.g. a cantilever tester beside a drape) with the study's ``--set`` and then its own overrides
+(``--run warp:`` none, ``--run weft:material.warp_angle=90``; several ``KEY=VALUE`` separated by commas), each target naming its run (``--target weft:probes.tip.z=-4.5``).
 The free keys are shared: every run takes the same values, so two strips cut along the warp and the
 weft identify B_warp and B_weft together.
 
@@ -55,10 +55,12 @@ class FitFailed(RuntimeError):
 
 @dataclass(frozen=True)
 class Run:
-    """One run of a fit: ``label`` (None: the scene alone, no ``--run``) and its own ``--set`` overrides."""
+    """One run of a fit: ``label`` (None: the scene alone, no ``--run``), its own ``--set`` overrides and
+    its own ``scene`` (None: the command's SCENE)."""
 
     label: str | None
     overrides: tuple = ()
+    scene: str | None = None
 
 
 @dataclass(frozen=True)
@@ -75,15 +77,17 @@ class Target:
 
 
 def parse_runs(texts, free) -> list[Run]:
-    """``--run LABEL:KEY=VALUE,...`` -> runs (none given: the scene alone). A run may not set a free key."""
+    """``--run LABEL[@SCENE]:KEY=VALUE,...`` -> runs (none given: the scene alone). A run may not set a free
+    key."""
     if not texts:
         return [Run(None)]
     runs = []
     for text in texts:
-        label, sep, raw = (s.strip() for s in text.partition(":"))
-        if not sep or not LABEL.match(label):
-            raise StudyError(f'--run "{text}": expected LABEL:[KEY=VALUE,...] with a label of letters, digits, '
-                             "- or _, e.g. --run warp: --run weft:material.warp_angle=90")
+        head, sep, raw = (s.strip() for s in text.partition(":"))
+        label, at, scene = (s.strip() for s in head.partition("@"))
+        if not sep or not LABEL.match(label) or (at and not scene):
+            raise StudyError(f'--run "{text}": expected LABEL[@SCENE]:[KEY=VALUE,...] with a label of letters, '
+                             "digits, - or _, e.g. --run warp: --run weft:material.warp_angle=90")
         if label in [r.label for r in runs]:
             raise StudyError(f'--run "{text}": the label {label} is used twice')
         overrides = tuple(p for p in split_values(raw) if p)
@@ -93,7 +97,7 @@ def parse_runs(texts, free) -> list[Run]:
                 raise StudyError(f'--run "{text}": "{o}" is not KEY=VALUE')
             if key in [r.key for r in free]:
                 raise StudyError(f'--run "{text}": {key} is a --free key; a run cannot set it')
-        runs.append(Run(label, overrides))
+        runs.append(Run(label, overrides, scene or None))
     return runs
 
 
@@ -251,16 +255,17 @@ def _setup(scene: str, sets, runs: list[Run], out, figures, target_texts):
     bases = {}
     for run in runs:
         try:
-            bases[run.label] = load_base(scene, [*sets, *run.overrides])
+            bases[run.label] = load_base(run.scene or scene, [*sets, *run.overrides])
         except api.SceneError as exc:
             if run.label is None:
                 raise
-            raise StudyError(f"--run {run.label}:{','.join(run.overrides)}: {exc}") from None
+            shown = run.label + (f"@{run.scene}" if run.scene else "")
+            raise StudyError(f"--run {shown}:{','.join(run.overrides)}: {exc}") from None
     targets = parse_targets(target_texts, bases)
     studies = {}
     for run in runs:
         measures = standard_columns(bases[run.label]) + [t.measure for t in targets if t.run == run.label]
-        studies[run.label] = Study(scene, [*sets, *run.overrides], out, list(dict.fromkeys(measures)), figures)
+        studies[run.label] = Study(run.scene or scene, [*sets, *run.overrides], out, list(dict.fromkeys(measures)), figures)
     return bases, studies, targets
 
 
@@ -289,7 +294,8 @@ def run_fit(scene: str, free_texts, target_texts, *, runs=(), sets=(), out=None,
         engine.close()
     analysis = identify.analyse(sens, [r.key for r in free])
     result = {"scene": base.name, "sets": list(sets),
-              "runs": {str(r.label): list(r.overrides) for r in run_list} if run_list[0].label else None,
+              "runs": {r.label: {"scene": bases[r.label].name, "overrides": list(r.overrides)} for r in run_list}
+              if run_list[0].label else None,
               "free": {r.key: [r.lo, r.hi] for r in free},
               "targets": {t.name: t.value for t in targets}, "fitted": fitted, "achieved": achieved,
               "relative_mismatch": {t.name: (achieved[t.name] - t.value) / abs(t.value) if t.value

@@ -227,7 +227,8 @@ def test_fit_over_two_runs_recovers_b_warp_and_b_weft_from_two_bending_lengths(t
     fit = json.loads((out / "fit.json").read_text())
     for k, v in truth.items():
         assert fit["fitted"][k] == pytest.approx(v, rel=1e-2)
-    assert fit["runs"] == {"warp": [], "weft": ["material.warp_angle=90"]}
+    assert fit["runs"] == {"warp": {"scene": "strip", "overrides": []},
+                           "weft": {"scene": "strip", "overrides": ["material.warp_angle=90"]}}
     assert set(fit["targets"]) == {"warp:cantilever.bending_length", "weft:cantilever.bending_length"}
     S = fit["identifiability"]["matrix"]  # each strip's bending length depends on its own rigidity only
     assert 0.2 < S[0][0] < 0.4 and 0.2 < S[1][1] < 0.4 and abs(S[0][1]) < 0.01 and abs(S[1][0]) < 0.01

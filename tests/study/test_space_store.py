@@ -116,9 +116,13 @@ def test_point_key_follows_the_resolved_scene():
     (["fit", "strip", "--run", "weft:material.warp_angel=90", "--free", "material.B_warp=0.03:0.3",
       "--target", "weft:probes.tip.z=-4"], ["--run weft:material.warp_angel=90", "warp_angel"]),
     (["fit", "strip", "--run", "warp", "--free", "material.B_warp=0.03:0.3", "--target", "warp:probes.tip.z=-4"],
-     ["--run", "expected LABEL:"]),
+     ["--run", "expected LABEL[@SCENE]:"]),
     (["fit", "strip", "--free", "material.B_warp=0.03:0.3", "--target", "weft:probes.tip.z=-4"],
      ["there is no --run weft"]),
+    (["fit", "strip", "--run", "warp:", "--run", "x@no-such-scene:", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4", "--target", "x:probes.tip.z=-4"], ["--run x@no-such-scene:", "no-such-scene"]),
+    (["fit", "strip", "--run", "warp:", "--run", "disc@pedestal-square-20:", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4", "--target", "disc:probes.tip.z=0.6"], ["--target", "no probe \"tip\""]),
 ])
 def test_bad_study_arguments_exit_2_with_one_line(argv, words, tmp_path, capsys):
     assert cli.main([*argv, "--out", str(tmp_path / "s")]) == cli.EXIT["input"]
@@ -135,6 +139,8 @@ def test_run_overrides_split_at_commas_outside_brackets():
     assert parse_runs([], free) == [Run(None)]
     assert parse_runs(["warp:", "fine:mesh.nodes=[17,5], material.warp_angle=90"], free) == [
         Run("warp", ()), Run("fine", ("mesh.nodes=[17,5]", "material.warp_angle=90"))]
+    assert parse_runs(["disc@pedestal-square-20:element=RFT3"], free) == [
+        Run("disc", ("element=RFT3",), "pedestal-square-20")]
 
 
 def test_identifiability_of_a_sensitivity_matrix():
