@@ -83,6 +83,8 @@ def _study_parsers(sub, common) -> None:
     shared.add_argument("--workers", type=int, default=None, metavar="N",
                         help="LocalCluster worker processes (default: the cores); with --scheduler: wait for N")
     shared.add_argument("--figures", action="store_true", help="each point writes its PNG views (off: faster)")
+    shared.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                        help="a point running longer is a failed row and its worker is restarted (default: no limit)")
     s = sub.add_parser("sweep", parents=[common, shared], help="run a scene over a grid or a Latin hypercube of keys")
     s.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2|LO:HI[:log]",
                    help="values of a scene key (a grid), or a range sampled with --samples")
@@ -91,8 +93,11 @@ def _study_parsers(sub, common) -> None:
     s.add_argument("--no-plots", action="store_true", help="skip the measure-against-key plots")
     s.add_argument("--retry-failed", action="store_true", help="run the failed points again")
     f = sub.add_parser("fit", parents=[common, shared], help="fit scene keys to measured values")
+    f.add_argument("--run", action="append", default=[], metavar="LABEL[@SCENE]:[KEY=VALUE,...]",
+                   help="a run of the scene (or of SCENE) with its own overrides (repeat: one fit over several runs, "
+                        "e.g. --run warp: --run weft:material.warp_angle=90); targets then name it, LABEL:MEASURE=VALUE")
     f.add_argument("--free", action="append", default=[], metavar="KEY=LO:HI", help="a key to fit, within bounds")
-    f.add_argument("--target", action="append", default=[], metavar="MEASURE=VALUE",
+    f.add_argument("--target", action="append", default=[], metavar="[LABEL:]MEASURE=VALUE",
                    help="a measured value: probes.NAME.x|y|z, drape.drape_coefficient, cantilever.bending_length, ...")
     f.add_argument("--max-evaluations", type=int, default=100, help="most evaluations of the optimiser")
 
@@ -103,14 +108,15 @@ def _study_command(args) -> int:
 
         rows = run_sweep(args.scene, args.vary, samples=args.samples, seed=args.seed, sets=args.set, out=args.out,
                           scheduler=args.scheduler, workers=args.workers, figures=args.figures,
-                          plots=not args.no_plots, retry_failed=args.retry_failed, argv=args.argv)
+                          plots=not args.no_plots, retry_failed=args.retry_failed, timeout=args.timeout,
+                          argv=args.argv)
         failed = sum(r.get("status") == "failed" for r in rows)
         return EXIT["done"] if not failed else EXIT["goal"]
     from rftstatic.study.fit import run_fit
 
-    result = run_fit(args.scene, args.free, args.target, sets=args.set, out=args.out, scheduler=args.scheduler,
-                     workers=args.workers, figures=args.figures, max_evaluations=args.max_evaluations,
-                     argv=args.argv)
+    result = run_fit(args.scene, args.free, args.target, runs=args.run, sets=args.set, out=args.out,
+                     scheduler=args.scheduler, workers=args.workers, figures=args.figures,
+                     max_evaluations=args.max_evaluations, timeout=args.timeout, argv=args.argv)
     return EXIT["done"] if result["success"] else EXIT["goal"]
 
 

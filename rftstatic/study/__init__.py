@@ -11,9 +11,10 @@ module             what it owns
 ``measures``       MEASURE paths into ``summary.json`` (``probes.tip.z``) and a row's columns
 ``store``          point keys (resolved scene + code fingerprint), ``results.csv``, ``study.json``
 ``worker``         what a worker runs for one point (:func:`~rftstatic.study.worker.run_point`)
-``runner``         the Dask client (LocalCluster or ``--scheduler``), batches, the progress line
+``runner``         the Dask client (LocalCluster or ``--scheduler``), batches, ``--timeout``, progress
 ``sweep``          the ``sweep`` command
-``fit``            the ``fit`` command: bounded least squares and sensitivities
+``fit``            the ``fit`` command: runs and targets, bounded least squares, sensitivities
+``identify``       the sensitivity matrix at a fit's optimum: which keys the targets determine
 ``plots``          each measure against each varied key (a line for one key, a map for two)
 =================  ===========================================================================
 

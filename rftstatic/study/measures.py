@@ -5,11 +5,14 @@ A MEASURE is a dotted path into the summary (scene units): ``drape.drape_coeffic
 
 - ``probes.NAME.x`` (``.y``, ``.z``): the deformed coordinate of the scene's probe NAME
   (``summary["probes"][NAME]["deformed"][0..2]``);
-- ``cantilever.bending_length``: Peirce's bending length of a strip clamped at one end, from its
-  probe ``tip``: c = l (cos(theta/2) / (8 tan theta))^(1/3), theta the angle below the horizontal
-  of the chord from the clamped edge to the tip, l the overhang (Peirce, J. Text. Inst. 21, 1930,
-  the cantilever test of ASTM D1388; exact for the elastica only at theta = 41.5 deg, and
-  a smooth, monotonic function of the bending rigidity B at any angle).
+- ``cantilever.KEY``: what a cantilever tester run (``analysis = "cantilever"``) writes under
+  ``summary["cantilever"]`` (``bending_length``, ``overhang``, ``flexural_rigidity``, ...), read as
+  any dotted path; ``cantilever.bending_length`` of a scene without that block (a strip clamped at one
+  end, such as ``strip``) is derived from its probe ``tip``: Peirce's c = l (cos(theta/2) / (8 tan
+  theta))^(1/3), theta the angle below the horizontal of the chord from the clamped edge to the tip, l
+  the overhang (Peirce, J. Text. Inst. 21, 1930, the cantilever test of ASTM D1388; exact for the
+  elastica only at theta = 41.5 deg, and a smooth, monotonic function of the bending rigidity B at any
+  angle).
 """
 
 from __future__ import annotations
@@ -46,15 +49,19 @@ def check_measure(path: str, scene, arg: str = "--target") -> None:
         elif parts[1] not in probes:
             problem = f'the scene has no probe "{parts[1]}" (its probes: {", ".join(probes) or "none"})'
     elif parts[0] == "cantilever":
-        if parts[1:] != ["bending_length"]:
-            problem = "the cantilever measure is cantilever.bending_length"
-        elif "tip" not in probes:
-            problem = 'cantilever.bending_length needs a probe named "tip" at the free end'
+        tester = scene.get("analysis") == "cantilever"
+        if len(parts) != 2 or not parts[1]:
+            problem = "a cantilever measure is cantilever.KEY, e.g. cantilever.bending_length"
+        elif not tester and parts[1] != "bending_length":
+            problem = f'{path} needs a cantilever tester scene (analysis = "cantilever")'
+        elif not tester and "tip" not in probes:
+            problem = ('cantilever.bending_length needs a cantilever tester scene (analysis = "cantilever") or '
+                       'a probe named "tip" at the free end of a clamped strip')
     elif parts[0] == "drape":
         if len(parts) != 2 or parts[1] not in DRAPE:
             problem = f"a drape measure is drape.{' / drape.'.join(DRAPE)}"
     elif len(parts) != 1 or parts[0] not in KNOWN_SCALARS:
-        problem = ("known measures: probes.NAME.x/y/z, cantilever.bending_length, drape.KEY ("
+        problem = ("known measures: probes.NAME.x/y/z, cantilever.KEY, drape.KEY ("
                    + ", ".join(DRAPE) + "), " + ", ".join(KNOWN_SCALARS))
     if problem:
         raise StudyError(f'{arg} "{path}": unknown MEASURE path: {problem}')
@@ -66,7 +73,7 @@ def measure(summary: dict, path: str) -> float | int | None:
     if parts[0] == "probes" and len(parts) == 3:
         probe = (summary.get("probes") or {}).get(parts[1])
         return None if probe is None else float(probe["deformed"][AXES[parts[2]]])
-    if parts == ["cantilever", "bending_length"]:
+    if parts == ["cantilever", "bending_length"] and "cantilever" not in summary:  # derived (module docstring)
         return bending_length(summary)
     node = summary
     for part in parts:

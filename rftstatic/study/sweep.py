@@ -55,7 +55,7 @@ def load_base(scene: str, sets) -> object:
 
 
 def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, scheduler=None, workers=None,
-              figures=False, plots=True, retry_failed=False, argv=None) -> list[dict]:
+              figures=False, plots=True, retry_failed=False, timeout=None, argv=None) -> list[dict]:
     """The ``sweep`` command (module docstring); returns the rows of its points, in their order."""
     t0 = time.perf_counter()
     base = load_base(scene, sets)
@@ -73,7 +73,7 @@ def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, sche
     print(f"sweep {base.name}: {len(specs)} points, {len(specs) - len(todo)} done"
           f"{f' ({store.recovered} recovered from their folders)' if store.recovered else ''}, {len(todo)} to run; "
           f"results in {out}/results.csv", flush=True)
-    engine = Engine(scheduler, workers)
+    engine = Engine(scheduler, workers, timeout=timeout)
     try:
         engine.run(todo, store.add, label="sweep")
         info = engine.info()

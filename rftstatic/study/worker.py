@@ -15,6 +15,15 @@ import traceback
 THREAD_VARIABLES = ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "RFTSTATIC_THREADS")
 """Environment of a worker: one thread for numba, OpenMP (CHOLMOD), BLAS and the explicit kernel."""
+STARTED = ".started"
+"""Suffix of the file beside a point's folder (``points/KEY.started``) while the point runs: its existence
+tells the driver (which enforces ``--timeout``) that the point left the queue and is running, whatever
+the clocks of driver and worker (the run replaces its folder as a whole, so the file is not inside)."""
+
+
+def started_marker(folder) -> str:
+    """``points/KEY.started`` for the point folder ``points/KEY``."""
+    return os.fspath(folder).rstrip("/\\") + STARTED
 
 
 def worker_environment() -> dict:
@@ -52,6 +61,10 @@ def run_point(spec: dict) -> dict:
         os.remove(stale)
     row = {"key": spec["key"], **spec["values"], "worker": _worker_address(), "folder": f"points/{spec['key']}"}
     summary, error = None, None
+    started = started_marker(spec["folder"])
+    os.makedirs(os.path.dirname(started), exist_ok=True)
+    with open(started, "w", encoding="utf-8") as fh:  # the --timeout clock starts (the imports are done)
+        fh.write(row["worker"])
     try:
         if code_fingerprint() != spec["code"]:
             raise RuntimeError(f"this worker runs other rftstatic code (fingerprint {code_fingerprint()[:12]}) "
@@ -72,6 +85,8 @@ def run_point(spec: dict) -> dict:
     row["wall_time_s"] = time.perf_counter() - t0
     os.makedirs(spec["folder"], exist_ok=True)
     write_json(os.path.join(spec["folder"], "point.json"), row)
+    if os.path.exists(started):
+        os.remove(started)
     return row
 
 

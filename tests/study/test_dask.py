@@ -1,6 +1,8 @@
 """Studies on Dask, on the strip with 9 x 3 nodes (0.1-0.5 s a point): a sweep on a 2-worker
-LocalCluster, the same sweep on a scheduler and two workers started as separate processes, a driver
-killed mid-sweep and resumed, and a fit that recovers the strip's bending rigidity from its tip drop."""
+LocalCluster, the same sweep on a scheduler and two workers started as separate processes (and a point
+over --timeout there), a driver killed mid-sweep and resumed, a fit that recovers the strip's bending
+rigidity from its tip drop, a fit over a warp and a weft strip that recovers B_warp and B_weft, and a
+point over --timeout on a LocalCluster (201 x 41 nodes)."""
 
 import csv
 import json
@@ -129,6 +131,16 @@ def test_sweep_on_an_external_scheduler_and_workers(tmp_path, processes, capsys)
     assert {r["worker"] for r in rows} <= workers  # the external workers ran every point
     run = json.loads((out / "study.json").read_text())["runs"][-1]
     assert run["engine"] == "scheduler" and run["address"] == address and set(run["workers"]) == workers
+    # --timeout on the external workers: the overdue point's worker is restarted by its nanny
+    slow = tmp_path / "slow"
+    assert cli.main(["sweep", "strip", "--vary", "mesh.nodes=[201,41],[9,3]", "--out", str(slow), "--no-plots",
+                     "--scheduler", address, "--timeout", "2"]) == cli.EXIT["goal"]
+    rows = {r["mesh.nodes"]: r for r in _rows(slow)}
+    assert rows["[201, 41]"]["error"] == "timed out after 2 s (--timeout; its worker was restarted)"
+    assert rows["[201, 41]"]["worker"] in workers and rows["[9, 3]"]["status"] == "ok"
+    with Client(address, timeout=5) as client:
+        client.wait_for_workers(2, timeout=60)  # the restarted worker joined again, under a new address
+        assert rows["[201, 41]"]["worker"] not in client.scheduler_info()["workers"]
 
 
 def test_unreachable_scheduler_is_an_input_error(tmp_path, capsys):
@@ -186,12 +198,50 @@ def test_fit_recovers_the_bending_rigidity_from_the_tip_drop(tmp_path, capsys):
     assert fit["history"][0]["objective"] > fit["history"][-1]["objective"]
     s = fit["sensitivity"]["probes.tip.z"]["material.B_warp"]
     assert -0.2 < s < -0.05  # the drop hardly moves: 0.1 % per 1 % of B, ...
-    assert "barely depends on material.B_warp" in captured.err  # ... and the fit says so
+    assert "material.B_warp is barely identifiable" in captured.err  # ... and the fit says so
+    assert fit["identifiability"]["amplification"]["material.B_warp"] == pytest.approx(1 / abs(s))
     n = len(_rows(out))
     assert cli.main(argv) == 0  # a repeated fit replays from results.csv: nothing runs, no cluster
     stdout = capsys.readouterr().out
     assert "Dask" not in stdout and len(_rows(out)) == n
     assert json.loads((out / "fit.json").read_text())["points_run"] == 0
+
+
+def test_fit_over_two_runs_recovers_b_warp_and_b_weft_from_two_bending_lengths(tmp_path, capsys):
+    # a warp strip and a weft strip (warp at 90 deg: B_weft bends it), each its cantilever bending length
+    truth = {"material.B_warp": 0.083, "material.B_weft": 0.06}
+    sets = [COARSE, *(f"{k}={v}" for k, v in truth.items())]
+    measured = {label: api.run("strip", tmp_path / label, overrides=[*sets, *extra], figures=False).summary
+                for label, extra in (("warp", []), ("weft", ["material.warp_angle=90"]))}
+    from rftstatic.study.measures import bending_length
+
+    c = {label: bending_length(s) for label, s in measured.items()}
+    assert c["warp"] > 1.05 * c["weft"]  # the weft strip is the softer one
+    out = tmp_path / "fit"
+    argv = ["fit", "strip", "--set", COARSE, "--run", "warp:", "--run", "weft:material.warp_angle=90",
+            "--free", "material.B_warp=0.03:0.3", "--free", "material.B_weft=0.03:0.3",
+            "--target", f"warp:cantilever.bending_length={c['warp']!r}",
+            "--target", f"weft:cantilever.bending_length={c['weft']!r}", "--out", str(out), "--workers", "2"]
+    assert cli.main(argv) == 0
+    captured = capsys.readouterr()
+    fit = json.loads((out / "fit.json").read_text())
+    for k, v in truth.items():
+        assert fit["fitted"][k] == pytest.approx(v, rel=1e-2)
+    assert fit["runs"] == {"warp": {"scene": "strip", "overrides": []},
+                           "weft": {"scene": "strip", "overrides": ["material.warp_angle=90"]}}
+    assert set(fit["targets"]) == {"warp:cantilever.bending_length", "weft:cantilever.bending_length"}
+    S = fit["identifiability"]["matrix"]  # each strip's bending length depends on its own rigidity only
+    assert 0.2 < S[0][0] < 0.4 and 0.2 < S[1][1] < 0.4 and abs(S[0][1]) < 0.01 and abs(S[1][0]) < 0.01
+    assert fit["identifiability"]["condition_number"] < 1.1 and fit["warnings"] == []
+    assert "warning" not in captured.err
+    rows = _rows(out)
+    assert {r["run"] for r in rows} == {"warp", "weft"} and {r["status"] for r in rows} == {"ok"}
+    # every evaluation ran both strips: each run has as many points
+    assert sum(r["run"] == "warp" for r in rows) == sum(r["run"] == "weft" for r in rows)
+    assert cli.main(argv) == 0  # replayed from results.csv: no cluster, nothing run, the same answer
+    assert "Dask" not in capsys.readouterr().out
+    again = json.loads((out / "fit.json").read_text())
+    assert again["points_run"] == 0 and again["fitted"] == fit["fitted"]
 
 
 def test_a_failed_point_is_a_row_with_its_error_and_can_be_retried(tmp_path, capsys):
@@ -219,3 +269,26 @@ def test_local_workers_run_on_one_thread_without_the_nanny_malloc_setting():
     finally:
         engine.close()
     assert env == {"MALLOC_TRIM_THRESHOLD_": None, "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+def test_a_point_over_the_timeout_is_a_failed_row_and_its_worker_is_restarted(tmp_path, capsys):
+    # 201 x 41 nodes take well over 2 s (3.3 s at 101 x 21 on the idle machine); 9 x 3 about 0.1-0.7 s
+    out = tmp_path / "sweep"
+    argv = ["sweep", "strip", "--vary", "mesh.nodes=[201,41],[9,3]", "--out", str(out), "--workers", "1",
+            "--no-plots", "--timeout", "2"]
+    assert cli.main(argv) == cli.EXIT["goal"]  # the study ran to its end; one point failed
+    rows = {r["mesh.nodes"]: r for r in _rows(out)}
+    slow, fast = rows["[201, 41]"], rows["[9, 3]"]
+    assert slow["status"] == "failed"
+    assert slow["error"] == "timed out after 2 s (--timeout; its worker was restarted)"
+    assert 2 <= float(slow["wall_time_s"]) < 10
+    assert fast["status"] == "ok"  # the study went on, on the restarted worker
+    assert fast["worker"] != slow["worker"]  # the one worker process was replaced (a new address)
+    assert not list((out / "points").glob("*.started"))
+    assert "timed out after 2 s" in capsys.readouterr().err
+
+
+def test_timeout_must_be_positive(tmp_path, capsys):
+    assert cli.main(["sweep", "strip", "--vary", "material.B_warp=0.05", "--out", str(tmp_path / "s"),
+                     "--timeout", "0"]) == cli.EXIT["input"]
+    assert "--timeout 0: must be > 0 seconds" in capsys.readouterr().err

@@ -58,6 +58,17 @@ def test_measures_from_a_summary_and_peirce_bending_length():
     assert measures.measure(summary, "drape.fold_count") == 7
     assert measures.measure(summary, "probes.other.x") is None
     assert measures.measure(summary, "cantilever.bending_length") == pytest.approx(0.5093 * l, rel=1e-3)
+    # a cantilever tester's own reading wins over the one derived from the tip (colleague's analysis)
+    tester = {**summary, "cantilever": {"bending_length": 1.7, "overhang": 3.4}}
+    assert measures.measure(tester, "cantilever.bending_length") == 1.7
+    assert measures.measure(tester, "cantilever.overhang") == 3.4
+    measures.check_measure("cantilever.overhang", {"analysis": "cantilever", "probes": []})
+    measures.check_measure("cantilever.bending_length", {"analysis": "cantilever"})
+    for bad in ("cantilever.overhang", "cantilever"):
+        with pytest.raises(space.StudyError, match="cantilever"):
+            measures.check_measure(bad, {"analysis": "static", "probes": [{"name": "tip"}]})
+    with pytest.raises(space.StudyError, match='probe named "tip"'):
+        measures.check_measure("cantilever.bending_length", {"analysis": "static", "probes": []})
     scene = api.load_scene("strip")
     measures.check_measure("probes.tip.z", scene)
     for bad in ("probes.tip.w", "probes.end.x", "drape.folds", "tip"):
@@ -96,6 +107,22 @@ def test_point_key_follows_the_resolved_scene():
      ["--target", "probes.tap.z", "unknown MEASURE path"]),
     (["fit", "strip", "--free", "material.B_wrp=0.03:0.3", "--target", "probes.tip.z=-4"], ["--free", "B_wrp"]),
     (["fit", "strip", "--free", "material.B_warp=0.3:0.03", "--target", "probes.tip.z=-4"], ["--free", "LO < HI"]),
+    (["fit", "strip", "--run", "warp:", "--run", "weft:material.warp_angle=90", "--free", "material.B_warp=0.03:0.3",
+      "--target", "probes.tip.z=-4"], ["--target", "name one of the runs (warp, weft)"]),
+    (["fit", "strip", "--run", "warp:", "--run", "weft:material.warp_angle=90", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4"], ["--run weft: no --target names it"]),
+    (["fit", "strip", "--run", "warp:material.B_warp=0.1", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4"], ["--run", "is a --free key"]),
+    (["fit", "strip", "--run", "weft:material.warp_angel=90", "--free", "material.B_warp=0.03:0.3",
+      "--target", "weft:probes.tip.z=-4"], ["--run weft:material.warp_angel=90", "warp_angel"]),
+    (["fit", "strip", "--run", "warp", "--free", "material.B_warp=0.03:0.3", "--target", "warp:probes.tip.z=-4"],
+     ["--run", "expected LABEL[@SCENE]:"]),
+    (["fit", "strip", "--free", "material.B_warp=0.03:0.3", "--target", "weft:probes.tip.z=-4"],
+     ["there is no --run weft"]),
+    (["fit", "strip", "--run", "warp:", "--run", "x@no-such-scene:", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4", "--target", "x:probes.tip.z=-4"], ["--run x@no-such-scene:", "no-such-scene"]),
+    (["fit", "strip", "--run", "warp:", "--run", "disc@pedestal-square-20:", "--free", "material.B_warp=0.03:0.3",
+      "--target", "warp:probes.tip.z=-4", "--target", "disc:probes.tip.z=0.6"], ["--target", "no probe \"tip\""]),
 ])
 def test_bad_study_arguments_exit_2_with_one_line(argv, words, tmp_path, capsys):
     assert cli.main([*argv, "--out", str(tmp_path / "s")]) == cli.EXIT["input"]
@@ -103,6 +130,45 @@ def test_bad_study_arguments_exit_2_with_one_line(argv, words, tmp_path, capsys)
     assert err.count("\n") == 0 and err.startswith("error: ")
     for w in words:
         assert w in err
+
+
+def test_run_overrides_split_at_commas_outside_brackets():
+    from rftstatic.study.fit import Run, parse_runs
+
+    free = space.parse_free(["material.B_warp=0.03:0.3"])
+    assert parse_runs([], free) == [Run(None)]
+    assert parse_runs(["warp:", "fine:mesh.nodes=[17,5], material.warp_angle=90"], free) == [
+        Run("warp", ()), Run("fine", ("mesh.nodes=[17,5]", "material.warp_angle=90"))]
+    assert parse_runs(["disc@pedestal-square-20:element=RFT3"], free) == [
+        Run("disc", ("element=RFT3",), "pedestal-square-20")]
+
+
+def test_identifiability_of_a_sensitivity_matrix():
+    from rftstatic.study import identify
+
+    keys = ["B_warp", "B_weft"]
+    good = identify.analyse({"warp:c": {"B_warp": 0.28, "B_weft": 0.0}, "weft:c": {"B_warp": 0.0, "B_weft": 0.28}},
+                            keys)
+    assert good["condition_number"] == pytest.approx(1.0)
+    assert good["amplification"] == pytest.approx({"B_warp": 1 / 0.28, "B_weft": 1 / 0.28})
+    assert identify.warnings(good) == []
+    # the tip drop: 0.1 % per 1 % of B, a 1 % error becomes 10 % in B
+    weak = identify.analyse({"z": {"B_warp": -0.1}}, ["B_warp"])
+    (line,) = identify.warnings(weak)
+    assert line.startswith("B_warp is barely identifiable from the targets") and "~10 %" in line
+    # two measures of the warp strip hardly see B_weft: near-singular, B_weft amplified
+    same = identify.analyse({"warp:x": {"B_warp": 0.65, "B_weft": 0.002}, "warp:z": {"B_warp": -0.1, "B_weft": 0.0}},
+                            keys)
+    lines = identify.warnings(same)
+    assert len(lines) == 3 and "near-singular" in lines[0] and "log B_weft" in lines[0]
+    # an exact solve of the 2 x 2 system passes z's error to B_warp through the tiny B_weft column
+    assert lines[1].startswith("B_warp is barely identifiable") and lines[2].startswith("B_weft is barely identifiable")
+    assert same["amplification"]["B_weft"] > 100
+    assert same["weakest_combination"]["B_weft"] == pytest.approx(1.0, abs=0.01)
+    # fewer targets than keys
+    under = identify.analyse({"c": {"B_warp": 0.28, "B_weft": 0.1}}, keys)
+    assert under["condition_number"] is None
+    assert "1 target(s) cannot identify 2 free keys" in identify.warnings(under)[0]
 
 
 def test_the_package_and_the_case_command_do_not_import_dask(tmp_path):
@@ -128,3 +194,19 @@ def test_plots_draw_numeric_and_category_keys_and_skip_failed_points(tmp_path):
     three = plot_study(rows, ["material.B_warp", "element", "mesh.nodes"], ["probes.tip.z"], tmp_path / "three")
     assert [p.name for p in one + two + three] == ["probes.tip.z.png"] * 3  # no drape on a strip: no plot
     assert all(p.stat().st_size > 1000 for p in one + two + three)
+
+
+def test_progress_lines_off_a_terminal_every_tenth_or_once_when_brief():
+    import io
+
+    from rftstatic.study.runner import StudyProgress
+
+    for brief, expected in ((False, 6), (True, 1)):
+        stream = io.StringIO()
+        progress = StudyProgress(6, "fit evaluation 1", 2, stream=stream, brief=brief)
+        for i in range(6):
+            progress.update({"status": "failed" if i == 2 else "ok"})
+        progress.close()
+        lines = stream.getvalue().splitlines()
+        assert len(lines) == expected
+        assert lines[-1].startswith("fit evaluation 1: 6/6 done, 0 running, 1 failed")
