@@ -160,6 +160,7 @@ SCHEMA = {
         "max_continuations": (int, "snap-through continuations per increment"),
         "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
+        "continuation": (str, "load (load increments) or arc-length (path following with inertia)"),
         "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
         "perturbation_folds": (int, "0: random modes; n: an n-fold lift about the sheet's centre"),
         "guide_folds": (int, "relax route: n-fold modulation of the weight in the first stage (0: none)"),
