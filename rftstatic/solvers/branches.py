@@ -8,7 +8,8 @@ factorisation, :func:`~rftstatic.solvers.inertia.lowest_modes`), pushes the stat
 line-searched descent (:func:`~rftstatic.solvers.newton.newton`, displacement iteration: an Armijo
 search on the energy with the positive semi-definite or shifted tangent where K is indefinite) settle
 each start at the given load factor. Of the equilibria reached, the stable ones (inertia 0) are
-preferred and among them the one of lower energy; both are recorded.
+preferred and among them the one of lower energy (at a bifurcation) or the one farther from the
+branch that ended (at a limit point); both are recorded.
 
 At a bifurcation the two pushes give the two halves of the secondary branch (mirror images on a
 symmetric sheet: equal energies); at a limit point (the load factor turned back) the load factor of
@@ -42,12 +43,15 @@ MODES = 4
 """Most eigenpairs computed at a switch (the lowest one is followed; the others are recorded)."""
 
 
-def switch_branch(model, U, lam, K, fac, opts, ws, inertia, max_step, *, seed=0):
+def switch_branch(model, U, lam, K, fac, opts, ws, inertia, max_step, *, seed=0, away_from=None):
     """Leave the unstable equilibrium ``(U (N, 3) [m], lam)`` along the lowest mode of ``K`` (free dofs,
     factorised as ``fac``, an :class:`~rftstatic.solvers.inertia.InertiaFactor`).
 
     Returns ``(choice, record)``: ``choice`` a dict (``U``, ``negative``, ``energy``, ``factor``,
-    ``K``) of the equilibrium chosen (module docstring), or None when no push converged; ``record`` the
+    ``K``) of the equilibrium chosen (module docstring), or None when no push converged; ``away_from``
+    (N, 3) [m]: at a limit point, the last stable state before it: the stable equilibrium farthest from
+    it is chosen (the branch snapped to; the other push may fall back onto the branch that ended when
+    the switch's load factor is still below the limit's); ``record`` the
     switch's summary (eigenvalues [N/m], each branch's energy [J], negative pivots and iterations).
     """
     free = model.free.ravel()
@@ -86,7 +90,10 @@ def switch_branch(model, U, lam, K, fac, opts, ws, inertia, max_step, *, seed=0)
         return None, record
     stable = [c for c in found if c["negative"] == 0]
     pool = stable or found
-    choice = min(pool, key=lambda c: (c["negative"], c["energy"]))
+    if away_from is None:
+        choice = min(pool, key=lambda c: (c["negative"], c["energy"]))
+    else:  # a limit point: the branch the sheet snaps to, not the one that ended
+        choice = max(pool, key=lambda c: float(np.abs(c["U"] - away_from).max()))
     record["chosen"] = choice["sign"]
     record["negative_after"] = int(choice["negative"])
     log.info("branch switch at load factor %.6g: lowest eigenvalue %.3g N/m, branch %+g (energy %.6g J, %d "

@@ -66,9 +66,11 @@ MIN_ARC = 1e-7
 CORRECTOR_ITERATIONS = 10
 """Most corrector iterations of one step; a step that needs more is retried with half the arc length."""
 
-PATH_RTOL = 1e-2
+PATH_RTOL = 1e-4
 """Force tolerance of a path point, relative to ``max(lam, LAM_FLOOR) |P|`` (the last point is polished
-to the solver's ``rtol``)."""
+to the solver's ``rtol``). Also the tolerance of the branch switches' descents. A path point's load
+factor is off by about this share near a limit point (1e-2 put the von Mises truss's limit 1 % high,
+past the true maximum, and the switch fell back onto the branch that had ended)."""
 
 LAM_FLOOR = 1e-4
 """Load factor below which the path tolerance stops shrinking with the load (the sheet's lift off the
@@ -368,7 +370,7 @@ def _follow(path, pt, result, record, bar, callback):
             callback(new.lam, new.U)
         if changed and new.fac.negative > pt.fac.negative and not final:
             lam_s = max(new.lam, lam_max) + (0.25 * last_dlam if kind == "limit" else 0.0)
-            new = _switch(path, result, record, new, min(lam_s, 1.0), pt)
+            new = _switch(path, result, record, new, min(lam_s, 1.0), pt if kind == "limit" else None)
             lam_max = max(lam_max, new.lam)
         ds = float(np.clip(ds * (2.0 if its <= 3 else 0.5 if its > 6 else 1.0), MIN_ARC, MAX_ARC))
         pt = new
@@ -381,8 +383,10 @@ def _follow(path, pt, result, record, bar, callback):
 def _switch(path, result, record, pt, lam, prev):
     """Branch switch from ``pt`` at load factor ``lam`` (:func:`switch_branch`); returns the point to go on
     from (``pt`` itself when no push converged), its tangent oriented with dlam > 0."""
-    choice, rec = switch_branch(path.model, pt.U, lam, pt.K, pt.fac, path.opts, path.ws, path.inertia,
-                                path.max_step, seed=len(record["switches"]))
+    choice, rec = switch_branch(path.model, pt.U, lam, pt.K, pt.fac, replace(path.opts, intermediate_rtol=PATH_RTOL),
+                                path.ws, path.inertia,
+                                path.max_step, seed=len(record["switches"]),
+                                away_from=None if prev is None else prev.U)
     rec["step"] = len(record["steps"])
     record["switches"].append(rec)
     if choice is None:
@@ -402,7 +406,8 @@ def _descend(path, result, record, pt, dlam):
     (:func:`~rftstatic.solvers.newton.newton`, displacement iteration) from ``pt``: the point it reaches
     (its tangent oriented with dlam > 0), or None."""
     lam = min(1.0, pt.lam + dlam)
-    nt = newton(path.model, pt.U, lam, replace(path.opts, max_iterations=max(path.opts.max_iterations, 80)),
+    nt = newton(path.model, pt.U, lam, replace(path.opts, max_iterations=max(path.opts.max_iterations, 80),
+                                               intermediate_rtol=PATH_RTOL),
                 path.ws, path.max_step, scheme="displacement")
     result.iterations += nt.iterations
     record["descents"] = record.get("descents", 0) + 1

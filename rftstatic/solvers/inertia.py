@@ -119,6 +119,10 @@ def count_negative(K: sp.spmatrix) -> int:
     return InertiaSolver().factor(K).negative
 
 
+DENSE_BELOW = 20
+"""Unknowns up to which :func:`lowest_modes` takes dense eigenvalues."""
+
+
 def lowest_modes(K: sp.spmatrix, fac: InertiaFactor, k: int = 1, *, seed: int = 0):
     """The ``k`` eigenpairs of ``K`` nearest 0, ascending: ``(values (k,), vectors (n, k))``.
 
@@ -128,6 +132,11 @@ def lowest_modes(K: sp.spmatrix, fac: InertiaFactor, k: int = 1, *, seed: int = 
     from scipy.sparse.linalg import LinearOperator, eigsh
 
     n = K.shape[0]
+    if n <= DENSE_BELOW:  # ARPACK needs k < n - 1
+        vals, vecs = np.linalg.eigh(sp.csr_matrix(K).toarray())
+        order = np.argsort(np.abs(vals))[:k]
+        order = order[np.argsort(vals[order])]
+        return vals[order], vecs[:, order]
     k = int(min(max(k, 1), n - 2))
     op = LinearOperator((n, n), matvec=fac.solve, dtype=float)
     v0 = np.random.default_rng(seed).standard_normal(n)
