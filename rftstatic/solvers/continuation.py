@@ -96,7 +96,15 @@ DESCENT_LOAD = 1e-3
 """Least load increment of such a descent [-] (else the last positive load increment)."""
 
 MAX_DESCENTS = 50
+DESCENT_CONTINUATIONS = 5
+"""Times a descent that ran out of iterations while the energy was still falling goes on (80 each)."""
 """Most descents of one path."""
+
+REPEAT_LOAD = 1e-3
+"""A switch requested within this share of the load factor of the previous one means the branch found
+was only marginally stable (a flat energy valley: sphere-30 17 x 17 at lam = 0.2579 switched 14 times
+between states 1e-8 apart in load): the path then jumps by a descent at a load 4^k times this share
+higher (k the repeat count) from the last stable point."""
 
 FINAL_SWITCHES = 3
 """Branch switches at full load when the equilibrium reached is not stable."""
@@ -127,7 +135,6 @@ class _Path:
         self.c = diagonal * np.sqrt(model.mesh.n_nodes)
         self.max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
         self.inertia = InertiaSolver()
-        self.floor = None
         self.eps = float(getattr(model.contact, "smoothing", 0.0) or 0.0) if model.contact is not None else 0.0
 
     def point(self, U, lam) -> _Point:
@@ -160,10 +167,15 @@ class _Path:
         change = float(np.abs(g1[near] - g0[near]).max())
         return 1.0 if change <= LAYER_STEP * eps else LAYER_STEP * eps / change
 
-    def tolerance(self, U, lam) -> float:
-        if self.floor is None:
-            self.floor = roundoff_floor(self.model, U)
-        return PATH_RTOL * max(abs(lam), LAM_FLOOR) * self.Pnorm + 10.0 * self.floor
+    def tolerance(self, U, lam, rnorm=None) -> float:
+        """Force tolerance [N] of a path point; when ``rnorm`` is within 1e3 of it, raised by the round-off
+        of the internal force at ``U`` (:func:`~rftstatic.solvers.iteration.roundoff_floor`, evaluated
+        there: it grows with the membrane's stretch, and a floor taken at the flat start left the
+        sphere's path stuck at |r| = 2.6e-7 N, its round-off, at lam = 0.258)."""
+        tol = PATH_RTOL * max(abs(lam), LAM_FLOOR) * self.Pnorm
+        if rnorm is not None and tol < rnorm < 1e3 * tol:
+            tol += 10.0 * roundoff_floor(self.model, U)
+        return tol
 
     def corrector(self, pt: _Point, ds: float, *, target: float | None = None, iterations=CORRECTOR_ITERATIONS):
         """One pseudo-arclength step of length ``ds`` from ``pt`` (``target``: to that load factor
@@ -189,7 +201,7 @@ class _Path:
                 return None, it
             try:
                 fac = self.inertia.factor(K)
-                if rnorm <= self.tolerance(U, lam):
+                if rnorm <= self.tolerance(U, lam, rnorm):
                     return _Point(U, lam, K, fac), it - 1
                 d_r, d_p = fac.solve(-r), fac.solve(self.P)
             except LinearSolveError:
@@ -318,6 +330,7 @@ def _follow(path, pt, result, record, bar, callback):
     """Steps from ``pt`` to lam = 1 (module docstring); the final polish and stability in :func:`_finish`."""
     opts = path.opts
     ds, s, halvings, descents = FIRST_ARC, 0.0, 0, 0
+    last_switch, repeat = -1.0, 0
     lam_max, last_dlam = pt.lam, 0.0
     while True:
         if len(record["steps"]) >= opts.max_load_steps:
@@ -370,8 +383,15 @@ def _follow(path, pt, result, record, bar, callback):
             callback(new.lam, new.U)
         if changed and new.fac.negative > pt.fac.negative and not final:
             lam_s = max(new.lam, lam_max) + (0.25 * last_dlam if kind == "limit" else 0.0)
-            new = _switch(path, result, record, new, min(lam_s, 1.0), pt if kind == "limit" else None)
+            repeat = repeat + 1 if abs(lam_s - last_switch) < REPEAT_LOAD * max(lam_s, LAM_FLOOR) else 0
+            last_switch = lam_s
+            snapped = None
+            if repeat and pt.fac.negative == 0:  # back at the same load: jump over the unstable stretch
+                snapped = _descend(path, result, record, pt, REPEAT_LOAD * max(lam_s, LAM_FLOOR) * 4.0**repeat)
+            new = snapped if snapped is not None else _switch(path, result, record, new, min(lam_s, 1.0),
+                                                              pt if kind == "limit" else None)
             lam_max = max(lam_max, new.lam)
+            ds = min(ds, FIRST_ARC)  # the branch found may turn back soon: approach it gently
         ds = float(np.clip(ds * (2.0 if its <= 3 else 0.5 if its > 6 else 1.0), MIN_ARC, MAX_ARC))
         pt = new
         if final:
@@ -406,10 +426,14 @@ def _descend(path, result, record, pt, dlam):
     (:func:`~rftstatic.solvers.newton.newton`, displacement iteration) from ``pt``: the point it reaches
     (its tangent oriented with dlam > 0), or None."""
     lam = min(1.0, pt.lam + dlam)
-    nt = newton(path.model, pt.U, lam, replace(path.opts, max_iterations=max(path.opts.max_iterations, 80),
-                                               intermediate_rtol=PATH_RTOL),
-                path.ws, path.max_step, scheme="displacement")
+    opts = replace(path.opts, max_iterations=max(path.opts.max_iterations, 80), intermediate_rtol=PATH_RTOL)
+    nt = newton(path.model, pt.U, lam, opts, path.ws, path.max_step, scheme="displacement")
     result.iterations += nt.iterations
+    for _ in range(DESCENT_CONTINUATIONS):  # a fold forming: still sliding downhill
+        if nt.converged or not nt.descending:
+            break
+        nt = newton(path.model, nt.U, lam, opts, path.ws, path.max_step, scheme="displacement")
+        result.iterations += nt.iterations
     record["descents"] = record.get("descents", 0) + 1
     if not nt.converged:
         return None
