@@ -14,7 +14,7 @@ RMS displacement or the whole load:
   K dU_r = -R, K dU_P = P, dlam = -(t_u . dU_r / c) / (t_u . dU_P / c + t_lam), dU = dU_r + dlam dU_P;
   each step is capped (``max_step``) and bounded by the self-contact collision test, both scaling dU
   and dlam alike;
-- ds doubles after a step that took at most 3 iterations, halves after one that took more than 6 or
+- ds doubles after a step that took at most 4 iterations, halves after one that took more than 8 or
   failed; a failed step restarts from the last point (penalty contact makes the path only piecewise
   smooth: its kinks are passed with smaller steps).
 
@@ -324,6 +324,8 @@ def _accept(path, result, record, pt, its, s, dlam, kind=None):
                               "scheme": "arc-length"})
     record["steps"].append({"lam": float(pt.lam), "s": float(s), "negative": int(pt.fac.negative),
                             "iterations": int(its), **({"event": kind} if kind else {})})
+    log.info("arc-length step %d: load factor %.6g, arc length %.4g, %d negative pivots, %d iterations%s",
+             len(record["steps"]), pt.lam, s, pt.fac.negative, its, f" ({kind})" if kind else "")
 
 
 def _follow(path, pt, result, record, bar, callback):
@@ -392,7 +394,7 @@ def _follow(path, pt, result, record, bar, callback):
                                                               pt if kind == "limit" else None)
             lam_max = max(lam_max, new.lam)
             ds = min(ds, FIRST_ARC)  # the branch found may turn back soon: approach it gently
-        ds = float(np.clip(ds * (2.0 if its <= 3 else 0.5 if its > 6 else 1.0), MIN_ARC, MAX_ARC))
+        ds = float(np.clip(ds * (2.0 if its <= 4 else 0.5 if its > 8 else 1.0), MIN_ARC, MAX_ARC))
         pt = new
         if final:
             _finish(path, result, record, pt)
