@@ -35,7 +35,7 @@ SWITCH_AMPLITUDE = 0.5
 the unstable equilibrium's neighbourhood in one push (a fold's amplitude is a few element sizes), small
 enough not to stretch the membrane."""
 
-SWITCH_ITERATIONS = 80
+SWITCH_ITERATIONS = 150
 """Newton iterations of the descent from each push (at an intermediate load factor the solver's
 ``max_iterations`` would apply): a fold forming on a coarse mesh takes 20-60 line-searched steps."""
 
