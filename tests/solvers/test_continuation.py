@@ -167,3 +167,14 @@ def test_arc_length_passes_the_limit_point_of_a_von_mises_truss_and_snaps_to_the
     u_exact = brentq(lambda u: -truss.force(u) - P, -10 * truss.h, -2 * truss.h)
     assert res.U[2, 2] == pytest.approx(u_exact, rel=1e-8)
     assert res.path["final_negative"] == 0 and truss.stiffness(res.U[2, 2]) > 0
+
+
+def test_solve_static_takes_the_arc_length_route_and_checks_stability():
+    from rftstatic.solvers.static import solve_static
+
+    model, _ = euler_strip()
+    res = solve_static(model, options=StaticOptions(progress=False, continuation="arc-length", relax_fallback=False))
+    assert res.route == "arc-length" and res.converged and res.stable
+    assert res.path["steps"][0]["event"] == "start" and res.path["final_negative"] == 0
+    with pytest.raises(ValueError, match="continuation"):
+        StaticOptions(continuation="riks")
