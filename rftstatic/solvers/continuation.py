@@ -100,6 +100,11 @@ DESCENT_CONTINUATIONS = 5
 """Times a descent that ran out of iterations while the energy was still falling goes on (80 each)."""
 """Most descents of one path."""
 
+SNAP_SHARE = 0.02
+"""Least load step, as a share of the largest load factor reached, of the descent that replaces a stable
+branch followed towards lower loads (the round pedestal at lam = 1.05e-3 turned back to lam = 1e-7 on
+one, then came back up)."""
+
 REPEAT_LOAD = 1e-3
 """A switch requested within this share of the load factor of the previous one means the branch found
 was only marginally stable (a flat energy valley: sphere-30 17 x 17 at lam = 0.2579 switched 14 times
@@ -383,6 +388,14 @@ def _follow(path, pt, result, record, bar, callback):
         bar.update(min(max(new.lam, 0.0), 1.0), f"s {s:.3g} neg {new.fac.negative}")
         if callback is not None:
             callback(new.lam, new.U)
+        if new.fac.negative == 0 and new.lam < pt.lam and not final:
+            # a stable branch followed towards lower loads leads back to a fold already passed: under a
+            # rising load the sheet snaps from that fold, so jump by a descent beyond the largest load
+            snapped = _descend(path, result, record, new, lam_max - new.lam + max(last_dlam, SNAP_SHARE * lam_max))
+            if snapped is not None:
+                pt, ds = snapped, min(ds, FIRST_ARC)
+                lam_max = max(lam_max, pt.lam)
+                continue
         if changed and new.fac.negative > pt.fac.negative and not final:
             lam_s = max(new.lam, lam_max) + (0.25 * last_dlam if kind == "limit" else 0.0)
             repeat = repeat + 1 if abs(lam_s - last_switch) < REPEAT_LOAD * max(lam_s, LAM_FLOOR) else 0
