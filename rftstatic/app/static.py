@@ -108,6 +108,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
                         for s in result.load_steps],
         "tangent_modes": result.tangent_modes,
         "route": result.route,
+        "path": result.path,
         "relax": result.relax,
         "stable_minimum": result.stable,
         "self_contact_stiffenings": getattr(result, "self_contact_stiffenings", 0),

@@ -166,6 +166,7 @@ SCHEMA = {
         "max_continuations": (int, "snap-through continuations per increment"),
         "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
+        "continuation": (str, "load (load increments) or arc-length (path following with inertia)"),
         "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
         "seeds": (int, "static drape: run this many seeded starts (seed, seed + 1, ...), as a lab tests several "
                        "specimens; the summary reports their mean, range and fold counts"),

@@ -78,6 +78,10 @@ class StaticOptions:
     max_load_steps : give up after this many increments
     start : ``"load-steps"`` (load-scaled Newton from the flat start) or ``"relax"`` (dynamic
         relaxation at full load, then Newton to polish: for drapes with many folds)
+    continuation : how ``start = "load-steps"`` follows the load from 0 to 1: ``"load"`` (load
+        increments, :mod:`~rftstatic.solvers.load_steps`) or ``"arc-length"`` (pseudo-arclength path
+        following with the tangent's inertia tracked and branch switching at critical points,
+        :mod:`~rftstatic.solvers.continuation`)
     relax_fallback : when the load steps fail, try dynamic relaxation + Newton before giving up
     reuse_factorisation : how many further steps may reuse a factorisation while the residual keeps
         falling by more than 70 % per step (modified Newton; 0 = full Newton)
@@ -113,6 +117,7 @@ class StaticOptions:
     max_continuations: int = 10
     reuse_factorisation: int = 2
     start: str = "load-steps"
+    continuation: str = "load"
     relax_fallback: bool = True
     perturbation: float = 0.0
     seed: int = 0
@@ -126,6 +131,8 @@ class StaticOptions:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
                 raise ValueError(f"solver.{name} must be an integer >= {least}, got {v!r}")
+        if self.continuation not in ("load", "arc-length"):
+            raise ValueError(f'solver.continuation must be "load" or "arc-length", got "{self.continuation}"')
         if self.start not in ("load-steps", "relax"):
             raise ValueError(f'solver.start must be "load-steps" or "relax", got "{self.start}"')
         if self.linear_solver not in ("auto", "cholmod", "scipy", "amg"):
@@ -191,6 +198,9 @@ class StaticResult:
     factorisations : numeric factorisations of the tangent (Newton steps, failed Cholesky attempts, the
         first increment's rate; not the stability check)
     state : the solve's final :class:`~rftstatic.model.state.State` (U, load factor, contact candidates)
+    path : the arc-length route's record (:func:`~rftstatic.solvers.continuation.solve_arc_length`: each
+        step's load factor, arc length and negative pivots, the critical points and the branches taken);
+        empty for the other routes
     """
 
     U: np.ndarray
@@ -212,6 +222,7 @@ class StaticResult:
     route: str = "load-steps"
     relax: dict = field(default_factory=dict)
     state: State | None = None
+    path: dict = field(default_factory=dict)
 
 @dataclass
 class NewtonWorkspace:

@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
+from rftstatic.solvers.continuation import solve_arc_length
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
 from rftstatic.solvers.load_steps import solve_load_steps
 from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult
@@ -70,6 +71,9 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     elif opts.start == "relax":
         return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint), opts, ws)
     try:
+        if opts.continuation == "arc-length" and restart is None:
+            return _finish(model, solve_arc_length(model, U0=U0, options=opts, callback=callback, workspace=ws),
+                           opts, ws)
         return _finish(model, solve_load_steps(
             model, U0=U0, options=opts, callback=callback, workspace=ws,
             checkpoint=None if checkpoint is None else checkpoint.load_step,
