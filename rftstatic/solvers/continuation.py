@@ -48,7 +48,7 @@ from rftstatic.solvers.branches import switch_branch
 from rftstatic.solvers.inertia import InertiaSolver
 from rftstatic.solvers.iteration import capped_step, roundoff_floor, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError, make_solver
-from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult, newton
+from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult, newton, route_outcome
 from rftstatic.solvers.perturbation import start_perturbation
 
 log = logging.getLogger(__name__)
@@ -249,26 +249,15 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
     record = {"steps": [], "critical_points": [], "switches": [], "arc_length": 0.0}
     result.path = record
     bar = Progress(1.0, f"arc-length {model.element}", enabled=opts.progress)
-    try:
+    def inertia_counters(res):
+        res.factorisations += path.inertia.factorisations
+        res.tangent_modes["ldl"] = path.inertia.ldl
+
+    with route_outcome(model, result, ws, t0, bar, extra=inertia_counters):
         pt = _start(path, U, result)
         record["start_negative"] = pt.fac.negative
         _accept(path, result, record, pt, result.iterations, 0.0, pt.lam, "start")
         _follow(path, pt, result, record, bar, callback)
-        result.converged = True
-        result.message = "converged"
-    except ConvergenceError as exc:
-        result.message = str(exc)
-        exc.result = result
-        raise
-    finally:
-        bar.close()
-        result.tangent_modes = dict(ws.modes)
-        result.factorisations = ws.factorisations + path.inertia.factorisations
-        result.tangent_modes["ldl"] = path.inertia.ldl
-        result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs)
-        ws.state.U, ws.state.lam = result.U, result.lam
-        result.state = ws.state
     return result
 
 

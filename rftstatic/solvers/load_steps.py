@@ -21,7 +21,7 @@ import numpy as np
 from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
-from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult, newton
+from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult, newton, route_outcome
 from rftstatic.solvers.perturbation import start_perturbation
 
 log = logging.getLogger(__name__)
@@ -78,7 +78,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         raise ConvergenceError(f"load factor 0: {what} are not finite (NaN or inf); check the scene's loads, "
                                "weight and mesh coordinates", None)
     ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
-    ws.modes = modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
+    ws.modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
     solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     ws.solver = solver
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
@@ -97,7 +97,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
     continuations = 0
     failures = 0  # mixed iterations failed in a row at this load level
     bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
-    try:
+    with route_outcome(model, result, ws, t0, bar):
         while lam < 1.0:
             if len(result.load_steps) >= opts.max_load_steps:
                 raise ConvergenceError(
@@ -165,20 +165,6 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                     f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
                     f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
                     f"min_increment = {opts.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
-        result.converged = True
-        result.message = "converged"
-    except ConvergenceError as exc:
-        result.message = str(exc)
-        exc.result = result
-        raise
-    finally:
-        bar.close()
-        result.tangent_modes = dict(modes)
-        result.factorisations = ws.factorisations
-        result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs)
-        ws.state.U, ws.state.lam = result.U, result.lam
-        result.state = ws.state
     return result
 
 

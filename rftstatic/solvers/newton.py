@@ -31,10 +31,13 @@ steps are :mod:`rftstatic.solvers.load_steps`, the route that chains them with d
 from __future__ import annotations
 
 import logging
+import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from rftstatic.errors import ConvergenceError
 from rftstatic.model.state import State
 from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError
@@ -399,3 +402,30 @@ def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=N
         else:
             alpha *= 0.1
     return None, Pi0
+
+
+@contextmanager
+def route_outcome(model, result: StaticResult, ws: NewtonWorkspace, t0: float, bar, *, extra=None):
+    """The ending every static route shares, around its body: ``converged`` and ``message`` on success; a
+    :class:`~rftstatic.errors.ConvergenceError` labelled with its message and carrying the last
+    equilibrium (``exc.result``); in any case the bar closed, tangent modes, factorisations, wall time
+    [s] (from ``t0``), energies and the workspace's State of the final ``result``. ``extra(result)``
+    adds a route's own counters before the energies."""
+    try:
+        yield
+        result.converged = True
+        result.message = "converged"
+    except ConvergenceError as exc:
+        result.message = str(exc)
+        exc.result = result
+        raise
+    finally:
+        bar.close()
+        result.tangent_modes = dict(ws.modes)
+        result.factorisations = ws.factorisations
+        if extra is not None:
+            extra(result)
+        result.wall_time = time.perf_counter() - t0
+        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs)
+        ws.state.U, ws.state.lam = result.U, result.lam
+        result.state = ws.state
