@@ -167,3 +167,11 @@ def test_dynamic_scene_with_self_contact_reports_its_counters(tmp_path):
     for key in ("pairs", "max_pairs", "broad_phase_s", "force_s", "filter_s", "impulses", "ccd_limited"):
         assert key in sc
     assert s["self_intersections"]["pairs"] == 0 and max(s["self_intersections"]["pairs_saved"]) == 0
+
+
+@pytest.mark.parametrize("floor", [-0.1, 1.0, float("nan")])
+def test_step_filter_refuses_a_gap_floor_outside_its_range(floor):
+    mesh, _ = _two_sheets()
+    sc = SelfContact(mesh, D, 1.0)
+    with pytest.raises(ValueError, match="floor must be in"):
+        StepFilter(sc, np.ones((mesh.n_nodes, 3)), floor=floor)
