@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from rftstatic.app.levels import solve_levels
 from rftstatic.errors import ConvergenceError
 from rftstatic.io.summary import drape_summary
 from rftstatic.solvers.static import solve_static
@@ -35,7 +36,7 @@ def seeded_specimens(scene, model, extras, opts, first: dict, n: int) -> dict:
         t0 = time.perf_counter()
         seeded = dataclasses.replace(opts, seed=opts.seed + k, progress=False)
         try:
-            res = solve_static(model, options=seeded)
+            res = solve_levels(scene, model, seeded) if seeded.levels > 1 else solve_static(model, options=seeded)
             ok = bool(res.converged)
         except ConvergenceError as exc:
             log.warning("seed %d: %s", seeded.seed, exc)

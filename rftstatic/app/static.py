@@ -18,6 +18,7 @@ import logging
 import time
 from pathlib import Path
 
+from rftstatic.app.levels import remove_levels, solve_levels
 from rftstatic.app.result import RunResult
 from rftstatic.errors import ConvergenceError
 from rftstatic.io.files import to_jsonable
@@ -44,7 +45,8 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     """Build and solve ``scene``; write the outputs into ``out``; return the result.
 
     ``resume``: continue from ``out/checkpoint.npz`` (a fresh solve, logged, when there is none; a
-    :class:`~rftstatic.errors.CheckpointError` when it is corrupt or another scene's, mesh's or options').
+    :class:`~rftstatic.errors.CheckpointError` when it is corrupt or another scene's, mesh's or options'); with
+    ``solver.levels`` > 1 (mesh sequencing, :mod:`rftstatic.app.levels`), from the levels saved in ``out``.
     ``callback``: ``callback(lam, U)`` after every converged increment. ``checkpoint_seconds``: least wall
     time between two checkpoint writes [s].
     """
@@ -58,16 +60,21 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     path = out / CHECKPOINT
     remove_stale(path)
     restart = None
-    if resume and path.exists():
+    single = opts.levels == 1  # mesh sequencing resumes from its own saved levels (level-K.npz)
+    if resume and single and path.exists():
         restart = load_static_checkpoint(path, model, opts, scene=scene.name)
         log.info("resuming the static solve from %s (%s)", path, restart.where)
-    elif resume:
+    elif resume and single:
         log.warning("no checkpoint %s: solving from the start", path)
     saver = StaticCheckpointer(path, model, opts, scene=scene.name, every_seconds=checkpoint_seconds)
     error = None
     try:
         with saver.on_interrupt():
-            result = solve_static(model, options=opts, callback=callback, checkpoint=saver, restart=restart)
+            if not single:
+                result = solve_levels(scene, model, opts, folder=out, resume=resume, callback=callback,
+                                      checkpoint=saver)
+            else:
+                result = solve_static(model, options=opts, callback=callback, checkpoint=saver, restart=restart)
     except ConvergenceError as exc:
         error, result = exc, exc.result
         if result is None:
@@ -81,6 +88,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     write_outputs(scene, model, extras, result.U, out, summary, figures=figures)
     if error is not None:
         raise error
+    remove_levels(out)
     return RunResult(to_jsonable(summary), model, result.U, extras, out)
 
 
@@ -109,6 +117,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "tangent_modes": result.tangent_modes,
         "route": result.route,
         "path": result.path,
+        "levels": result.levels,
         "relax": result.relax,
         "stable_minimum": result.stable,
         "self_contact_stiffenings": getattr(result, "self_contact_stiffenings", 0),

@@ -262,6 +262,26 @@ class PenaltyContact:
         phi, _ = self._distances(x)
         return phi.min(axis=0) if phi.shape[0] else np.full(x.shape[0], np.inf)
 
+    def project_out(self, x: np.ndarray, clearance: float = 0.0, rounds: int = 4) -> np.ndarray:
+        """``x (N, 3)`` [m] with every node closer than ``clearance`` [m] to an obstacle (or inside it)
+        moved along that obstacle's outward normal to the distance ``clearance``, the deepest obstacle
+        first, for ``rounds`` rounds (a node between two obstacles). A copy; the nodes outside stay.
+        Used to lift a state carried from another mesh out of the obstacles (the new nodes of a coarse
+        chord across a rounded edge lie inside it) before Newton starts from it."""
+        x = np.array(_as_points(x, self.n_nodes), dtype=float)
+        if not self.obstacles:
+            return x
+        for _ in range(rounds):
+            phi, normal = self._distances(x)
+            deepest = phi.argmin(axis=0)
+            cols = np.arange(x.shape[0])
+            depth = phi[deepest, cols]
+            inside = depth < clearance
+            if not inside.any():
+                break
+            x[inside] += (clearance - depth[inside])[:, None] * normal[deepest[inside], cols[inside]]
+        return x
+
     def max_penetration(self, x: np.ndarray) -> float:
         """Largest penetration depth ``max(0, -min gap)`` [m] at ``x (N, 3)`` [m]."""
         gap = self.gaps(x)

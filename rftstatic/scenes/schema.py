@@ -175,6 +175,8 @@ SCHEMA = {
         "guide_weight": (NUM, "relative amplitude of that modulation, in [0, 1)"),
         "start": (str, "load-steps or relax (dynamic relaxation, then Newton)"),
         "relax_fallback": (bool, "try dynamic relaxation + Newton when the load steps fail"),
+        "levels": (int, "mesh sequencing: meshes of the sequence, each about twice as coarse as the next; the "
+                        "coarsest by the route above, the finer ones by Newton at full load (1: none)"),
         "membrane": (bool, "false: linear Kirchhoff plate (bending only)"),
     }, "static solver options (rftstatic.static.StaticOptions)"),
     "dynamics": ({

@@ -99,27 +99,66 @@ class Criteria:
         return left <= limit
 
 
+MODIFIED_SHIFTS = (1e-7, 1e-1)
+"""Smallest and largest diagonal shift tau of the modified exact tangent ``K + tau I``, relative to the mean
+diagonal of the tangent (Nocedal & Wright, Numerical Optimization, 2nd ed., Algorithm 3.3: Cholesky with
+added multiple of the identity)."""
+
+MODIFIED_GROWTH = 8.0
+"""Factor between two shifts tried; the first is the last one that worked divided by it."""
+
+MODIFIED_TRIES = 4
+"""Most factorisations of the modified exact tangent per iteration before the projected one is used."""
+
+
 def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
     """Newton direction on the free dofs, with the indefinite-tangent safeguard: ``(d, mode, shift)``.
 
     ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt); ``shift`` [N/m]
     is the diagonal shift of the tangent that gave ``d``; ``stress``: the mixed membrane stress of the
     geometric stiffness (:func:`rftstatic.solvers.mixed.mixed_iterations`; None: the exact Hessian).
+
+    ``tangent = "auto"`` tries, in turn, the exact tangent; the modified exact tangent ``K + tau I``
+    (:data:`MODIFIED_SHIFTS`, from the last shift that worked over :data:`MODIFIED_GROWTH`; while the
+    last iteration needed one, the exact tangent is not tried first: its factorisation would fail
+    again); the projected tangent (compressive membrane stress dropped); and that one shifted. Each
+    tangent is assembled once per call, its shifts added to the diagonal.
     """
-    solver, modes, cand = ws.solver, ws.modes, ws.candidates
-    sequence = {"auto": ["exact", "psd", "shift"], "exact": ["exact", "shift"], "psd": ["psd", "shift"]}[opts.tangent]
+    solver, modes = ws.solver, ws.modes
+    sequence = {"auto": ["exact", "modified", "psd", "shift"], "exact": ["exact", "shift"],
+                "psd": ["psd", "shift"]}[opts.tangent]
+    matrices = {}
+
+    def tangent(psd, shift):
+        if psd not in matrices:
+            matrices[psd] = model.tangent(U, psd=psd, lam=lam, candidates=ws.candidates, stress=stress,
+                                          pairs=ws.pairs)[1]
+        K = matrices[psd]
+        if shift:
+            K = K.copy()
+            K.setdiag(K.diagonal() + shift)
+        return K
+
+    base = damping * diagonal_scale(model, U, ws) if damping else 0.0
+    if "modified" in sequence:
+        least = MODIFIED_SHIFTS[0] * diagonal_scale(model, U, ws)
+        if ws.modified_shift / MODIFIED_GROWTH < least:
+            ws.modified_shift = 0.0
+        elif base == 0.0:
+            sequence = sequence[1:]  # the exact tangent was indefinite at the last iterate
     last_error = None
-    base = 0.0
-    if damping:
-        base = damping * diagonal_scale(model, U, ws)
     for mode in sequence:
-        shifts = [base] if mode != "shift" else None
+        shifts = [base]
+        if mode == "modified":
+            scale = diagonal_scale(model, U, ws)
+            first = max(ws.modified_shift / MODIFIED_GROWTH, MODIFIED_SHIFTS[0] * scale, base)
+            shifts = [t for t in (first * MODIFIED_GROWTH ** k for k in range(MODIFIED_TRIES))
+                      if t <= MODIFIED_SHIFTS[1] * scale]
         if mode == "shift":
-            _, K = model.tangent(U, psd=True, lam=lam, candidates=cand, stress=stress, pairs=ws.pairs)
-            scale = float(np.abs(K.diagonal()).mean())
+            scale = float(np.abs(tangent(True, 0.0).diagonal()).mean())
             shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
         for shift in shifts:
-            _, K = model.tangent(U, psd=(mode != "exact"), shift=shift, lam=lam, candidates=cand, stress=stress, pairs=ws.pairs)
+            K = tangent(mode not in ("exact", "modified"), shift)
             ws.factorisations += 1
             try:
                 d = solver.solve(K, -r)
@@ -130,7 +169,8 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
                 last_error = LinearSolveError("non-finite step")
                 continue
             if float(r @ d) < 0.0 or not np.any(r):
-                modes[mode] += 1
+                modes[mode] = modes.get(mode, 0) + 1
+                ws.modified_shift = shift if mode == "modified" else 0.0
                 return d, mode, shift
             last_error = LinearSolveError("the step is not a descent direction of the energy")
     raise LinearSolveError(str(last_error))

@@ -47,7 +47,7 @@ log = logging.getLogger(__name__)
 
 
 _COUNTS = {"max_iterations": 1, "max_load_steps": 1, "max_continuations": 0, "reuse_factorisation": 0, "seed": 0,
-           "perturbation_folds": 0, "guide_folds": 0}
+           "perturbation_folds": 0, "guide_folds": 0, "levels": 1}
 """The integer options of :class:`StaticOptions` and their least values (a seed: numpy's generators take
 none below 0)."""
 
@@ -100,6 +100,10 @@ class StaticOptions:
         ``1 + guide_weight (r/R)^2 cos(n theta + phi)`` with n = ``guide_folds`` (:func:`fold_pattern`),
         then restored, so that the sheet falls into n folds and the rest of the relaxation tells
         whether that drape is a stable equilibrium; 0 = no guide
+    levels : meshes of a mesh sequence (1: the scene's mesh alone). A scene run with ``levels = L``
+        (:mod:`rftstatic.app.levels`) solves the coarsest of L meshes by this route and each finer one
+        by Newton at full load from the solution below; :func:`solve_static` solves the one model it
+        is given and does not read it
     """
 
     initial_increment: float = 0.1
@@ -127,6 +131,7 @@ class StaticOptions:
     perturbation_folds: int = 0
     guide_folds: int = 0
     guide_weight: float = 0.0
+    levels: int = 1
     progress: bool = True
 
     def __post_init__(self):
@@ -204,6 +209,8 @@ class StaticResult:
     path : the arc-length route's record (:func:`~rftstatic.solvers.continuation.solve_arc_length`: each
         step's load factor, arc length and negative pivots, the critical points and the branches taken);
         empty for the other routes
+    levels : mesh sequencing (:mod:`rftstatic.app.levels`): one record per mesh, coarsest first (nodes,
+        route, iterations, residual, energy, wall time); empty for a single mesh
     """
 
     U: np.ndarray
@@ -226,6 +233,7 @@ class StaticResult:
     relax: dict = field(default_factory=dict)
     state: State | None = None
     path: dict = field(default_factory=dict)
+    levels: list = field(default_factory=list)
 
 @dataclass
 class NewtonWorkspace:
@@ -240,6 +248,8 @@ class NewtonWorkspace:
     factorisations : numeric factorisations of a tangent (failed Cholesky attempts included)
     lm_scale : mean tangent diagonal [N/m], the scale of the Levenberg-Marquardt damping, computed once
         per solve at the state where damping is first needed
+    modified_shift : the last diagonal shift [N/m] that made the indefinite exact tangent positive definite
+        (:func:`~rftstatic.solvers.iteration.direction`, mode ``"modified"``): the next try starts below it
     """
 
     state: State
@@ -247,6 +257,7 @@ class NewtonWorkspace:
     modes: dict = field(default_factory=lambda: {"exact": 0, "psd": 0, "shift": 0})
     lm_scale: float | None = None
     factorisations: int = 0
+    modified_shift: float = 0.0
 
     @classmethod
     def for_model(cls, model) -> NewtonWorkspace:
@@ -304,6 +315,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
             return Iteration(True, U, it - 1, rnorm, stable=stable, history=hist)
         d = None
         fresh = False
+        mode = "reused"
         if reuse and age < opts.reuse_factorisation:
             try:
                 d = solver.resolve(-r)
@@ -334,7 +346,8 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
             return Iteration(False, U, it, rnorm, "line search found no decrease of the energy")
         U = U + alpha * step
         Pi = Pi_new
-        hist.append({"residual": rnorm, "alpha": alpha, "cap": cap, "mu": mu, "fresh": fresh})
+        hist.append({"residual": rnorm, "alpha": alpha, "cap": cap, "mu": mu, "fresh": fresh,
+                     "mode": mode if fresh else "reused"})
         Pi_history.append(Pi)
         # Levenberg-Marquardt damping as a trust region (More's update): the ratio of the actual to
         # the predicted energy decrease of a fresh Newton step decides; a step the line search had to

@@ -52,6 +52,8 @@ class SelfContactStats:
         would have added kinetic energy (dropped for the Jacobi sweeps)
     ccd_limited : steps whose motion the CCD fail-safe had to shorten; ccd_min_fraction : the smallest factor
     swept : steps that needed a swept broad phase (a step longer than ``margin / 2``)
+    sweeps_limited : static steps too long to sweep within the pair budget, bounded to
+        :attr:`~rftstatic.contact.self_contact.law.SelfContact.sweep_limit` of relative motion
     """
 
     rebuilds: int = 0
@@ -69,6 +71,7 @@ class SelfContactStats:
     ccd_limited: int = 0
     ccd_min_fraction: float = 1.0
     swept: int = 0
+    sweeps_limited: int = 0
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)

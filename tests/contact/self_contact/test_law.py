@@ -129,3 +129,27 @@ def test_step_bound_stops_an_edge_through_an_edge():
     gap = 0.2 + alpha * -0.4
     assert 0 < alpha < 0.5 and gap >= sc.min_fraction * 0.2 * (1 - 1e-6)
     assert gap == pytest.approx(sc.min_fraction * 0.2, rel=2e-2)
+
+
+def test_a_step_too_long_to_sweep_is_bounded_to_the_sweep_limit():
+    """The swept broad phase keeps its pair budget: a step whose relative motion exceeds
+    ``sweep_limit`` is tested over its first ``sweep_limit / spread`` and bounded there, and a point
+    driven through a triangle still stops short of it."""
+    mesh = rectangle(1.0, 1.0, 5, 5, pattern="right")
+    sc = SelfContact(mesh, 0.05, 1.0)
+    assert sc.sweep_limit == pytest.approx(0.25 * np.sqrt(4e6 / 32), rel=0.3)  # h sqrt(budget / E)
+    X = mesh.X3.copy()
+    centre = X[mesh.tri[0]].mean(axis=0)
+    X[24] = centre + [0, 0, 0.3]
+    dx = np.zeros_like(X)
+    dx[24] = [0, 0, -0.6]
+    free = sc.max_step_fraction(X, dx)
+    sc.sweep_limit = 0.1  # [m]: the relative motion of the step (2 x its largest departure from the
+    # midrange motion, 2 x 0.3 m) is 0.6 m
+    alpha = sc.max_step_fraction(X, dx)
+    assert alpha == pytest.approx(0.1 / 0.6, rel=1e-12) and alpha < free
+    assert sc.stats.sweeps_limited == 1
+    sc.sweep_limit = 0.5  # the bounded part reaches the triangle: the collision bound still holds
+    alpha = sc.max_step_fraction(X, dx)
+    assert alpha == pytest.approx(free, rel=1e-9)
+    assert X[24, 2] + alpha * dx[24, 2] >= sc.min_fraction * 0.3 * (1 - 1e-6)

@@ -131,15 +131,17 @@ def test_scene_keys(tmp_path):
 
 
 def test_a_pair_below_half_the_thickness_raises_the_stiffness(tmp_path):
-    # the 50 cm sheet over the sphere on the floor at 31 x 31: under the automatic stiffness a pinched
-    # fold on the floor rests 0.38 d apart; the static route raises the stiffness (x 8) and converges
-    # again from that state: 0.77 d, no crossing, a stable minimum (measured 19 s)
+    # the 50 cm sheet over the sphere on the floor at 31 x 31 with a fifth of the automatic stiffness: a
+    # pinched fold on the floor rests closer than d/2; the static route raises the stiffness (x 8) and
+    # converges again from that state: 0.79 d, no crossing, a stable minimum (measured 12 s; with the
+    # automatic stiffness this drape now rests 0.74 d apart and needs no raise)
     import json
 
     from rftstatic.api import run
     from rftstatic.solvers import static
 
-    s = run("sphere-floor", tmp_path / "o", overrides=["mesh.nodes=[31,31]"], figures=False).summary
+    s = run("sphere-floor", tmp_path / "o", overrides=["mesh.nodes=[31,31]", "contact.self_factor=0.2"],
+            figures=False).summary
     assert s["converged"] and s["stable_minimum"] and s["self_intersections"]["pairs"] == 0
     assert 1 <= s["self_contact_stiffenings"] <= static.SELF_CONTACT_STIFFENINGS
     d = s["self_contact"]["thickness"]

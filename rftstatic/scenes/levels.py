@@ -1,0 +1,86 @@
+"""The coarser meshes of a scene for mesh sequencing (``solver.levels``).
+
+Mesh sequencing (nested iteration, grid continuation) solves a drape on a hierarchy of meshes of the
+same sheet: the coarsest by the scene's own route, every finer one by Newton at full load from the
+solution of the mesh below (:mod:`rftstatic.app.levels`). Each level has about twice the element size
+of the one above it:
+
+==================  ======================================================================
+mesh kind           level ``k`` below the scene's mesh (``k = 1, 2, ...``)
+==================  ======================================================================
+``rectangle``       ``nodes = [ceil((nx - 1) / 2^k) + 1, ceil((ny - 1) / 2^k) + 1]``
+``polar``,          ``nodes = [ceil((n_radial - 1) / 2^k) + 1, round(n_circ / 2^k)]``
+``square-polar``    (the rings keep their radii' grading, the circle its sectors' symmetry)
+``unstructured``    ``h = 2^k h``
+``file``            none: a mesh read from a file has no coarser version (a scene error)
+==================  ======================================================================
+
+so the rectangle's 201 x 201 nodes give 101 x 101 and 51 x 51 (nested: every coarse node is a fine
+node), 81 x 81 gives 41 x 41 and 21 x 21, the round pedestal's 21 x 160 rings give 11 x 80 and 6 x 40.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+from rftstatic.scenes.schema import Scene, validate
+
+__all__ = ["MAX_LEVELS", "level_scenes", "level_mesh"]
+
+MAX_LEVELS = 6
+"""Most meshes of a sequence (the finest 2^5 = 32 times finer than the coarsest)."""
+
+LEAST_NODES = {"rectangle": (3, 3), "polar": (2, 12), "square-polar": (2, 12)}
+"""Fewest nodes per direction of a coarse level (a patch needs neighbours; a ring at least 12 sectors)."""
+
+
+def level_mesh(scene: Scene, k: int) -> dict:
+    """The ``[mesh]`` table of the mesh ``k`` levels below the scene's own (k = 0: the scene's)."""
+    m = dict(scene.get("mesh", {}))
+    kind = m.get("kind", "rectangle")
+    if k == 0:
+        return m
+    if kind in LEAST_NODES:
+        if "nodes" not in m:
+            raise scene.error("solver.levels", f"a {kind} mesh needs its mesh.nodes to make coarser levels; "
+                              "give mesh.nodes")
+        a, b = m["nodes"]
+        a2 = math.ceil((a - 1) / 2 ** k) + 1
+        b2 = math.ceil((b - 1) / 2 ** k) + 1 if kind == "rectangle" else round(b / 2 ** k)
+        least = LEAST_NODES[kind]
+        if a2 < least[0] or b2 < least[1]:
+            raise scene.error("solver.levels", f"{k + 1} levels make the coarsest mesh [{a2}, {b2}] nodes from "
+                              f"mesh.nodes = [{a}, {b}], fewer than a {kind} mesh needs ({list(least)}); give "
+                              "fewer levels")
+        m["nodes"] = [int(a2), int(b2)]
+        return m
+    if kind == "unstructured":
+        if "h" not in m:
+            raise scene.error("mesh.h", "an unstructured mesh needs its target element size h")
+        m["h"] = m["h"] * 2 ** k
+        return m
+    raise scene.error("solver.levels", f'a mesh of kind "{kind}" has no coarser levels (it is read as it is); '
+                      "use solver.levels = 1 or a generated mesh (rectangle, polar, square-polar, unstructured)")
+
+
+def level_scenes(scene: Scene, levels: int) -> list[Scene]:
+    """The scenes of a sequence of ``levels`` meshes, coarsest first; the last is ``scene`` itself.
+
+    Each coarser scene is ``scene`` with the ``[mesh]`` of :func:`level_mesh` and ``solver.levels = 1``
+    and ``solver.seeds`` removed (a level is one solve), validated like a scene file.
+    """
+    if not (isinstance(levels, int) and 1 <= levels <= MAX_LEVELS):
+        raise scene.error("solver.levels", f"{levels!r} must be an integer in [1, {MAX_LEVELS}] (the meshes of the "
+                          "sequence, the scene's own included)")
+    out = []
+    for k in range(levels - 1, 0, -1):
+        data = copy.deepcopy(scene.data)
+        data["mesh"] = level_mesh(scene, k)
+        solver = data.setdefault("solver", {})
+        solver["levels"] = 1
+        solver.pop("seeds", None)
+        coarse = Scene(data, scene.path, f"{scene.name} (level {levels - k} of {levels})", dict(scene.overrides))
+        validate(coarse)
+        out.append(coarse)
+    return out + [scene]

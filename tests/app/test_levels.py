@@ -1,0 +1,99 @@
+"""Mesh sequencing (``solver.levels``): the coarser meshes of a scene, the transfer of an equilibrium to
+the next mesh, and a drape solved level by level, saved as it goes and taken up again by a resume."""
+
+import json
+
+import numpy as np
+import pytest
+
+from rftstatic.app import static as app
+from rftstatic.app.levels import solve_levels, transfer_start
+from rftstatic.errors import SceneError
+from rftstatic.scenes.build import build_model
+from rftstatic.scenes.levels import level_mesh, level_scenes
+from rftstatic.scenes.options import static_options
+from rftstatic.scenes.schema import load_scene
+
+DRAPE = ["mesh.nodes=[17,17]", "solver.levels=2"]  # 9 x 9 by the scene's relaxation, 17 x 17 by Newton: ~6 s
+
+
+@pytest.mark.parametrize("scene, nodes, expected", [
+    ("pedestal-square-80", [201, 201], [[51, 51], [101, 101], [201, 201]]),
+    ("pedestal-square-80", [81, 81], [[21, 21], [41, 41], [81, 81]]),
+    ("pedestal-square-20", [34, 33], [[10, 9], [18, 17], [34, 33]]),
+    ("pedestal-round-50", [21, 160], [[6, 40], [11, 80], [21, 160]]),
+])
+def test_each_level_has_about_twice_the_element_size_of_the_next(scene, nodes, expected):
+    sc = load_scene(scene, [f"mesh.nodes={nodes}", "solver.levels=3"])
+    levels = level_scenes(sc, 3)
+    assert [s.get("mesh.nodes") for s in levels] == expected
+    assert levels[-1] is sc
+    assert all(s.get("solver.levels") == 1 for s in levels[:-1])
+    assert level_scenes(sc, 1) == [sc]
+
+
+def test_an_unstructured_level_doubles_h_and_a_file_mesh_has_none(tmp_path):
+    sc = load_scene("pedestal-round-50-unstructured")
+    h = sc.get("mesh.h")
+    assert level_mesh(sc, 2)["h"] == pytest.approx(4 * h)
+    path = tmp_path / "file.toml"
+    path.write_text('[mesh]\nkind = "file"\npath = "sheet.msh"\n[solver]\nlevels = 2\n')
+    with pytest.raises(SceneError, match="solver.levels.*file"):
+        level_scenes(load_scene(str(path)), 2)
+
+
+def test_too_many_levels_name_the_key_and_the_coarsest_mesh():
+    sc = load_scene("pedestal-square-20", ["mesh.nodes=[9,9]"])
+    with pytest.raises(SceneError, match=r"solver.levels.*\[2, 2\]"):
+        level_scenes(sc, 4)
+    with pytest.raises(SceneError, match=r"solver.levels.*\[1, 6\]"):
+        level_scenes(sc, 7)
+
+
+def test_the_transfer_carries_a_linear_field_exactly_and_keeps_the_supports():
+    coarse, _ = build_model(load_scene("strip", ["mesh.nodes=[11,3]"]))
+    fine, _ = build_model(load_scene("strip", ["mesh.nodes=[21,5]"]))
+    A = np.array([[0.01, -0.02], [0.03, 0.005], [0.2, -0.1]])  # (3, 2): U = A X + b on the free nodes
+    U = coarse.mesh.X @ A.T + [0.001, 0.002, -0.003]
+    U0 = transfer_start(coarse, U, fine)
+    expected = fine.mesh.X @ A.T + [0.001, 0.002, -0.003]
+    free = fine.free
+    assert np.allclose(U0[free], expected[free], atol=1e-14)
+    assert not np.any(U0[fine.fixed]) and fine.fixed.any()
+
+
+@pytest.fixture(scope="module")
+def drape(tmp_path_factory):
+    out = tmp_path_factory.mktemp("levels") / "run"
+    result = app.run(load_scene("pedestal-square-20", DRAPE), out, progress=False, figures=False)
+    return result, out
+
+
+def test_a_drape_solved_level_by_level_is_a_stable_equilibrium_of_the_fine_mesh(drape):
+    result, out = drape
+    s = json.loads((out / "summary.json").read_text())
+    assert s["converged"] and s["stable_minimum"] and s["route"] == "relax+newton+levels"
+    assert [lv["mesh"] for lv in s["levels"]] == ["[9, 9]", "[17, 17]"]
+    assert s["levels"][1]["route"] == "newton" and s["levels"][0]["route"] == "relax+newton"
+    assert s["newton_iterations"] == sum(lv["iterations"] for lv in s["levels"])
+    # the equilibrium checked by its own residual on the scene's (fine) model
+    r = result.model.residual(result.U, 1.0)[result.model.free]
+    assert np.linalg.norm(r) <= 1e-5 * np.linalg.norm(result.model.load)
+    assert s["drape"]["fold_count"] == 4 and s["max_penetration"] < 1e-3
+    assert not list(out.glob("level-*.npz"))  # a finished run keeps no levels
+
+
+def test_a_resumed_sequence_takes_up_the_saved_levels(tmp_path, drape):
+    scene = load_scene("pedestal-square-20", DRAPE)
+    model, _ = build_model(scene)
+    opts = static_options(scene, progress=False)
+    first = solve_levels(scene, model, opts, folder=tmp_path)
+    assert (tmp_path / "level-1.npz").exists()
+    again = solve_levels(scene, build_model(scene)[0], opts, folder=tmp_path, resume=True)
+    assert again.levels[0]["resumed"] and "resumed" not in again.levels[1]
+    assert np.allclose(again.U, first.U, rtol=0, atol=1e-9)
+    # a level saved for another model (another fabric) is solved again
+    other = load_scene("pedestal-square-20", DRAPE + ["material.weight=0.03"])
+    res = solve_levels(other, build_model(other)[0], static_options(other, progress=False), folder=tmp_path,
+                       resume=True)
+    assert "resumed" not in res.levels[0]
