@@ -91,6 +91,15 @@ def test_a_scene_key_overrides_one_key_of_a_ctd_preset():
     assert b.Db[0, 0] == pytest.approx(0.2 * GF_CM_MOMENT) and b.Db[1, 1] == base.Db[1, 1]
 
 
+def test_fabrics_command_lists_the_ctd_presets(capsys):
+    from rftstatic.cli import main
+
+    assert main(["fabrics"]) == 0
+    out = capsys.readouterr().out
+    assert "ctd-213-medium" in out and "1.941 / 1.725" in out and "Feng et al. (2022) data set, row 213" in out
+    assert "not from the source: membrane rigidities" in out
+
+
 def test_cantilever_recovers_a_ctd_preset_rigidity(tmp_path):
     """The cantilever scene (default mesh) on the medium preset reads its B_warp within 0.5 % (measured
     2026-12-02: -0.09 %, 4 s)."""
