@@ -3,6 +3,10 @@ their bending lengths against values computed by hand from that row, the rule fo
 not give, and the cantilever tester recovering a preset's rigidity."""
 
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -113,3 +117,23 @@ def test_cantilever_recovers_a_ctd_preset_rigidity(tmp_path):
     assert cant["given_bending_rigidity"] == pytest.approx(given, rel=1e-12)
     assert cant["flexural_rigidity"] == pytest.approx(given, rel=5e-3)
     assert cant["bending_length"] == pytest.approx(HAND_C_CM["ctd-213-medium"][0], rel=5e-3 / 3)
+
+
+CTD_CSV = os.environ.get("RFTSTATIC_CTD_CSV")
+
+
+@pytest.mark.skipif(not CTD_CSV, reason="set RFTSTATIC_CTD_CSV to a copy of the data set's dataset/dataset.csv")
+def test_ctd_presets_are_the_rows_of_the_file_and_the_rule_picks_them():
+    """Against the file itself (not in this repository): each preset's seven values are its row, and the
+    selection rule of tools/select_ctd_fabrics.py picks exactly these rows."""
+    lines = open(CTD_CSV).read().splitlines()
+    assert tuple(c.strip() for c in lines[0].split(",")) == CTD_COLUMNS and len(lines) - 1 == 618
+    for name in HAND_C_CM:
+        fab, row = FABRICS[name], int(name.split("-")[1])
+        cells = [float(c) for c in lines[row + 1].split(",")]
+        published = {**{k: fab.values[v] for k, v in zip(CTD_COLUMNS[:3], ("ctd_density", "ctd_B_warp",
+                                                                               "ctd_B_weft"))}, **fab.not_used}
+        assert [published[k] for k in CTD_COLUMNS] == cells, name
+    out = subprocess.run([sys.executable, str(Path(__file__).parents[2] / "tools" / "select_ctd_fabrics.py"),
+                          CTD_CSV], capture_output=True, text=True, check=True).stdout
+    assert sorted(n.split(":")[0] for n in out.splitlines()[1:]) == sorted(HAND_C_CM)
