@@ -145,10 +145,16 @@ def _command(args) -> int:
                 print(f"{name:32s} {title}")
             return 0
         if args.command == "fabrics":
-            print(f"{'preset':18s} {'B warp/weft [gf cm]':>20s} {'W [gf/cm2]':>11s} {'c warp/weft [cm]':>17s}  source")
-            for f in api.list_fabrics():
-                print(f"{f['name']:18s} {f['B_warp']:>9.4g} / {f['B_weft']:<8.4g} {f['weight']:>11.4g} "
-                      f"{f['c_warp']:>7.4g} / {f['c_weft']:<7.4g}  {f['source']}")
+            rows = api.list_fabrics()
+            print(f"{'preset':22s} {'B warp/weft [gf cm]':>20s} {'W [gf/cm2]':>11s} {'c warp/weft [cm]':>17s}  "
+                  "not from the source             source")
+            for f in rows:
+                print(f"{f['name']:22s} {f['B_warp']:>9.4g} / {f['B_weft']:<8.4g} {f['weight']:>11.4g} "
+                      f"{f['c_warp']:>7.4g} / {f['c_weft']:<7.4g}  {','.join(f['derived']) or '-':30s}  "
+                      f"{f['short_source']}")
+            for rule in dict.fromkeys(f["derived_rule"] for f in rows if f["derived_rule"]):
+                print(f"not from the source: {rule}")
+            print("sources in full: rftstatic.fabrics.library.FABRICS[name].source")
             return 0
         if args.command == "case":
             scene = api.load_scene(args.name, args.set)

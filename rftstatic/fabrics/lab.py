@@ -30,6 +30,36 @@ fast_W             g/m^2               weight [N/m^2] = W * 1e-3 * 9.80665
 fast_T             mm                  thickness (T2, at 2 gf/cm^2)
 =================  ==================  ===================================================================
 
+Feng et al.'s public data set (below; ``ctd_*``, the ClothDrapeTester repository's ``dataset/dataset.csv``):
+
+=================  ==================  ===================================================================
+ctd_density        kg/m^2              weight [N/m^2] = density * g (standard gravity 9.80665 m/s^2; the
+                                       repository's own ``bending_validation/Main.m`` takes 9.8)
+ctd_B_warp/weft    1e-9 N m            B [N m] = value * 1e-9 (column "linear warp/weft[SI*1e9]")
+=================  ==================  ===================================================================
+
+What the data set's columns are, as far as its repository (commit 24a980c) establishes them (its readme
+calls the file "the 618-fabric parameter dataset" and says no more): they are the parameters of the
+repository's bending law, ``arcsim/AdaptiveCloth/physics.cpp`` (``principal_curvature_based_bending_*``):
+per unit edge length the bending moment is ``M = k1 kappa + k2 kappa^2`` (energy ``(k1 kappa theta/2 + k2
+kappa^2 theta/3) l``), with ``k1, k2`` interpolated between warp, bias and weft values by the direction of
+principal curvature (``nonlinear_bending_stiff``: cos^2/sin^2 of twice the angle). So "linear warp" is k1
+along the warp, a moment per width per curvature [N m], stored x 1e9; "nonlinear" is k2 [N m^2], stored
+x 1e12 (negative: the data set's fabrics soften as they bend); "diag" is the bias (45 deg) value. That k1
+is the flexural rigidity B of the continuum rests on ``bending_validation/Main.m``, which runs the law
+against the cantilever master curve of Romero et al. (2021) with the abscissa ``density * gravity * L^3 /
+modulus`` (density [kg/m^2], gravity [m/s^2], L [m]): the dimensionless group rho g L^3 / B of a strip
+(Peirce's bending length c = (B / rho g)^(1/3)). How the values were obtained (which tester; the paper's
+drape tester and its network, or another instrument) the repository does not say, and the paper was not
+read here: they are the published parameters, not necessarily a direct measurement. This module reads
+only k1 (warp, weft) and the density; the linear model's B is the data set's small-curvature rigidity.
+What it drops: k2 (at the curvature 1/c of the bending length, k2 kappa / k1 over the 618 rows is, warp
+and weft, -0.41 / -0.36 at the 5th percentile, -0.13 / -0.14 at the median, -0.05 / -0.04 at the 95th:
+the data set's own moment at that curvature is that fraction below k1 kappa; ``tools/select_ctd_fabrics.py``
+prints these) and the bias k1 (it is a value of the repository's interpolation, not of a plate
+theory: turning it into a twisting rigidity would need the plate's compliance rotation, which the
+repository's law does not follow).
+
 What the linear model drops: the bending and shear hysteresis (KES 2HB, 2HG, 2HG5), the nonlinear
 shear curve beyond the small angles where G is measured (0.5-5 deg), the tensile curve's nonlinearity
 (the secant at Fm replaces it: crimp interchange makes the initial modulus far lower, so a drape that
@@ -45,9 +75,10 @@ What the bounds rest on (searched for through public material on 2026-12-02; not
 - bending rigidity and weight: the public data set of Feng, Huang, Xu & Wang (2022), "Learning-Based Bending
   Stiffness Parameter Estimation by a Drape Tester", ACM Trans. Graph. 41(6) (SIGGRAPH Asia),
   doi:10.1145/3550454.3555464, file ``dataset/dataset.csv`` of github.com/DrapeTester/ClothDrapeTester
-  (commit 24a980c): 618 real fabrics (251 distinct rows), cantilever-measured, columns "density[kg.m-2]"
-  and "linear warp/weft[SI*1e9]". Read as N m per width x 1e9 (dimensionally the modulus rho g L^3 / gamma
-  of the repository's ``GenerateModulusForSampling.m``; the paper itself was not read), they span
+  (commit 24a980c): 618 fabrics (251 distinct rows), columns "density[kg.m-2]" and "linear
+  warp/weft[SI*1e9]" (the ``ctd_*`` keys above: how the data set's values were obtained its repository does
+  not say). Read as N m per width x 1e9 (dimensionally the modulus rho g L^3 / gamma of the repository's
+  ``GenerateModulusForSampling.m``; the paper itself was not read), they span
   B 0.223-265.7 uN m (0.00227-2.71 gf cm^2/cm) and 15.3-870.3 g/m^2 (1.53-87.0 mg/cm^2). The bounds lie
   a factor 4.5-7.5 beyond that span (tests/fabrics/test_lab.py checks the extremes are inside);
 - the paper's wool (B 0.083/0.063 gf cm, G 0.73 gf/(cm deg), W 19 mg/cm^2) is inside every bound;
@@ -97,6 +128,9 @@ LAB_KEYS = {
     "fast_G": ("N/m", "FAST shear rigidity 123/EB5"),
     "fast_W": ("g/m^2", "FAST mass per area"),
     "fast_T": ("mm", "FAST-1 thickness T2"),
+    "ctd_B_warp": ("1e-9 N m", 'Feng et al. (2022) data set, column "linear warp[SI*1e9]" (k1 along the warp)'),
+    "ctd_B_weft": ("1e-9 N m", 'Feng et al. (2022) data set, column "linear weft[SI*1e9]"'),
+    "ctd_density": ("kg/m^2", 'Feng et al. (2022) data set, column "density[kg.m-2]" (mass per area)'),
 }
 """Lab keys of ``[material]``: (unit as printed by the instrument, meaning)."""
 
@@ -108,6 +142,9 @@ RANGES = {
     "fast_B_warp": (0.05, 2000.0), "fast_B_weft": (0.05, 2000.0), "fast_E100_warp": (0.1, 60.0),
     "fast_E100_weft": (0.1, 60.0), "fast_G": (2.0, 2000.0), "fast_W": (3.0, 5000.0), "fast_T": (0.05, 10.0),
 }
+RANGES.update({"ctd_B_warp": tuple(b * 1e3 for b in RANGES["fast_B_warp"]),   # uN m -> 1e-9 N m
+               "ctd_B_weft": tuple(b * 1e3 for b in RANGES["fast_B_weft"]),
+               "ctd_density": tuple(w * 1e-3 for w in RANGES["fast_W"])})      # g/m^2 -> kg/m^2
 """Plausible bounds (inclusive) of each lab key, in its lab unit (module docstring: B and W from a public
 618-fabric data set; the others unverified and loose)."""
 
@@ -119,12 +156,12 @@ RANGE_EVIDENCE = {
 """The measured span the B and W bounds were set against (module docstring)."""
 
 QUANTITY_KEYS = {
-    "B_warp": ("kes_B_warp", "fast_B_warp"),
-    "B_weft": ("kes_B_weft", "fast_B_weft"),
+    "B_warp": ("kes_B_warp", "fast_B_warp", "ctd_B_warp"),
+    "B_weft": ("kes_B_weft", "fast_B_weft", "ctd_B_weft"),
     "C_shear": ("kes_G", "fast_G"),
     "C_warp": ("kes_EMT_warp", "kes_WT_warp", "fast_E100_warp"),
     "C_weft": ("kes_EMT_weft", "kes_WT_weft", "fast_E100_weft"),
-    "weight": ("kes_W", "fast_W"),
+    "weight": ("kes_W", "fast_W", "ctd_density"),
     "thickness": ("kes_T", "fast_T"),
 }
 """Model quantity -> the lab keys that give it (one source per quantity)."""
@@ -219,6 +256,8 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
             put(f"B_{d}", f"kes_B_{d}", _CM_GF.to_si(lab[f"kes_B_{d}"], "moment"), "gf cm^2/cm = gf cm (per width)")
         if f"fast_B_{d}" in lab:
             put(f"B_{d}", f"fast_B_{d}", lab[f"fast_B_{d}"] * 1e-6, "uN m = 1e-6 N m (per width)")
+        if f"ctd_B_{d}" in lab:
+            put(f"B_{d}", f"ctd_B_{d}", lab[f"ctd_B_{d}"] * 1e-9, "1e-9 N m (per width): the data set's k1")
         tensile = _tensile(lab, d)
         if tensile is not None:
             key = next(k for k in (f"kes_EMT_{d}", f"kes_WT_{d}", f"fast_E100_{d}") if k in lab)
@@ -232,6 +271,8 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
         put("weight", "kes_W", lab["kes_W"] * 1e-2 * STANDARD_GRAVITY, "mg/cm^2 = 1e-2 kg/m^2, times g")
     if "fast_W" in lab:
         put("weight", "fast_W", lab["fast_W"] * 1e-3 * STANDARD_GRAVITY, "g/m^2 = 1e-3 kg/m^2, times g")
+    if "ctd_density" in lab:
+        put("weight", "ctd_density", lab["ctd_density"] * STANDARD_GRAVITY, "kg/m^2 times g")
     for key in ("kes_T", "fast_T"):
         if key in lab:
             put("thickness", key, lab[key] * 1e-3, "mm")

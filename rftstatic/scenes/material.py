@@ -59,6 +59,10 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
                               f'{", ".join(FABRICS)} (python -m rftstatic fabrics lists them)')
         fab = FABRICS[name]
         si, record = _to_si(fab.values, unit_system(fab.units))
+        derived, _ = _to_si(fab.derived, unit_system(fab.units))
+        for q in set(derived) - set(si):  # what the source does not give, by the preset's stated rule
+            si[q] = derived[q]
+            record[q] = {"rule": fab.derived_rule}
     own_si, own_record = _to_si(m, scene.units)
     for q in own_si:  # a scene key replaces the preset's value of its quantity, whatever its form
         record.pop(q, None)
@@ -134,7 +138,9 @@ def material_summary(scene, material: mat.Material) -> dict:
 
 def list_fabrics() -> list[dict]:
     """Every library fabric as built for a scene in cm-gf-s: name, bending rigidities B [gf cm] and bending
-    lengths c = (B/W)^(1/3) [cm] along warp and weft, weight [gf/cm^2], description and source."""
+    lengths c = (B/W)^(1/3) [cm] along warp and weft, weight [gf/cm^2], description and source (full and
+    short), ``derived``: the quantities not from the source (by ``derived_rule``, or B_twist by default),
+    and ``not_used``: published values the linear model does not take."""
     from rftstatic.scenes.schema import scene_from_dict
 
     rows = []
@@ -144,5 +150,7 @@ def list_fabrics() -> list[dict]:
         rows.append({"name": name, "B_warp": m["B_warp"], "B_weft": m["B_weft"], "weight": m["weight"],
                      "c_warp": m["bending_length_warp"], "c_weft": m["bending_length_weft"],
                      "published_units": fab.units, "description": fab.description, "source": fab.source,
-                     "measured_dc": dict(fab.measured_dc)})
+                     "short_source": fab.short_source or fab.source, "measured_dc": dict(fab.measured_dc),
+                     "derived": sorted(q for q, rec in m.get("lab", {}).items() if "from" not in rec),
+                     "derived_rule": fab.derived_rule, "not_used": dict(fab.not_used)})
     return rows

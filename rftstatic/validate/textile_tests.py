@@ -7,7 +7,8 @@
   apart. Pass: within 0.5 % on the default mesh and finer, both directions.
 - Cusick (BS 5058, ISO 9073-9; ``cusick-30``): drape coefficient and fold count on four meshes, the spread of
   seeded starts (a lab's specimens), and DC against the dimensionless group disc radius / bending length
-  (the wool with its bending rigidities scaled, and the three specimen sizes). Reported, not checked: a
+  (the wool with its bending rigidities scaled, the three specimen sizes, and the library's ``ctd-*``
+  fabrics on the 30 cm specimen). Reported, not checked: a
   drape has several stable equilibria (§6.2), so DC and fold count are a distribution, not one number.
 - Measured DC: where a published fabric gives both mechanical data and a Cusick DC, simulation against
   measurement (none in the library yet: see the report).
@@ -23,6 +24,7 @@ import time
 from pathlib import Path
 
 from rftstatic import api
+from rftstatic.fabrics.library import FABRICS
 from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures
 
 TOLERANCE = 0.005
@@ -129,7 +131,7 @@ def _cusick_seeds(result, tmp):
                             f"{g['fold_counts']} ({t:.0f} s for {SEEDS} solves)."))
 
 
-def _dc_vs_group(result, tmp, out, factors):
+def _dc_vs_group(result, tmp, out, factors, library=()):
     lines = ["| fabric | specimen [cm] | c warp / weft [cm] | R_disc / c | DC [%] | folds | time [s] |",
              "|" + "---|" * 7]
     curves = {}
@@ -140,10 +142,19 @@ def _dc_vs_group(result, tmp, out, factors):
     for size in (24, 36):
         s, t = _run(f"cusick-{size}", [], tmp)
         curves.setdefault(f"{size} cm specimen, wool", []).append(_group_row(s, "wool", size, t, lines))
+    for name in library:
+        s, t = _run("cusick-30", [f"material.preset={name}"], tmp)
+        curves.setdefault("30 cm specimen, library fabrics", []).append(_group_row(s, name, 30, t, lines))
+    for points in curves.values():
+        points.sort(key=lambda p: p[0])
     result.sections.append(("Cusick tester: DC against disc radius / bending length", "\n".join(lines)
                             + "\n\nc = sqrt(c_warp c_weft); scaling all bending rigidities by f scales c by f^(1/3). "
                               "At a fixed specimen/disc ratio the DC is a function of R_disc/c (and of the weaker "
-                              "groups C/B R^2 and the anisotropy): a limper fabric (larger R_disc/c) drapes lower."))
+                              "groups C/B R^2 and the anisotropy): a limper fabric (larger R_disc/c) drapes lower. "
+                              "The library fabrics (ctd-*: Feng et al. 2022's data set) carry the data set's "
+                              "bending rigidities and weight and the wool's membrane rigidities (rftstatic.fabrics."
+                              "library), so they test the group across fabrics that differ in weight, anisotropy "
+                              "and C/B R^2."))
     for label, points in curves.items():
         for group, dc, row in points:
             result.rows.append(row)
@@ -164,7 +175,7 @@ def _plot_group(out, curves) -> str:
     ax.set_ylabel("drape coefficient [%]")
     ax.grid(True, lw=0.3, alpha=0.5)
     ax.legend(loc="best", fontsize="small")
-    set_title(ax, "Cusick drape coefficient against disc radius / bending length (wool, its bending rigidities scaled)")
+    set_title(ax, "Cusick drape coefficient against disc radius / bending length (wool scaled; library fabrics)")
     name = "textile_tests_dc_vs_group.png"
     save_png(fig, out / name)
     return name
@@ -196,7 +207,7 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
                        {"graded": CUSICK_MESHES, "uniform": UNIFORM_MESHES})
         if not quick:
             _cusick_seeds(result, tmp)
-            _dc_vs_group(result, tmp, out, B_FACTORS)
+            _dc_vs_group(result, tmp, out, B_FACTORS, [n for n in FABRICS if n.startswith("ctd-")])
     result.sections.append(("Simulation against measured DC", MEASURED_NOTE))
     if out is not None:
         result.figures += convergence_figures(result, out)
@@ -204,13 +215,18 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
 
 
 MEASURED_NOTE = (
-    "Not done: no fabric in the library (rftstatic.fabrics.library) has both published mechanical data and a "
-    "published Cusick DC. Kang & Yu (1995) give the wool's rigidities but no drape-tester reading. A search of "
-    "public copies (2026-12-02) found the studies that pair KES-F or FAST data with a Cusick DC by title and "
-    "abstract only, their tables out of reach: Hu & Chan (1998), Text. Res. J. 68(1) 57-64; Kenkare et al. (2008), "
-    "J. Text. Inst., doi:10.1080/00405000701489222; Jeong & Phillips (1998), J. Text. Inst. 89(1) 70-79; Kuijpers "
-    "(2017), MPhil thesis, Manchester; Sanad et al. (2013), J. Fiber Bioeng. Inform. 6(1). The public measured data "
-    "sets found (Feng et al. 2022, 618 fabrics: density and cantilever bending only; Wang et al. 2011, ten fabrics "
-    "in ARCSim's format) give no Cusick DC. No value is entered from memory. A fabric enters the library with its "
-    "source table (Fabric.measured_dc with the specimen and disc sizes), and this section then compares "
-    "(README, Fabric data in lab units).")
+    "Not done: no fabric in the library (rftstatic.fabrics.library) has a published Cusick DC (Fabric.measured_dc "
+    "is empty for every preset). Kang & Yu (1995) give the wool's rigidities but no drape-tester reading. The "
+    "library's other fabrics (" + ", ".join(n for n in FABRICS if n.startswith("ctd-")) + ") are rows of the "
+    "public data set of Feng et al. (2022), ACM TOG 41(6), github.com/DrapeTester/ClothDrapeTester "
+    "dataset/dataset.csv: published density and bending rigidities, no tensile, shear or Cusick data; their "
+    "membrane rigidities are the wool's by a stated rule. Their DC above (DC against disc radius / bending length) "
+    "is a simulation only and rests on that rule: with the membrane rigidities x 0.1 the DC of ctd-213-medium "
+    "falls from 55.4 % to 42.3 % on the default mesh (README, The fabric library). A search of public copies "
+    "(2026-12-02) found the studies that pair KES-F or FAST data with a Cusick DC by title and abstract only, "
+    "their tables out of reach: Hu & Chan (1998), Text. Res. J. 68(1) 57-64; Kenkare et al. (2008), J. Text. "
+    "Inst., doi:10.1080/00405000701489222; Jeong & Phillips (1998), J. Text. Inst. 89(1) 70-79; Kuijpers (2017), "
+    "MPhil thesis, Manchester; Sanad et al. (2013), J. Fiber Bioeng. Inform. 6(1); Wang et al. (2011, ten "
+    "fabrics in ARCSim's format) give no Cusick DC either. No value is entered from memory. A fabric enters the "
+    "library with its source table (Fabric.measured_dc with the specimen and disc sizes), and this section then "
+    "compares (README, The fabric library).")

@@ -54,7 +54,7 @@ def test_out_of_range_lab_values_are_refused(key, value):
 
 
 def test_bounds_of_b_and_w_hold_the_measured_data_set_with_margin():
-    """The B and W bounds against the span of Feng et al.'s (2022) 618 cantilever-measured fabrics
+    """The B and W bounds against the span of Feng et al.'s (2022) 618 fabrics
     (RANGE_EVIDENCE): each extreme is inside, and the bound lies a factor >= 4 beyond it."""
     b_lo, b_hi = RANGE_EVIDENCE["B_uNm"]
     w_lo, w_hi = RANGE_EVIDENCE["W_g_per_m2"]
@@ -112,7 +112,7 @@ def test_twist_default_without_measurement():
 
 
 def test_missing_quantity_names_its_lab_keys():
-    with pytest.raises(SceneError, match="weight \\(or kes_W / fast_W\\)"):
+    with pytest.raises(SceneError, match="weight \\(or kes_W / fast_W / ctd_density\\)"):
         _material({k: v for k, v in WOOL_KES.items() if k != "kes_W"})
 
 
