@@ -174,6 +174,8 @@ def put(data, path, value) -> bool:
     a value is in the way)."""
     node = data
     for part, nxt in itertools.pairwise(path):
+        if isinstance(node, dict) and isinstance(part, int):
+            return False  # an array index where a table stands (e.g. after a swap): TOML has no int keys
         if isinstance(node, dict):
             node = node.setdefault(part, [{}] if isinstance(nxt, int) else {})
         elif isinstance(node, list) and isinstance(part, int):
@@ -516,7 +518,7 @@ def scenes(draw):
 # ------------------------------------------------------------------------------------------ TOML out
 def toml_key(key) -> str:
     """A TOML key: bare when it can be, else quoted."""
-    return key if re.fullmatch(r"[A-Za-z0-9_-]+", str(key)) else toml_string(str(key))
+    return str(key) if re.fullmatch(r"[A-Za-z0-9_-]+", str(key)) else toml_string(str(key))
 
 
 def toml_string(s: str) -> str:
