@@ -71,11 +71,11 @@ MIN_FRACTION = 0.2
 """Default ``min_fraction`` of the step bound: no pair comes closer than this fraction of its distance
 at the start of a step."""
 
-SWEEP_PAIRS = 4_000_000
-"""Budget of candidate pairs of one swept broad phase (about 1 GB with their node positions). The swept
-boxes of a step whose relative motion is s cover about (s / h)^2 triangles each, so a swept test of the
-E triangles finds about E (s / h)^2 candidates: :attr:`SelfContact.sweep_limit` = h sqrt(budget / E)
-bounds s. Without it one Newton step of the 80 cm sheet at 201 x 201 nodes (80,000 triangles, h = 4 mm)
+SWEEP_PAIRS = 1_000_000
+"""Budget of candidate pairs of one swept broad phase. The swept boxes of a step whose relative motion is
+s cover about (s / h)^2 triangles each, so a swept test of the E triangles finds about E (s / h)^2
+point-triangle candidates (and as many again edge-edge ones, more where folded layers are stacked):
+:attr:`SelfContact.sweep_limit` = h sqrt(budget / E) bounds s. Without it one Newton step of the 80 cm sheet at 201 x 201 nodes (80,000 triangles, h = 4 mm)
 from a transferred coarse drape swept ~10 cm and the process ran out of 24 GB."""
 
 

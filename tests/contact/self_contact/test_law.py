@@ -137,7 +137,7 @@ def test_a_step_too_long_to_sweep_is_bounded_to_the_sweep_limit():
     driven through a triangle still stops short of it."""
     mesh = rectangle(1.0, 1.0, 5, 5, pattern="right")
     sc = SelfContact(mesh, 0.05, 1.0)
-    assert sc.sweep_limit == pytest.approx(0.25 * np.sqrt(4e6 / 32), rel=0.3)  # h sqrt(budget / E)
+    assert sc.sweep_limit == pytest.approx(0.25 * np.sqrt(1e6 / 32), rel=0.3)  # h sqrt(budget / E)
     X = mesh.X3.copy()
     centre = X[mesh.tri[0]].mean(axis=0)
     X[24] = centre + [0, 0, 0.3]
