@@ -74,7 +74,8 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     callback, checkpoint : as for :func:`~rftstatic.solvers.static.solve_static`, on the finest level
 
     Returns the finest level's :class:`~rftstatic.solvers.newton.StaticResult`, its ``route``
-    ``"<coarsest route>+levels"``, ``levels`` one record per mesh and the counters summed over them.
+    ``"<coarsest route>+levels"``, ``levels`` one record per mesh, the counters summed over them, and
+    ``path`` and ``relax`` those of the coarsest level's route (the path followed, the relaxation).
 
     Raises
     ------
@@ -105,7 +106,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
                                          checkpoint=checkpoint if last else None)
         else:
             U0 = transfer_start(prev[0], prev[1], m)
-            newton = replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement",
+            newton = replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement", continuation="load",
                              progress=opts.progress and last)
             what = f"Newton at full load from level {k - 1}"
             solve = lambda: solve_static(m, U0=U0, options=newton, callback=callback if last else None,  # noqa: E731
@@ -130,9 +131,14 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
                                    f"{res.message}", result=res if last else None)
         if folder is not None and not last:
             _save_level(folder, k, m, res.U, record)
+        if prev is None:  # the coarsest route's own record (its path or relaxation) stands for the sequence
+            first_path, first_relax = res.path, res.relax
         prev = (m, res.U)
     res.route = f"{records[0]['route']}+levels"
     res.levels = records
+    if records[0].get("resumed"):
+        first_path, first_relax = {}, {}
+    res.path, res.relax = res.path or first_path, res.relax or first_relax
     for key, value in totals.items():
         setattr(res, key, value)
     res.wall_time = time.perf_counter() - t_all

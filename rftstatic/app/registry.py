@@ -65,6 +65,12 @@ def _publish(partial: Path, out: Path) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
+def _resumable(folder: Path) -> bool:
+    """Whether ``folder`` holds work a ``--resume`` continues: a checkpoint, or the saved levels of a mesh
+    sequence (``level-K.npz``, :mod:`rftstatic.app.levels`)."""
+    return (folder / "checkpoint.npz").exists() or any(folder.glob("level-*.npz"))
+
+
 def run(scene, out_dir, *, progress=True, figures=True):
     """Run ``scene`` with its analysis (:func:`analysis_of`) and return the
     :class:`~rftstatic.app.result.RunResult`.
@@ -87,7 +93,7 @@ def run(scene, out_dir, *, progress=True, figures=True):
             _publish(partial, out)
         raise
     except Exception:
-        if not (partial / "checkpoint.npz").exists():  # nothing to resume: leave no partial folder
+        if not _resumable(partial):  # nothing to resume: leave no partial folder
             shutil.rmtree(partial, ignore_errors=True)
         raise
     _publish(partial, out)
@@ -112,11 +118,11 @@ def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
     resume = importlib.import_module(ANALYSES[name]).resume_scene
     out = Path(out_dir)
     partial = out.with_name(out.name + PARTIAL)
-    if (partial / "checkpoint.npz").exists():
+    if _resumable(partial):
         summary = resume(scene, partial, progress=progress, figures=figures)
         _publish(partial, out)
         return summary
-    if static and not (out / "checkpoint.npz").exists():
+    if static and not _resumable(out):
         log.warning("no checkpoint in %s or %s: running %s from the start", partial, out, scene.name)
         return run(scene, out, progress=progress, figures=figures).summary
     return resume(scene, out, progress=progress, figures=figures)

@@ -97,3 +97,28 @@ def test_a_resumed_sequence_takes_up_the_saved_levels(tmp_path, drape):
     res = solve_levels(other, build_model(other)[0], static_options(other, progress=False), folder=tmp_path,
                        resume=True)
     assert "resumed" not in res.levels[0]
+
+
+def test_resume_from_the_command_line_takes_up_a_saved_level(tmp_path):
+    """``case NAME --resume`` on a folder that holds only saved levels (a run killed on its finest mesh)
+    continues from them (:func:`rftstatic.app.registry.resume_scene`), then leaves no level behind."""
+    from rftstatic.app.registry import resume_scene
+
+    scene = load_scene("pedestal-square-20", DRAPE)
+    out = tmp_path / "run"
+    solve_levels(scene, build_model(scene)[0], static_options(scene, progress=False), folder=out)
+    (out / "level-2.npz").unlink(missing_ok=True)  # the finest level is never saved; as if killed there
+    s = resume_scene(scene, out, progress=False, figures=False)
+    assert s["converged"] and s["levels"][0]["resumed"] and "resumed" not in s["levels"][1]
+    assert not list(out.glob("level-*.npz"))
+
+
+def test_the_load_scaled_route_on_the_coarsest_mesh_and_newton_above_it(tmp_path):
+    """``continuation = "arc-length"`` follows the path on the coarsest mesh only; the finer levels are
+    Newton at full load from the level below (no path from their transferred start), no relaxation."""
+    scene = load_scene("pedestal-square-20", DRAPE + ["solver.start=load-steps", "solver.continuation=arc-length",
+                                                      "solver.relax_fallback=false"])
+    s = app.run(scene, tmp_path / "run", progress=False, figures=False).summary
+    assert s["converged"] and s["stable_minimum"] and s["route"] == "arc-length+levels"
+    assert [lv["route"] for lv in s["levels"]] == ["arc-length", "newton"]
+    assert s["relax"] == {} and len(s["path"]["steps"]) > 0 and s["path"]["final_negative"] == 0
