@@ -9,14 +9,16 @@ of the one above it:
 mesh kind           level ``k`` below the scene's mesh (``k = 1, 2, ...``)
 ==================  ======================================================================
 ``rectangle``       ``nodes = [ceil((nx - 1) / 2^k) + 1, ceil((ny - 1) / 2^k) + 1]``
-``polar``,          ``nodes = [ceil((n_radial - 1) / 2^k) + 1, round(n_circ / 2^k)]``
-``square-polar``    (the rings keep their radii' grading, the circle its sectors' symmetry)
+``polar``,          ``nodes = [ceil((n_radial - 1) / 2^k) + 1, round(n_circ / 2^k)]`` (a square-polar
+``square-polar``    mesh whose n_circ is a multiple of 8 keeps a multiple of 8: a node at each corner)
 ``unstructured``    ``h = 2^k h``
 ``file``            none: a mesh read from a file has no coarser version (a scene error)
 ==================  ======================================================================
 
 so the rectangle's 201 x 201 nodes give 101 x 101 and 51 x 51 (nested: every coarse node is a fine
-node), 81 x 81 gives 41 x 41 and 21 x 21, the round pedestal's 21 x 160 rings give 11 x 80 and 6 x 40.
+node), 81 x 81 gives 41 x 41 and 21 x 21, the round pedestal's 21 x 160 rings give 11 x 80 and 6 x 40,
+its 31 x 240 give 16 x 120 and 9 x 64. A coarser level keeps the scene's obstacles, supports and loads; it
+drops the probes (they report on the scene's own mesh only) and ``solver.seeds``.
 """
 
 from __future__ import annotations
@@ -47,7 +49,12 @@ def level_mesh(scene: Scene, k: int) -> dict:
                               "give mesh.nodes")
         a, b = m["nodes"]
         a2 = math.ceil((a - 1) / 2 ** k) + 1
-        b2 = math.ceil((b - 1) / 2 ** k) + 1 if kind == "rectangle" else round(b / 2 ** k)
+        if kind == "rectangle":
+            b2 = math.ceil((b - 1) / 2 ** k) + 1
+        elif kind == "square-polar":  # a multiple of 8 sectors keeps a node at every corner of the square
+            b2 = 8 * max(1, round(b / 2 ** k / 8)) if b % 8 == 0 else round(b / 2 ** k)
+        else:
+            b2 = round(b / 2 ** k)
         least = LEAST_NODES[kind]
         if a2 < least[0] or b2 < least[1]:
             raise scene.error("solver.levels", f"{k + 1} levels make the coarsest mesh [{a2}, {b2}] nodes from "
@@ -67,8 +74,8 @@ def level_mesh(scene: Scene, k: int) -> dict:
 def level_scenes(scene: Scene, levels: int) -> list[Scene]:
     """The scenes of a sequence of ``levels`` meshes, coarsest first; the last is ``scene`` itself.
 
-    Each coarser scene is ``scene`` with the ``[mesh]`` of :func:`level_mesh` and ``solver.levels = 1``
-    and ``solver.seeds`` removed (a level is one solve), validated like a scene file.
+    Each coarser scene is ``scene`` with the ``[mesh]`` of :func:`level_mesh`, ``solver.levels = 1``, and
+    ``solver.seeds`` and the probes removed (a level is one solve), validated like a scene file.
     """
     if not (isinstance(levels, int) and 1 <= levels <= MAX_LEVELS):
         raise scene.error("solver.levels", f"{levels!r} must be an integer in [1, {MAX_LEVELS}] (the meshes of the "
@@ -80,6 +87,7 @@ def level_scenes(scene: Scene, levels: int) -> list[Scene]:
         solver = data.setdefault("solver", {})
         solver["levels"] = 1
         solver.pop("seeds", None)
+        data.pop("probes", None)
         coarse = Scene(data, scene.path, f"{scene.name} (level {levels - k} of {levels})", dict(scene.overrides))
         validate(coarse)
         out.append(coarse)

@@ -22,13 +22,14 @@ DRAPE = ["mesh.nodes=[17,17]", "solver.levels=2"]  # 9 x 9 by the scene's relaxa
     ("pedestal-square-80", [81, 81], [[21, 21], [41, 41], [81, 81]]),
     ("pedestal-square-20", [34, 33], [[10, 9], [18, 17], [34, 33]]),
     ("pedestal-round-50", [21, 160], [[6, 40], [11, 80], [21, 160]]),
+    ("pedestal-round-50", [31, 240], [[9, 64], [16, 120], [31, 240]]),
 ])
 def test_each_level_has_about_twice_the_element_size_of_the_next(scene, nodes, expected):
     sc = load_scene(scene, [f"mesh.nodes={nodes}", "solver.levels=3"])
     levels = level_scenes(sc, 3)
     assert [s.get("mesh.nodes") for s in levels] == expected
     assert levels[-1] is sc
-    assert all(s.get("solver.levels") == 1 for s in levels[:-1])
+    assert all(s.get("solver.levels") == 1 and s.get("probes") is None for s in levels[:-1])
     assert level_scenes(sc, 1) == [sc]
 
 
