@@ -86,6 +86,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     scenes = level_scenes(scene, opts.levels)
     records, totals = [], {"iterations": 0, "factorisations": 0, "cutbacks": 0, "retries": 0}
     prev = None
+    first_path, first_relax = {}, {}  # the coarsest route's own record (its path or relaxation), if solved here
     t_all = time.perf_counter()
     for k, sc in enumerate(scenes, start=1):
         last = k == len(scenes)
@@ -100,20 +101,17 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             prev = (m, saved["U"])
             continue
         if prev is None:
-            first = replace(opts, levels=1, progress=opts.progress and last)
+            start = {"options": replace(opts, levels=1, progress=opts.progress and last)}
             what = f"the scene's route ({opts.start})"
-            solve = lambda: solve_static(m, options=first, callback=callback if last else None,  # noqa: E731
-                                         checkpoint=checkpoint if last else None)
         else:
-            U0 = transfer_start(prev[0], prev[1], m)
-            newton = replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement", continuation="load",
-                             progress=opts.progress and last)
+            start = {"U0": transfer_start(prev[0], prev[1], m),
+                     "options": replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement",
+                                        continuation="load", progress=opts.progress and last)}
             what = f"Newton at full load from level {k - 1}"
-            solve = lambda: solve_static(m, U0=U0, options=newton, callback=callback if last else None,  # noqa: E731
-                                         checkpoint=checkpoint if last else None)
         log.info("mesh sequencing: level %d of %d, %s nodes, by %s", k, len(scenes), m.mesh.n_nodes, what)
         try:
-            res = solve()
+            res = solve_static(m, **start, callback=callback if last else None,
+                               checkpoint=checkpoint if last else None)
         except ConvergenceError as exc:
             raise ConvergenceError(
                 f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}, {m.mesh.n_nodes} nodes) did not "
@@ -131,13 +129,11 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
                                    f"{res.message}", result=res if last else None)
         if folder is not None and not last:
             _save_level(folder, k, m, res.U, record)
-        if prev is None:  # the coarsest route's own record (its path or relaxation) stands for the sequence
+        if prev is None:
             first_path, first_relax = res.path, res.relax
         prev = (m, res.U)
     res.route = f"{records[0]['route']}+levels"
     res.levels = records
-    if records[0].get("resumed"):
-        first_path, first_relax = {}, {}
     res.path, res.relax = res.path or first_path, res.relax or first_relax
     for key, value in totals.items():
         setattr(res, key, value)
