@@ -146,8 +146,8 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
             ws.modified_shift = 0.0
         elif base == 0.0:
             sequence = sequence[1:]  # the exact tangent was indefinite at the last iterate
-    last_error = None
-    for mode in sequence:
+    last_error = "no tangent tried"  # a message, not the exception: its traceback holds this frame, and
+    for mode in sequence:              # the cycle would keep the tangents until the cyclic collector ran
         shifts = [base]
         if mode == "modified":
             scale = diagonal_scale(model, U, ws)
@@ -163,17 +163,17 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
             try:
                 d = solver.solve(K, -r)
             except NotPositiveDefinite as exc:
-                last_error = exc
+                last_error = str(exc)
                 continue
             if not np.all(np.isfinite(d)):
-                last_error = LinearSolveError("non-finite step")
+                last_error = "non-finite step"
                 continue
             if float(r @ d) < 0.0 or not np.any(r):
                 modes[mode] = modes.get(mode, 0) + 1
                 ws.modified_shift = shift if mode == "modified" else 0.0
                 return d, mode, shift
-            last_error = LinearSolveError("the step is not a descent direction of the energy")
-    raise LinearSolveError(str(last_error))
+            last_error = "the step is not a descent direction of the energy"
+    raise LinearSolveError(last_error)
 
 def roundoff_floor(model, U) -> float:
     """Residual [N] below which round-off rules: the larger of 100 eps times the summed magnitudes of
