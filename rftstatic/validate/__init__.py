@@ -41,6 +41,7 @@ BENCHMARKS = {
     "drape_sq20": "square sheet on a square pedestal (§4.2, Fig. 6): boundary and DC mesh convergence",
     "drape_sharp": "RFT3 vs RFT6 sharp-fold indicators on coarse meshes (§4.3, §4.5)",
     "drape_folds": "fold count on the round pedestal (§4.4, Fig. 10)",
+    "path_following": "the load-scaled route alone (arc-length, levels) from the flat sheet on the §4 drapes",
     "self_contact": "self-contact: crossing pairs and smallest distance with and without it",
     "textile_tests": "cantilever bending tester and Cusick drape tester (ASTM D1388, BS 3356, BS 5058)",
     "peers": "a general FE code (scikit-fem Morley/Argyris plates; cited ABAQUS S4R) next to RF triangles",
