@@ -177,6 +177,16 @@ class CholmodSolver:
     SIMPLICIAL_BELOW = 500
     """Unknowns below which the factorisation is simplicial; supernodal from there on."""
 
+    NESTED_DISSECTION_FROM = 60_000
+    """Unknowns from which the supernodal factorisation is ordered by CHOLMOD's nested dissection
+    (``nesdis``: METIS separators, CAMD on the parts). Measured 2026-12-02 (the 80 cm drape carried from
+    101 x 101 to 201 x 201 nodes, exact tangent + 1e-3 x its mean diagonal; best of 3 per ordering, three
+    processes on the 2 cores, so compare within a row): 121,200 unknowns: AMD 47.4e6 entries of L, 4.0 and
+    4.5 s per factorisation, analysis 0.6 s; METIS 41.6e6, 3.2 s, 1.6 s; nested dissection 41.1e6, 2.6 and
+    2.9 s, 1.5-2.9 s; 30,600 unknowns (101 x 101): AMD 8.4e6, 0.47 s; nested dissection 7.9e6, 0.41-0.65 s
+    (a tie). The analysis is redone when self-contact changes the pattern (8 times in the first 16
+    Newton iterations at 201 x 201, 29 factorisations), so the costlier analysis is paid back there too."""
+
     def __init__(self):
         self._factor = None
         self._pattern = None
@@ -221,7 +231,9 @@ class CholmodSolver:
         sheets (strip 101 x 21: 0.76e6 against 0.97e6 entries of L, 1.0e8 against 1.8e8 flops; sheet
         81 x 81: 4.60e6 against 4.70e6), so the supernodal mode takes CHOLMOD's default ordering,
         which is AMD here (same L) and tries METIS only where AMD fills badly, keeping the better;
-        the analysis is done once per pattern (6,300 unknowns: 12 ms, METIS 26 ms). The ordering
+        the analysis is done once per pattern (6,300 unknowns: 12 ms, METIS 26 ms). From
+        :data:`NESTED_DISSECTION_FROM` unknowns (the 201 x 201 sheet) nested dissection fills and costs
+        less (measured there). The ordering
         changes the round-off of the steps, which matters where the tangent is nearly singular: the
         33 x 33 sheet's load steps from the flat start now get through (193 Newton iterations, 6.8 s)
         where with METIS they failed at load factor 1e-5 and fell back to dynamic relaxation (359
@@ -229,16 +241,21 @@ class CholmodSolver:
         """
         if n < cls.SIMPLICIAL_BELOW:
             return "simplicial", "amd"
+        if n >= cls.NESTED_DISSECTION_FROM:
+            return "supernodal", "nesdis"
         return "supernodal", "default"
 
     def solve(self, K: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
-        from sksparse.cholmod import CholmodNotPositiveDefiniteError, analyze
+        from sksparse.cholmod import CholmodError, CholmodNotPositiveDefiniteError, analyze
 
         A = K.T  # CSR of a symmetric matrix = its CSC transpose, no copy
         with SerialOpenMP():
             if self._factor is None or not self._same_pattern(K):
                 mode, ordering = self.choose_mode(A.shape[0])
-                self._factor = analyze(A, mode=mode, ordering_method=ordering)
+                try:
+                    self._factor = analyze(A, mode=mode, ordering_method=ordering)
+                except CholmodError:  # a CHOLMOD built without its Partition module (METIS): no nesdis
+                    self._factor = analyze(A, mode=mode, ordering_method="default")
                 self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
                 self.analyses += 1
             try:

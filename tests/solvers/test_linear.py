@@ -40,6 +40,17 @@ def test_cholmod_detects_indefinite(n):
 def test_modes_by_size():
     assert linear.CholmodSolver.choose_mode(100) == ("simplicial", "amd")
     assert linear.CholmodSolver.choose_mode(6300)[0] == "supernodal"
+    assert linear.CholmodSolver.choose_mode(121_200) == ("supernodal", "nesdis")
+
+
+def test_nested_dissection_solves_a_large_system():
+    n = linear.CholmodSolver.NESTED_DISSECTION_FROM + 10
+    K, b = _laplacian(n, 0.5), np.cos(np.arange(n))
+    s = linear.CholmodSolver()
+    x = s.solve(K, b)
+    assert s.analyses == 1 and np.allclose(K @ x, b, rtol=0, atol=1e-10)
+    with pytest.raises(linear.NotPositiveDefinite):
+        s.solve(_laplacian(n, -1.0), b)
 
 
 def test_serial_openmp_restores_the_threads():
