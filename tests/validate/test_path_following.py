@@ -120,3 +120,14 @@ def test_run_builds_the_report_from_the_runs(tmp_path, monkeypatch):
     monkeypatch.setattr(pf, "QUICK", [("pedestal-round-50", (21, 160), False, 2)])
     res = pf.run(quick=True)
     assert res.passed and "12 folds" in res.discrepancy and "21 x 160: 9 folds" in res.discrepancy
+
+
+def test_rows_run_through_the_apps_static_route_which_does_the_levels():
+    """The drape bench's child calls the solver directly (no mesh sequencing): the rows use this module's child."""
+    import inspect
+
+    from rftstatic.bench.drape import run_key
+
+    src = inspect.getsource(pf.run_case_cached)
+    assert "rftstatic.validate.path_following:child" in src and "run_static" in inspect.getsource(pf.child)
+    assert run_key("sphere-30", [*pf.ROUTE, pf.KEY_TAG]) != run_key("sphere-30", pf.ROUTE)
