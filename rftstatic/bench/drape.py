@@ -72,6 +72,7 @@ def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
     """
     import resource
 
+    from rftstatic.app.levels import solve_levels
     from rftstatic.app.static import static_summary
     from rftstatic.errors import ConvergenceError
     from rftstatic.io.results import write_outputs
@@ -88,8 +89,9 @@ def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
     model, extras = build_model(scene)
     build = time.perf_counter() - t0
     error = ""
-    try:
-        result = solve_static(model, options=static_options(scene, progress=False))
+    opts = static_options(scene, progress=False)
+    try:  # a scene with solver.levels > 1 is solved by mesh sequencing, as `python -m rftstatic case` does
+        result = solve_levels(scene, model, opts) if opts.levels > 1 else solve_static(model, options=opts)
     except ConvergenceError as exc:
         error, result = str(exc), exc.result
     solved = time.perf_counter() - t0
