@@ -6,8 +6,7 @@ and grown with fast convergence; the mixed iteration starts each one from the la
 first step is the tangent predictor), the displacement iteration from a secant predictor; an increment
 that does not converge is cut back (``increment / 4``) from the last equilibrium, after two mixed
 failures the displacement iteration takes it, and one still sliding downhill when its iterations run
-out continues (snap-through into a fold), as does the whole load from a given state (a relaxed or
-transferred drape, which a cut back would unload), up to ``max_continuations`` times. Below ``min_increment`` the solve stops with
+out continues (snap-through into a fold). Below ``min_increment`` the solve stops with
 :class:`~rftstatic.errors.ConvergenceError`, which carries the last equilibrium.
 """
 
@@ -149,15 +148,11 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                 if checkpoint is not None:
                     checkpoint(LoadPath(lam, U, dlam, target, lam_prev, U_prev, result))
                 continue
-            # from a given state at full load a cut back would unload the drape (the start is no equilibrium
-            # of a lower load): Newton goes on from where it stopped, also where its energy falls only slowly
-            # (201 x 201 sheet: a hem fold that settles over hundreds of iterations, |r| 1.7e-7 N)
-            if (nt.descending or whole_from_state) and continuations < opts.max_continuations:
+            if nt.descending and continuations < opts.max_continuations:
                 continuations += 1
                 continuing = nt
-                log.info("load factor %.6g: %s after %d iterations (|r| = %.3e); continuing (%d/%d)", lam_next,
-                         "still descending (snap-through)" if nt.descending else "not converged from the given state",
-                         nt.iterations, nt.residual, continuations, opts.max_continuations)
+                log.info("load factor %.6g: still descending after %d iterations (snap-through); continuing "
+                         "(%d/%d)", lam_next, nt.iterations, continuations, opts.max_continuations)
                 continue
             failures += nt.scheme == "mixed"
             result.cutbacks += 1

@@ -197,37 +197,3 @@ def test_static_options_refuse_nan(key):
 
     with pytest.raises(ValueError):
         StaticOptions(**{key: float("nan")})
-
-
-def test_newton_from_a_given_state_goes_on_instead_of_unloading(monkeypatch):
-    """The whole load from a given state (a transferred or relaxed drape): when Newton runs out of
-    iterations there, even with its energy falling only slowly, it continues from where it stopped; a cut
-    back would treat the start as the equilibrium of a lower load and unload the drape."""
-    from dataclasses import replace
-
-    from rftstatic.solvers import load_steps
-
-    mod = strip_model(21, 5, element="RFT6")
-    ref = static.solve_static(mod, options=static.StaticOptions(progress=False))
-    U0 = ref.U.copy()
-    U0[:, 2] += 1e-4 * mod.free[:, 2] * np.sin(40 * mod.X3[:, 0])
-    real, loads = load_steps.newton, []
-
-    def stalling(model, U, lam, opts, ws, max_step, **kw):  # the first two tries stop short, not descending
-        loads.append(lam)
-        if len(loads) <= 2:
-            it = real(model, U, lam, replace(opts, max_iterations=1), ws, max_step, **kw)
-            return replace(it, converged=False, descending=False, reason="stopped short")
-        return real(model, U, lam, opts, ws, max_step, **kw)
-
-    monkeypatch.setattr(load_steps, "newton", stalling)
-    opts = static.StaticOptions(progress=False, iteration="displacement").from_state(relax_fallback=False)
-    res = static.solve_static(mod, U0=U0, options=opts)
-    assert res.converged and res.cutbacks == 0 and loads == [1.0, 1.0, 1.0]
-    assert np.abs(res.U - ref.U).max() < 1e-6 * np.abs(ref.U).max()
-    loads.clear()
-    # without continuations the increment is cut back as before: here the sheet, started under full
-    # load, cannot find the lower loads' equilibria from that start at all
-    with pytest.raises(static.ConvergenceError, match="Last equilibrium at load factor 0"):
-        static.solve_static(mod, U0=U0, options=replace(opts, max_continuations=0))
-    assert loads[:2] == [1.0, 0.25]
