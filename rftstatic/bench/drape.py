@@ -93,6 +93,8 @@ def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
     try:  # a scene with solver.levels > 1 is solved by mesh sequencing, as `python -m rftstatic case` does
         result = solve_levels(scene, model, opts) if opts.levels > 1 else solve_static(model, options=opts)
     except ConvergenceError as exc:
+        if exc.result is None:  # no state to write (a coarser level failed): the solver's error, as the CLI does
+            raise
         error, result = str(exc), exc.result
     solved = time.perf_counter() - t0
     summary = static_summary(scene, model, extras, result, build)
@@ -122,10 +124,10 @@ def run_one(name: str, overrides=(), out=None, *, figures: bool = True, timeout:
     The record adds ``process_s`` [s] (the whole child process, interpreter start-up and imports
     included), ``cpu_s`` [s] (its user + system time), ``target_s`` and ``within_target``; its
     ``peak_rss_mb`` [MB] is the child's peak to its exit. A solve that does not converge returns
-    ``converged = False`` and the solver's message in ``error``; a crash raises
-    :class:`rftstatic.bench.harness.ChildError` (a ``RuntimeError``) naming the scene, with the
-    child's stderr; a child still running after ``timeout`` [s] is killed
-    (:class:`~rftstatic.bench.harness.ChildTimeout`).
+    ``converged = False`` and the solver's message in ``error``; a crash, or a solve that failed with no
+    state to write (a coarser level of ``solver.levels``), raises :class:`rftstatic.bench.harness.ChildError`
+    (a ``RuntimeError``) naming the scene, with the child's stderr; a child still running after ``timeout``
+    [s] is killed (:class:`~rftstatic.bench.harness.ChildTimeout`).
     """
     from rftstatic.bench.harness import run_child
 
@@ -178,14 +180,16 @@ def cached_dir(name: str, overrides=(), *, root: Path) -> Path | None:
     return d if code == code_version() else None  # the child ran other code than the key says: stale
 
 
-def run_cached(name: str, overrides=(), *, root: Path, refresh: bool = False, figures: bool = True) -> dict:
+def run_cached(name: str, overrides=(), *, root: Path, refresh: bool = False, figures: bool = True,
+               timeout: float | None = None) -> dict:
     """:func:`run_one` into ``root/<key>/`` (:func:`run_key`), reusing a finished run there unless ``refresh``.
 
+    ``timeout`` [s]: the child is killed after this long (None: :func:`run_one`'s default, :data:`TIMEOUT_S`).
     Returns the record with ``state`` (the arrays of ``state.npz``) and ``dir``.
     """
     d = Path(root) / run_key(name, overrides)
     if refresh or cached_dir(name, overrides, root=root) is None:
-        run_one(name, list(overrides), d, figures=figures)
+        run_one(name, list(overrides), d, figures=figures, **({} if timeout is None else {"timeout": timeout}))
     rec = json.loads((d / "record.json").read_text(encoding="utf-8"))
     if "process_s" not in rec:  # the child finished but its parent was stopped: in-process time only
         rec["process_s"] = rec["wall_s"]

@@ -4,10 +4,9 @@ Each §4 drape scene of ``cases/`` is solved on its default mesh (and the coarse
 round pedestal) by the load-scaled route only: ``solver.start = "load-steps"``, ``solver.continuation
 = "arc-length"``, ``solver.relax_fallback = false`` and, where given, ``solver.levels = L`` (the path
 on the coarsest of L meshes, Newton at full load on each finer one): no explicit or damped stage.
-Each run is ``python -m rftstatic case`` in a fresh child interpreter (:func:`child`: the app's static run,
-which does the mesh sequencing of ``solver.levels``; the drape bench's child calls the solver directly
-and would ignore ``levels``), cached by code fingerprint beside the drape reports' runs
-(:func:`rftstatic.bench.drape.run_key` with the tag :data:`KEY_TAG`).
+Each run is the drape bench's run in a fresh child interpreter (:func:`rftstatic.bench.drape.run_cached`:
+its child solves as ``python -m rftstatic case`` does, mesh sequencing of ``solver.levels`` included),
+cached by code fingerprint beside the drape reports' runs (:func:`rftstatic.bench.drape.run_key`).
 The report lists per scene the levels and their meshes, convergence, the stable-minimum check, the
 path (steps, critical points, branch switches, fixed-load descents), Newton iterations per level, the
 drape coefficient, the fold count, the energy, the wall time, peak memory and the machine's load
@@ -43,7 +42,6 @@ ROUND = "pedestal-round-50"
 ROUND_MESHES = [(21, 160), (31, 240)]
 PAPER_FOLDS = 12  # Sze & Zhou (2016) §4.4, Fig. 10: 12 folds with RFT6 on 21 x 160 and 31 x 240 nodes
 LOADAVG = "loadavg.json"  # written beside a run's record when this benchmark solved it
-KEY_TAG = "via-case"  # in the cache key: a run of the app's static route (levels), not the drape bench's child
 TIMEOUT_S = 3 * 3600.0  # a row's child is killed after this long [s]
 
 
@@ -57,85 +55,18 @@ def case_label(scene: str, nodes) -> str:
     return f"{scene}, {nodes[0]} x {nodes[1]}" if nodes else f"{scene}, default mesh"
 
 
-def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
-    """In a fresh interpreter: ``python -m rftstatic case NAME --set ...`` into ``out`` (the app's static run,
-    mesh sequencing included); save ``state.npz`` and ``record.json`` as the drape bench's child does.
-    """
-    import resource
-
-    import numpy as np
-
-    from rftstatic.app.static import run as run_static
-    from rftstatic.errors import ConvergenceError
-    from rftstatic.provenance import software
-    from rftstatic.scenes.build import build_model
-    from rftstatic.scenes.schema import load_scene
-
-    out_dir = Path(out)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    scene = load_scene(name, overrides)
-    t0 = time.perf_counter()
-    error = ""
-    try:
-        res = run_static(scene, out_dir, progress=False, figures=figures)
-        model, U = res.model, res.U
-    except ConvergenceError as exc:  # the last state was written, labelled converged = false
-        if exc.result is None:
-            raise
-        error, U = str(exc), exc.result.U
-        model, _ = build_model(scene)
-    wall = time.perf_counter() - t0
-    summary = json.loads((out_dir / "summary.json").read_text(encoding="utf-8"))
-    u = scene.units.length
-    x = model.positions(U) / u
-    rel = model.relative_curvature(U)
-    np.savez_compressed(out_dir / "state.npz", x=x, X=model.X3 / u, tri=model.mesh.tri, relative_curvature=rel)
-    rec = {"scene": name, "overrides": overrides, "element": model.element, "nodes": model.mesh.n_nodes,
-           "elements": model.mesh.n_elements, "converged": bool(summary.get("converged")), "error": error,
-           "load_factor": float(summary.get("load_factor", float("nan"))),
-           "newton_iterations": summary.get("newton_iterations"), "build_s": summary.get("build_time_s", 0.0),
-           "solve_s": summary.get("wall_time_s", 0.0), "wall_s": wall,
-           "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, "drape": summary.get("drape", {}),
-           "software": software()}
-    (out_dir / "record.json").write_text(json.dumps(rec, indent=1, default=float), encoding="utf-8")
-    return rec
-
-
-def run_case_cached(scene: str, ov: list[str], *, root: Path, refresh: bool = False, figures: bool = True) -> dict:
-    """:func:`child` in a fresh interpreter into ``root/<key>/``, reusing a finished run by this code there."""
-    from rftstatic.bench.drape import cached_dir, run_key
-    from rftstatic.bench.harness import run_child
-
-    key = [*ov, KEY_TAG]
-    d = Path(root) / run_key(scene, key)
-    if refresh or cached_dir(scene, key, root=root) is None:
-        run = run_child("rftstatic.validate.path_following:child",
-                        {"name": scene, "out": str(d), "overrides": list(ov), "figures": figures},
-                        name=f"path-following run of {scene} {list(ov)}", timeout=TIMEOUT_S)
-        rec = run.result
-        rec.update(process_s=run.wall_s, cpu_s=run.cpu_s, peak_rss_mb=run.peak_rss_mb)
-        (d / "record.json").write_text(json.dumps(rec, indent=1, default=float), encoding="utf-8")
-    rec = json.loads((d / "record.json").read_text(encoding="utf-8"))
-    import numpy as np
-
-    with np.load(d / "state.npz") as z:
-        rec["state"] = {k: z[k] for k in z.files}
-    rec["dir"] = str(d)
-    return rec
-
-
 def solve_case(scene: str, ov: list[str]) -> dict:
     """The record of one run (cached), with ``summary`` and ``loadavg``; ``crashed`` when the child failed."""
-    from rftstatic.bench.drape import cached_dir
+    from rftstatic.bench.drape import cached_dir, run_cached
 
     root = cache_root()
-    fresh = cached_dir(scene, [*ov, KEY_TAG], root=root) is None
+    fresh = cached_dir(scene, ov, root=root) is None
     if fresh and os.environ.get("RFTSTATIC_DRAPE_CACHED_ONLY") == "1":
         return {"scene": scene, "overrides": ov, "crashed": "not run (not in the cache, "
                                                             "RFTSTATIC_DRAPE_CACHED_ONLY=1)"}
     try:
-        rec = run_case_cached(scene, ov, root=root, refresh=os.environ.get("RFTSTATIC_DRAPE_REFRESH") == "1",
-                              figures=scene == ROUND)
+        rec = run_cached(scene, ov, root=root, refresh=os.environ.get("RFTSTATIC_DRAPE_REFRESH") == "1",
+                         figures=scene == ROUND, timeout=TIMEOUT_S)
     except RuntimeError as exc:  # ChildError / ChildTimeout: the child crashed or was killed
         text = str(exc).strip().splitlines()
         return {"scene": scene, "overrides": ov, "crashed": " ".join(text[:1] + text[-3:])[:600],
@@ -277,12 +208,13 @@ def route_section(rows: list) -> str:
         lines.append(crashed_line(label, rec) if v is None else table_line(label, v))
     codes = sorted({f"{v['commit']} (code {v['code']})" for _, _, v in rows if v})
     notes = sorted({v["loadavg_note"] for _, _, v in rows if v})
-    return ("Each run: `python -m rftstatic case SCENE --set solver.start=load-steps --set "
+    return ("Each run: the scene solved as `python -m rftstatic case SCENE --set solver.start=load-steps --set "
             "solver.continuation=arc-length --set solver.relax_fallback=false [--set solver.levels=L] [--set "
-            "mesh.nodes=[..]]`, in a fresh interpreter (`rftstatic.validate.path_following.child`). *levels*: the path "
-            "(arc-length, inertia, branch switches, descents) on the coarsest mesh, Newton at full load on each "
-            "finer one; the Newton iterations of the path level are its corrector iterations. *critical points*: "
-            "where the tangent's negative-pivot count changed (limit: the load factor turned back). *descents*: "
+            "mesh.nodes=[..]]` does, in a fresh interpreter (the drape bench's run, `rftstatic.bench.drape.child`). "
+            "*levels*: the path (arc-length, inertia, branch switches, descents) on the coarsest mesh, Newton at "
+            "full load on each finer one; the Newton iterations of the path level are its corrector iterations. "
+            "*critical points*: where the tangent's negative-pivot count changed (limit: the load factor turned "
+            "back). *descents*: "
             "fixed-load descents beyond the largest load reached (snaps). Energy: bending + membrane + contact - "
             "work of the weight, in the scene's units (gf cm). Wall and memory on a 2-core machine shared with "
             "other jobs: the load average (1 min, `os.getloadavg()`) when the run ended is beside each.\n\n"

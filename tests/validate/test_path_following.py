@@ -1,6 +1,7 @@
 """The path-following report on synthetic runs (record + summary.json as the drape child writes them): no solve."""
 
 import json
+from pathlib import Path
 
 from rftstatic.validate import BENCHMARKS, path_following as pf
 from rftstatic.validate.report import write_report
@@ -122,12 +123,64 @@ def test_run_builds_the_report_from_the_runs(tmp_path, monkeypatch):
     assert res.passed and "12 folds" in res.discrepancy and "21 x 160: 9 folds" in res.discrepancy
 
 
-def test_rows_run_through_the_apps_static_route_which_does_the_levels():
-    """The drape bench's child calls the solver directly (no mesh sequencing): the rows use this module's child."""
-    import inspect
+def _no_cache_env(monkeypatch, root):
+    monkeypatch.setattr(pf, "cache_root", lambda: root)
+    monkeypatch.delenv("RFTSTATIC_DRAPE_REFRESH", raising=False)
+    monkeypatch.delenv("RFTSTATIC_DRAPE_CACHED_ONLY", raising=False)
 
-    from rftstatic.bench.drape import run_key
 
-    src = inspect.getsource(pf.run_case_cached)
-    assert "rftstatic.validate.path_following:child" in src and "run_static" in inspect.getsource(pf.child)
-    assert run_key("sphere-30", [*pf.ROUTE, pf.KEY_TAG]) != run_key("sphere-30", pf.ROUTE)
+def test_a_row_is_the_drape_benchs_cached_run_with_its_levels(tmp_path, monkeypatch):
+    """A row is solved by rftstatic.bench.drape.run_cached (its child, in a fresh interpreter, does the mesh
+    sequencing of solver.levels) with the row's overrides and TIMEOUT_S; the report reads its record and summary."""
+    from rftstatic.bench import drape
+    from rftstatic.scenes.schema import load_scene
+
+    _no_cache_env(monkeypatch, tmp_path)
+    calls, real_run_one = [], drape.run_one
+
+    def spy(name, overrides, out, **kw):
+        calls.append((name, list(overrides), Path(out), kw))
+        return real_run_one(name, overrides, out, **kw)
+
+    monkeypatch.setattr(drape, "run_one", spy)
+    scene, ov = "pedestal-square-20", pf.overrides((9, 9), True, 2)
+    rec = pf.solve_case(scene, ov)
+    assert "crashed" not in rec, rec.get("crashed")
+    d = tmp_path / drape.run_key(scene, ov)
+    assert calls == [(scene, ov, d, {"figures": False, "timeout": pf.TIMEOUT_S})] and rec["dir"] == str(d)
+    assert rec["loadavg"]["measured"] == "at the end of this run"
+    v = pf.row_values(rec, load_scene(scene, rec["overrides"]).units.energy)
+    assert v["levels"] == 2 and v["meshes"] == "5 x 5 -> 9 x 9" and v["route"] == "arc-length+levels"
+    assert v["iterations"].split(" / ")[0].endswith("(path)") and v["steps"] > 0 and v["nodes"] == 81
+    assert v["converged"] and v["stable"] is True and v["dc"] > 0 and v["folds"] >= 0 and v["energy"] < 0
+    assert rec["process_s"] >= rec["wall_s"] > 0 and v["wall"] > 0 and v["peak_mb"] > 50 and rec["cpu_s"] > 0
+    assert pf.row_passed(rec)
+    row = pf.solves_row("pedestal-square-20, 9 x 9", rec, v)
+    assert row["iterations"] == rec["newton_iterations"] > 0 and row["run_dir"] == str(d)
+    assert v["code"] == rec["software"]["code"] == drape.code_version()
+
+    again = pf.solve_case(scene, ov)  # cached: nothing solved, the load average of the run kept
+    assert len(calls) == 1 and again["dir"] == str(d) and again["loadavg"] == rec["loadavg"]
+
+
+def test_a_row_whose_child_fails_or_is_not_cached_is_listed_not_raised(tmp_path, monkeypatch):
+    from rftstatic.bench import drape
+    from rftstatic.bench.harness import ChildTimeout
+
+    _no_cache_env(monkeypatch, tmp_path)
+    calls = []
+
+    def killed(name, overrides, out, **kw):
+        calls.append((name, list(overrides), kw))
+        raise ChildTimeout(f"{name}: no result within the timeout of {kw['timeout']:g} s\nstderr line", name=name)
+
+    monkeypatch.setattr(drape, "run_one", killed)
+    ov = pf.overrides((31, 240), True, 3)
+    rec = pf.solve_case(pf.ROUND, ov)
+    assert calls == [(pf.ROUND, ov, {"figures": True, "timeout": pf.TIMEOUT_S})]
+    assert "solver.levels=3" in calls[0][1] and pf.TIMEOUT_S == 3 * 3600.0
+    assert rec["crashed"].startswith(f"{pf.ROUND}: no result within the timeout of 10800 s") and not pf.row_passed(rec)
+
+    monkeypatch.setenv("RFTSTATIC_DRAPE_CACHED_ONLY", "1")
+    rec = pf.solve_case(pf.ROUND, ov)
+    assert len(calls) == 1 and rec["crashed"].startswith("not run (not in the cache")
