@@ -181,15 +181,15 @@ def cached_dir(name: str, overrides=(), *, root: Path) -> Path | None:
 
 
 def run_cached(name: str, overrides=(), *, root: Path, refresh: bool = False, figures: bool = True,
-               timeout: float | None = None) -> dict:
+               timeout: float = TIMEOUT_S) -> dict:
     """:func:`run_one` into ``root/<key>/`` (:func:`run_key`), reusing a finished run there unless ``refresh``.
 
-    ``timeout`` [s]: the child is killed after this long (None: :func:`run_one`'s default, :data:`TIMEOUT_S`).
+    ``timeout`` [s]: the child is killed after this long.
     Returns the record with ``state`` (the arrays of ``state.npz``) and ``dir``.
     """
     d = Path(root) / run_key(name, overrides)
     if refresh or cached_dir(name, overrides, root=root) is None:
-        run_one(name, list(overrides), d, figures=figures, **({} if timeout is None else {"timeout": timeout}))
+        run_one(name, list(overrides), d, figures=figures, timeout=timeout)
     rec = json.loads((d / "record.json").read_text(encoding="utf-8"))
     if "process_s" not in rec:  # the child finished but its parent was stopped: in-process time only
         rec["process_s"] = rec["wall_s"]

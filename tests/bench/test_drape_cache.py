@@ -23,7 +23,7 @@ def test_a_changed_code_fingerprint_misses_the_drape_cache(tmp_path, monkeypatch
 
     calls = []
 
-    def fake_run_one(name, overrides, out, *, figures=True):
+    def fake_run_one(name, overrides, out, *, figures=True, timeout=None):
         """Stands in for a solve: the first run's files, stamped with the code version of now."""
         calls.append(Path(out))
         shutil.copytree(first["dir"], out)
