@@ -132,6 +132,13 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
     })
     if model.self_contact is not None:
         summary["self_contact"] = self_contact_summary(scene, model)
+        crossing = summary["self_intersections"].get("pairs", 0)
+        if crossing:  # the law failed to keep the layers apart: say so beside the converged flag
+            text = (f"{crossing} triangle pairs of the final state cross although self-contact is on: the "
+                    "layers passed through each other, so this equilibrium is not physical; raise "
+                    "contact.self_factor (or refine the mesh at the fold)")
+            log.warning(text)
+            summary["warnings"].append(text)
     if model.contact is not None:
         x = model.positions(U)
         summary["max_penetration"] = model.contact.max_penetration(x) / u.length

@@ -6,6 +6,8 @@ Energy. For every point-triangle pair (a node and a triangle without it) and eve
 
     E_s = sum_pairs k / (3 d) (d - delta)^3                                   [J]
 
+(plus, for a pair closer than ``d / 4``, a log barrier: :func:`pair_law`)
+
 (``k`` [N/m]). Its slope ``-k (d - delta)^2 / d`` and curvature ``2 k (d - delta) / d`` vanish at
 ``delta = d``, so energy, force and tangent are continuous when a pair enters or leaves (C2), and a
 pair pressed by a force ``F`` rests at ``delta = d - sqrt(F d / k)``. The pair's Hessian
@@ -20,13 +22,16 @@ energy line search sees descent directions and the stable-minimum check (Cholesk
 judges the sheet, not the projection. The force and energy are exact; the tangent is exact wherever
 every pair's block is already PSD.
 
-Why a penalty and not the IPC log barrier: the solvers start from the flat sheet or from a relaxed
-or transferred state in which layers may already be closer than ``d`` (a relaxation without
-self-contact, a remeshed transfer): a barrier is infinite at contact and undefined for a pair that
-has already crossed, the penalty is finite and starts from any state. The price is that a load
-above ``k d`` per pair could press a pair through; :meth:`SelfContact.max_step_fraction` closes that
-hole for the steps (a pair never comes closer than ``min_fraction`` of its distance within a step),
-and :func:`auto_stiffness` makes ``k d`` four times the design load of a pair.
+Why a penalty first and the IPC log barrier only below ``d / 4`` (:func:`pair_law`): the solvers start
+from the flat sheet or from a relaxed or transferred state in which layers may already be closer than
+``d`` (a relaxation without self-contact, a remeshed transfer): a barrier over the whole range would be
+stiff far from contact and is infinite at contact, the penalty is finite and starts from any state.
+:func:`auto_stiffness` makes ``k d`` four times the design load of a pair, so a pair never reaches the
+barrier under that load. A pair pressed harder than ``k d`` (a sharp fold, a stiffness lowered by
+``contact.self_factor``) would with the cubic alone be closed a little more by every Newton step, each
+of which :meth:`SelfContact.max_step_fraction` lets close up to ``1 - min_fraction`` of the gap, and
+pass through once at zero distance; the barrier's energy grows without bound on the way, so the pair
+rests at a positive distance (and the static route then raises k until it is above ``d / 2``).
 
 Stiffness (:func:`auto_stiffness`): a pair carries the weight of about one node's area ``A``; under a
 design pressure ``p`` the pair rests at ``delta = d (1 - sqrt(p A / (k d)) )``; ``k = 4 p_design A / d``
@@ -65,7 +70,7 @@ from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distan
 from rftstatic.contact.self_contact.law_kernels import additive_ccd_nodes, psd_project
 from rftstatic.contact.self_contact.near_pairs import NearPairCache, SelfContactStats, pair_nodes
 
-__all__ = ["SelfContact", "SelfContactState", "auto_stiffness"]
+__all__ = ["SelfContact", "SelfContactState", "auto_stiffness", "pair_law"]
 
 MIN_FRACTION = 0.2
 """Default ``min_fraction`` of the step bound: no pair comes closer than this fraction of its distance
@@ -99,6 +104,40 @@ class SelfContactState:
     blocks: np.ndarray | None
     min_distance: float
     n_active: int
+
+
+BARRIER_GAP = 0.25
+"""Distance below which the barrier term of :func:`pair_law` acts, as a fraction of the thickness d: below
+the d / 2 at which the automatic stiffness rests a pair under its design load, so a scene whose pairs keep
+that gap never feels it."""
+
+
+def pair_law(delta: np.ndarray, d: float, k: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The energy of one pair at distance ``delta (A,)`` [m] and its first and second derivatives in
+    ``delta``: ``(e [J], e' [N], e'' [N/m])``, each ``(A,)``, for pairs closer than the thickness ``d``.
+
+    ``e = k / (3 d) (d - delta)^3`` (module docstring), plus below ``dhat = BARRIER_GAP d`` the log
+    barrier of IPC (Li et al., "Incremental Potential Contact", SIGGRAPH 2020, Eq. 6) with stiffness k,
+    ``-k (delta - dhat)^2 ln(delta / dhat)``, C2 at ``dhat`` (value, slope and curvature vanish there) and
+    unbounded as the pair closes: the cubic penalty alone pushes with at most ``k d``, so a fold pressed
+    harder than that was driven to zero distance over successive Newton steps, each of which the step
+    bound lets close 80 % of the gap, and then passed through (``sphere-floor`` at a fifth of the
+    automatic stiffness: 7 crossing pairs); with the barrier its energy grows without bound on the way
+    and the pair rests at a positive distance, where the stiffening of the static route opens it.
+    """
+    gap = d - delta
+    e = k / (3.0 * d) * gap**3
+    e1 = -k / d * gap**2
+    e2 = 2.0 * k / d * gap
+    dhat = BARRIER_GAP * d
+    near = delta < dhat
+    if np.any(near):
+        x = delta[near]
+        r, log = x - dhat, np.log(x / dhat)
+        e[near] -= k * r * r * log
+        e1[near] -= k * (2.0 * r * log + r * r / x)
+        e2[near] -= k * (2.0 * log + 4.0 * r / x - r * r / (x * x))
+    return e, e1, e2
 
 
 def auto_stiffness(*, weight: float, node_area: float, thickness: float, pressure_factor: float = 10.0,
@@ -202,7 +241,7 @@ class SelfContact:
     def evaluate_pairs(self, x, npt, nee, *, tangent: bool = True, project: bool = True) -> SelfContactState:
         """The law (module docstring) summed over the given pairs: ``npt (Q, 4)`` point-triangle rows
         (node, triangle), ``nee (R, 4)`` edge-edge rows (edge, edge), at ``x (N, 3)`` [m]. The one source
-        of the energy ``sum k / (3 d) (d - delta)^3`` [J], its gradient ``(N, 3)`` [N] and the pair blocks,
+        of the energy ``sum e(delta)`` [J] (:func:`pair_law`), its gradient ``(N, 3)`` [N] and the pair blocks,
         for the static solver (:meth:`evaluate`) and the explicit one
         (:meth:`near_force`)."""
         t0 = time.perf_counter()
@@ -228,16 +267,14 @@ class SelfContact:
         nodes = np.concatenate(nodes_list)
         gs = np.concatenate(grads)
         delta = np.maximum(np.concatenate(dist), 1e-12 * d)
-        gap = d - delta
-        energy = float(np.sum(k / (3.0 * d) * gap**3))
-        e1 = -k / d * gap**2  # de/d delta
+        e, e1, e2 = pair_law(delta, d, k)
+        energy = float(np.sum(e))
         gd = gs / (2.0 * delta[:, None])  # grad delta (A, 12)
         idx = (3 * nodes[:, :, None] + np.arange(3)).ravel()
         force = np.bincount(idx, (e1[:, None] * gd).ravel(), minlength=3 * self.n_nodes).reshape(-1, 3)
         blocks = None
         if tangent:
             Hs = np.concatenate(hess)
-            e2 = 2.0 * k / d * gap
             hd = Hs / (2.0 * delta[:, None, None]) - np.einsum("am,an->amn", gs, gs) / (4.0 * delta[:, None, None] ** 3)
             blocks = e2[:, None, None] * np.einsum("am,an->amn", gd, gd) + e1[:, None, None] * hd
             if project:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
+from rftstatic.contact.self_contact.law import BARRIER_GAP, SelfContact, auto_stiffness, pair_law
 from rftstatic.mesh.trimesh import rectangle
 
 D = 0.02  # thickness [m]; edges 0.1 m
@@ -49,6 +49,41 @@ def test_force_and_tangent_match_finite_differences():
     err = np.linalg.norm(df - K @ v.ravel()) / np.linalg.norm(df)
     assert err < 1e-5
     np.testing.assert_allclose(st.force.sum(axis=0), 0.0, atol=1e-12)  # internal: no net force
+
+
+def test_pair_law_derivatives_and_the_barrier_below_a_quarter_of_the_thickness():
+    d, k = 5e-4, 3.0
+    delta = np.concatenate([np.geomspace(1e-6 * d, 0.999 * d, 400), BARRIER_GAP * d * np.array([0.999, 1.001])])
+    e, e1, e2 = pair_law(delta, d, k)
+    h = 1e-7 * delta
+    ep, e1p, _ = pair_law(delta + h, d, k)
+    em, e1m, _ = pair_law(delta - h, d, k)
+    np.testing.assert_allclose((ep - em) / (2 * h), e1, rtol=1e-6, atol=1e-12 * k * d)
+    np.testing.assert_allclose((e1p - e1m) / (2 * h), e2, rtol=1e-6, atol=1e-9 * k)
+    cubic = k / (3 * d) * (d - delta) ** 3
+    above = delta >= BARRIER_GAP * d
+    np.testing.assert_array_equal(e[above], cubic[above])  # the cubic penalty alone down to d / 4
+    # C2 at the barrier's edge: value, slope and curvature continuous
+    for f in pair_law(BARRIER_GAP * d * np.array([1 - 1e-9, 1 + 1e-9]), d, k):
+        assert f[0] == pytest.approx(f[1], rel=1e-6)
+    # the cubic pushes with at most k d; the barrier's push grows without bound as the pair closes
+    assert -e1[-3] < k * d
+    assert -pair_law(np.array([1e-6 * d]), d, k)[1][0] > 1e3 * k * d
+    assert np.all(np.diff(e[:400]) < 0) and np.all(e1 < 0) and np.all(e2 > 0)
+
+
+def test_force_and_tangent_match_finite_differences_inside_the_barrier():
+    mesh, X = folded(seed=3, gap=0.12 * D)
+    sc = SelfContact(mesh, D, 50.0)
+    st = sc.evaluate(X, project=False)
+    assert st.min_distance < BARRIER_GAP * D and st.n_active > 20
+    v = np.random.default_rng(4).standard_normal(X.shape)
+    h = 1e-8
+    dE = (sc.energy(X + h * v) - sc.energy(X - h * v)) / (2 * h)
+    assert dE == pytest.approx(float(np.sum(st.force * v)), rel=1e-6)
+    df = (sc.force(X + h * v) - sc.force(X - h * v)).ravel() / (2 * h)
+    K = assembled(sc, st, mesh.n_nodes)
+    assert np.linalg.norm(df - K @ v.ravel()) / np.linalg.norm(df) < 1e-5
 
 
 def test_projected_blocks_are_psd_and_exact_where_already_psd():
