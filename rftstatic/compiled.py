@@ -37,13 +37,23 @@ NUMPY_BUDGET_S = 1.0
 """Seconds the "auto" back end may spend in the numpy twins before it loads the compiled kernels (about
 what loading costs): a process that solves one small scene never pays for numba, one that solves many
 (a validation report, a study) pays at most twice the cheaper choice (the ski-rental rule). The
-sze2004 report's small cantilevers took 0.37 s instead of 0.04 s each on the numpy twins alone."""
+sze2004 report's small cantilevers took 0.37 s instead of 0.04 s each on the numpy twins alone.
+
+The seconds are modelled, not read from the clock: each numpy call charges its rows (elements, pairs,
+nodes) times a cost per row measured once (:func:`charged_numpy`), so the switch to the compiled twins
+falls at the same call in every run of the same command. The twins agree to round-off only, and a
+clock-charged budget made runs of one command differ there: pedestal-square-20 on 33 x 33 by
+arc-length, three runs each (2026-12-02, the machine loaded by two other jobs): total energy
+-9.770568309163982, ...4037, ...4005 gf cm with the clock, ...4037 three times with the numpy twins
+throughout, ...3998 three times with this budget; on the 7,800-step path of the 31 x 240 round pedestal such a difference picked another
+fold branch."""
 
 _numpy_seconds = [0.0]
 
 
 def charge_numpy(seconds: float) -> None:
-    """Count ``seconds`` spent in a numpy twin chosen by the "auto" back end."""
+    """Count ``seconds`` (modelled: rows times a cost per row, :data:`NUMPY_BUDGET_S`) spent in a numpy
+    twin chosen by the "auto" back end."""
     _numpy_seconds[0] += seconds
 
 
@@ -52,12 +62,20 @@ def numpy_budget_spent() -> bool:
     return _numpy_seconds[0] > NUMPY_BUDGET_S
 
 
-def charged_numpy(loaded):
-    """Decorator: the wall time of a call of the wrapped function counts against the numpy budget
-    (:func:`charge_numpy`) when ``loaded()`` (whether the compiled twins are in this process) is false
-    before and after the call, i.e. when it ran the numpy twin. Nested charged calls count once."""
+def charged_numpy(loaded, per_row: float):
+    """Decorator: a call of the wrapped function charges ``per_row`` seconds [s] per row of its first array
+    argument to the numpy budget (:func:`charge_numpy`) when ``loaded()`` (whether the compiled twins are
+    in this process) is false before and after the call, i.e. when it ran the numpy twin. Nested charged
+    calls count once."""
     import functools
-    import time
+
+    import numpy as np
+
+    def rows(args, kwargs) -> int:
+        for a in (*args, *kwargs.values()):
+            if isinstance(a, np.ndarray):
+                return len(a) if a.ndim else 1
+        return 0
 
     def wrap(f):
         @functools.wraps(f)
@@ -65,13 +83,12 @@ def charged_numpy(loaded):
             if _depth[0] or loaded():
                 return f(*args, **kwargs)
             _depth[0] += 1
-            t0 = time.perf_counter()
             try:
                 return f(*args, **kwargs)
             finally:
                 _depth[0] -= 1
                 if not loaded():
-                    charge_numpy(time.perf_counter() - t0)
+                    charge_numpy(per_row * rows(args, kwargs))
         return charged
     return wrap
 

@@ -133,7 +133,7 @@ def _unique_pairs(a, b, nb):
     return np.stack([key // nb, key % nb], axis=1)
 
 
-@distance.numpy_charged
+@distance.numpy_charged(1.9e-5)
 def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.ndarray | None = None) -> Pairs:
     """Point-triangle and edge-edge pairs whose primitives may be closer than ``radius``.
 

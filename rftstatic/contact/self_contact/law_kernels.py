@@ -24,7 +24,7 @@ __all__ = ["psd_project", "additive_ccd", "additive_ccd_nodes"]
 _SIDES = (((0,), (1, 2, 3)), ((0, 1), (2, 3)))
 
 
-@distance.numpy_charged
+@distance.numpy_charged(8.7e-5)
 def psd_project(H: np.ndarray) -> np.ndarray:
     """Symmetric ``(A, n, n)`` matrices projected onto the PSD cone (eigenvalues clamped at 0).
 
@@ -43,7 +43,7 @@ def psd_project(H: np.ndarray) -> np.ndarray:
     return np.einsum("aij,aj,akj->aik", Q, np.maximum(lam, 0.0), Q)
 
 
-@distance.numpy_charged
+@distance.numpy_charged(2e-7)
 def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rounds: int,
                  floor: float = 0.0) -> float:
     """Smallest safe time in [0, 1] over pairs ``x4, dx4 (P, 4, 3)`` [m] (``kind`` 0 point-triangle,

@@ -120,7 +120,7 @@ def translation_free_motion(a: np.ndarray, c: np.ndarray, *, b: np.ndarray | Non
     return _motion_numpy(a, c, b, s, out)
 
 
-@distance.numpy_charged
+@distance.numpy_charged(2.5e-7)
 def _motion_numpy(a, c, b, s, out):
     w = a - c if b is None or s == 0.0 else a + s * b - c
     w -= 0.5 * (w.max(axis=0) + w.min(axis=0))

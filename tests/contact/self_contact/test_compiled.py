@@ -127,7 +127,11 @@ def test_load_compiled_loads_the_twins_and_the_budget_switches_to_them(monkeypat
     assert not distance.compiled_for(10)
     x4 = np.random.default_rng(1).normal(size=(50, 4, 3))
     distance.point_triangle(x4)
-    assert 0.0 < compiled._numpy_seconds[0] < compiled.NUMPY_BUDGET_S  # the numpy twin's time was charged
+    # the numpy twin's modelled time was charged: its 50 rows at 1.3 us, not the clock, so that every run
+    # of a command switches at the same call (compiled.NUMPY_BUDGET_S)
+    assert compiled._numpy_seconds[0] == pytest.approx(50 * 1.3e-6, rel=1e-12)
+    distance.point_triangle(x4)
+    assert compiled._numpy_seconds[0] == pytest.approx(100 * 1.3e-6, rel=1e-12)
     compiled._numpy_seconds[0] = 2 * compiled.NUMPY_BUDGET_S
     assert distance.compiled_for(10)
 
@@ -177,3 +181,26 @@ def test_near_pair_distances_by_index_agree(monkeypatch):
     assert len(pa) == len(pairs.pt) and len(eb) == len(pairs.ee) and len(pa) and len(ea)
     np.testing.assert_allclose(pb, pa, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(eb, ea, rtol=1e-12, atol=1e-15)
+
+
+def test_the_membrane_numpy_twins_charge_a_modelled_time(monkeypatch):
+    # the membrane's numpy twins under the "auto" back end charge rows x a cost per element, the same in
+    # every run (a clock-charged budget made runs of one command differ at round-off: README)
+    from rftstatic import compiled
+    from rftstatic.element import membrane
+    from rftstatic.material import preset
+    from rftstatic.mesh.trimesh import rectangle
+    from rftstatic.model.model import Model
+
+    model = Model(rectangle(0.2, 0.1, 5, 3), preset("wool-kang-yu"), element="RFT6", quiet=True)
+    mem, E = model.membrane, len(model.membrane.nodes)
+    U = 1e-3 * np.random.default_rng(0).standard_normal((model.mesh.n_nodes, 3))
+    monkeypatch.setattr(compiled, "_numpy_seconds", [0.0])
+    monkeypatch.setattr(compiled, "static_kernels_compiled", lambda n: False)
+    monkeypatch.setattr(membrane, "static_kernels_compiled", lambda n: False)
+    mem.element_energy(U, model.material.Dm)
+    mem.element_tangents(U, model.material.Dm)
+    cost = membrane.NUMPY_SECONDS_PER_ELEMENT
+    assert compiled._numpy_seconds[0] == pytest.approx(E * (cost["energies_numpy"] + cost["tangents_numpy"]), rel=1e-12)
+    mem.element_energy(U, model.material.Dm, backend="numpy")  # an explicit choice is not charged
+    assert compiled._numpy_seconds[0] == pytest.approx(E * (cost["energies_numpy"] + cost["tangents_numpy"]), rel=1e-12)
