@@ -45,8 +45,8 @@ falls at the same call in every run of the same command. The twins agree to roun
 clock-charged budget made runs of one command differ there: pedestal-square-20 on 33 x 33 by
 arc-length, three runs each (2026-12-02, the machine loaded by two other jobs): total energy
 -9.770568309163982, ...4037, ...4005 gf cm with the clock, ...4037 three times with the numpy twins
-throughout, ...3998 three times with this budget; on the 7,800-step path of the 31 x 240 round pedestal such a difference picked another
-fold branch."""
+throughout, ...3998 three times with this budget; on the 7,800-step path of the 31 x 240 round
+pedestal such a difference picked another fold branch."""
 
 _numpy_seconds = [0.0]
 

@@ -6,9 +6,7 @@ Energy. For every point-triangle pair (a node and a triangle without it) and eve
 
     E_s = sum_pairs k / (3 d) (d - delta)^3                                   [J]
 
-(plus, for a pair closer than ``d / 4``, a log barrier: :func:`pair_law`)
-
-(``k`` [N/m]). Its slope ``-k (d - delta)^2 / d`` and curvature ``2 k (d - delta) / d`` vanish at
+(``k`` [N/m]; for a pair closer than ``d / 4`` a log barrier joins it, :func:`pair_law`). Its slope ``-k (d - delta)^2 / d`` and curvature ``2 k (d - delta) / d`` vanish at
 ``delta = d``, so energy, force and tangent are continuous when a pair enters or leaves (C2), and a
 pair pressed by a force ``F`` rests at ``delta = d - sqrt(F d / k)``. The pair's Hessian
 
