@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 
+import math
+
 import numpy as np
 
 from rftstatic.errors import MeshError
@@ -358,6 +360,32 @@ def polar(r_outer, n_radial, n_circ, *, r_inner=0.0, centre=(0.0, 0.0), pattern=
     return TriMesh(X, tri, z0=z0, name=f"{kind} {n_radial}x{n_circ}", info=info)
 
 
+def equilateral_nodes(area, h) -> float:
+    """Nodes of a mesh of equilateral triangles of side ``h`` on ``area`` (any one length unit): ``2 area /
+    (sqrt(3) h^2)``, two triangles of area ``sqrt(3) h^2 / 4`` per node; what the advancing-front mesher
+    gives at target size ``h``, boundary effects aside (Python floats: inf, no warning, on overflow)."""
+    return 2.0 / math.sqrt(3.0) * float(area) / h / h
+
+
+def square_polar_core_radius(half_side, n_radial, n_circ) -> float:
+    """The default core radius of :func:`square_polar` [m]: the quadrilaterals next to the core are square
+    (circumferential spacing ``2 pi r0 / n_circ`` = radial spacing ``(R - r0) / (n_radial - 1)``)."""
+    return float(half_side) / (1.0 + 2 * np.pi / n_circ * (n_radial - 1))
+
+
+def square_polar_nodes(half_side, n_radial, n_circ, core_radius=None) -> int:
+    """Nodes of :func:`square_polar` without meshing its core: the rings exactly, the core's interior as
+    :func:`equilateral_nodes` on its disc at its spacing less its boundary ring (within a few percent)."""
+    r0 = square_polar_core_radius(half_side, n_radial, n_circ) if core_radius is None else float(core_radius)
+    core = equilateral_nodes(np.pi * r0 * r0, 2 * np.pi * r0 / n_circ)
+    return int(n_radial * n_circ + max(0.0, core - n_circ))
+
+
+def polar_nodes(n_radial, n_circ, r_inner=0.0) -> int:
+    """Nodes of :func:`polar`: ``n_radial`` rings of ``n_circ``, the innermost of a disc being its centre."""
+    return int((n_radial - 1) * n_circ + 1 if r_inner == 0.0 else n_radial * n_circ)
+
+
 def square_polar(half_side, n_radial, n_circ, *, centre=(0.0, 0.0), core_radius=None, pattern="right",
                  z0=0.0) -> TriMesh:
     """A square sheet meshed by rings that blend from a circle to the square's edge, around a core.
@@ -386,8 +414,7 @@ def square_polar(half_side, n_radial, n_circ, *, centre=(0.0, 0.0), core_radius=
         raise MeshError(f'unknown diagonal pattern "{pattern}" for a square-polar mesh; use right, left or alternate')
     R = float(half_side)
     if core_radius is None:
-        a = 2 * np.pi / n_circ * (n_radial - 1)
-        core_radius = R / (1.0 + a)
+        core_radius = square_polar_core_radius(R, n_radial, n_circ)
     if not (0 < core_radius < R):
         raise MeshError(f"core_radius must lie in (0, half_side = {R}), got {core_radius}")
     theta = 2 * np.pi * np.arange(n_circ) / n_circ

@@ -126,7 +126,7 @@ def _check_unstructured_size(scene, h, width, area) -> None:
     if h > width:
         raise scene.error("mesh.h", f"{h!r} is larger than the sheet ({width:g} across, scene units); give an "
                           "element size below it")
-    nodes = 2.0 / math.sqrt(3.0) * float(area) / h / h  # Python floats: inf (no warning) when it overflows
+    nodes = meshmod.equilateral_nodes(area, h)
     if nodes > MAX_MESH_NODES:
         many = f"about {nodes:.3g}" if math.isfinite(nodes) else "countless"
         raise scene.error("mesh.h", f"{h!r} would give {many} nodes, more than {MAX_MESH_NODES:,}; give a larger "

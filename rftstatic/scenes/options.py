@@ -28,8 +28,22 @@ MAX_PERTURBATION = 10.0
 the relaxation from it becomes unstable (above about 200 its stable step collapses)."""
 
 
+def _levels(scene, value) -> int:
+    """``solver.levels`` as a count: an integer as given (checked by the mesh sequence), ``"auto"`` by the
+    mesh's size."""
+    from rftstatic.scenes.levels import auto_levels
+
+    if value == "auto":
+        return auto_levels(scene)
+    if isinstance(value, str):
+        raise scene.error("solver.levels", f'"{value}" is not a number of meshes; give an integer >= 1 or "auto" '
+                          "(from 15,000 nodes as many as bring the coarsest mesh to 3,000 or fewer, else 1)")
+    return value
+
+
 def static_options(scene, *, progress=True) -> StaticOptions:
-    """The scene's ``[solver]`` table as :class:`StaticOptions` (lengths in SI [m]).
+    """The scene's ``[solver]`` table as :class:`StaticOptions` (lengths in SI [m]); ``solver.levels`` ``"auto"``
+    (the default) resolved to a number of meshes (:func:`rftstatic.scenes.levels.auto_levels`).
 
     ``solver.membrane`` is a model switch (:func:`rftstatic.scenes.build.build_model`), not a solver
     option, and is left out here.
@@ -47,6 +61,7 @@ def static_options(scene, *, progress=True) -> StaticOptions:
     for key, least in _STATIC_COUNTS.items():
         if key in s and s[key] < least:
             raise scene.error(f"solver.{key}", f"{s[key]!r} must be an integer >= {least}")
+    s["levels"] = _levels(scene, s.get("levels", "auto"))
     lift = s.get("perturbation", 0.0)
     if not 0.0 <= lift <= MAX_PERTURBATION:
         raise scene.error("solver.perturbation", f"{lift!r} must lie in [0, {MAX_PERTURBATION:g}] (element sizes of "

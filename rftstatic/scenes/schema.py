@@ -175,8 +175,9 @@ SCHEMA = {
         "guide_weight": (NUM, "relative amplitude of that modulation, in [0, 1)"),
         "start": (str, "load-steps or relax (dynamic relaxation, then Newton)"),
         "relax_fallback": (bool, "try dynamic relaxation + Newton when the load steps fail"),
-        "levels": (int, "mesh sequencing: meshes of the sequence, each about twice as coarse as the next; the "
-                        "coarsest by the route above, the finer ones by Newton at full load (1: none)"),
+        "levels": ((int, str), "mesh sequencing: meshes of the sequence, each about twice as coarse as the "
+                               "next; the coarsest by the route above, the finer ones by Newton at full load (1: "
+                               "none; \"auto\", the default: from 15,000 nodes, enough for a coarsest mesh of 3,000)"),
         "membrane": (bool, "false: linear Kirchhoff plate (bending only)"),
     }, "static solver options (rftstatic.static.StaticOptions)"),
     "dynamics": ({

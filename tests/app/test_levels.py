@@ -10,7 +10,7 @@ from rftstatic.app import static as app
 from rftstatic.app.levels import solve_levels, transfer_start
 from rftstatic.errors import SceneError
 from rftstatic.scenes.build import build_model
-from rftstatic.scenes.levels import level_mesh, level_scenes
+from rftstatic.scenes.levels import AUTO_COARSEST, AUTO_FROM, auto_levels, level_mesh, level_nodes, level_scenes
 from rftstatic.scenes.options import static_options
 from rftstatic.scenes.schema import load_scene
 
@@ -41,6 +41,49 @@ def test_an_unstructured_level_doubles_h_and_a_file_mesh_has_none(tmp_path):
     path.write_text('[mesh]\nkind = "file"\npath = "sheet.msh"\n[solver]\nlevels = 2\n')
     with pytest.raises(SceneError, match="solver.levels.*file"):
         level_scenes(load_scene(str(path)), 2)
+
+
+@pytest.mark.parametrize("scene, overrides, levels", [
+    ("pedestal-square-80", [], 1),  # the paper's 81 x 81: the scene's own route
+    ("pedestal-square-80", ["mesh.nodes=[101,101]"], 1),  # 10,201 nodes
+    ("pedestal-square-80", ["mesh.nodes=[121,121]"], 1),  # 14,641 nodes
+    ("pedestal-square-80", ["mesh.nodes=[141,141]"], 3),  # 19,881 nodes: from 36 x 36
+    ("pedestal-square-80", ["mesh.nodes=[201,201]"], 3),  # 40,401 nodes: from 51 x 51
+    ("pedestal-round-50", ["mesh.nodes=[31,240]"], 1),  # 12,464 nodes, the finer mesh of the reports
+    ("pedestal-round-50", ["mesh.nodes=[61,480]"], 4),  # 49,000 nodes: from 9 x 64 (16 x 120 has 3,100)
+    ("pedestal-round-50-unstructured", [], 1),
+    ("pedestal-round-50-unstructured", ["mesh.h=0.2"], 4),
+    ("strip", ["mesh.nodes=[6001,3]"], 1),  # 18,003 nodes, but a coarser strip would have 2 nodes across
+    ("pedestal-square-80", ["mesh.nodes=[201,201]", "solver.levels=2"], 2),  # a count given is kept
+])
+def test_auto_levels_sequence_large_meshes_from_a_coarsest_of_at_most_AUTO_COARSEST(scene, overrides, levels):
+    sc = load_scene(scene, overrides)
+    given = "solver.levels=2" in overrides
+    assert sc.get("solver.levels") is None or given  # "auto" is the default
+    assert static_options(sc, progress=False).levels == levels
+    if not given:
+        assert auto_levels(sc) == levels
+        assert (level_nodes(sc) >= AUTO_FROM) == (levels > 1 or scene == "strip")
+        if levels > 1:
+            assert level_nodes(sc, levels - 1) <= AUTO_COARSEST < level_nodes(sc, levels - 2)
+
+
+def test_the_auto_node_counts_are_the_built_meshes_and_a_file_mesh_has_one_level(tmp_path):
+    for scene, ov in [("pedestal-square-80", ["mesh.nodes=[41,41]"]), ("pedestal-round-50", ["mesh.nodes=[11,80]"]), ("pedestal-round-50", ["mesh.nodes=[31,240]"]),
+                      ("cusick-30", []),
+                      ("pedestal-round-50-unstructured", [])]:
+        sc = load_scene(scene, ov)
+        built = build_model(sc, quiet=True)[0].mesh.n_nodes
+        assert level_nodes(sc) == pytest.approx(built, rel=0.0 if scene == "pedestal-square-80" else 0.05)
+    path = tmp_path / "file.toml"
+    path.write_text('[mesh]\nkind = "file"\npath = "sheet.msh"\n')
+    assert auto_levels(load_scene(str(path))) == 1
+
+
+def test_a_levels_word_other_than_auto_names_the_key():
+    sc = load_scene("pedestal-square-20", ['solver.levels="many"'])
+    with pytest.raises(SceneError, match=r'solver.levels.*"many".*"auto"'):
+        static_options(sc, progress=False)
 
 
 def test_too_many_levels_name_the_key_and_the_coarsest_mesh():
