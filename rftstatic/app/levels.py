@@ -113,32 +113,51 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             res = solve_static(m, **start, callback=callback if last else None,
                                checkpoint=checkpoint if last else None)
         except ConvergenceError as exc:
+            failed = exc.result if last else None
+            if failed is not None:  # the summary of the failed run lists the levels solved and this one
+                _add_counts(totals, failed)
+                _sequence_outcome(failed, records + [_record(k, sc, m, failed, prev is None, build)], totals)
             raise ConvergenceError(
                 f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}, {m.mesh.n_nodes} nodes) did not "
-                f"converge by {what}: {exc}", result=exc.result if last else None) from None
-        record = {"level": k, "mesh": _nodes(sc), "nodes": m.mesh.n_nodes, "elements": m.mesh.n_elements,
-                  "route": res.route if prev is None else "newton", "converged": bool(res.converged),
-                  "stable_minimum": res.stable, "iterations": res.iterations,
-                  "factorisations": res.factorisations, "residual_N": res.residual,
-                  "energy_J": res.energies.get("total"), "build_time_s": build, "wall_time_s": res.wall_time}
-        records.append(record)
-        for key in totals:
-            totals[key] += getattr(res, key)
+                f"converge by {what}: {exc}", result=failed) from None
+        records.append(_record(k, sc, m, res, prev is None, build))
+        _add_counts(totals, res)
         if not res.converged:
+            if last:
+                _sequence_outcome(res, records, totals)
             raise ConvergenceError(f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}) did not converge: "
                                    f"{res.message}", result=res if last else None)
         if folder is not None and not last:
-            _save_level(folder, k, m, res.U, record)
+            _save_level(folder, k, m, res.U, records[-1])
         if prev is None:
             first_path, first_relax = res.path, res.relax
         prev = (m, res.U)
-    res.route = f"{records[0]['route']}+levels"
-    res.levels = records
+    _sequence_outcome(res, records, totals)
     res.path, res.relax = res.path or first_path, res.relax or first_relax
-    for key, value in totals.items():
-        setattr(res, key, value)
     res.wall_time = time.perf_counter() - t_all
     return res
+
+
+def _record(k, scene, model, res, coarsest: bool, build: float) -> dict:
+    """The ``levels`` record of level ``k`` (its mesh, route, counts, residual [N], energy [J], times [s])."""
+    return {"level": k, "mesh": _nodes(scene), "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements,
+            "route": res.route if coarsest else "newton", "converged": bool(res.converged),
+            "stable_minimum": res.stable, "iterations": res.iterations,
+            "factorisations": res.factorisations, "residual_N": res.residual,
+            "energy_J": res.energies.get("total"), "build_time_s": build, "wall_time_s": res.wall_time}
+
+
+def _sequence_outcome(res, records, totals) -> None:
+    """``res`` (the finest level's result) as the sequence's: its route, levels and counters over all levels."""
+    res.route = f"{records[0]['route']}+levels"
+    res.levels = records
+    for key, value in totals.items():
+        setattr(res, key, value)
+
+
+def _add_counts(totals: dict, res) -> None:
+    for key in totals:
+        totals[key] += getattr(res, key)
 
 
 def remove_levels(folder) -> None:

@@ -22,10 +22,16 @@ class Iteration:
     residual: float
     reason: str = ""
     stable: bool | None = None
-    descending: bool = False  # the energy still fell markedly over the last iterations
+    descending: bool = False  # the energy still fell markedly over the last iterations (progress > DESCENDING)
+    progress: float = 0.0  # energy drop over the last third of the iterations / the work scale [-]
     history: list = field(default_factory=list)  # per iteration: |r| before the step, step length, tangent
     stress: np.ndarray | None = None  # the mixed scheme's membrane stress at U (E, 3) [N/m]
     scheme: str = "displacement"
+
+
+DESCENDING = 1e-6
+"""Least energy drop over the last third of an unconverged Newton call, relative to the work of the load, at
+which the iterate still counts as sliding downhill (snapping through) rather than stalled."""
 
 
 def unloaded_scales(model) -> tuple[float, float]:

@@ -2,13 +2,15 @@
 the next mesh, and a drape solved level by level, saved as it goes and taken up again by a resume."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+import rftstatic.app.levels as levels_mod
 from rftstatic.app import static as app
 from rftstatic.app.levels import solve_levels, transfer_start
-from rftstatic.errors import SceneError
+from rftstatic.errors import ConvergenceError, SceneError
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.levels import AUTO_COARSEST, AUTO_FROM, auto_levels, level_mesh, level_nodes, level_scenes
 from rftstatic.scenes.options import static_options
@@ -166,3 +168,26 @@ def test_the_load_scaled_route_on_the_coarsest_mesh_and_newton_above_it(tmp_path
     assert s["converged"] and s["stable_minimum"] and s["route"] == "arc-length+levels"
     assert [lv["route"] for lv in s["levels"]] == ["arc-length", "newton"]
     assert s["relax"] == {} and len(s["path"]["steps"]) > 0 and s["path"]["final_negative"] == 0
+
+
+def test_a_failed_finest_level_is_reported_with_the_levels_solved_below_it(tmp_path, monkeypatch):
+    """When the finest Newton fails, summary.json still lists every level (the coarse ones converged, the
+    finest not), the route and the counters over all of them; the state written is the finest level's
+    last iterate at full load (a cut back would have unloaded the carried drape)."""
+    solve = levels_mod.solve_static
+
+    def starved_finest(model, *, U0=None, options=None, **kw):  # the fine level gets a single iteration
+        if U0 is not None:
+            options = replace(options, max_iterations=1, max_continuations=0)
+        return solve(model, U0=U0, options=options, **kw)
+
+    monkeypatch.setattr(levels_mod, "solve_static", starved_finest)
+    out = tmp_path / "run"
+    with pytest.raises(ConvergenceError, match=r"level 2 of 2 .* from the given state") as info:
+        app.run(load_scene("pedestal-square-20", DRAPE), out, progress=False, figures=False)
+    assert info.value.result.lam == 1.0 and info.value.result.cutbacks == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert not s["converged"] and s["route"] == "relax+newton+levels" and s["load_factor"] == 1.0
+    assert [(lv["mesh"], lv["converged"]) for lv in s["levels"]] == [("[9, 9]", True), ("[17, 17]", False)]
+    assert s["newton_iterations"] == sum(lv["iterations"] for lv in s["levels"])
+    assert (out / "level-1.npz").exists()  # kept for a --resume

@@ -1,5 +1,7 @@
 """Load-scaled Newton against exact and published solutions: plates, the heavy elastica."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -197,3 +199,18 @@ def test_static_options_refuse_nan(key):
 
     with pytest.raises(ValueError):
         StaticOptions(**{key: float("nan")})
+
+
+def test_the_whole_load_from_a_given_state_is_never_cut_back():
+    """A full-load Newton from a given state that does not converge stops with its last iterate at full
+    load (cutting back would unload the given shape), and says so; with continuations it gets there."""
+    mod = strip_model(11, 3, element="RFT3")
+    opts = static.StaticOptions(progress=False, relax_fallback=False).from_state()
+    U0 = np.zeros((mod.mesh.n_nodes, 3))  # the flat strip, as if carried from elsewhere
+    starved = replace(opts, max_iterations=2, max_continuations=0)
+    with pytest.raises(static.ConvergenceError, match=r"load factor 1 from the given state") as info:
+        static.solve_static(mod, U0=U0, options=starved)
+    res = info.value.result
+    assert res.lam == 1.0 and res.cutbacks == 0 and not res.converged and np.any(res.U != 0.0)
+    ok = static.solve_static(mod, U0=U0, options=replace(opts, max_iterations=2, max_continuations=40))
+    assert ok.converged and ok.cutbacks == 0 and len(ok.load_steps) == 1
