@@ -165,11 +165,13 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                 # a cut back would unload the given drape (measured on that level: eight cut backs down to
                 # a load factor of 1.5e-5, none converged): stop with the last iterate at full load
                 result.U, result.lam, result.residual = nt.U, lam_next, nt.residual
+                drop = (f" (energy drop over the last third {nt.progress:.2g} of the load's work)"
+                        if nt.scheme == "displacement" else "")
                 raise ConvergenceError(
                     f"load factor {lam_next:.6g} from the given state, iteration {result.iterations}: {nt.reason}, "
-                    f"|r| = {nt.residual:.3e} N after {continuations} continuations (energy drop over the last "
-                    f"third {nt.progress:.2g} of the load's work); the result is the last iterate at full "
-                    "load, not an equilibrium. Raise solver.max_continuations or start from a closer state.")
+                    f"|r| = {nt.residual:.3e} N after {continuations} continuations{drop}; the result is the last "
+                    "iterate at full load, not an equilibrium. Raise solver.max_continuations or start from a "
+                    "closer state.")
             failures += nt.scheme == "mixed"
             result.cutbacks += 1
             log.info("load factor %.6g: %s after %d iterations (|r| = %.3e); cutting back the increment",
