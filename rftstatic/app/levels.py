@@ -156,6 +156,7 @@ def _sequence_outcome(res, records, totals) -> None:
 
 
 def _add_counts(totals: dict, res) -> None:
+    """Add the counters of one level's ``res`` (iterations, factorisations, cut backs, retries) to ``totals``."""
     for key in totals:
         totals[key] += getattr(res, key)
 

@@ -22,11 +22,15 @@ class Iteration:
     residual: float
     reason: str = ""
     stable: bool | None = None
-    descending: bool = False  # the energy still fell markedly over the last iterations (progress > DESCENDING)
     progress: float = 0.0  # energy drop over the last third of the iterations / the work scale [-]
     history: list = field(default_factory=list)  # per iteration: |r| before the step, step length, tangent
     stress: np.ndarray | None = None  # the mixed scheme's membrane stress at U (E, 3) [N/m]
     scheme: str = "displacement"
+
+    @property
+    def descending(self) -> bool:
+        """The energy still fell markedly over the last iterations (``progress`` > :data:`DESCENDING`)."""
+        return self.progress > DESCENDING
 
 
 DESCENDING = 1e-6

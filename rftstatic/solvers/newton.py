@@ -39,7 +39,7 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError
 from rftstatic.model.state import State
-from rftstatic.solvers.iteration import DESCENDING, Criteria, Iteration, capped_step, direction, self_contact_limited
+from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.mixed import mixed_iterations
 
@@ -389,7 +389,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     drop = Pi_history[-k] - Pi_history[-1]
     progress = drop / max(work0 or 0.0, abs(lam * float(np.einsum("ni,ni->", P, U))), 1e-300)
     return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
-                     descending=progress > DESCENDING, progress=progress, history=hist)
+                     progress=progress, history=hist)
 
 def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, max_trials=12):
     """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""
