@@ -166,6 +166,8 @@ SCHEMA = {
         "max_continuations": (int, "snap-through continuations per increment"),
         "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
         "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
+        "step_solver": (str, "auto, direct (a factorisation per Newton step) or krylov (CG preconditioned "
+                             "with the last factorisation; auto: from 60,000 unknowns)"),
         "continuation": (str, "load (load increments) or arc-length (path following with inertia)"),
         "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
         "seeds": (int, "static drape: run this many seeded starts (seed, seed + 1, ...), as a lab tests several "

@@ -14,7 +14,9 @@ Newton iteration minimises Pi(U) = E_b + E_m + E_c - lam P.U. Two iterations are
      Levenberg-Marquardt shift is added (the mixed iteration uses the same safeguards);
   2. the step is scaled so that no node moves more than ``max_step`` (the "simple scaling" of Liu &
      Sze 2009), which keeps the first steps from a flat start in range (both iterations);
-  3. an Armijo backtracking line search on Pi makes every accepted step lower the energy.
+  3. an Armijo backtracking line search on Pi makes every accepted step lower the energy;
+  4. on large meshes (``step_solver``, :mod:`~rftstatic.solvers.krylov`) a step between two factorisations
+     is solved by conjugate gradients on the exact tangent, preconditioned with the last factorisation.
 
 Convergence (:class:`~rftstatic.solvers.iteration.Criteria`) needs both the force residual
 ``|r| <= rtol |lam P|`` (plus the round-off floor of the internal force) and the energy criterion
@@ -39,7 +41,9 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError
 from rftstatic.model.state import State
-from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
+from rftstatic.solvers.iteration import (Criteria, Iteration, capped_step, diagonal_scale, direction,
+                                         self_contact_limited)
+from rftstatic.solvers.krylov import KRYLOV_FROM, forcing, truncated_cg
 from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.mixed import mixed_iterations
 
@@ -78,6 +82,12 @@ class StaticOptions:
         route's intermediate handovers, where the relaxation goes on instead
     tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
     linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
+    step_solver : how the displacement iteration solves its Newton step: ``"direct"`` (a factorisation
+        of the tangent per step, reused by ``reuse_factorisation``), ``"krylov"`` (conjugate gradients on
+        the exact tangent preconditioned with the last factorisation, factorised anew when CG slows,
+        :mod:`~rftstatic.solvers.krylov`) or ``"auto"``: krylov from
+        :data:`~rftstatic.solvers.krylov.KRYLOV_FROM` free unknowns when the linear solver re-solves
+        cheaply, else direct
     max_load_steps : give up after this many increments
     start : ``"load-steps"`` (load-scaled Newton from the flat start) or ``"relax"`` (dynamic
         relaxation at full load, then Newton to polish: for drapes with many folds)
@@ -120,6 +130,7 @@ class StaticOptions:
     iteration_fallback: bool = True
     tangent: str = "auto"
     linear_solver: str = "auto"
+    step_solver: str = "auto"
     max_load_steps: int = 2000
     max_continuations: int = 10
     reuse_factorisation: int = 2
@@ -146,6 +157,8 @@ class StaticOptions:
         if self.linear_solver not in ("auto", "cholmod", "scipy", "amg"):
             raise ValueError(f'solver.linear_solver must be "auto", "cholmod", "scipy" or "amg", got '
                              f'"{self.linear_solver}"')
+        if self.step_solver not in ("auto", "direct", "krylov"):
+            raise ValueError(f'solver.step_solver must be "auto", "direct" or "krylov", got "{self.step_solver}"')
         if self.iteration not in ("mixed", "displacement"):
             raise ValueError(f'solver.iteration must be "mixed" or "displacement", got "{self.iteration}"')
         if self.tangent not in ("auto", "exact", "psd"):
@@ -244,7 +257,8 @@ class NewtonWorkspace:
     state : the solve's :class:`~rftstatic.model.state.State` (its contact candidate list is used by
         every energy, residual and tangent evaluation)
     solver : the linear solver (symbolic analysis reused between factorisations)
-    modes : counts of the tangents used: exact, psd, shift, reused
+    modes : counts of the tangents used: exact, psd, shift, reused, krylov (steps by preconditioned CG, and
+        their "CG iterations")
     factorisations : numeric factorisations of a tangent (failed Cholesky attempts included)
     lm_scale : mean tangent diagonal [N/m], the scale of the Levenberg-Marquardt damping, computed once
         per solve at the state where damping is first needed
@@ -310,13 +324,19 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     reuse = False  # the last factorisation may serve the next step (modified Newton)
     age = 0
     hist = []
+    krylov = uses_krylov(opts, len(r), solver)
+    refresh = True  # krylov steps: the next step factorises the tangent anew
+    first_rnorm = rnorm
     for it in range(1, max_iterations + 1):
         if it > 1 and test.met(U, r, last_work, solver):
             return Iteration(True, U, it - 1, rnorm, stable=stable, history=hist)
         d = None
         fresh = False
         mode = "reused"
-        if reuse and age < opts.reuse_factorisation:
+        if krylov and not refresh:
+            d, dKd, refresh = _krylov_direction(model, U, lam, r, ws, mu, forcing(rnorm, first_rnorm))
+            fresh, mode = d is not None, "krylov"
+        elif reuse and age < opts.reuse_factorisation and not krylov:
             try:
                 d = solver.resolve(-r)
             except LinearSolveError:
@@ -334,6 +354,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
             stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
             age = 0
             fresh = True
+            refresh = False
             # curvature of the quadratic model along d: (K + s I) d = -r  =>  d.K.d = -d.r - s d.d
             dKd = -float(r @ d) - shift * float(d @ d)
         step, cap = capped_step(model, d, max_step)
@@ -390,6 +411,32 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     progress = drop / max(work0 or 0.0, abs(lam * float(np.einsum("ni,ni->", P, U))), 1e-300)
     return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
                      progress=progress, history=hist)
+
+def uses_krylov(opts, unknowns: int, solver) -> bool:
+    """Whether the displacement iteration solves its steps by CG preconditioned with the last factorisation
+    (``opts.step_solver``; ``"auto"``: from :data:`~rftstatic.solvers.krylov.KRYLOV_FROM` unknowns). Needs
+    a solver whose re-solve with its factorisation is a back-substitution."""
+    if opts.step_solver == "direct" or not getattr(solver, "cheap_resolve", False):
+        return False
+    return opts.step_solver == "krylov" or unknowns >= KRYLOV_FROM
+
+
+def _krylov_direction(model, U, lam, r, ws, mu, rtol):
+    """A Newton step by CG on the exact tangent, preconditioned with the solver's last factorisation
+    (:func:`~rftstatic.solvers.krylov.truncated_cg`): ``(d, d.K.d, refresh)``, ``d`` None when no descent
+    step came out (then the caller factorises); ``refresh``: factorise at the next step."""
+    try:
+        K = model.tangent(U, lam=lam, candidates=ws.candidates, pairs=ws.pairs)[1]
+        shift = mu * diagonal_scale(model, U, ws) if mu else 0.0
+        step = truncated_cg(K, r, ws.solver.resolve, shift=shift, rtol=rtol)
+    except LinearSolveError:
+        return None, 0.0, True
+    ws.modes["CG iterations"] = ws.modes.get("CG iterations", 0) + step.iterations
+    if not (np.all(np.isfinite(step.d)) and float(r @ step.d) < 0.0):
+        return None, 0.0, True
+    ws.modes["krylov"] = ws.modes.get("krylov", 0) + 1
+    return step.d, step.curvature, step.stale
+
 
 def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, max_trials=12):
     """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""
