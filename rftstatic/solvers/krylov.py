@@ -21,6 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rftstatic.solvers.iteration import diagonal_scale
+from rftstatic.solvers.linear import LinearSolveError
+
 KRYLOV_FROM = 60_000
 """Free unknowns from which ``step_solver = "auto"`` takes the preconditioned CG step (the 201 x 201 sheet
 has 121,200; at 101 x 101, 30,600, a factorisation costs 0.4 s and the direct step is as fast or faster:
@@ -108,3 +111,32 @@ def truncated_cg(K, r: np.ndarray, precondition, *, shift: float = 0.0, rtol: fl
         p = z + (gz_next / gz) * p
         gz = gz_next
     return KrylovStep(d, iterations, outcome, float(d @ (K @ d)))
+
+
+def uses_krylov(opts, unknowns: int, solver) -> bool:
+    """Whether the displacement iteration solves its steps by CG preconditioned with the last factorisation
+    (``opts.step_solver``; ``"auto"``: from :data:`KRYLOV_FROM` unknowns). Needs
+    a solver whose re-solve with its factorisation is a back-substitution."""
+    if opts.step_solver == "direct" or not getattr(solver, "cheap_resolve", False):
+        return False
+    return opts.step_solver == "krylov" or unknowns >= KRYLOV_FROM
+
+
+def krylov_direction(model, U, lam, r, ws, mu, rtol):
+    """A Newton step by CG on the exact tangent, preconditioned with the solver's last factorisation
+    (:func:`truncated_cg`): ``(d, d.K.d, refresh)``, ``d`` None when no descent
+    step came out (then the caller factorises); ``refresh``: factorise at the next step. ``ws``: the
+    :class:`~rftstatic.solvers.newton.NewtonWorkspace` (its solver holds the factorisation; the steps and CG
+    iterations are counted in its modes); ``mu``: the Levenberg-Marquardt damping relative to the mean
+    tangent diagonal; ``rtol``: the forcing term (:func:`forcing`)."""
+    try:
+        K = model.tangent(U, lam=lam, candidates=ws.candidates, pairs=ws.pairs)[1]
+        shift = mu * diagonal_scale(model, U, ws) if mu else 0.0
+        step = truncated_cg(K, r, ws.solver.resolve, shift=shift, rtol=rtol)
+    except LinearSolveError:
+        return None, 0.0, True
+    ws.modes["CG iterations"] = ws.modes.get("CG iterations", 0) + step.iterations
+    if not (np.all(np.isfinite(step.d)) and float(r @ step.d) < 0.0):
+        return None, 0.0, True
+    ws.modes["krylov"] = ws.modes.get("krylov", 0) + 1
+    return step.d, step.curvature, step.stale

@@ -41,9 +41,8 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError
 from rftstatic.model.state import State
-from rftstatic.solvers.iteration import (Criteria, Iteration, capped_step, diagonal_scale, direction,
-                                         self_contact_limited)
-from rftstatic.solvers.krylov import KRYLOV_FROM, forcing, truncated_cg
+from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
+from rftstatic.solvers.krylov import forcing, krylov_direction, uses_krylov
 from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.mixed import mixed_iterations
 
@@ -311,7 +310,8 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
     free = model.free.ravel()
     U = U.copy()
-    Pi = model.potential(U, lam, candidates=cand, pairs=ws.pairs)
+    parts = model.energies(U, lam, candidates=cand, pairs=ws.pairs)
+    Pi, scale = parts["total"], _energy_scale(parts)
     r = (model.residual(U, lam, candidates=cand, pairs=ws.pairs)).ravel()[free]
     rnorm = float(np.linalg.norm(r))
     if not np.isfinite(rnorm):
@@ -334,7 +334,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
         fresh = False
         mode = "reused"
         if krylov and not refresh:
-            d, dKd, refresh = _krylov_direction(model, U, lam, r, ws, mu, forcing(rnorm, first_rnorm))
+            d, dKd, refresh = krylov_direction(model, U, lam, r, ws, mu, forcing(rnorm, first_rnorm))
             fresh, mode = d is not None, "krylov"
         elif reuse and age < opts.reuse_factorisation and not krylov:
             try:
@@ -362,9 +362,10 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
         step, frac = self_contact_limited(model, U, step, ws)
         cap *= frac
         slope = float(r @ step.ravel()[free])
-        alpha, Pi_new = _line_search(model, U, step, lam, Pi, slope, opts, cand, ws.pairs)
+        alpha, parts = _line_search(model, U, step, lam, Pi, slope, opts, cand, ws.pairs, scale)
         if alpha is None:
             return Iteration(False, U, it, rnorm, "line search found no decrease of the energy")
+        Pi_new, scale = parts["total"], _energy_scale(parts)
         U = U + alpha * step
         Pi = Pi_new
         hist.append({"residual": rnorm, "alpha": alpha, "cap": cap, "mu": mu, "fresh": fresh,
@@ -390,8 +391,8 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
         work = abs(float(alpha * step.ravel()[free] @ r_new))
         if work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
-            # (a good predictor makes the first step tiny; round-off must not stall the criterion)
-            parts = model.energies(U, lam, candidates=cand, pairs=ws.pairs)
+            # (a good predictor makes the first step tiny; round-off must not stall the criterion);
+            # ``parts``: the energies at the new U, from the line search
             work0 = max(abs(alpha * slope), abs(lam * float(np.einsum("ni,ni->", P, U))),
                         parts["bending"] + parts["membrane"], 1e-300)
             test.work_ref = work0
@@ -412,48 +413,29 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
                      progress=progress, history=hist)
 
-def uses_krylov(opts, unknowns: int, solver) -> bool:
-    """Whether the displacement iteration solves its steps by CG preconditioned with the last factorisation
-    (``opts.step_solver``; ``"auto"``: from :data:`~rftstatic.solvers.krylov.KRYLOV_FROM` unknowns). Needs
-    a solver whose re-solve with its factorisation is a back-substitution."""
-    if opts.step_solver == "direct" or not getattr(solver, "cheap_resolve", False):
-        return False
-    return opts.step_solver == "krylov" or unknowns >= KRYLOV_FROM
+def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, scale=None, max_trials=12):
+    """Armijo backtracking on Pi along ``step``: ``(alpha, parts)``, ``parts`` the energies
+    (:meth:`~rftstatic.model.model.Model.energies`) at ``U + alpha step``; ``(None, None)`` when no trial
+    lowers the energy. ``scale`` [J]: :func:`_energy_scale` of the energies at ``U`` (computed when None;
+    the caller passes the last accepted step's, which saves an evaluation per iteration)."""
+    def parts_at(alpha):
+        return model.energies(U + alpha * step, lam, candidates=candidates, pairs=pairs)
 
-
-def _krylov_direction(model, U, lam, r, ws, mu, rtol):
-    """A Newton step by CG on the exact tangent, preconditioned with the solver's last factorisation
-    (:func:`~rftstatic.solvers.krylov.truncated_cg`): ``(d, d.K.d, refresh)``, ``d`` None when no descent
-    step came out (then the caller factorises); ``refresh``: factorise at the next step."""
-    try:
-        K = model.tangent(U, lam=lam, candidates=ws.candidates, pairs=ws.pairs)[1]
-        shift = mu * diagonal_scale(model, U, ws) if mu else 0.0
-        step = truncated_cg(K, r, ws.solver.resolve, shift=shift, rtol=rtol)
-    except LinearSolveError:
-        return None, 0.0, True
-    ws.modes["CG iterations"] = ws.modes.get("CG iterations", 0) + step.iterations
-    if not (np.all(np.isfinite(step.d)) and float(r @ step.d) < 0.0):
-        return None, 0.0, True
-    ws.modes["krylov"] = ws.modes.get("krylov", 0) + 1
-    return step.d, step.curvature, step.stale
-
-
-def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, max_trials=12):
-    """Armijo backtracking on Pi along ``step``; returns (alpha, Pi) or (None, Pi0)."""
     if not opts.line_search:
-        return 1.0, model.potential(U + step, lam, candidates=candidates, pairs=pairs)
-    parts = model.energies(U, lam, candidates=candidates, pairs=pairs)
-    scale = abs(parts["bending"]) + abs(parts["membrane"]) + abs(parts["contact"]) + abs(parts["external_work"])
+        return 1.0, parts_at(1.0)
+    if scale is None:
+        scale = _energy_scale(model.energies(U, lam, candidates=candidates, pairs=pairs))
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence
-        return 1.0, model.potential(U + step, lam, candidates=candidates, pairs=pairs)
+        return 1.0, parts_at(1.0)
     roundoff = 1e-13 * scale
     alpha = 1.0
     for _ in range(max_trials):
-        Pi = model.potential(U + alpha * step, lam, candidates=candidates, pairs=pairs)
+        parts = parts_at(alpha)
+        Pi = parts["total"]
         if np.isfinite(Pi) and Pi <= Pi0 + 1e-4 * alpha * slope + roundoff:
-            return alpha, Pi
+            return alpha, parts
         # minimiser of the quadratic through Pi0, slope and Pi(alpha), safeguarded
         if np.isfinite(Pi):
             denom = 2.0 * (Pi - Pi0 - slope * alpha)
@@ -461,7 +443,13 @@ def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=N
             alpha = float(np.clip(a_q, 0.1 * alpha, 0.5 * alpha))
         else:
             alpha *= 0.1
-    return None, Pi0
+    return None, None
+
+
+def _energy_scale(parts: dict) -> float:
+    """Magnitude of the energy [J] against which the line search judges round-off: the summed magnitudes
+    of bending, membrane, contact energies and the load's work."""
+    return abs(parts["bending"]) + abs(parts["membrane"]) + abs(parts["contact"]) + abs(parts["external_work"])
 
 
 @contextmanager

@@ -10,7 +10,8 @@ from rftstatic.bench.problems import strip_model
 from rftstatic.solvers import static
 from rftstatic.solvers.krylov import LEAST_FORCING, REFRESH_ITERATIONS, forcing, truncated_cg
 from rftstatic.solvers.linear import AmgSolver, CholmodSolver, ScipySolver, cholmod_available
-from rftstatic.solvers.newton import StaticOptions, uses_krylov
+from rftstatic.solvers.krylov import uses_krylov
+from rftstatic.solvers.newton import StaticOptions
 
 
 def spd(n, seed=0, condition=1e3):
