@@ -184,66 +184,24 @@ class CholmodSolver:
     processes on the 2 cores, so compare within a row): 121,200 unknowns: AMD 47.4e6 entries of L, 4.0 and
     4.5 s per factorisation, analysis 0.6 s; METIS 41.6e6, 3.2 s, 1.6 s; nested dissection 41.1e6, 2.6 and
     2.9 s, 1.5-2.9 s; 30,600 unknowns (101 x 101): AMD 8.4e6, 0.47 s; nested dissection 7.9e6, 0.41-0.65 s
-    (a tie). The analysis is kept for the union of the patterns met (:meth:`_on_pattern`: self-contact
-    changes the pattern at almost every iteration), so its cost is paid once or a few times a solve."""
+    (a tie). The analysis is redone when self-contact changes the pattern (8 times in the first 16
+    Newton iterations at 201 x 201, 29 factorisations), so the costlier analysis is paid back there too."""
 
     def __init__(self):
         self._factor = None
-        self._pattern = None  # (shape, indptr, indices) of the analysed pattern
-        self._keys = None  # its entries as sorted row * n + column keys
+        self._pattern = None
         self.analyses = 0  # symbolic analyses done (one per sparsity pattern met)
 
-    def _on_pattern(self, K):
-        """``K`` (CSR) on the analysed pattern: K itself when its pattern is that one; else a CSR of that
-        pattern with K's values and explicit zeros elsewhere, when K's pattern lies inside it; else None.
-
-        Self-contact (:meth:`rftstatic.model.model.Model.tangent`) adds pair blocks outside the patch
-        pattern, a different set at almost every iteration (242 pair-list rebuilds in the finest Newton of
-        the 201 x 201 drape); a new analysis for each costs 1.1 s there (nested dissection, machine idle)
-        against 2.1 s for the factorisation. So the analysis is kept for the union of the patterns met
-        (:meth:`solve`), and a tangent inside it is factorised on it: CHOLMOD factorises the structure it is
-        given, explicit zeros included. Costs one ``searchsorted`` of the entries (O(nnz log nnz))."""
+    def _same_pattern(self, K) -> bool:
+        """Whether ``K`` has the sparsity pattern of the analysed matrix. Compared entry by entry, not by
+        shape and nnz alone: self-contact (:meth:`rftstatic.model.model.Model.tangent`) adds blocks
+        outside the patch pattern, and two pair sets can give the same nnz in different places (the
+        old analysis would then not fit). Costs O(nnz), a few percent of a factorisation."""
         if self._pattern is None:
-            return None
+            return False
         shape, indptr, indices = self._pattern
-        if K.shape != shape:
-            return None
-        if (K.indptr.shape == indptr.shape and K.indices.shape == indices.shape
-                and np.array_equal(K.indptr, indptr) and np.array_equal(K.indices, indices)):
-            return K
-        keys = _entry_keys(K)
-        pos = np.searchsorted(self._keys, keys)
-        if keys.size and (pos[-1] >= self._keys.size or not np.array_equal(self._keys[pos], keys)):
-            return None
-        data = np.zeros(self._keys.size)
-        data[pos] = K.data
-        return sp.csr_matrix((data, indices, indptr), shape=shape)
-
-    def _analyse(self, K):
-        """Symbolic analysis for ``K`` on the union of its pattern and the one analysed before (same
-        shape); returns K on that pattern."""
-        keys = _entry_keys(K)
-        if self._keys is not None and self._pattern[0] == K.shape:
-            keys = np.union1d(self._keys, keys)
-        if keys.size != K.nnz:
-            n = K.shape[0]
-            rows, cols = np.divmod(keys, n)
-            indptr = np.searchsorted(rows, np.arange(n + 1)).astype(K.indptr.dtype)
-            data = np.zeros(keys.size)
-            data[np.searchsorted(keys, _entry_keys(K))] = K.data
-            K = sp.csr_matrix((data, cols.astype(K.indices.dtype), indptr), shape=K.shape)
-        from sksparse.cholmod import CholmodError, analyze
-
-        A = K.T
-        mode, ordering = self.choose_mode(A.shape[0])
-        try:
-            self._factor = analyze(A, mode=mode, ordering_method=ordering)
-        except CholmodError:  # a CHOLMOD built without its Partition module (METIS): no nesdis
-            self._factor = analyze(A, mode=mode, ordering_method="default")
-        self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
-        self._keys = keys
-        self.analyses += 1
-        return K
+        return (K.shape == shape and K.indptr.shape == indptr.shape and K.indices.shape == indices.shape
+                and np.array_equal(K.indptr, indptr) and np.array_equal(K.indices, indices))
 
     @classmethod
     def choose_mode(cls, n: int) -> tuple[str, str]:
@@ -288,15 +246,18 @@ class CholmodSolver:
         return "supernodal", "default"
 
     def solve(self, K: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
-        from sksparse.cholmod import CholmodNotPositiveDefiniteError
+        from sksparse.cholmod import CholmodError, CholmodNotPositiveDefiniteError, analyze
 
-        if not K.has_sorted_indices:
-            K = K.sorted_indices()
+        A = K.T  # CSR of a symmetric matrix = its CSC transpose, no copy
         with SerialOpenMP():
-            fitted = self._on_pattern(K) if self._factor is not None else None
-            if fitted is None:
-                fitted = self._analyse(K)
-            A = fitted.T  # CSR of a symmetric matrix = its CSC transpose, no copy
+            if self._factor is None or not self._same_pattern(K):
+                mode, ordering = self.choose_mode(A.shape[0])
+                try:
+                    self._factor = analyze(A, mode=mode, ordering_method=ordering)
+                except CholmodError:  # a CHOLMOD built without its Partition module (METIS): no nesdis
+                    self._factor = analyze(A, mode=mode, ordering_method="default")
+                self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
+                self.analyses += 1
             try:
                 self._factor.cholesky_inplace(A)
             except CholmodNotPositiveDefiniteError as exc:
@@ -311,12 +272,6 @@ class CholmodSolver:
             raise LinearSolveError("no factorisation to reuse")
         with SerialOpenMP():
             return self._factor(b)
-
-
-def _entry_keys(K) -> np.ndarray:
-    """The entries of ``K`` (CSR, sorted indices) as sorted ``row * n + column`` int64 keys."""
-    rows = np.repeat(np.arange(K.shape[0], dtype=np.int64), np.diff(K.indptr))
-    return rows * K.shape[1] + K.indices
 
 
 class ScipySolver:

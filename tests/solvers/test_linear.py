@@ -65,25 +65,3 @@ def test_serial_openmp_restores_the_threads():
     assert (rt.omp_get_dynamic(), rt.omp_get_max_threads()) == before
     with linear.SerialOpenMP(enabled=False):
         assert (rt.omp_get_dynamic(), rt.omp_get_max_threads()) == before
-
-
-def test_one_analysis_serves_every_pattern_inside_the_union_met():
-    """Self-contact adds pair blocks outside the patch pattern, another set each iteration: a tangent whose
-    pattern lies inside the analysed one is factorised on it (explicit zeros), a new entry widens it."""
-    n = 600
-    K = _laplacian(n, 0.5)
-    s = linear.CholmodSolver()
-    b = np.sin(np.arange(n))
-
-    def coupled(i, j):
-        C = sp.lil_matrix((n, n))
-        C[i, i] = C[j, j] = 1.0
-        C[i, j] = C[j, i] = -1.0
-        return (K + C).tocsr()
-
-    for A, analyses in [(K, 1), (coupled(3, 400), 2), (K, 2), (coupled(3, 400), 2), (coupled(10, 500), 3),
-                        (coupled(3, 400), 3), (K, 3)]:
-        x = s.solve(A, b)
-        assert s.analyses == analyses
-        assert np.allclose(A @ x, b, rtol=0, atol=1e-10)
-        assert np.allclose(s.resolve(b), x, rtol=0, atol=1e-12)
