@@ -413,6 +413,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} iterations",
                      progress=progress, history=hist)
 
+
 def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, scale=None, max_trials=12):
     """Armijo backtracking on Pi along ``step``: ``(alpha, parts)``, ``parts`` the energies
     (:meth:`~rftstatic.model.model.Model.energies`) at ``U + alpha step``; ``(None, None)`` when no trial
