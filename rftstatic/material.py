@@ -8,7 +8,7 @@ All rigidities are per unit width: tensile/shear [N/m], bending/twisting [N m].
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -83,6 +83,16 @@ class Material:
     def bending_scale(self) -> float:
         """Largest bending rigidity [N m]."""
         return float(np.linalg.eigvalsh(self.Db).max())
+
+    def membrane_scaled(self, factor: float) -> Material:
+        """This material with the membrane rigidity ``D^m`` multiplied by ``factor`` (> 0) [-]: the model of a
+        coarse level matched to a finer mesh's locking number (:mod:`rftstatic.app.levels`)."""
+        if not (np.isfinite(factor) and factor > 0):
+            raise ValueError(f"{self.name}: a membrane scale must be a finite number > 0, got {factor!r}")
+        if factor == 1.0:
+            return self
+        return replace(self, Dm=self.Dm * factor, name=f"{self.name} (membrane x {factor:.4g})",
+                       info={**self.info, "membrane_scale": float(factor)})
 
     def as_dict(self) -> dict:
         return {

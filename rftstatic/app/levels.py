@@ -15,7 +15,16 @@ of the same sheet (:func:`rftstatic.scenes.levels.level_scenes`, each about twic
    Cholesky factorisation wherever the tangent is positive definite), then the self-contact and stability
    checks of :func:`~rftstatic.solvers.static.solve_static`; repeated up to the scene's mesh.
 
-The folds are found where they are cheap to find; the fine meshes only sharpen them. Each level's
+The folds are found where they are cheap to find; the fine meshes only sharpen them.
+
+A coarse mesh of RFT6 locks more than the fine one (the parasitic membrane energy of a fold grows with the
+locking number ``(C/B) h^2``, :func:`~rftstatic.model.model.locking_number`), so its folds are another shape,
+and the finest Newton has to carry them there along a curved, nearly flat valley (hundreds of short steps
+on the 80 cm drape at 201 x 201 nodes). ``solver.level_membrane = "matched"`` solves every level below the
+finest with its membrane rigidity scaled by :func:`membrane_match`, ``(h_finest / h)^2``, so that each has
+the finest mesh's locking number; the coarsest level's route still finds the branch with the scene's own
+fabric, and its equilibrium is then solved again with the matched membrane (Newton at full load) before it
+is carried up. Only the finest level is the scene's model. Each level's
 equilibrium is saved in the run folder (``level-K.npz``, with the fingerprint of its model) as soon as it
 converges; ``--resume`` takes it up again, so an interrupted run loses at most the level it was on.
 """
@@ -31,7 +40,7 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError
 from rftstatic.remesh.transfer import transfer_fields
-from rftstatic.scenes.build import build_model
+from rftstatic.scenes.build import build_mesh, build_model
 from rftstatic.scenes.levels import level_scenes
 from rftstatic.solvers.checkpoint import save_atomic
 from rftstatic.solvers.static import solve_static
@@ -39,7 +48,7 @@ from rftstatic.solvers.static_checkpoint import static_fingerprint
 
 log = logging.getLogger(__name__)
 
-__all__ = ["TRANSFER", "solve_levels", "transfer_start"]
+__all__ = ["TRANSFER", "membrane_match", "solve_levels", "transfer_start"]
 
 TRANSFER = "mesh"
 """How an equilibrium goes to the next mesh (:func:`rftstatic.remesh.transfer.transfer_fields`): linear
@@ -87,27 +96,31 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     records, totals = [], {"iterations": 0, "factorisations": 0, "cutbacks": 0, "retries": 0}
     prev = None
     first_path, first_relax = {}, {}  # the coarsest route's own record (its path or relaxation), if solved here
+    matched = opts.level_membrane == "matched"
     t_all = time.perf_counter()
     for k, sc in enumerate(scenes, start=1):
         last = k == len(scenes)
         t0 = time.perf_counter()
-        m = model if last else build_model(sc, quiet=True)[0]
+        mesh = model.mesh if last else build_mesh(sc)
+        scale = membrane_match(mesh, model.mesh) if matched and not last else 1.0
+        # ``carry``: the model whose equilibrium goes to the next mesh (matched membrane, if asked)
+        carry = model if last else build_model(sc, mesh, quiet=True, membrane_scale=scale)[0]
         build = time.perf_counter() - t0
-        saved = _load_level(folder, k, m) if resume else None
+        saved = _load_level(folder, k, carry) if resume else None
         if saved is not None:
-            log.info("mesh sequencing: level %d of %d (%d nodes) taken from %s", k, len(scenes), m.mesh.n_nodes,
+            log.info("mesh sequencing: level %d of %d (%d nodes) taken from %s", k, len(scenes), carry.mesh.n_nodes,
                      _level_path(folder, k))
             records.append({**saved["record"], "resumed": True})
-            prev = (m, saved["U"])
+            prev = (carry, saved["U"])
             continue
-        if prev is None:
+        if prev is None:  # the route finds the branch with the scene's own fabric
+            m = carry if scale == 1.0 else build_model(sc, mesh, quiet=True)[0]
             start = {"options": replace(opts, levels=1, progress=opts.progress and last)}
             what = f"the scene's route ({opts.start})"
         else:
-            start = {"U0": transfer_start(prev[0], prev[1], m),
-                     "options": replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement",
-                                        continuation="load", progress=opts.progress and last)}
-            what = f"Newton at full load from level {k - 1}"
+            m = carry
+            start = {"U0": transfer_start(prev[0], prev[1], m), "options": _newton_options(opts, opts.progress and last)}
+            what = f"Newton at full load from level {k - 1}" + (f", membrane x {scale:.4g}" if scale != 1.0 else "")
         log.info("mesh sequencing: level %d of %d, %s nodes, by %s", k, len(scenes), m.mesh.n_nodes, what)
         try:
             res = solve_static(m, **start, callback=callback if last else None,
@@ -116,32 +129,76 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             failed = exc.result if last else None
             if failed is not None:  # the summary of the failed run lists the levels solved and this one
                 _add_counts(totals, failed)
-                _sequence_outcome(failed, records + [_record(k, sc, m, failed, prev is None, build)], totals)
+                _sequence_outcome(failed, records + [_record(k, sc, m, failed, prev is None, build, m.material)], totals)
             raise ConvergenceError(
                 f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}, {m.mesh.n_nodes} nodes) did not "
                 f"converge by {what}: {exc}", result=failed) from None
-        records.append(_record(k, sc, m, res, prev is None, build))
+        records.append(_record(k, sc, m, res, prev is None, build, m.material))
         _add_counts(totals, res)
         if not res.converged:
             if last:
                 _sequence_outcome(res, records, totals)
             raise ConvergenceError(f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}) did not converge: "
                                    f"{res.message}", result=res if last else None)
+        U = res.U
+        if m is not carry:  # the coarsest level, matched: its equilibrium again with the matched membrane
+            U, carry = _rematched(m, carry, res, opts, records[-1], totals)
         if folder is not None and not last:
-            _save_level(folder, k, m, res.U, records[-1])
+            _save_level(folder, k, carry, U, records[-1])
         if prev is None:
             first_path, first_relax = res.path, res.relax
-        prev = (m, res.U)
+        prev = (carry, U)
     _sequence_outcome(res, records, totals)
     res.path, res.relax = res.path or first_path, res.relax or first_relax
     res.wall_time = time.perf_counter() - t_all
     return res
 
 
-def _record(k, scene, model, res, coarsest: bool, build: float) -> dict:
-    """The ``levels`` record of level ``k`` (its mesh, route, counts, residual [N], energy [J], times [s])."""
+def membrane_match(mesh, finest) -> float:
+    """``min(1, (h_finest / h)^2)`` [-], ``h`` the mean element size of ``mesh`` and ``h_finest`` of the mesh
+    ``finest``: the factor on a coarse level's membrane rigidity that gives it the finest mesh's locking number
+    ``(C/B) h^2`` (:func:`~rftstatic.model.model.locking_number`), ``solver.level_membrane = "matched"``."""
+    h, h_finest = float(mesh.element_size.mean()), float(finest.element_size.mean())
+    return min(1.0, (h_finest / h) ** 2)
+
+
+def _newton_options(opts, progress: bool):
+    """The options of a level's Newton at full load from a carried state (module docstring, step 3)."""
+    return replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement", continuation="load",
+                   progress=progress)
+
+
+def _rematched(model, matched, res, opts, record: dict, totals: dict):
+    """``(U, carry)``: the coarsest level's equilibrium ``res`` on ``model`` (the scene's fabric) solved again by
+    Newton on ``matched`` (its membrane scaled), and that model; ``record["matched"]`` tells how. A matched
+    solve that fails carries the equilibrium of ``model`` instead (a warning)."""
+    t0 = time.perf_counter()
+    try:
+        r = solve_static(matched, U0=res.U, options=_newton_options(opts, False))
+        why = r.message
+    except ConvergenceError as exc:
+        r, why = exc.result, str(exc)
+    ok = r is not None and r.converged
+    record["matched"] = {"membrane_scale": matched.material.info.get("membrane_scale", 1.0), "converged": ok, "iterations": getattr(r, "iterations", 0),
+                         "factorisations": getattr(r, "factorisations", 0),
+                         "energy_J": r.energies.get("total") if ok else None,
+                         "wall_time_s": time.perf_counter() - t0}
+    if r is not None:
+        _add_counts(totals, r)
+    if not ok:
+        log.warning("mesh sequencing: the coarsest level did not converge with its membrane matched (%s); its "
+                    "equilibrium with the scene's fabric goes to the next level", why)
+        return res.U, model
+    return r.U, matched
+
+
+def _record(k, scene, model, res, coarsest: bool, build: float, material=None) -> dict:
+    """The ``levels`` record of level ``k`` (its mesh, route, membrane scale, counts, residual [N], energy [J],
+    times [s]); the energy is that of ``model``, whose membrane the coarsest level keeps for its route."""
     return {"level": k, "mesh": _nodes(scene), "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements,
-            "route": res.route if coarsest else "newton", "converged": bool(res.converged),
+            "route": res.route if coarsest else "newton",
+            "membrane_scale": (material.info.get("membrane_scale", 1.0) if material is not None else 1.0),
+            "converged": bool(res.converged),
             "stable_minimum": res.stable, "iterations": res.iterations,
             "factorisations": res.factorisations, "residual_N": res.residual,
             "energy_J": res.energies.get("total"), "build_time_s": build, "wall_time_s": res.wall_time}

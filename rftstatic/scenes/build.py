@@ -376,17 +376,21 @@ def check_static_scene(scene: Scene, material, supports: Supports, load: np.ndar
                               "components) or an obstacle")
 
 
-def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: bool = False) -> tuple[Model, dict]:
+def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: bool = False,
+                membrane_scale: float = 1.0) -> tuple[Model, dict]:
     """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras.
 
     ``contact``: how the obstacles act, ``"penalty"`` (in the model's energy) or ``"kinematic"`` (by the
     explicit solver; the model has no contact term); default :func:`contact_law` of the scene's analysis.
     ``quiet``: the model's warnings at debug level (a remeshed run warns for its first mesh only).
+    ``membrane_scale``: the fabric's membrane rigidity multiplied by this factor, before the contact and
+    self-contact stiffnesses are derived from it (a coarse level of mesh sequencing matched to the finest
+    mesh's locking number, :mod:`rftstatic.app.levels`); 1: the scene's fabric.
     ``extras``: ``{"obstacles": [...], "probes": {name: (2,) reference point [m]}, "disc": a tester's clamping
     disc (:func:`clamping_disc`) or None}``.
     """
     mesh = build_mesh(scene) if mesh is None else mesh
-    material = build_material(scene)
+    material = build_material(scene).membrane_scaled(membrane_scale)
     if material.weight < 0:
         raise scene.error("material.weight", f"{material.weight!r} N/m^2 is negative; give the fabric's areal weight "
                           "(>= 0; upward loads are loads.pressure < 0)")

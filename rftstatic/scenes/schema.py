@@ -180,6 +180,8 @@ SCHEMA = {
         "levels": ((int, str), "mesh sequencing: meshes of the sequence, each about twice as coarse as the "
                                "next; the coarsest by the route above, the finer ones by Newton at full load (1: "
                                "none; \"auto\", the default: from 15,000 nodes, enough for a coarsest mesh of 3,000)"),
+        "level_membrane": (str, "mesh sequencing: same (the coarse levels keep the fabric) or matched (their "
+                                "membrane rigidity scaled by (h_finest / h)^2, the finest mesh's locking number)"),
         "membrane": (bool, "false: linear Kirchhoff plate (bending only)"),
     }, "static solver options (rftstatic.static.StaticOptions)"),
     "dynamics": ({

@@ -113,6 +113,10 @@ class StaticOptions:
         (:mod:`rftstatic.app.levels`) solves the coarsest of L meshes by this route and each finer one
         by Newton at full load from the solution below; :func:`solve_static` solves the one model it
         is given and does not read it
+    level_membrane : the coarse levels' membrane: ``"same"`` (the scene's fabric) or ``"matched"`` (every level
+        below the finest solved with its membrane rigidity scaled by ``(h_finest / h)^2``, the finest mesh's
+        locking number ``(C/B) h^2``, the coarsest after its route has found the branch; see
+        :mod:`rftstatic.app.levels`)
     """
 
     initial_increment: float = 0.1
@@ -142,6 +146,7 @@ class StaticOptions:
     guide_folds: int = 0
     guide_weight: float = 0.0
     levels: int = 1
+    level_membrane: str = "same"
     progress: bool = True
 
     def __post_init__(self):
@@ -158,6 +163,8 @@ class StaticOptions:
                              f'"{self.linear_solver}"')
         if self.step_solver not in ("auto", "direct", "krylov"):
             raise ValueError(f'solver.step_solver must be "auto", "direct" or "krylov", got "{self.step_solver}"')
+        if self.level_membrane not in ("same", "matched"):
+            raise ValueError(f'solver.level_membrane must be "same" or "matched", got "{self.level_membrane}"')
         if self.iteration not in ("mixed", "displacement"):
             raise ValueError(f'solver.iteration must be "mixed" or "displacement", got "{self.iteration}"')
         if self.tangent not in ("auto", "exact", "psd"):

@@ -191,3 +191,70 @@ def test_a_failed_finest_level_is_reported_with_the_levels_solved_below_it(tmp_p
     assert [(lv["mesh"], lv["converged"]) for lv in s["levels"]] == [("[9, 9]", True), ("[17, 17]", False)]
     assert s["newton_iterations"] == sum(lv["iterations"] for lv in s["levels"])
     assert (out / "level-1.npz").exists()  # kept for a --resume
+
+
+MATCHED = DRAPE[:1] + ["solver.levels=3", "solver.level_membrane=matched"]  # 5 x 5, 9 x 9, 17 x 17
+
+
+def test_membrane_match_gives_a_coarse_level_the_finest_meshs_locking_number():
+    from rftstatic.app.levels import membrane_match
+    from rftstatic.model.model import locking_number
+
+    scenes = level_scenes(load_scene("pedestal-square-80", ["mesh.nodes=[201,201]"]), 3)
+    meshes = [build_model(sc, quiet=True)[0].mesh for sc in scenes]
+    assert [membrane_match(m, meshes[-1]) for m in meshes] == pytest.approx([1 / 16, 1 / 4, 1.0], rel=1e-12)
+    assert membrane_match(meshes[-1], meshes[0]) == 1.0  # a finer mesh is never stiffened
+    coarse = build_model(scenes[0], quiet=True, membrane_scale=1 / 16)[0]
+    fine = build_model(scenes[-1], quiet=True)[0]
+    assert locking_number(coarse.mesh, coarse.material) == pytest.approx(locking_number(fine.mesh, fine.material),
+                                                                         rel=1e-9)
+    assert np.allclose(coarse.material.Db, fine.material.Db) and coarse.material.weight == fine.material.weight
+
+
+def test_a_membrane_scale_must_be_positive_and_one_leaves_the_fabric_alone():
+    material = build_model(load_scene("pedestal-square-20", ["mesh.nodes=[5,5]"]), quiet=True)[0].material
+    assert material.membrane_scaled(1.0) is material
+    half = material.membrane_scaled(0.5)
+    assert np.allclose(half.Dm, 0.5 * material.Dm) and half.info["membrane_scale"] == 0.5
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="membrane scale"):
+            material.membrane_scaled(bad)
+    with pytest.raises(SceneError, match="level_membrane"):
+        static_options(load_scene("pedestal-square-20", ["solver.level_membrane=soft"]))
+
+
+def test_matched_levels_reach_an_equilibrium_of_the_scenes_own_fabric(tmp_path):
+    """``level_membrane = "matched"``: the coarsest route with the scene's fabric, then again with the matched
+    membrane, the middle level matched, the finest the scene's model; the result is checked on that model."""
+    scene = load_scene("pedestal-square-20", MATCHED)
+    model = build_model(scene)[0]
+    res = solve_levels(scene, model, static_options(scene, progress=False), folder=tmp_path)
+    first, middle, finest = res.levels
+    assert first["membrane_scale"] == 1.0 and first["route"] == "relax+newton"
+    assert first["matched"]["converged"] and first["matched"]["membrane_scale"] == pytest.approx(1 / 16)
+    assert middle["membrane_scale"] == pytest.approx(1 / 4) and finest["membrane_scale"] == 1.0
+    assert res.converged and res.stable
+    assert res.iterations == sum(lv["iterations"] + lv.get("matched", {}).get("iterations", 0) for lv in res.levels)
+    assert np.array_equal(model.material.Dm, build_model(scene)[0].material.Dm)
+    r = model.residual(res.U, 1.0)[model.free]
+    assert np.linalg.norm(r) <= 1e-5 * np.linalg.norm(model.load)
+    # the saved levels are those of the matched models: a resume takes them up
+    again = solve_levels(scene, build_model(scene)[0], static_options(scene, progress=False), folder=tmp_path,
+                         resume=True)
+    assert again.levels[0]["resumed"] and again.levels[1]["resumed"]
+    assert np.allclose(again.U, res.U, rtol=0, atol=1e-9)
+
+
+def test_a_coarsest_level_that_fails_with_its_membrane_matched_carries_the_scenes_fabric(tmp_path, monkeypatch, caplog):
+    solve = levels_mod.solve_static
+
+    def matched_fails(model, **kw):
+        if model.material.info.get("membrane_scale", 1.0) < 1.0 and model.mesh.n_nodes == 25:
+            raise ConvergenceError("no convergence (as if)", result=None)
+        return solve(model, **kw)
+
+    monkeypatch.setattr(levels_mod, "solve_static", matched_fails)
+    scene = load_scene("pedestal-square-20", MATCHED)
+    res = solve_levels(scene, build_model(scene)[0], static_options(scene, progress=False))
+    assert not res.levels[0]["matched"]["converged"] and res.converged
+    assert "did not converge with its membrane matched" in caplog.text
