@@ -1,8 +1,7 @@
 """Linear solvers for the Newton step ``K d = -r`` on the free degrees of freedom.
 
 - ``cholmod``: CHOLMOD sparse Cholesky (scikit-sparse); the symbolic analysis (fill-reducing
-  ordering) is done once per sparsity pattern and reused by every factorisation (on large tangents a
-  new pattern keeps the last ordering for a while), and a tangent that is not positive
+  ordering) is done once and reused by every factorisation, and a tangent that is not positive
   definite is detected (:class:`NotPositiveDefinite`), which the Newton solver uses to switch to
   its safeguarded tangent. CHOLMOD's own OpenMP loops run on the calling thread
   (:class:`SerialOpenMP`: Debian's build opens 4-thread regions per supernode, which on 2 cores took
@@ -188,27 +187,10 @@ class CholmodSolver:
     (a tie). The analysis is redone when self-contact changes the pattern (8 times in the first 16
     Newton iterations at 201 x 201, 29 factorisations), so the costlier analysis is paid back there too."""
 
-    ORDERING_REUSE = 8
-    """Changed patterns of a large tangent (from :data:`NESTED_DISSECTION_FROM` unknowns) that keep the
-    fill-reducing permutation of the last full analysis: the tangent is permuted by it and analysed in its
-    natural order, the symbolic factorisation alone. Self-contact adds and drops a few pair blocks between
-    two Newton steps; the ordering of the bulk of the sheet stays good. Measured 2026-12-03 (the 80 cm drape at
-    201 x 201 nodes, 121,200 unknowns, 6.85e6 entries; one run, another job on the other core): nested
-    dissection 1.15 s, the natural analysis of the permuted tangent 0.12 s, its permutation by scipy 0.37 s
-    (once per pattern; each factorisation then gathers the entries through a map), factorisation 2.0-2.3 s
-    either way, the same solution to 1.4e-14. After this many reuses the next changed pattern is ordered
-    afresh, so that pair blocks the kept ordering never saw do not accumulate fill. The finest Newton of
-    that drape from the matched 101 x 101 level, both codes side by side on the 2 cores: 200 iterations,
-    82 factorisations, 575 s against 204, 83 and 607 s with an ordering per pattern (the same equilibrium;
-    the steps differ in round-off)."""
-
     def __init__(self):
         self._factor = None
         self._pattern = None
-        self._perm = None  # the permutation of the last fresh ordering and its uses, or None
-        self._map = None  # gather of the permuted tangent's entries from K.T's, or None (not permuted)
         self.analyses = 0  # symbolic analyses done (one per sparsity pattern met)
-        self.orderings = 0  # of them, those with a fresh fill-reducing ordering
 
     def _same_pattern(self, K) -> bool:
         """Whether ``K`` has the sparsity pattern of the analysed matrix. Compared entry by entry, not by
@@ -264,63 +246,32 @@ class CholmodSolver:
         return "supernodal", "default"
 
     def solve(self, K: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
-        from sksparse.cholmod import CholmodNotPositiveDefiniteError
+        from sksparse.cholmod import CholmodError, CholmodNotPositiveDefiniteError, analyze
 
         A = K.T  # CSR of a symmetric matrix = its CSC transpose, no copy
         with SerialOpenMP():
             if self._factor is None or not self._same_pattern(K):
-                self._analyse(A)
+                mode, ordering = self.choose_mode(A.shape[0])
+                try:
+                    self._factor = analyze(A, mode=mode, ordering_method=ordering)
+                except CholmodError:  # a CHOLMOD built without its Partition module (METIS): no nesdis
+                    self._factor = analyze(A, mode=mode, ordering_method="default")
                 self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
-            if self._map is not None:  # the pattern permuted by a kept ordering (ORDERING_REUSE)
-                A = sp.csc_matrix((A.data[self._map[0]], self._map[1], self._map[2]), shape=A.shape)
+                self.analyses += 1
             try:
                 self._factor.cholesky_inplace(A)
             except CholmodNotPositiveDefiniteError as exc:
                 self._valid = False
                 raise NotPositiveDefinite(str(exc)) from None
             self._valid = True
-            return self._back_substitute(b)
-
-    def _analyse(self, A) -> None:
-        """Symbolic analysis of the pattern of ``A`` (CSC, symmetric): a fresh ordering (:meth:`choose_mode`),
-        or for a large tangent the last one kept (:data:`ORDERING_REUSE`)."""
-        from sksparse.cholmod import CholmodError, analyze
-
-        mode, ordering = self.choose_mode(A.shape[0])
-        self.analyses += 1
-        keep = self._perm
-        if (ordering == "nesdis" and keep is not None and keep["uses"] < self.ORDERING_REUSE
-                and A.has_canonical_format and len(keep["p"]) == A.shape[0]):
-            p = keep["p"]
-            marked = sp.csc_matrix((np.arange(1, A.nnz + 1, dtype=float), A.indices, A.indptr), shape=A.shape)
-            P = marked[p][:, p].tocsc()
-            P.sort_indices()
-            self._map = (P.data.astype(np.int64) - 1, P.indices, P.indptr)
-            self._factor = analyze(P, mode=mode, ordering_method="natural")
-            keep["uses"] += 1
-            return
-        try:
-            self._factor = analyze(A, mode=mode, ordering_method=ordering)
-        except CholmodError:  # a CHOLMOD built without its Partition module (METIS): no nesdis
-            self._factor = analyze(A, mode=mode, ordering_method="default")
-        self._map = None
-        self.orderings += 1
-        self._perm = {"p": self._factor.P(), "uses": 0} if ordering == "nesdis" else None
-
-    def _back_substitute(self, b):
-        if self._map is None:
             return self._factor(b)
-        p = self._perm["p"]
-        x = np.empty_like(b)
-        x[p] = self._factor(b[p])
-        return x
 
     def resolve(self, b: np.ndarray) -> np.ndarray:
         """Solve with the last factorisation (modified Newton)."""
         if self._factor is None or not getattr(self, "_valid", False):
             raise LinearSolveError("no factorisation to reuse")
         with SerialOpenMP():
-            return self._back_substitute(b)
+            return self._factor(b)
 
 
 class ScipySolver:
