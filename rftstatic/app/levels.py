@@ -119,7 +119,8 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             what = f"the scene's route ({opts.start})"
         else:
             m = carry
-            start = {"U0": transfer_start(prev[0], prev[1], m), "options": _newton_options(opts, opts.progress and last)}
+            start = {"U0": transfer_start(prev[0], prev[1], m),
+                     "options": _newton_options(opts, opts.progress and last)}
             what = f"Newton at full load from level {k - 1}" + (f", membrane x {scale:.4g}" if scale != 1.0 else "")
         log.info("mesh sequencing: level %d of %d, %s nodes, by %s", k, len(scenes), m.mesh.n_nodes, what)
         try:
@@ -129,11 +130,11 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             failed = exc.result if last else None
             if failed is not None:  # the summary of the failed run lists the levels solved and this one
                 _add_counts(totals, failed)
-                _sequence_outcome(failed, records + [_record(k, sc, m, failed, prev is None, build, m.material)], totals)
+                _sequence_outcome(failed, records + [_record(k, sc, m, failed, prev is None, build)], totals)
             raise ConvergenceError(
                 f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}, {m.mesh.n_nodes} nodes) did not "
                 f"converge by {what}: {exc}", result=failed) from None
-        records.append(_record(k, sc, m, res, prev is None, build, m.material))
+        records.append(_record(k, sc, m, res, prev is None, build))
         _add_counts(totals, res)
         if not res.converged:
             if last:
@@ -162,6 +163,12 @@ def membrane_match(mesh, finest) -> float:
     return min(1.0, (h_finest / h) ** 2)
 
 
+def _membrane_scale(model) -> float:
+    """The factor on ``model``'s membrane rigidity (:meth:`~rftstatic.material.Material.membrane_scaled`; 1: the
+    scene's fabric)."""
+    return float(model.material.info.get("membrane_scale", 1.0))
+
+
 def _newton_options(opts, progress: bool):
     """The options of a level's Newton at full load from a carried state (module docstring, step 3)."""
     return replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement", continuation="load",
@@ -179,10 +186,9 @@ def _rematched(model, matched, res, opts, record: dict, totals: dict):
     except ConvergenceError as exc:
         r, why = exc.result, str(exc)
     ok = r is not None and r.converged
-    record["matched"] = {"membrane_scale": matched.material.info.get("membrane_scale", 1.0), "converged": ok, "iterations": getattr(r, "iterations", 0),
-                         "factorisations": getattr(r, "factorisations", 0),
-                         "energy_J": r.energies.get("total") if ok else None,
-                         "wall_time_s": time.perf_counter() - t0}
+    record["matched"] = {"membrane_scale": _membrane_scale(matched), "converged": ok,
+                         "iterations": getattr(r, "iterations", 0), "factorisations": getattr(r, "factorisations", 0),
+                         "energy_J": r.energies.get("total") if ok else None, "wall_time_s": time.perf_counter() - t0}
     if r is not None:
         _add_counts(totals, r)
     if not ok:
@@ -192,12 +198,11 @@ def _rematched(model, matched, res, opts, record: dict, totals: dict):
     return r.U, matched
 
 
-def _record(k, scene, model, res, coarsest: bool, build: float, material=None) -> dict:
-    """The ``levels`` record of level ``k`` (its mesh, route, membrane scale, counts, residual [N], energy [J],
-    times [s]); the energy is that of ``model``, whose membrane the coarsest level keeps for its route."""
+def _record(k, scene, model, res, coarsest: bool, build: float) -> dict:
+    """The ``levels`` record of level ``k`` solved on ``model`` (its mesh, route, membrane scale, counts, residual
+    [N], energy [J], times [s])."""
     return {"level": k, "mesh": _nodes(scene), "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements,
-            "route": res.route if coarsest else "newton",
-            "membrane_scale": (material.info.get("membrane_scale", 1.0) if material is not None else 1.0),
+            "route": res.route if coarsest else "newton", "membrane_scale": _membrane_scale(model),
             "converged": bool(res.converged),
             "stable_minimum": res.stable, "iterations": res.iterations,
             "factorisations": res.factorisations, "residual_N": res.residual,
