@@ -14,7 +14,7 @@ from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
 from rftstatic.scenes.material import build_material
-from rftstatic.scenes.schema import Scene
+from rftstatic.scenes.schema import MESH_NODES, Scene
 from rftstatic.scenes.self_contact import build_self_contact
 
 MESH_KEYS = {
@@ -49,12 +49,12 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
     try:
         if kind == "rectangle":
             lx, ly = _pair(scene, "mesh.size", m.get("size", [1.0, 1.0]))
-            nx, ny = _pair(scene, "mesh.nodes", m.get("nodes", [11, 11]), int)
+            nx, ny = _pair(scene, "mesh.nodes", m.get("nodes", MESH_NODES["rectangle"]), int)
             ox, oy = _pair(scene, "mesh.origin", m.get("origin", [-lx / 2, -ly / 2]))
             return meshmod.rectangle(lx * u, ly * u, nx, ny, origin=(ox * u, oy * u),
                                      pattern=m.get("pattern", "right"), z0=z0)
         if kind == "square-polar":
-            nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", [21, 160]), int)
+            nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", MESH_NODES["square-polar"]), int)
             cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
             if "radius" not in m:
                 raise scene.error("mesh.radius", "a square-polar mesh needs its half side as radius")
@@ -63,7 +63,7 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
                                         core_radius=None if core is None else core * u,
                                         pattern=m.get("pattern", "right"), z0=z0)
         if kind == "polar":
-            nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", [11, 40]), int)
+            nr, nc = _pair(scene, "mesh.nodes", m.get("nodes", MESH_NODES["polar"]), int)
             cx, cy = _pair(scene, "mesh.centre", m.get("centre", [0.0, 0.0]))
             if "radius" not in m:
                 raise scene.error("mesh.radius", f"a {kind} mesh needs its radius")

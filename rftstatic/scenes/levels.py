@@ -32,7 +32,7 @@ import math
 
 from rftstatic.errors import SceneError
 from rftstatic.mesh import trimesh as meshmod
-from rftstatic.scenes.schema import Scene, validate
+from rftstatic.scenes.schema import MESH_NODES, Scene, validate
 
 __all__ = ["AUTO_COARSEST", "AUTO_FROM", "MAX_LEVELS", "auto_levels", "level_mesh", "level_nodes", "level_scenes"]
 
@@ -47,12 +47,11 @@ def level_mesh(scene: Scene, k: int) -> dict:
     """The ``[mesh]`` table of the mesh ``k`` levels below the scene's own (k = 0: the scene's)."""
     m = dict(scene.get("mesh", {}))
     kind = m.get("kind", "rectangle")
+    if kind in MESH_NODES:
+        m.setdefault("nodes", list(MESH_NODES[kind]))
     if k == 0:
         return m
     if kind in LEAST_NODES:
-        if "nodes" not in m:
-            raise scene.error("solver.levels", f"a {kind} mesh needs its mesh.nodes to make coarser levels; "
-                              "give mesh.nodes")
         a, b = m["nodes"]
         a2 = math.ceil((a - 1) / 2 ** k) + 1
         if kind == "rectangle":

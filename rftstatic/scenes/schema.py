@@ -25,6 +25,8 @@ from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
 NUM = (int, float)
+MESH_NODES = {"rectangle": [11, 11], "polar": [11, 40], "square-polar": [21, 160]}
+"""``mesh.nodes`` of a generated mesh whose scene gives none (the mesh builder and the mesh sequence read it)."""
 LIST = (list,)
 
 

@@ -258,3 +258,20 @@ def test_a_coarsest_level_that_fails_with_its_membrane_matched_carries_the_scene
     res = solve_levels(scene, build_model(scene)[0], static_options(scene, progress=False))
     assert not res.levels[0]["matched"]["converged"] and res.converged
     assert "did not converge with its membrane matched" in caplog.text
+
+
+def test_a_generated_mesh_without_nodes_has_the_builders_default_nodes():
+    """A rectangle without ``mesh.nodes`` is built with the default nodes, and the mesh sequence counts the same
+    (found by the scene property test: ``levels = "auto"`` raised KeyError 'nodes')."""
+    import copy
+
+    from rftstatic.scenes.schema import MESH_NODES, Scene
+
+    base = load_scene("pedestal-square-20")
+    data = copy.deepcopy(base.data)
+    del data["mesh"]["nodes"]
+    sc = Scene(data, base.path, base.name, {})
+    built = build_model(sc, quiet=True)[0].mesh.n_nodes
+    assert built == level_nodes(sc) == MESH_NODES["rectangle"][0] * MESH_NODES["rectangle"][1]
+    assert auto_levels(sc) == 1 and static_options(sc, progress=False).levels == 1
+    assert level_mesh(sc, 1)["nodes"] == [6, 6]
