@@ -6,8 +6,8 @@ Optimization, 2nd ed., Algorithm 7.2 without the trust radius, which the step ca
 
 Why: on the finest mesh of a drape a Newton step costs one supernodal factorisation (2.1 s at 201 x 201
 nodes, 121,200 unknowns, 42e6 entries of L) against 0.12 s for a back-substitution with it, and the
-finest level creeps along a flat valley for ~350 steps (README, "Mesh sequencing"), in which the tangent
-changes little from one step to the next. Solving ``K d = -r`` by preconditioned CG with the last
+finest level creeps along a flat valley for ~350 steps (~200 from locking-matched coarse levels, README,
+"Mesh sequencing"), in which the tangent changes little from one step to the next. Solving ``K d = -r`` by preconditioned CG with the last
 factorisation takes 3-12 back-substitutions while that factorisation is fresh; the solver factorises
 anew when CG needs more than :data:`REFRESH_ITERATIONS` or meets negative curvature. Measured
 (``python -m rftstatic case pedestal-square-80 --set mesh.nodes=[201,201]``, default settings, the finest
