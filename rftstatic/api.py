@@ -24,8 +24,10 @@ from rftstatic.errors import ConvergenceError, InstabilityError, SceneError
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.material import list_fabrics
 from rftstatic.scenes.schema import Scene, list_scenes, load_scene, scene_from_dict
+from rftstatic.scenes.sections import format_rows, option_rows
 
-__all__ = ["load_scene", "scene_from_dict", "list_scenes", "list_fabrics", "build_model", "run", "resume", "analysis_of",
+__all__ = ["option_rows", "format_rows", "load_scene", "scene_from_dict", "list_scenes", "list_fabrics", "build_model",
+           "run", "resume", "analysis_of",
            "ANALYSES", "RunResult", "Scene", "SceneError", "ConvergenceError", "InstabilityError"]
 
 

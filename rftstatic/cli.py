@@ -1,4 +1,4 @@
-"""Command line: ``python -m rftstatic {case, list, fabrics, sweep, fit, bench, validate}``, on the Python API
+"""Command line: ``python -m rftstatic {case, list, fabrics, options, sweep, fit, bench, validate}``, on the Python API
 (:mod:`rftstatic.api`) and the studies on Dask (:mod:`rftstatic.study`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
@@ -40,6 +40,10 @@ def main(argv=None) -> int:
 
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
     sub.add_parser("fabrics", parents=[common], help="list the fabric library with bending lengths and sources")
+    o = sub.add_parser("options", parents=[common], help="list a scene table's keys with type, unit, range, default "
+                       "and meaning (e.g. options solver)")
+    o.add_argument("section", nargs="?", default=None, help="the scene table (default: every declared one)")
+    o.add_argument("--format", default="text", choices=("text", "markdown"), help="plain text or a Markdown table")
     _study_parsers(sub, common)
 
     b = sub.add_parser("bench", parents=[common], help="print wall time and peak memory of the benchmarks")
@@ -155,6 +159,9 @@ def _command(args) -> int:
             for rule in dict.fromkeys(f["derived_rule"] for f in rows if f["derived_rule"]):
                 print(f"not from the source: {rule}")
             print("sources in full: rftstatic.fabrics.library.FABRICS[name].source")
+            return 0
+        if args.command == "options":
+            print(api.format_rows(api.option_rows(args.section), args.format))
             return 0
         if args.command == "case":
             scene = api.load_scene(args.name, args.set)

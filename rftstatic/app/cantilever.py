@@ -27,7 +27,6 @@ twist); both are in the summary, in the strip's axes.
 from __future__ import annotations
 
 import copy
-import dataclasses
 import logging
 import math
 import time
@@ -76,7 +75,7 @@ class _Tester:
         U0 = None
         if self.last is not None:
             U0 = self.last[2] * (l / self.last[0])
-            opts = dataclasses.replace(opts, initial_increment=1.0, perturbation=0.0)
+            opts = opts.replace(initial_increment=1.0, perturbation=0.0)
         res = solve_static(model, U0=U0, options=opts)
         if not res.converged:
             raise ConvergenceError(f"cantilever: overhang {l:.6g}: {res.message}", res)
@@ -137,7 +136,7 @@ def run(scene, out: Path, *, progress=True, figures=True) -> RunResult:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     opts = cantilever_options(scene)
-    sopts = dataclasses.replace(static_options(scene, progress=False))
+    sopts = static_options(scene, progress=False)
     tester = _Tester(scene, sopts)
     l0 = float(scene.get("mesh.size", [1.0, 1.0])[0])
     error = None

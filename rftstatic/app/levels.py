@@ -42,6 +42,7 @@ from rftstatic.errors import ConvergenceError
 from rftstatic.remesh.transfer import transfer_fields
 from rftstatic.scenes.build import build_mesh, build_model
 from rftstatic.scenes.levels import level_scenes
+from rftstatic.scenes.options import run_options
 from rftstatic.solvers.checkpoint import save_atomic
 from rftstatic.solvers.static import solve_static
 from rftstatic.solvers.static_checkpoint import static_fingerprint
@@ -71,13 +72,14 @@ def transfer_start(coarse_model, U, fine_model) -> np.ndarray:
 
 
 def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None, checkpoint=None):
-    """Solve ``model`` (the model of ``scene``) by mesh sequencing over ``opts.levels`` meshes.
+    """Solve ``model`` (the model of ``scene``) by mesh sequencing over the scene's ``solver.levels`` meshes
+    (:func:`~rftstatic.scenes.options.run_options`).
 
     Parameters
     ----------
     scene : the :class:`~rftstatic.scenes.schema.Scene` (its coarser levels are built from it)
     model : the scene's :class:`~rftstatic.model.Model` (the finest level)
-    opts : :class:`~rftstatic.solvers.newton.StaticOptions` (``levels`` > 1)
+    opts : :class:`~rftstatic.solvers.options.StaticOptions` of every level's solve
     folder : run folder where each converged level is saved (``level-K.npz``); None: nothing saved
     resume : take up the levels saved in ``folder`` (those of the same model only)
     callback, checkpoint : as for :func:`~rftstatic.solvers.static.solve_static`, on the finest level
@@ -92,11 +94,12 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
         when a level does not converge; the message names the level and its mesh, ``.result`` holds its
         last state when it is the finest (else None).
     """
-    scenes = level_scenes(scene, opts.levels)
+    run = run_options(scene)
+    scenes = level_scenes(scene, run.levels)
     records, totals = [], {"iterations": 0, "factorisations": 0, "cutbacks": 0, "retries": 0}
     prev = None
     first_path, first_relax = {}, {}  # the coarsest route's own record (its path or relaxation), if solved here
-    matched = opts.level_membrane == "matched"
+    matched = run.level_membrane == "matched"
     t_all = time.perf_counter()
     for k, sc in enumerate(scenes, start=1):
         last = k == len(scenes)
@@ -115,8 +118,8 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             continue
         if prev is None:  # the route finds the branch with the scene's own fabric
             m = carry if scale == 1.0 else build_model(sc, mesh, quiet=True)[0]
-            start = {"options": replace(opts, levels=1, progress=opts.progress and last)}
-            what = f"the scene's route ({opts.start})"
+            start = {"options": replace(opts, progress=opts.progress and last)}
+            what = f"the scene's route ({opts.route.start})"
         else:
             m = carry
             start = {"U0": transfer_start(prev[0], prev[1], m),
@@ -171,8 +174,8 @@ def _membrane_scale(model) -> float:
 
 def _newton_options(opts, progress: bool):
     """The options of a level's Newton at full load from a carried state (module docstring, step 3)."""
-    return replace(opts.from_state(relax_fallback=False), levels=1, iteration="displacement", continuation="load",
-                   progress=progress)
+    return opts.from_state(relax_fallback=False).replace(iteration="displacement", continuation="load",
+                                                          progress=progress)
 
 
 def _rematched(model, matched, res, opts, record: dict, totals: dict):

@@ -11,7 +11,6 @@ and range, in the scene's units.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import time
 
@@ -20,28 +19,30 @@ import numpy as np
 from rftstatic.app.levels import solve_levels
 from rftstatic.errors import ConvergenceError
 from rftstatic.io.summary import drape_summary
+from rftstatic.scenes.options import run_options
 from rftstatic.solvers.static import solve_static
 
 log = logging.getLogger(__name__)
 
 
 def seeded_specimens(scene, model, extras, opts, first: dict, n: int) -> dict:
-    """Solve ``model`` from ``n - 1`` further seeds after ``opts.seed`` and summarise all ``n`` drapes.
+    """Solve ``model`` from ``n - 1`` further seeds after ``opts.route.seed`` and summarise all ``n`` drapes.
 
-    ``first``: the drape summary of the run's own solve (seed ``opts.seed``). A seed whose solve does not
+    ``first``: the drape summary of the run's own solve (seed ``opts.route.seed``). A seed whose solve does not
     converge is listed (``converged: false``) and left out of the statistics.
     """
-    rows = [{"seed": opts.seed, "converged": True, **_row(first)}]
+    rows = [{"seed": opts.route.seed, "converged": True, **_row(first)}]
+    levels = run_options(scene).levels
     for k in range(1, n):
         t0 = time.perf_counter()
-        seeded = dataclasses.replace(opts, seed=opts.seed + k, progress=False)
+        seeded = opts.replace(seed=opts.route.seed + k, progress=False)
         try:
-            res = solve_levels(scene, model, seeded) if seeded.levels > 1 else solve_static(model, options=seeded)
+            res = solve_levels(scene, model, seeded) if levels > 1 else solve_static(model, options=seeded)
             ok = bool(res.converged)
         except ConvergenceError as exc:
-            log.warning("seed %d: %s", seeded.seed, exc)
+            log.warning("seed %d: %s", seeded.route.seed, exc)
             res, ok = exc.result, False
-        row = {"seed": seeded.seed, "converged": ok, "wall_time_s": time.perf_counter() - t0}
+        row = {"seed": seeded.route.seed, "converged": ok, "wall_time_s": time.perf_counter() - t0}
         if ok:
             row.update(_row(drape_summary(scene, model, extras, res.U)), stable_minimum=res.stable)
         rows.append(row)

@@ -26,7 +26,7 @@ from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import drape_summary, probe_summary, self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.scenes.build import build_model
 from rftstatic.app.specimens import seeded_specimens
-from rftstatic.scenes.options import seed_count, static_options
+from rftstatic.scenes.options import run_options, seed_count, static_options
 from rftstatic.solvers.static import solve_static
 from rftstatic.solvers.static_checkpoint import (
     CHECKPOINT_SECONDS,
@@ -60,7 +60,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     path = out / CHECKPOINT
     remove_stale(path)
     restart = None
-    single = opts.levels == 1  # mesh sequencing resumes from its own saved levels (level-K.npz)
+    single = run_options(scene).levels == 1  # mesh sequencing resumes from its own saved levels (level-K.npz)
     if resume and single and path.exists():
         restart = load_static_checkpoint(path, model, opts, scene=scene.name)
         log.info("resuming the static solve from %s (%s)", path, restart.where)

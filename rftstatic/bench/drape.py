@@ -78,7 +78,7 @@ def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
     from rftstatic.io.results import write_outputs
     from rftstatic.provenance import software
     from rftstatic.scenes.build import build_model
-    from rftstatic.scenes.options import static_options
+    from rftstatic.scenes.options import run_options, static_options
     from rftstatic.scenes.schema import load_scene
     from rftstatic.solvers.static import solve_static
 
@@ -91,7 +91,8 @@ def child(name: str, out: str, overrides: list[str], figures: bool) -> dict:
     error = ""
     opts = static_options(scene, progress=False)
     try:  # a scene with solver.levels > 1 is solved by mesh sequencing, as `python -m rftstatic case` does
-        result = solve_levels(scene, model, opts) if opts.levels > 1 else solve_static(model, options=opts)
+        single = run_options(scene).levels == 1
+        result = solve_static(model, options=opts) if single else solve_levels(scene, model, opts)
     except ConvergenceError as exc:
         if exc.result is None:  # no state to write (a coarser level failed): the solver's error, as the CLI does
             raise

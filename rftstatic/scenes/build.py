@@ -14,6 +14,7 @@ from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
 from rftstatic.scenes.material import build_material
+from rftstatic.scenes.options import declared_run_options
 from rftstatic.scenes.schema import MESH_NODES, Scene
 from rftstatic.scenes.self_contact import build_self_contact
 
@@ -402,7 +403,7 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
     if scene.get("analysis", "static") == "static":
         check_static_scene(scene, material, supports, load, obstacles)
-    membrane = scene.get("solver.membrane", True)
+    membrane = declared_run_options(scene).membrane
     self_contact = build_self_contact(scene, mesh, material)
     model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
                   contact=contact, membrane=membrane, quiet=quiet, self_contact=self_contact)

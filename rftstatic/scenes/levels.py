@@ -32,12 +32,11 @@ import math
 
 from rftstatic.errors import SceneError
 from rftstatic.mesh import trimesh as meshmod
+from rftstatic.scenes.run_options import MAX_LEVELS
 from rftstatic.scenes.schema import MESH_NODES, Scene, validate
 
 __all__ = ["AUTO_COARSEST", "AUTO_FROM", "MAX_LEVELS", "auto_levels", "level_mesh", "level_nodes", "level_scenes"]
 
-MAX_LEVELS = 6
-"""Most meshes of a sequence (the finest 2^5 = 32 times finer than the coarsest)."""
 
 LEAST_NODES = {"rectangle": (3, 3), "polar": (2, 12), "square-polar": (2, 12)}
 """Fewest nodes per direction of a coarse level (a patch needs neighbours; a ring at least 12 sectors)."""

@@ -1,76 +1,64 @@
 """The one step that turns a scene's ``[solver]``, ``[dynamics]`` and ``[remesh]`` tables into SI options.
 
-Every default is written once: the static solver's in :class:`~rftstatic.solvers.newton.StaticOptions`,
-the explicit and relaxation runs' in :data:`DYNAMICS_DEFAULTS` (per analysis type), the remeshing
-drivers' in :class:`RemeshOptions`. A bad value raises :class:`~rftstatic.errors.SceneError` naming the
+Every default is written once: the static solver's in :mod:`rftstatic.solvers.options` (the app's
+``[solver]`` keys in :mod:`rftstatic.scenes.run_options`), the explicit and relaxation runs' in
+:data:`DYNAMICS_DEFAULTS` (per analysis type), the remeshing drivers' in :class:`RemeshOptions`. A bad value raises :class:`~rftstatic.errors.SceneError` naming the
 file, the key and the value.
 """
 
 from __future__ import annotations
 
-from dataclasses import MISSING, dataclass, fields
+from dataclasses import MISSING, dataclass, fields, replace
 
 import numpy as np
 
 from rftstatic.errors import ParameterError, SceneError
+from rftstatic.optionspec import from_table
 from rftstatic.remesh.adapt import check_remesh_parameters
+from rftstatic.scenes.run_options import SOLVER_GROUPS, RunOptions
 from rftstatic.solvers.explicit import default_max_steps
-from rftstatic.solvers.newton import StaticOptions
+from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 
-_STATIC_KEYS = {f.name for f in fields(StaticOptions)} - {"progress"}
-_STATIC_LENGTH_KEYS = ("max_step", "increment_displacement")
-_STATIC_COUNTS = {"seed": 0, "max_continuations": 0, "reuse_factorisation": 0, "max_load_steps": 1}
-"""``[solver]`` integers and their least value (a seed: numpy's generators take none below 0)."""
-MAX_PERTURBATION = 10.0
-"""Largest ``solver.perturbation`` [element sizes]: the seeded lift tips a flat sheet off its bifurcation
-(0.01-0.5 in the scenes and validations); a lift of many element sizes stretches the membrane instead, and
-the relaxation from it becomes unstable (above about 200 its stable step collapses)."""
 
-
-def _levels(scene, value) -> int:
-    """``solver.levels`` as a count: an integer as given (checked by the mesh sequence), ``"auto"`` by the
-    mesh's size."""
-    from rftstatic.scenes.levels import auto_levels
-
-    if value == "auto":
-        return auto_levels(scene)
-    if isinstance(value, str):
-        raise scene.error("solver.levels", f'"{value}" is not a number of meshes; give an integer >= 1 or "auto" '
-                          "(from 15,000 nodes as many as bring the coarsest mesh to 3,000 or fewer, else 1)")
-    return value
+def _solver_table(scene) -> dict:
+    """The scene's ``[solver]`` table split over its declared groups, in SI
+    (:func:`rftstatic.optionspec.from_table`)."""
+    try:
+        return from_table(SOLVER_GROUPS, dict(scene.get("solver", {})), "solver", scene.units)
+    except ParameterError as exc:
+        raise scene.error(exc.key, exc.detail) from None
 
 
 def static_options(scene, *, progress=True) -> StaticOptions:
-    """The scene's ``[solver]`` table as :class:`StaticOptions` (lengths in SI [m]); ``solver.levels`` ``"auto"``
-    (the default) resolved to a number of meshes (:func:`rftstatic.scenes.levels.auto_levels`).
-
-    ``solver.membrane`` is a model switch (:func:`rftstatic.scenes.build.build_model`), not a solver
-    option, and is left out here.
-    """
-    s = dict(scene.get("solver", {}))
-    s.pop("membrane", None)
-    s.pop("seeds", None)
-    u = scene.units.length
-    for key in _STATIC_LENGTH_KEYS:
-        if key in s:
-            s[key] = s[key] * u
-    unknown = set(s) - _STATIC_KEYS
-    if unknown:
-        raise scene.error("solver", f"unknown option(s) {sorted(unknown)}")
-    for key, least in _STATIC_COUNTS.items():
-        if key in s and s[key] < least:
-            raise scene.error(f"solver.{key}", f"{s[key]!r} must be an integer >= {least}")
-    s["levels"] = _levels(scene, s.get("levels", "auto"))
-    lift = s.get("perturbation", 0.0)
-    if not 0.0 <= lift <= MAX_PERTURBATION:
-        raise scene.error("solver.perturbation", f"{lift!r} must lie in [0, {MAX_PERTURBATION:g}] (element sizes of "
-                          "a seeded lift that tips the sheet off its bifurcation; a larger lift stretches the "
-                          "membrane instead)")
+    """The scene's ``[solver]`` table as :class:`StaticOptions` (lengths in SI [m]); the app's keys (mesh
+    sequence, seeds, membrane switch) are :func:`run_options`'."""
+    table = _solver_table(scene)
     try:
-        return StaticOptions(**s, progress=progress)
-    except (TypeError, ValueError) as exc:
-        raise scene.error("solver", str(exc)) from None
+        return StaticOptions(newton=NewtonOptions(**table[NewtonOptions]),
+                             increments=IncrementOptions(**table[IncrementOptions]),
+                             route=RouteOptions(**table[RouteOptions]), progress=progress)
+    except ParameterError as exc:
+        raise scene.error(exc.key, exc.detail) from None
+
+
+def declared_run_options(scene) -> RunOptions:
+    """The app's ``[solver]`` keys as the scene gives them (``levels`` None when ``"auto"``)."""
+    try:
+        return RunOptions(**_solver_table(scene)[RunOptions])
+    except ParameterError as exc:
+        raise scene.error(exc.key, exc.detail) from None
+
+
+def run_options(scene) -> RunOptions:
+    """The app's ``[solver]`` keys as :class:`~rftstatic.scenes.run_options.RunOptions`, ``levels = "auto"`` (the
+    default) resolved to a number of meshes by the mesh's size (:func:`rftstatic.scenes.levels.auto_levels`)."""
+    from rftstatic.scenes.levels import auto_levels
+
+    run = declared_run_options(scene)
+    if run.levels is None:
+        run = replace(run, levels=auto_levels(scene))
+    return run
 
 
 DYNAMICS_DEFAULTS = {
@@ -239,10 +227,8 @@ class CantileverOptions:
 def seed_count(scene) -> int:
     """``solver.seeds``: how many seeded starts a static drape runs (a lab's specimens), checked; 1 by default.
     More than one needs a seeded start (``solver.perturbation`` > 0)."""
-    n = scene.get("solver.seeds", 1)
-    if not (isinstance(n, int) and 1 <= n <= 100):
-        raise scene.error("solver.seeds", f"{n!r} must be an integer in [1, 100] (seeded starts, one per specimen)")
-    if n > 1 and not scene.get("solver.perturbation", 0.0) > 0:
+    n = declared_run_options(scene).seeds
+    if n > 1 and not static_options(scene).route.perturbation > 0:
         raise scene.error("solver.seeds", f"{n} seeded starts need a seeded lift: give solver.perturbation > 0 "
                           "(e.g. 0.01 element sizes), or every start is the same")
     if n > 1 and scene.get("analysis", "static") != "static":
@@ -267,5 +253,6 @@ def cantilever_options(scene) -> CantileverOptions:
     return CantileverOptions(**c)
 
 
-__all__ = ["seed_count", "cantilever_options", "CantileverOptions", "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
+__all__ = ["run_options", "declared_run_options", "seed_count", "cantilever_options", "CantileverOptions",
+           "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
            "DYNAMICS_DEFAULTS", "SceneError"]

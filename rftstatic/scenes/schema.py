@@ -19,7 +19,9 @@ from pathlib import Path
 from rftstatic.contact.obstacles import scene_schema as obstacle_schema
 from rftstatic.errors import SceneError
 from rftstatic.fabrics.lab import LAB_KEYS
+from rftstatic.optionspec import schema_entries
 from rftstatic.scenes.analyses import SCENE_ANALYSES
+from rftstatic.scenes.run_options import SOLVER_GROUPS
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
@@ -158,34 +160,8 @@ SCHEMA = {
                                 "below half the smallest edge"),
         "self_factor": (NUM, "multiplier of the automatic self-contact stiffness (default 1)"),
     }, "penalty contact and self-contact"),
-    "solver": ({
-        "initial_increment": (NUM, ""), "min_increment": (NUM, ""), "max_increment": (NUM, ""),
-        "max_iterations": (int, ""), "rtol": (NUM, ""), "intermediate_rtol": (NUM, ""), "etol": (NUM, ""),
-        "max_step": (NUM, "cap on the largest nodal increment per iteration [length]"),
-        "increment_displacement": (NUM, "target nodal displacement per increment [length]"),
-        "line_search": (bool, ""), "tangent": (str, "auto, exact or psd"),
-        "iteration": (str, "mixed (MIP Newton) or displacement"),
-        "max_continuations": (int, "snap-through continuations per increment"),
-        "reuse_factorisation": (int, "modified-Newton reuses of a factorisation (0: full Newton)"),
-        "linear_solver": (str, "auto, cholmod, scipy or amg"), "max_load_steps": (int, ""),
-        "step_solver": (str, "auto, direct (a factorisation per Newton step) or krylov (CG preconditioned "
-                             "with the last factorisation; auto: from 60,000 unknowns)"),
-        "continuation": (str, "load (load increments) or arc-length (path following with inertia)"),
-        "perturbation": (NUM, "seeded out-of-plane start, in element sizes"), "seed": (int, ""),
-        "seeds": (int, "static drape: run this many seeded starts (seed, seed + 1, ...), as a lab tests several "
-                       "specimens; the summary reports their mean, range and fold counts"),
-        "perturbation_folds": (int, "0: random modes; n: an n-fold lift about the sheet's centre"),
-        "guide_folds": (int, "relax route: n-fold modulation of the weight in the first stage (0: none)"),
-        "guide_weight": (NUM, "relative amplitude of that modulation, in [0, 1)"),
-        "start": (str, "load-steps or relax (dynamic relaxation, then Newton)"),
-        "relax_fallback": (bool, "try dynamic relaxation + Newton when the load steps fail"),
-        "levels": ((int, str), "mesh sequencing: meshes of the sequence, each about twice as coarse as the "
-                               "next; the coarsest by the route above, the finer ones by Newton at full load (1: "
-                               "none; \"auto\", the default: from 15,000 nodes, enough for a coarsest mesh of 3,000)"),
-        "level_membrane": (str, "mesh sequencing: same (the coarse levels keep the fabric) or matched (their "
-                                "membrane rigidity scaled by (h_finest / h)^2, the finest mesh's locking number)"),
-        "membrane": (bool, "false: linear Kirchhoff plate (bending only)"),
-    }, "static solver options (rftstatic.static.StaticOptions)"),
+    "solver": (schema_entries(*SOLVER_GROUPS), "static solver options (rftstatic.solvers.options) and the app's "
+               "(rftstatic.scenes.run_options): python -m rftstatic options solver"),
     "dynamics": ({
         "t_end": (NUM, "end time [time]"), "dt": (NUM, "time step (default: automatic)"),
         "alpha": (NUM, "mass damping [1/time]"), "mass_scale": (NUM, "mass scaling factor"),

@@ -48,7 +48,8 @@ from rftstatic.solvers.branches import switch_branch
 from rftstatic.solvers.inertia import InertiaSolver
 from rftstatic.solvers.iteration import capped_step, roundoff_floor, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError, make_solver
-from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult, newton, route_outcome
+from rftstatic.solvers.newton import NewtonWorkspace, StaticResult, newton, route_outcome
+from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
 
 log = logging.getLogger(__name__)
@@ -138,7 +139,7 @@ class _Path:
         self.Pnorm = float(np.linalg.norm(self.P))
         diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
         self.c = diagonal * np.sqrt(model.mesh.n_nodes)
-        self.max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
+        self.max_step = opts.newton.max_step if opts.newton.max_step is not None else 0.1 * diagonal
         self.inertia = InertiaSolver()
         self.eps = float(getattr(model.contact, "smoothing", 0.0) or 0.0) if model.contact is not None else 0.0
 
@@ -237,12 +238,12 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
     n = model.mesh.n_nodes
     U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
     seed = None
-    if opts.perturbation and U0 is None:
-        seed = opts.seed
-        U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
+    if opts.route.perturbation and U0 is None:
+        seed = opts.route.seed
+        U[:, 2] += start_perturbation(model.mesh, opts.route) * model.free[:, 2]
     ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
     ws.modes = {"exact": 0, "psd": 0, "shift": 0}
-    ws.solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    ws.solver = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     path = _Path(model, opts, ws)
     result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=path.inertia.name, seed=seed,
                           route="arc-length")
@@ -329,9 +330,9 @@ def _follow(path, pt, result, record, bar, callback):
     last_switch, repeat = -1.0, 0
     lam_max, last_dlam = pt.lam, 0.0
     while True:
-        if len(record["steps"]) >= opts.max_load_steps:
+        if len(record["steps"]) >= opts.increments.max_load_steps:
             raise ConvergenceError(f"arc-length step {len(record['steps']) + 1}, load factor {pt.lam:.6g}: "
-                                   f"{opts.max_load_steps} steps used without reaching full load; raise "
+                                   f"{opts.increments.max_load_steps} steps used without reaching full load; raise "
                                    "solver.max_load_steps", None)
         final = pt.t_lam > 0 and pt.lam + ds * pt.t_lam >= 1.0
         new, its = path.corrector(pt, ds, target=1.0 if final else None)
@@ -407,7 +408,8 @@ def _follow(path, pt, result, record, bar, callback):
 def _switch(path, result, record, pt, lam, prev):
     """Branch switch from ``pt`` at load factor ``lam`` (:func:`switch_branch`); returns the point to go on
     from (``pt`` itself when no push converged), its tangent oriented with dlam > 0."""
-    choice, rec = switch_branch(path.model, pt.U, lam, pt.K, pt.fac, replace(path.opts, intermediate_rtol=PATH_RTOL),
+    looser = replace(path.opts.newton, intermediate_rtol=PATH_RTOL)
+    choice, rec = switch_branch(path.model, pt.U, lam, pt.K, pt.fac, looser,
                                 path.ws, path.inertia,
                                 path.max_step, seed=len(record["switches"]),
                                 away_from=None if prev is None else prev.U)
@@ -430,7 +432,8 @@ def _descend(path, result, record, pt, dlam):
     (:func:`~rftstatic.solvers.newton.newton`, displacement iteration) from ``pt``: the point it reaches
     (its tangent oriented with dlam > 0), or None."""
     lam = min(1.0, pt.lam + dlam)
-    opts = replace(path.opts, max_iterations=max(path.opts.max_iterations, 80), intermediate_rtol=PATH_RTOL)
+    base = path.opts.newton
+    opts = replace(base, max_iterations=max(base.max_iterations, 80), intermediate_rtol=PATH_RTOL)
     nt = newton(path.model, pt.U, lam, opts, path.ws, path.max_step, scheme="displacement")
     result.iterations += nt.iterations
     for _ in range(DESCENT_CONTINUATIONS):  # a fold forming: still sliding downhill
@@ -456,9 +459,9 @@ def _finish(path, result, record, pt):
     model, opts, ws = path.model, path.opts, path.ws
     U = pt.U
     for attempt in range(FINAL_SWITCHES + 1):
-        nt = newton(model, U, 1.0, opts, ws, path.max_step)
+        nt = newton(model, U, 1.0, opts.newton, ws, path.max_step)
         if not nt.converged:
-            nt = newton(model, U, 1.0, opts, ws, path.max_step, scheme="displacement")
+            nt = newton(model, U, 1.0, opts.newton, ws, path.max_step, scheme="displacement")
         result.iterations += nt.iterations
         if not nt.converged:
             raise ConvergenceError(f"arc-length final point, load factor 1, iteration {nt.iterations}: {nt.reason}, "

@@ -24,7 +24,8 @@ import numpy as np
 from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
-from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult, newton, route_outcome
+from rftstatic.solvers.newton import NewtonWorkspace, StaticResult, newton, route_outcome
+from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
 
 log = logging.getLogger(__name__)
@@ -57,39 +58,42 @@ class LoadPath:
 
 def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None,
                      workspace: NewtonWorkspace | None = None, checkpoint=None,
-                     resume: LoadPath | None = None) -> StaticResult:
+                     resume: LoadPath | None = None, iteration_fallback: bool = True) -> StaticResult:
     """The load-scaled Newton iteration of :func:`solve_static` (module docstring).
 
     ``workspace``: shared with the other phases of one solve (:class:`NewtonWorkspace`; default a new one).
     ``checkpoint``: called as ``checkpoint(path)`` with the :class:`LoadPath` after every converged increment
     (after ``callback``). ``resume``: such a path, from which the solve continues as the uninterrupted one
-    did (``U0`` is then unused).
+    did (``U0`` is then unused). ``iteration_fallback``: an increment the mixed iteration cannot converge
+    and that cannot be cut back (or has failed twice) is tried with the displacement iteration; off for the
+    relaxation route's intermediate handovers, where the relaxation goes on instead.
     """
     opts = options or StaticOptions()
     t0 = time.perf_counter()
     n = model.mesh.n_nodes
     if resume is not None:
         U0 = resume.U
-    from_state = U0 is not None and resume is None and opts.initial_increment >= 1.0
+    from_state = U0 is not None and resume is None and opts.increments.initial_increment >= 1.0
     U = np.zeros((n, 3)) if U0 is None else np.array(U0, dtype=float)
     seed = None if resume is None else resume.result.seed
-    if opts.perturbation and U0 is None:
-        seed = opts.seed
-        U[:, 2] += start_perturbation(model.mesh, opts) * model.free[:, 2]
+    if opts.route.perturbation and U0 is None:
+        seed = opts.route.seed
+        U[:, 2] += start_perturbation(model.mesh, opts.route) * model.free[:, 2]
     if not (np.isfinite(U).all() and np.isfinite(model.load).all()):
         what = "the load (nodal forces)" if not np.isfinite(model.load).all() else "the start displacements"
         raise ConvergenceError(f"load factor 0: {what} are not finite (NaN or inf); check the scene's loads, "
                                "weight and mesh coordinates", None)
     ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
     ws.modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
-    solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    solver = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     ws.solver = solver
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
-    max_step = opts.max_step if opts.max_step is not None else 0.1 * diagonal
-    target = opts.increment_displacement if opts.increment_displacement is not None else TARGET_SHARE * diagonal
+    max_step = opts.newton.max_step if opts.newton.max_step is not None else 0.1 * diagonal
+    inc = opts.increments
+    target = inc.increment_displacement if inc.increment_displacement is not None else TARGET_SHARE * diagonal
     result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
     lam = 0.0
-    mixed = opts.iteration == "mixed" and model.with_membrane
+    mixed = opts.newton.iteration == "mixed" and model.with_membrane
     if resume is None:
         dlam = _first_increment(model, U, opts, ws, target)
         U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
@@ -102,14 +106,14 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
     bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
     with route_outcome(model, result, ws, t0, bar):
         while lam < 1.0:
-            if len(result.load_steps) >= opts.max_load_steps:
+            if len(result.load_steps) >= opts.increments.max_load_steps:
                 raise ConvergenceError(
-                    f"load factor {lam:.6g}: {opts.max_load_steps} load increments used without reaching "
+                    f"load factor {lam:.6g}: {opts.increments.max_load_steps} load increments used without reaching "
                     "full load; raise solver.max_load_steps or solver.initial_increment")
             lam_next = min(1.0, lam + dlam)
             # the displacement iteration takes over while snapping through, and after repeated failures
             # of the mixed one at this load level or where the increment cannot be cut back
-            fallback = continuing is not None or (opts.iteration_fallback and failures >= MIXED_FAILURES)
+            fallback = continuing is not None or (iteration_fallback and failures >= MIXED_FAILURES)
             start = U
             if continuing is not None:
                 start = continuing.U
@@ -118,18 +122,18 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
             # the mixed iteration starts from the last equilibrium itself: its first step there is the
             # tangent predictor (a secant start stretches a stiff membrane: the 21 x 5 RFT6 strip at
             # C/B = 1e9 /cm^2 took 177 iterations from it, 38 from the equilibrium)
-            nt = newton(model, start, lam_next, opts, ws, max_step, scheme="displacement" if fallback else None)
+            nt = newton(model, start, lam_next, opts.newton, ws, max_step, scheme="displacement" if fallback else None)
             continuing = None
             result.iterations += nt.iterations
             # the whole load from a given state (a relaxed or transferred drape) retries with the
             # displacement iteration before cutting back, which would unload the drape
             whole_from_state = from_state and not result.load_steps and lam_next >= 1.0
-            if (not nt.converged and nt.scheme == "mixed" and opts.iteration_fallback
-                    and (whole_from_state or not dlam / 4.0 >= opts.min_increment)):
+            if (not nt.converged and nt.scheme == "mixed" and iteration_fallback
+                    and (whole_from_state or not dlam / 4.0 >= opts.increments.min_increment)):
                 result.retries += 1
                 log.info("load factor %.6g: %s (|r| = %.3e); retrying with displacement iterations",
                          lam_next, nt.reason, nt.residual)
-                nt = newton(model, start, lam_next, opts, ws, max_step, scheme="displacement")
+                nt = newton(model, start, lam_next, opts.newton, ws, max_step, scheme="displacement")
                 result.iterations += nt.iterations
             if nt.converged:
                 continuations = 0
@@ -147,7 +151,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                 target *= _target_factor(nt.iterations)
                 rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
                 grow = GROWTH * (lam - lam_prev)
-                dlam = float(np.clip(target / max(rate, 1e-300), opts.min_increment, min(opts.max_increment, grow)))
+                dlam = float(np.clip(target / max(rate, 1e-300), inc.min_increment, min(inc.max_increment, grow)))
                 if checkpoint is not None:
                     checkpoint(LoadPath(lam, U, dlam, target, lam_prev, U_prev, result))
                 continue
@@ -155,11 +159,11 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
             # 31 x 240 round pedestal's finest level needed 468 iterations, 20 of them at |r| ~ 1e-3 |P|
             # with a drop below DESCENDING before converging quadratically
             creeping = whole_from_state and nt.progress > FROM_STATE_PROGRESS
-            if (nt.descending or creeping) and continuations < opts.max_continuations:
+            if (nt.descending or creeping) and continuations < opts.increments.max_continuations:
                 continuations += 1
                 continuing = nt
                 log.info("load factor %.6g: still descending after %d iterations (snap-through); continuing "
-                         "(%d/%d)", lam_next, nt.iterations, continuations, opts.max_continuations)
+                         "(%d/%d)", lam_next, nt.iterations, continuations, opts.increments.max_continuations)
                 continue
             if whole_from_state:
                 # a cut back would unload the given drape (measured on that level: eight cut backs down to
@@ -178,11 +182,11 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                      lam_next, nt.reason, nt.iterations, nt.residual)
             dlam /= 4.0
             target /= 4.0
-            if not dlam >= opts.min_increment:  # also stops on a NaN increment
+            if not dlam >= opts.increments.min_increment:  # also stops on a NaN increment
                 raise ConvergenceError(
                     f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
                     f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
-                    f"min_increment = {opts.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
+                    f"min_increment = {opts.increments.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
     return result
 
 
@@ -232,13 +236,14 @@ def _first_increment(model, U, opts, ws, target) -> float:
     free = model.free.ravel()
     P = model.load.ravel()[free]
     if not np.any(P) or model.load_terms:
-        return opts.initial_increment
+        return opts.increments.initial_increment
     try:
         _, K = model.tangent(U, psd=True, candidates=ws.candidates, pairs=ws.pairs)
         du = np.zeros(3 * model.mesh.n_nodes)
         ws.factorisations += 1
         du[free] = ws.solver.solve(K, P)
     except (NotPositiveDefinite, LinearSolveError):
-        return opts.initial_increment
+        return opts.increments.initial_increment
     rate = float(np.linalg.norm(du.reshape(-1, 3), axis=1).max())
-    return float(np.clip(target / max(rate, 1e-300), opts.min_increment, opts.initial_increment))
+    inc = opts.increments
+    return float(np.clip(target / max(rate, 1e-300), inc.min_increment, inc.initial_increment))

@@ -25,9 +25,9 @@ An increment that does not converge is cut back (``increment / 4``) from the las
 below ``min_increment`` the solve stops with :class:`~rftstatic.errors.ConvergenceError`, which
 carries the last equilibrium, labelled as not converged.
 
-This module holds the iteration at one load factor (:func:`newton`), its options and result; the load
-steps are :mod:`rftstatic.solvers.load_steps`, the route that chains them with dynamic relaxation
-:mod:`rftstatic.solvers.static`.
+This module holds the iteration at one load factor (:func:`newton`) and the static result; the options
+are :mod:`rftstatic.solvers.options`, the load steps :mod:`rftstatic.solvers.load_steps`, the route that
+chains them with dynamic relaxation :mod:`rftstatic.solvers.static`.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ from __future__ import annotations
 import logging
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -47,166 +47,6 @@ from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.mixed import mixed_iterations
 
 log = logging.getLogger(__name__)
-
-
-_COUNTS = {"max_iterations": 1, "max_load_steps": 1, "max_continuations": 0, "reuse_factorisation": 0, "seed": 0,
-           "perturbation_folds": 0, "guide_folds": 0, "levels": 1}
-"""The integer options of :class:`StaticOptions` and their least values (a seed: numpy's generators take
-none below 0)."""
-
-
-@dataclass(frozen=True, kw_only=True)
-class StaticOptions:
-    """Options of :func:`solve_static` (scene table ``[solver]``).
-
-    Attributes
-    ----------
-    initial_increment, min_increment, max_increment : load-factor increments [-]
-    max_iterations : Newton iterations per increment
-    rtol : force tolerance, relative to the applied load |lam P| [-], at full load
-    intermediate_rtol : looser force tolerance for the increments on the way to full load [-]
-    etol : energy tolerance on the work of the residual over the last step, relative to the larger
-        of the first step's work and the work of the applied load [-]
-    max_step : cap on the largest nodal increment per Newton iteration [m]; ``None``: 10 % of the
-        sheet's diagonal
-    increment_displacement : target largest nodal displacement per load increment [m], from which
-        the next increment is sized by the secant (first: tangent) rate d|U|/d lam; ``None``: 10 %
-        of the sheet's diagonal. Halved or grown with the Newton iteration count.
-    line_search : Armijo backtracking on Pi (displacement iteration)
-    iteration : ``"mixed"`` (MIP Newton, the membrane stress carried as an unknown; an increment it
-        cannot converge is retried with the displacement iteration) or ``"displacement"`` (Newton on
-        the displacements alone, energy line search)
-    iteration_fallback : an increment the mixed iteration cannot converge and that cannot be cut back
-        (or has failed twice) is tried with the displacement iteration; off for the relaxation
-        route's intermediate handovers, where the relaxation goes on instead
-    tangent : ``"auto"`` (exact, safeguarded when indefinite), ``"exact"`` or ``"psd"``
-    linear_solver : ``"auto"``, ``"cholmod"``, ``"scipy"`` or ``"amg"``
-    step_solver : how the displacement iteration solves its Newton step: ``"direct"`` (a factorisation
-        of the tangent per step, reused by ``reuse_factorisation``), ``"krylov"`` (conjugate gradients on
-        the exact tangent preconditioned with the last factorisation, factorised anew when CG slows,
-        :mod:`~rftstatic.solvers.krylov`) or ``"auto"``: krylov from
-        :data:`~rftstatic.solvers.krylov.KRYLOV_FROM` free unknowns when the linear solver re-solves
-        cheaply, else direct
-    max_load_steps : give up after this many increments
-    start : ``"load-steps"`` (load-scaled Newton from the flat start) or ``"relax"`` (dynamic
-        relaxation at full load, then Newton to polish: for drapes with many folds)
-    continuation : how ``start = "load-steps"`` follows the load from 0 to 1: ``"load"`` (load
-        increments, :mod:`~rftstatic.solvers.load_steps`) or ``"arc-length"`` (pseudo-arclength path
-        following with the tangent's inertia tracked and branch switching at critical points,
-        :mod:`~rftstatic.solvers.continuation`)
-    relax_fallback : when the load steps fail, try dynamic relaxation + Newton before giving up
-    reuse_factorisation : how many further steps may reuse a factorisation while the residual keeps
-        falling by more than 70 % per step (modified Newton; 0 = full Newton)
-    max_continuations : an increment whose Newton iteration runs out of iterations while the energy
-        is still falling markedly (snap-through into a fold) continues from where it stopped, up to
-        this many times, instead of cutting back
-    perturbation : amplitude of a seeded random out-of-plane start, in element sizes [-]
-    seed : seed of that perturbation
-    perturbation_folds : 0 for random low Fourier modes; n > 0 for an n-fold lift around the sheet's
-        centre (:func:`fold_perturbation`), to look for the drape branch with n folds
-    guide_folds, guide_weight : ``start = "relax"`` only: during the first stage of the relaxation
-        (:data:`GUIDE_DAMPING_TIMES` damping times) the weight is modulated by
-        ``1 + guide_weight (r/R)^2 cos(n theta + phi)`` with n = ``guide_folds`` (:func:`fold_pattern`),
-        then restored, so that the sheet falls into n folds and the rest of the relaxation tells
-        whether that drape is a stable equilibrium; 0 = no guide
-    levels : meshes of a mesh sequence (1: the scene's mesh alone). A scene run with ``levels = L``
-        (:mod:`rftstatic.app.levels`) solves the coarsest of L meshes by this route and each finer one
-        by Newton at full load from the solution below; :func:`solve_static` solves the one model it
-        is given and does not read it
-    level_membrane : the coarse levels' membrane: ``"same"`` (the scene's fabric) or ``"matched"`` (every level
-        below the finest solved with its membrane rigidity scaled by ``(h_finest / h)^2``, the finest mesh's
-        locking number ``(C/B) h^2``, the coarsest after its route has found the branch; see
-        :mod:`rftstatic.app.levels`)
-    """
-
-    initial_increment: float = 0.1
-    min_increment: float = 1e-5
-    max_increment: float = 1.0
-    max_iterations: int = 30
-    rtol: float = 1e-6
-    intermediate_rtol: float = 0.1
-    etol: float = 1e-12
-    max_step: float | None = None
-    increment_displacement: float | None = None
-    line_search: bool = True
-    iteration: str = "mixed"
-    iteration_fallback: bool = True
-    tangent: str = "auto"
-    linear_solver: str = "auto"
-    step_solver: str = "auto"
-    max_load_steps: int = 2000
-    max_continuations: int = 10
-    reuse_factorisation: int = 2
-    start: str = "load-steps"
-    continuation: str = "load"
-    relax_fallback: bool = True
-    perturbation: float = 0.0
-    seed: int = 0
-    perturbation_folds: int = 0
-    guide_folds: int = 0
-    guide_weight: float = 0.0
-    levels: int = 1
-    level_membrane: str = "same"
-    progress: bool = True
-
-    def __post_init__(self):
-        for name, least in _COUNTS.items():
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
-                raise ValueError(f"solver.{name} must be an integer >= {least}, got {v!r}")
-        if self.continuation not in ("load", "arc-length"):
-            raise ValueError(f'solver.continuation must be "load" or "arc-length", got "{self.continuation}"')
-        if self.start not in ("load-steps", "relax"):
-            raise ValueError(f'solver.start must be "load-steps" or "relax", got "{self.start}"')
-        if self.linear_solver not in ("auto", "cholmod", "scipy", "amg"):
-            raise ValueError(f'solver.linear_solver must be "auto", "cholmod", "scipy" or "amg", got '
-                             f'"{self.linear_solver}"')
-        if self.step_solver not in ("auto", "direct", "krylov"):
-            raise ValueError(f'solver.step_solver must be "auto", "direct" or "krylov", got "{self.step_solver}"')
-        if self.level_membrane not in ("same", "matched"):
-            raise ValueError(f'solver.level_membrane must be "same" or "matched", got "{self.level_membrane}"')
-        if self.iteration not in ("mixed", "displacement"):
-            raise ValueError(f'solver.iteration must be "mixed" or "displacement", got "{self.iteration}"')
-        if self.tangent not in ("auto", "exact", "psd"):
-            raise ValueError(f'solver.tangent must be "auto", "exact" or "psd", got "{self.tangent}"')
-        if not (0 < self.min_increment <= self.initial_increment <= self.max_increment <= 1):
-            raise ValueError(
-                "need 0 < min_increment <= initial_increment <= max_increment <= 1, got "
-                f"{self.min_increment}, {self.initial_increment}, {self.max_increment}")
-        if self.perturbation_folds < 0:
-            raise ValueError(f"solver.perturbation_folds must be 0 (random modes) or a fold count, "
-                             f"got {self.perturbation_folds}")
-        if self.guide_folds < 0 or not (0.0 <= self.guide_weight < 1.0):
-            raise ValueError(f"solver.guide_folds must be >= 0 and solver.guide_weight in [0, 1) (a weight "
-                             f"modulation that keeps the weight downward), got {self.guide_folds}, {self.guide_weight}")
-        if self.guide_folds and self.guide_weight and self.start != "relax":
-            raise ValueError('solver.guide_folds guides the dynamic relaxation: it needs solver.start = "relax"')
-        if self.rtol <= 0 or self.max_iterations < 1:
-            raise ValueError(f"need rtol > 0 and max_iterations >= 1, got {self.rtol}, {self.max_iterations}")
-        for name in ("rtol", "intermediate_rtol", "etol", "max_step", "increment_displacement", "guide_weight",
-                     "perturbation"):
-            v = getattr(self, name)
-            if v is not None and not np.isfinite(v):
-                raise ValueError(f"solver.{name} must be a finite number, got {v!r}")
-        for name in ("intermediate_rtol", "max_step", "increment_displacement"):
-            v = getattr(self, name)
-            if v is not None and not v > 0:
-                raise ValueError(f"solver.{name} must be > 0, got {v!r}")
-        if self.perturbation < 0 or self.etol < 0:
-            raise ValueError(f"need solver.perturbation >= 0 and solver.etol >= 0, got {self.perturbation}, "
-                             f"{self.etol}")
-
-    def single_step(self) -> StaticOptions:
-        """These options with the whole load in one increment (no displacement-sized increments)."""
-        return replace(self, initial_increment=1.0, max_increment=1.0, increment_displacement=1e30)
-
-    def from_state(self, *, relax_fallback: bool | None = None) -> StaticOptions:
-        """Options for Newton at full load straight from a given state (a relaxed or transferred
-        equilibrium): one load step, no relaxation start, no perturbation or fold guide.
-        ``relax_fallback``: override the fallback to relaxation when that Newton fails."""
-        fallback = self.relax_fallback if relax_fallback is None else relax_fallback
-        return replace(self.single_step(), start="load-steps", perturbation=0.0, guide_folds=0,
-                       relax_fallback=fallback)
 
 
 @dataclass
@@ -295,7 +135,8 @@ class NewtonWorkspace:
 
 
 def newton(model, U, lam, opts, ws, max_step, *, stress=None, scheme=None) -> Iteration:
-    """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified).
+    """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified), with the options ``opts``
+    (:class:`~rftstatic.solvers.options.NewtonOptions`).
 
     ``scheme``: ``"mixed"`` (MIP Newton, :func:`~rftstatic.solvers.mixed.mixed_iterations`) or ``"displacement"``
     (:func:`displacement_iterations`); default ``opts.iteration``. ``stress (E, 3)`` [N/m]: the

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -19,7 +19,8 @@ from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
 from rftstatic.solvers.continuation import solve_arc_length
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
 from rftstatic.solvers.load_steps import solve_load_steps
-from rftstatic.solvers.newton import NewtonWorkspace, StaticOptions, StaticResult
+from rftstatic.solvers.newton import NewtonWorkspace, StaticResult
+from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, relax
 from rftstatic.solvers.timestep import stable_time_step
@@ -68,10 +69,10 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         if restart.route is not None:
             return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint,
                                                      route=restart.route, segment=restart.segment), opts, ws)
-    elif opts.start == "relax":
+    elif opts.route.start == "relax":
         return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint), opts, ws)
     try:
-        if opts.continuation == "arc-length" and restart is None:
+        if opts.increments.continuation == "arc-length" and restart is None:
             return _finish(model, solve_arc_length(model, U0=U0, options=opts, callback=callback, workspace=ws),
                            opts, ws)
         return _finish(model, solve_load_steps(
@@ -79,7 +80,7 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
             checkpoint=None if checkpoint is None else checkpoint.load_step,
             resume=None if restart is None else restart.load_path), opts, ws)
     except ConvergenceError as exc:
-        if not opts.relax_fallback or model.load_terms or not np.any(model.load):
+        if not opts.route.relax_fallback or model.load_terms or not np.any(model.load):
             raise
         log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
         return _finish(model, _relax_then_newton(model, opts, callback, ws, first=exc, checkpoint=checkpoint),
@@ -109,7 +110,7 @@ def _stiffen_self_contact(model, result, opts, ws):
     result.self_contact_stiffenings = 0
     if sc is None or not result.converged:
         return result
-    polish = replace(opts.from_state(relax_fallback=False), max_continuations=0)
+    polish = opts.from_state(relax_fallback=False).replace(max_continuations=0)
     for _ in range(SELF_CONTACT_STIFFENINGS):
         gap = sc.min_distance(model.positions(result.U))
         if not gap < SELF_CONTACT_MIN_GAP * sc.thickness:
@@ -140,7 +141,7 @@ def _finish(model, result, opts, ws):
 def _check_stability(model, result, opts):
     """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact
     tangent positive definite, one Cholesky factorisation)? None when the linear solver cannot tell."""
-    solver = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    solver = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     result.stable = _positive_definite(model, result.U, solver, lam=result.lam) if solver.detects_indefinite else None
     return result
 
@@ -274,12 +275,12 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
             checkpoint.route(route)
     polish = opts.from_state(relax_fallback=False)
     # a handover that fails gives way to more relaxation, not to the slower displacement iteration
-    short = replace(polish, max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS,
-                    iteration_fallback=False)
+    # (solved without the fallback to the displacement iteration)
+    short = polish.replace(max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS)
     # in the basin of a stable minimum the line-searched displacement iteration gets there where the
     # mixed one (at most 2 x MIXED_ITERATIONS) wanders: the long try may fall back to it
-    basin = replace(short, max_iterations=RELAX_BASIN_NEWTON_ITERATIONS, iteration_fallback=True)
-    checker = make_solver(opts.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    basin = short.replace(max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
+    checker = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     info = route.info
 
     def fail(text, result=None):
@@ -290,7 +291,7 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
         return ConvergenceError(text, result if result is not None else (first.result if first else None))
 
     if route.phase in ("start", "guide"):
-        if opts.guide_folds and opts.guide_weight:
+        if opts.route.guide_folds and opts.route.guide_weight:
             _guided_relaxation(model, opts, plan, route, fail, checkpoint, segment)
             segment = None
         route.phase = "relax"
@@ -311,7 +312,7 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
             long_try = route.tol_force < 1.0 and not any(h.get("basin") for h in info["handovers"][:-1])
             handover["basin"] = route.tol_force < 1.0
             res = solve_load_steps(model, U0=route.U, options=polish if final else basin if long_try else short,
-                                   callback=callback, workspace=ws)
+                                   callback=callback, workspace=ws, iteration_fallback=final or long_try)
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
             if final:
@@ -323,7 +324,7 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
             log.info("Newton did not converge from the relaxed state at t = %.3g s (%s); relaxing further",
                      route.t_used, exc)
-            route.tol_force, route.span, route.phase = 0.5 * opts.rtol, plan.chunk, "relax"
+            route.tol_force, route.span, route.phase = 0.5 * opts.newton.rtol, plan.chunk, "relax"
             if checkpoint is not None:
                 checkpoint.route(route)
             continue
@@ -343,10 +344,10 @@ def _start_route(model, opts, plan, first) -> RelaxRoute:
     """The relaxation route before its first segment: from the flat sheet, lifted by the same seeded
     perturbation as the load steps' start (it picks the fold branch)."""
     U, seed = None, None
-    if opts.perturbation:
-        seed = opts.seed
+    if opts.route.perturbation:
+        seed = opts.route.seed
         U = np.zeros((model.mesh.n_nodes, 3))
-        U[:, 2] = start_perturbation(model.mesh, opts) * model.free[:, 2]
+        U[:, 2] = start_perturbation(model.mesh, opts.route) * model.free[:, 2]
     info = {"mass_scale": plan.mass_scale, "alpha_per_s": plan.alpha, "time_s": 0.0, "steps": 0, "handovers": [],
             "after_failure": None if first is None else str(first)}
     # the first stop: motion died down, |r| < |P|
@@ -387,7 +388,8 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, checkpoint
     stays about the same and the load stays downward) for :data:`GUIDE_DAMPING_TIMES` damping
     times; the model itself keeps its true load. ``restart``: the explicit state saved during this stage.
     """
-    guided = model.load * (1.0 + opts.guide_weight * fold_pattern(model.mesh, opts.guide_folds, opts.seed))[:, None]
+    guide = opts.route
+    guided = model.load * (1.0 + guide.guide_weight * fold_pattern(model.mesh, guide.guide_folds, guide.seed))[:, None]
     route.phase = "guide"
     saver = None if checkpoint is None else checkpoint.segment(route)
     try:
@@ -400,8 +402,8 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, checkpoint
     except StepLimitError as exc:
         raise fail(f"the guided dynamic relaxation cannot run: {exc}") from None
     route.U, route.V, route.peak, route.t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
-    route.seed = opts.seed
-    route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": opts.guide_folds, "weight": opts.guide_weight,
+    route.seed = guide.seed
+    route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": guide.guide_folds, "weight": guide.guide_weight,
                                                             "time_s": rel.t, "steps": rel.steps})
     route.phase = "relax"
     if checkpoint is not None:

@@ -23,7 +23,7 @@ from rftstatic.solvers import static
 from rftstatic.validate.report import BenchmarkResult, Study, convergence_figures
 
 SHELL = material.isotropic_shell(E=1.0e4, nu=0.3, thickness=0.01)
-LINEAR = static.StaticOptions(initial_increment=1.0, increment_displacement=1e9, progress=False)
+LINEAR = static.StaticOptions.from_keys(initial_increment=1.0, increment_displacement=1e9, progress=False)
 CASES = [("simply_supported", "uniform"), ("clamped", "uniform"), ("simply_supported", "point"),
          ("clamped", "point")]
 TOLERANCE = 0.01

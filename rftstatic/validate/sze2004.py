@@ -73,7 +73,7 @@ def end_shear(nx, ny, element, table):
     P = model.edge_load(m, edges, (0.0, 0.0, c.load_max / c.b))
     mod = model.Model(m, _shell(c), element=element, supports=_clamp(m, m.nodes_in_box(0, 0, -1, 1)), load=P)
     rec = []
-    opts = static.StaticOptions(progress=False, initial_increment=0.025, max_increment=0.025,
+    opts = static.StaticOptions.from_keys(progress=False, initial_increment=0.025, max_increment=0.025,
                                 intermediate_rtol=1e-6)
     message, converged, iterations = "", True, 0
     try:
@@ -119,7 +119,7 @@ def end_moment(nx, ny, element, table, *, plane=True, steps_per_table=4):
                       load_terms=[LeverMoment(tip, lever, c.load_max * share)])
     rec = []
     increment = float(np.diff(table["load_fraction"]).min()) / steps_per_table  # 0.0125 by default
-    opts = static.StaticOptions(progress=False, initial_increment=increment, max_increment=increment,
+    opts = static.StaticOptions.from_keys(progress=False, initial_increment=increment, max_increment=increment,
                                 intermediate_rtol=1e-6)
     converged, message, iterations, steps = True, "", 0, 0
     try:
@@ -181,7 +181,7 @@ def slit_annular(n_radial, n_circ, element, table):
     P = model.edge_load(m, np.column_stack([loaded[:-1], loaded[1:]]), (0.0, 0.0, c.line_force_max))
     mod = model.Model(m, _shell(c), element=element, supports=_clamp(m, grid[:, 0]), load=P)
     rec = []
-    opts = static.StaticOptions(progress=False, initial_increment=0.0125, max_increment=0.025,
+    opts = static.StaticOptions.from_keys(progress=False, initial_increment=0.0125, max_increment=0.025,
                                 intermediate_rtol=1e-6)
     converged, message, iterations = True, "", 0
     try:

@@ -29,7 +29,7 @@ def test_sheet_laid_on_a_floor_rests_on_it_with_its_weight_as_reaction():
     sup = model.Supports.none(m.n_nodes)
     hold_inplane_rigid_modes(m, sup)
     mod = model.Model(m, wool, supports=sup, load=model.gravity_load(m, wool.weight), contact=contact)
-    res = static.solve_static(mod, options=static.StaticOptions(**QUIET))
+    res = static.solve_static(mod, options=static.StaticOptions.from_keys(**QUIET))
     assert res.converged
     x = mod.positions(res.U)
     reaction = -contact.force(x)  # what the floor pushes on the sheet

@@ -47,7 +47,7 @@ def test_moment_force_and_load_stiffness_are_derivatives_of_its_potential():
 
 def test_end_moment_rolls_the_strip_into_a_full_circle():
     mod, _, tip, L = _rolled_strip()
-    opts = static.StaticOptions(progress=False, initial_increment=0.0125, max_increment=0.0125)
+    opts = static.StaticOptions.from_keys(progress=False, initial_increment=0.0125, max_increment=0.0125)
     res = static.solve_static(mod, options=opts)
     assert res.converged
     end = mod.X3[tip] + res.U[tip]

@@ -281,7 +281,7 @@ def test_remesh_relax_with_static_stepper_settles():
 
     def advance(m, U, V, n_steps):  # a "stepper" that jumps to equilibrium: at rest at once
         calls.append(m.mesh.n_nodes)
-        opts = StaticOptions(progress=False) if not U.any() else StaticOptions(
+        opts = StaticOptions(progress=False) if not U.any() else StaticOptions.from_keys(
             progress=False, initial_increment=1.0, max_increment=1.0, increment_displacement=1e30)
         return solve_static(m, U0=U if U.any() else None, options=opts).U, np.zeros_like(V), 0.0
 

@@ -11,7 +11,7 @@ pytest.importorskip("sksparse")
 
 from rftstatic.solvers.continuation import solve_arc_length  # noqa: E402
 from rftstatic.solvers.inertia import InertiaSolver, count_negative, lowest_modes  # noqa: E402
-from rftstatic.solvers.newton import StaticOptions  # noqa: E402
+from rftstatic.solvers.options import StaticOptions  # noqa: E402
 
 
 @pytest.mark.parametrize("shift", [0.0, 0.003, 0.02, 0.2])
@@ -63,7 +63,7 @@ def euler_strip(nx=21, ny=5, overload=1.5):
 def test_arc_length_detects_euler_bifurcation_and_follows_the_elastica():
     overload = 1.5
     model, L = euler_strip(overload=overload)
-    res = solve_arc_length(model, options=StaticOptions(progress=False, rtol=1e-8))
+    res = solve_arc_length(model, options=StaticOptions.from_keys(progress=False, rtol=1e-8))
     assert res.converged and res.lam == 1.0
     crit = res.path["critical_points"]
     assert crit and crit[0]["kind"] == "bifurcation"
@@ -154,7 +154,7 @@ class _VonMisesTruss:
 def test_arc_length_passes_the_limit_point_of_a_von_mises_truss_and_snaps_to_the_inverted_branch():
     truss = _VonMisesTruss()
     P = -truss.load[2, 2]
-    res = solve_arc_length(truss, options=StaticOptions(progress=False, rtol=1e-10, iteration="displacement"))
+    res = solve_arc_length(truss, options=StaticOptions.from_keys(progress=False, rtol=1e-10, iteration="displacement"))
     assert res.converged and res.lam == 1.0
     crit = res.path["critical_points"][0]
     assert crit["kind"] == "limit" and crit["negative_after"] == 1
@@ -173,8 +173,8 @@ def test_solve_static_takes_the_arc_length_route_and_checks_stability():
     from rftstatic.solvers.static import solve_static
 
     model, _ = euler_strip()
-    res = solve_static(model, options=StaticOptions(progress=False, continuation="arc-length", relax_fallback=False))
+    res = solve_static(model, options=StaticOptions.from_keys(progress=False, continuation="arc-length", relax_fallback=False))
     assert res.route == "arc-length" and res.converged and res.stable
     assert res.path["steps"][0]["event"] == "start" and res.path["final_negative"] == 0
     with pytest.raises(ValueError, match="continuation"):
-        StaticOptions(continuation="riks")
+        StaticOptions.from_keys(continuation="riks")

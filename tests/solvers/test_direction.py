@@ -10,7 +10,7 @@ import scipy.sparse as sp
 
 from rftstatic.solvers import linear
 from rftstatic.solvers.iteration import direction
-from rftstatic.solvers.newton import StaticOptions
+from rftstatic.solvers.options import NewtonOptions
 
 pytestmark = pytest.mark.skipif(not linear.cholmod_available(), reason="scikit-sparse is not installed")
 
@@ -48,7 +48,7 @@ def test_failed_factorisations_leave_no_reference_cycle():
     gc.collect()
     gc.disable()
     try:
-        d, mode, _ = direction(model, np.zeros((n // 3, 3)), 1.0, r, StaticOptions(), ws)
+        d, mode, _ = direction(model, np.zeros((n // 3, 3)), 1.0, r, NewtonOptions(), ws)
         assert mode == "psd" and ws.factorisations > 2  # the exact and modified tangents failed first
         gc.set_debug(gc.DEBUG_SAVEALL)
         gc.collect()

@@ -1,6 +1,5 @@
 """The Newton step by preconditioned CG (rftstatic.solvers.krylov) and its use in the displacement iteration."""
 
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -11,7 +10,7 @@ from rftstatic.solvers import static
 from rftstatic.solvers.krylov import LEAST_FORCING, REFRESH_ITERATIONS, forcing, truncated_cg
 from rftstatic.solvers.linear import AmgSolver, CholmodSolver, ScipySolver, cholmod_available
 from rftstatic.solvers.krylov import uses_krylov
-from rftstatic.solvers.newton import StaticOptions
+from rftstatic.solvers.options import NewtonOptions, StaticOptions
 
 
 def spd(n, seed=0, condition=1e3):
@@ -75,7 +74,7 @@ def test_forcing_term_tightens_with_the_residual_within_its_bounds():
 
 
 def test_auto_takes_krylov_on_large_meshes_with_a_cheap_resolve_only():
-    auto, direct, krylov = StaticOptions(), StaticOptions(step_solver="direct"), StaticOptions(step_solver="krylov")
+    auto, direct, krylov = NewtonOptions(), NewtonOptions(step_solver="direct"), NewtonOptions(step_solver="krylov")
     chol = CholmodSolver() if cholmod_available() else ScipySolver()
     assert not uses_krylov(auto, 30_600, chol) and uses_krylov(auto, 121_200, chol)
     assert uses_krylov(krylov, 10, chol) and not uses_krylov(direct, 121_200, chol)
@@ -84,8 +83,8 @@ def test_auto_takes_krylov_on_large_meshes_with_a_cheap_resolve_only():
 
 
 def test_step_solver_option_is_checked():
-    with pytest.raises(ValueError, match=r'solver.step_solver must be "auto", "direct" or "krylov", got "lu"'):
-        StaticOptions(step_solver="lu")
+    with pytest.raises(ValueError, match=r'solver.step_solver: "lu" is not one of auto, direct, krylov'):
+        StaticOptions.from_keys(step_solver="lu")
 
 
 @pytest.mark.parametrize("element", ["RFT3", "RFT6"])
@@ -93,9 +92,9 @@ def test_krylov_steps_reach_the_direct_equilibrium(element):
     """The displacement iteration with preconditioned-CG steps converges to the equilibrium of the direct
     one (the §4.1 strip under its weight, load steps from flat), with fewer factorisations."""
     mod = strip_model(21, 5, element=element)
-    base = StaticOptions(progress=False, iteration="displacement", relax_fallback=False)
-    a = static.solve_static(mod, options=replace(base, step_solver="direct"))
-    b = static.solve_static(mod, options=replace(base, step_solver="krylov"))
+    base = StaticOptions.from_keys(progress=False, iteration="displacement", relax_fallback=False)
+    a = static.solve_static(mod, options=base.replace(step_solver="direct"))
+    b = static.solve_static(mod, options=base.replace(step_solver="krylov"))
     assert a.converged and b.converged and b.stable
     assert b.tangent_modes.get("krylov", 0) > 0 and b.tangent_modes["CG iterations"] >= b.tangent_modes["krylov"]
     assert "krylov" not in a.tangent_modes

@@ -1,6 +1,5 @@
 """Load-scaled Newton against exact and published solutions: plates, the heavy elastica."""
 
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -105,7 +104,7 @@ def test_newton_from_a_nearby_state_reaches_round_off_in_three_iterations():
 
 def test_unconverged_state_is_never_reported_as_converged():
     mod = strip_model(11, 3, element="RFT3")
-    opts = static.StaticOptions(progress=False, max_iterations=1, min_increment=1e-2, initial_increment=0.5,
+    opts = static.StaticOptions.from_keys(progress=False, max_iterations=1, min_increment=1e-2, initial_increment=0.5,
                                 max_increment=1.0, relax_fallback=False)
     with pytest.raises(static.ConvergenceError, match=r"load factor .* iteration .*\|r\| = ") as info:
         static.solve_static(mod, options=opts)
@@ -117,7 +116,7 @@ def test_unconverged_state_is_never_reported_as_converged():
 def test_other_linear_solvers_agree(solver):
     mod = strip_model(11, 3)
     a = static.solve_static(mod, options=static.StaticOptions(progress=False))
-    b = static.solve_static(mod, options=static.StaticOptions(progress=False, linear_solver=solver))
+    b = static.solve_static(mod, options=static.StaticOptions.from_keys(progress=False, linear_solver=solver))
     assert b.linear_solver == solver and b.converged
     assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
 
@@ -125,7 +124,7 @@ def test_other_linear_solvers_agree(solver):
 def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
     mod = strip_model(11, 3)
     a = static.solve_static(mod, options=static.StaticOptions(progress=False))
-    b = static.solve_static(mod, options=static.StaticOptions(progress=False, start="relax"))
+    b = static.solve_static(mod, options=static.StaticOptions.from_keys(progress=False, start="relax"))
     assert a.route == "load-steps" and b.route == "relax+newton" and b.relax["at_rest"]
     assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
 
@@ -135,8 +134,8 @@ def test_fold_perturbation_has_n_fold_symmetry():
     from rftstatic.mesh.trimesh import rectangle
 
     mesh = rectangle(0.5, 0.5, 41, 41, origin=(-0.25, -0.25))
-    opts = static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=3)
-    w = perturbation.start_perturbation(mesh, opts)
+    opts = static.StaticOptions.from_keys(perturbation=2.0, perturbation_folds=4, seed=3)
+    w = perturbation.start_perturbation(mesh, opts.route)
     h = float(mesh.element_size.mean())
     # the edge (r / R >= 1 / sqrt 2) passes every angle, so some node lifts by at least half the amplitude
     assert w.min() >= 0.0 and w.max() <= 2.0 * h * (1 + 1e-12) and w.max() > 0.5 * 2.0 * h
@@ -147,10 +146,10 @@ def test_fold_perturbation_has_n_fold_symmetry():
     partner = np.array([index[tuple(np.round(p, 9))] for p in turned])
     np.testing.assert_allclose(w[partner], w, atol=1e-12 * h)
     # a different seed turns the pattern (another phase), the random start is something else again
-    assert not np.allclose(perturbation.start_perturbation(mesh, opts), perturbation.start_perturbation(
-        mesh, static.StaticOptions(perturbation=2.0, perturbation_folds=4, seed=4)))
+    assert not np.allclose(perturbation.start_perturbation(mesh, opts.route), perturbation.start_perturbation(
+        mesh, static.StaticOptions.from_keys(perturbation=2.0, perturbation_folds=4, seed=4).route))
     with pytest.raises(ValueError, match="perturbation_folds"):
-        static.StaticOptions(perturbation_folds=-1)
+        static.StaticOptions.from_keys(perturbation_folds=-1)
 
 
 def test_guided_relaxation_restores_the_weight_and_reaches_the_same_equilibrium():
@@ -159,7 +158,7 @@ def test_guided_relaxation_restores_the_weight_and_reaches_the_same_equilibrium(
     mod = strip_model(11, 3)
     load = mod.load.copy()
     a = static.solve_static(mod, options=static.StaticOptions(progress=False))
-    b = static.solve_static(mod, options=static.StaticOptions(progress=False, start="relax", guide_folds=3,
+    b = static.solve_static(mod, options=static.StaticOptions.from_keys(progress=False, start="relax", guide_folds=3,
                                                                guide_weight=0.5, seed=2))
     assert b.converged and b.relax["guide"]["folds"] == 3 and b.relax["guide"]["steps"] > 0
     np.testing.assert_array_equal(mod.load, load)
@@ -177,9 +176,9 @@ def test_fold_pattern_and_guide_options():
     for bad in ({"guide_weight": 1.0, "guide_folds": 12, "start": "relax"},
                 {"guide_weight": -0.1, "start": "relax"}, {"guide_folds": -2}):
         with pytest.raises(ValueError, match="guide"):
-            static.StaticOptions(**bad)
+            static.StaticOptions.from_keys(**bad)
     with pytest.raises(ValueError, match='start = "relax"'):
-        static.StaticOptions(guide_folds=12, guide_weight=0.3)
+        static.StaticOptions.from_keys(guide_folds=12, guide_weight=0.3)
 
 
 @pytest.mark.parametrize("key, value", [("seed", -1), ("seed", 1.5), ("seed", float("nan")), ("seed", True),
@@ -187,30 +186,30 @@ def test_fold_pattern_and_guide_options():
                                         ("reuse_factorisation", float("nan")), ("perturbation_folds", -2),
                                         ("guide_folds", 0.5)])
 def test_static_options_refuse_bad_counts(key, value):
-    from rftstatic.solvers.newton import StaticOptions
+    from rftstatic.solvers.options import StaticOptions
 
-    with pytest.raises(ValueError, match=rf"solver\.{key} must be an integer >= \d, got {value!r}"):
-        StaticOptions(**{key: value})
+    with pytest.raises(ValueError, match=rf"solver\.{key}: (must be an integer|.* out of range: must be (>= \d|in \[\d))"):
+        StaticOptions.from_keys(**{key: value})
 
 
 @pytest.mark.parametrize("key", ["rtol", "etol", "intermediate_rtol", "initial_increment", "perturbation"])
 def test_static_options_refuse_nan(key):
-    from rftstatic.solvers.newton import StaticOptions
+    from rftstatic.solvers.options import StaticOptions
 
     with pytest.raises(ValueError):
-        StaticOptions(**{key: float("nan")})
+        StaticOptions.from_keys(**{key: float("nan")})
 
 
 def test_the_whole_load_from_a_given_state_is_never_cut_back():
     """A full-load Newton from a given state that does not converge stops with its last iterate at full
     load (cutting back would unload the given shape), and says so; with continuations it gets there."""
     mod = strip_model(11, 3, element="RFT3")
-    opts = static.StaticOptions(progress=False, relax_fallback=False).from_state()
+    opts = static.StaticOptions.from_keys(progress=False, relax_fallback=False).from_state()
     U0 = np.zeros((mod.mesh.n_nodes, 3))  # the flat strip, as if carried from elsewhere
-    starved = replace(opts, max_iterations=2, max_continuations=0)
+    starved = opts.replace(max_iterations=2, max_continuations=0)
     with pytest.raises(static.ConvergenceError, match=r"load factor 1 from the given state") as info:
         static.solve_static(mod, U0=U0, options=starved)
     res = info.value.result
     assert res.lam == 1.0 and res.cutbacks == 0 and not res.converged and np.any(res.U != 0.0)
-    ok = static.solve_static(mod, U0=U0, options=replace(opts, max_iterations=2, max_continuations=40))
+    ok = static.solve_static(mod, U0=U0, options=opts.replace(max_iterations=2, max_continuations=40))
     assert ok.converged and ok.cutbacks == 0 and len(ok.load_steps) == 1

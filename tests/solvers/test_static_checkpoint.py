@@ -9,7 +9,7 @@ from rftstatic.mesh import trimesh
 from rftstatic.model import model as model_mod
 from rftstatic.model.loads import LeverMoment
 from rftstatic.references import END_MOMENT
-from rftstatic.solvers.newton import StaticOptions
+from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.static import solve_static
 from rftstatic.solvers.static_checkpoint import StaticCheckpointer, load_static_checkpoint
 
@@ -27,7 +27,7 @@ def _rolled_strip(nx=9):
 
 
 def test_a_resumed_roll_up_keeps_the_branch_of_its_lever_angles(tmp_path):
-    opts = StaticOptions(progress=False, initial_increment=0.1, max_increment=0.1, intermediate_rtol=1e-6)
+    opts = StaticOptions.from_keys(progress=False, initial_increment=0.1, max_increment=0.1, intermediate_rtol=1e-6)
     full = solve_static(_rolled_strip(), options=opts)
     assert full.converged and len(full.load_steps) >= 5
     path = tmp_path / "checkpoint.npz"

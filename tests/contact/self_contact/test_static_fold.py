@@ -10,7 +10,7 @@ from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
 from rftstatic.material import preset
 from rftstatic.mesh.trimesh import rectangle
 from rftstatic.model.model import Model, Supports, gravity_load
-from rftstatic.solvers.newton import StaticOptions
+from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.static import solve_static
 
 D = 5e-4  # 0.05 cm

@@ -1,0 +1,50 @@
+"""The scene tables whose keys are declared as data (:mod:`rftstatic.optionspec`), for the reference that
+``python -m rftstatic options [SECTION]`` prints and the documentation renders.
+
+Each section maps to its option groups; the scene schema of that table is generated from the same groups
+(:data:`rftstatic.scenes.schema.SCHEMA`), so the listing and the checks cannot disagree.
+"""
+
+from __future__ import annotations
+
+from rftstatic.errors import SceneError
+from rftstatic.optionspec import describe
+from rftstatic.scenes.run_options import SOLVER_GROUPS
+
+__all__ = ["SECTIONS", "option_rows", "format_rows"]
+
+SECTIONS = {"solver": SOLVER_GROUPS}
+"""Scene table -> its declared option groups."""
+
+
+def option_rows(section: str | None = None) -> list[dict]:
+    """One row per declared key (``key``, ``type``, ``unit``, ``range``, ``default``, ``help``, ``group``) of
+    ``section`` (None: every section); an unknown section is a :class:`SceneError` naming the known ones."""
+    if section is None:
+        return [row for name in SECTIONS for row in describe(SECTIONS[name], name)]
+    if section not in SECTIONS:
+        raise SceneError(f'options: no section "{section}" declares its keys as data; known: {", ".join(SECTIONS)} '
+                         "(the other tables are listed in the README's scene reference)")
+    return describe(SECTIONS[section], section)
+
+
+def format_rows(rows: list[dict], style: str = "text") -> str:
+    """``rows`` (:func:`option_rows`) as a plain-text listing (``"text"``) or a Markdown table (``"markdown"``)."""
+    def cell(row, k):
+        v = row[k]
+        return str(v).lower() if isinstance(v, bool) else str(v)
+
+    if style == "markdown":
+        lines = ["| key | type | unit | range | default | meaning |", "|---|---|---|---|---|---|"]
+        lines += [f"| `{r['key']}` | {r['type']} | {r['unit']} | {r['range']} | `{cell(r, 'default')}` | "
+                  f"{r['help'].replace('|', '&#124;')} |" for r in rows]
+        return "\n".join(lines)
+    if style != "text":
+        raise SceneError(f'options --format: "{style}" is not a format; use text or markdown')
+    width = max(len(r["key"]) for r in rows) if rows else 0
+    lines = []
+    for r in rows:
+        what = ", ".join(x for x in (r["type"], r["unit"] if r["unit"] != "-" else "", r["range"]) if x)
+        lines.append(f"{r['key']:<{width}}  {what}; default {cell(r, 'default')}")
+        lines.append(f"{'':<{width}}  {r['help']}")
+    return "\n".join(lines)

@@ -1,0 +1,107 @@
+"""Options declared once (rftstatic.optionspec): the [solver] schema, the checks, the unit conversion and the
+``options`` command all come from the same declarations, and disagree nowhere."""
+
+import math
+
+import pytest
+
+from rftstatic.cli import main
+from rftstatic.errors import ParameterError, SceneError
+from rftstatic.optionspec import declared, describe, option
+from rftstatic.scenes.options import run_options, static_options
+from rftstatic.scenes.run_options import SOLVER_GROUPS, RunOptions
+from rftstatic.scenes.schema import SCHEMA, load_scene
+from rftstatic.scenes.sections import SECTIONS, option_rows
+from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
+
+
+def _declared_keys():
+    return [(cls, name, spec, default) for cls in SOLVER_GROUPS for name, spec, default in declared(cls)]
+
+
+def test_each_solver_key_is_declared_once_and_the_schema_and_listing_are_generated_from_it():
+    names = [name for _, name, spec, _ in _declared_keys() if spec.scene]
+    assert len(names) == len(set(names)), "a [solver] key declared in two groups"
+    assert set(SCHEMA["solver"][0]) == set(names)
+    assert [r["key"] for r in option_rows("solver")] == [f"solver.{n}" for n in names]
+    for _, name, spec, default in _declared_keys():
+        assert spec.help and SCHEMA["solver"][0][name][1].startswith(spec.help)
+
+
+def test_the_groups_are_split_by_concern_and_none_is_over_fifteen_fields():
+    for cls in (*SOLVER_GROUPS, StaticOptions):
+        assert len(cls.__dataclass_fields__) <= 15, cls.__name__
+    assert {"rtol", "tangent", "step_solver"} <= {n for n, _, _ in declared(NewtonOptions)}
+    assert {"initial_increment", "continuation"} <= {n for n, _, _ in declared(IncrementOptions)}
+    assert {"start", "seed", "perturbation"} <= {n for n, _, _ in declared(RouteOptions)}
+    assert {"levels", "seeds", "membrane"} == {n for n, _, _ in declared(RunOptions)} - {"level_membrane"}
+
+
+@pytest.mark.parametrize("cls, name, spec, default",
+                         [pytest.param(*k, id=f"{k[0].__name__}.{k[1]}") for k in _declared_keys()])
+def test_every_declared_range_is_enforced_with_the_key_named(cls, name, spec, default):
+    assert spec.problem(default) is None  # the default lies in its own range
+    bad = []
+    if spec.kind in ("int", "float"):
+        bad.append("seven" if not spec.nullable else [7])
+        if spec.low is not None:
+            bad.append(spec.low - (1 if spec.kind == "int" else abs(spec.low) * 0.5 + 1e-3))
+        if spec.high is not None:
+            bad.append(spec.high + (1 if spec.kind == "int" else abs(spec.high) + 1.0))
+        if spec.kind == "float":
+            bad += [math.nan, math.inf]
+        else:
+            bad += [1.5, True]
+    elif spec.kind == "str":
+        bad += ["no-such-choice", 3]
+    else:
+        bad.append(1)
+    for value in bad:
+        with pytest.raises(ParameterError, match=rf"^solver\.{name}: "):
+            cls(**{name: value})
+
+
+def test_a_scene_value_is_checked_in_the_scenes_units_and_converted_to_si():
+    opts = static_options(load_scene("strip", ["solver.max_step=0.5", "solver.increment_displacement=2.0"]))
+    assert opts.newton.max_step == pytest.approx(0.005) and opts.increments.increment_displacement == pytest.approx(0.02)
+    with pytest.raises(SceneError, match=r"strip\.toml: solver\.max_step: -0\.5 is out of range: must be > 0"):
+        static_options(load_scene("strip", ["solver.max_step=-0.5"]))
+    auto = static_options(load_scene("strip", ['solver.max_step="auto"']))
+    assert auto.newton.max_step is None
+
+
+def test_flat_keys_reach_their_groups_and_an_unknown_one_is_named():
+    opts = StaticOptions.from_keys(rtol=1e-9, start="relax", continuation="arc-length", progress=False)
+    assert (opts.newton.rtol, opts.route.start, opts.increments.continuation, opts.progress) == \
+        (1e-9, "relax", "arc-length", False)
+    assert opts.replace(rtol=1e-3).newton.rtol == 1e-3 and opts.newton.rtol == 1e-9  # a copy
+    with pytest.raises(ParameterError, match=r"solver\.rtoll: unknown option"):
+        StaticOptions.from_keys(rtoll=1e-9)
+    with pytest.raises(SceneError, match=r'solver\.rtoll: unknown key .*did you mean "solver\.rtol"'):
+        load_scene("strip", ["solver.rtoll=1e-9"])
+
+
+def test_the_app_keys_resolve_auto_levels():
+    assert run_options(load_scene("strip")).levels == 1
+    assert run_options(load_scene("strip", ["solver.levels=2"])).levels == 2
+    with pytest.raises(SceneError, match=r"solver\.seeds: 0 is out of range"):
+        run_options(load_scene("strip", ["solver.seeds=0"]))
+
+
+def test_an_option_default_outside_its_own_range_is_a_programming_error():
+    with pytest.raises(TypeError, match="option default"):
+        option(2.0, "a share", low=0.0, high=1.0)
+
+
+def test_the_options_command_lists_every_key_and_refuses_an_unknown_section(capsys):
+    assert main(["options", "solver"]) == 0
+    out = capsys.readouterr().out
+    for row in describe(SECTIONS["solver"], "solver"):
+        assert row["key"] in out
+    assert main(["options", "solver", "--format", "markdown"]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert table[0].startswith("| key |") and len(table) == 2 + len(option_rows("solver"))
+    assert all(line.count("|") == 7 for line in table)  # no cell breaks the table
+    assert main(["options", "solverr"]) == 2
+    err = capsys.readouterr().err
+    assert 'no section "solverr"' in err and "known: solver" in err
