@@ -48,6 +48,7 @@ from rftstatic.solvers.branches import switch_branch
 from rftstatic.solvers.inertia import InertiaSolver
 from rftstatic.solvers.iteration import capped_step, roundoff_floor, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError, make_solver
+from rftstatic.solvers.loop import Direction, Iterate, StepFailure, newton_loop
 from rftstatic.solvers.newton import NewtonWorkspace, StaticResult, newton, route_outcome
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
@@ -187,7 +188,7 @@ class _Path:
         """One pseudo-arclength step of length ``ds`` from ``pt`` (``target``: to that load factor
         instead, from the tangent predictor). Returns ``(point, iterations)``, point None when the
         corrector failed."""
-        model, ws, free = self.model, self.ws, self.free
+        model, free = self.model, self.free
         if target is not None:
             a_u, a_lam = np.zeros(len(free.nonzero()[0])), 1.0
             dl0 = target - pt.lam
@@ -195,31 +196,47 @@ class _Path:
         else:
             a_u, a_lam = pt.t_u / self.c, pt.t_lam
             du0, dl0 = ds * pt.t_u * self.c, ds * pt.t_lam
-        step, cap = capped_step(model, du0, np.inf)
-        U = pt.U + step
-        lam = pt.lam + dl0
-        K = fac = None
-        for it in range(1, iterations + 1):
-            f, K = model.tangent(U, lam=lam, candidates=ws.candidates, pairs=ws.pairs)
-            r = (f - lam * model.load).ravel()[free]
-            rnorm = float(np.linalg.norm(r))
-            if not np.isfinite(rnorm):
-                return None, it
-            try:
-                fac = self.inertia.factor(K)
-                if rnorm <= self.tolerance(U, lam, rnorm):
-                    return _Point(U, lam, K, fac), it - 1
-                d_r, d_p = fac.solve(-r), fac.solve(self.P)
-            except LinearSolveError:
-                return None, it
-            dlam = -float(a_u @ d_r) / (float(a_u @ d_p) + a_lam)
-            step, cap = capped_step(model, d_r + dlam * d_p, self.max_step)
-            step, frac = self_contact_limited(model, U, step, ws)
-            layer = self.layer_limit(U, step)
-            step, frac = step * layer, frac * layer
-            U = U + step
-            lam = lam + cap * frac * dlam
-        return None, iterations
+        step, _ = capped_step(model, du0, np.inf)
+        x = Iterate(pt.U + step, pt.lam + dl0)
+        out = newton_loop(x, test=self._converged, direction=lambda x: self._bordered(x, a_u, a_lam),
+                          globalise=self._advance, max_iterations=iterations, first_test=1, final_test=False)
+        if not out.converged:
+            return None, out.iterations
+        x = out.x
+        return _Point(x.U, x.lam, x.tangent, x.factor), out.iterations
+
+    def _converged(self, x: Iterate) -> bool:
+        """The corrector's test: the residual at ``x`` within :meth:`tolerance`; evaluates and factorises the
+        tangent there (the converged point keeps both: its inertia and the next predictor)."""
+        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.ws.candidates, pairs=self.ws.pairs)
+        x.r = (f - x.lam * self.model.load).ravel()[self.free]
+        x.rnorm = float(np.linalg.norm(x.r))
+        if not np.isfinite(x.rnorm):
+            raise StepFailure("non-finite residual")
+        try:
+            x.factor = self.inertia.factor(x.tangent)
+        except LinearSolveError as exc:
+            raise StepFailure(f"linear solve failed ({exc})") from None
+        return x.rnorm <= self.tolerance(x.U, x.lam, x.rnorm)
+
+    def _bordered(self, x: Iterate, a_u, a_lam) -> Direction:
+        """The bordered direction (module docstring): ``K dU_r = -R``, ``K dU_P = P`` with the factorisation at
+        ``x``, ``dlam`` from the linear constraint ``a_u . dU + a_lam dlam = 0``."""
+        try:
+            d_r, d_p = x.factor.solve(-x.r), x.factor.solve(self.P)
+        except LinearSolveError as exc:
+            raise StepFailure(f"linear solve failed ({exc})") from None
+        dlam = -float(a_u @ d_r) / (float(a_u @ d_p) + a_lam)
+        return Direction(d_r + dlam * d_p, "exact", dlam=dlam)
+
+    def _advance(self, x: Iterate, dn: Direction):
+        """The corrector's step: capped (``max_step``), bounded by the self-contact collision test and the
+        contact layer (:meth:`layer_limit`), the load factor scaled alike."""
+        step, cap = capped_step(self.model, dn.d, self.max_step)
+        step, frac = self_contact_limited(self.model, x.U, step, self.ws)
+        layer = self.layer_limit(x.U, step)
+        step, frac = step * layer, frac * layer
+        return Iterate(x.U + step, x.lam + cap * frac * dn.dlam), {"cap": cap * frac, "dlam": cap * frac * dn.dlam}
 
 
 def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, callback=None,

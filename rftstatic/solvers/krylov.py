@@ -2,7 +2,7 @@
 factorisation of it (inexact Newton: Dembo, Eisenstat & Steihaug, SIAM J. Numer. Anal. 19, 1982;
 truncated at negative curvature: Steihaug, SIAM J. Numer. Anal. 20, 1983; Nocedal & Wright, Numerical
 Optimization, 2nd ed., Algorithm 7.2 without the trust radius, which the step cap and line search of
-:func:`~rftstatic.solvers.newton.displacement_iterations` replace).
+:func:`~rftstatic.solvers.displacement.displacement_iterations` replace).
 
 Why: on the finest mesh of a drape a Newton step costs one supernodal factorisation (2.1 s at 201 x 201
 nodes, 121,200 unknowns, 42e6 entries of L) against 0.12 s for a back-substitution with it, and the

@@ -6,6 +6,7 @@ import numpy as np
 
 from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError
+from rftstatic.solvers.loop import Direction, Iterate, StepFailure, newton_loop
 
 MIXED_ITERATIONS = 12
 """Most mixed iterations per increment (twice at full load, at most ``max_iterations``): where it
@@ -32,42 +33,68 @@ def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
     iteration that fails returns to the load steps (:mod:`rftstatic.solvers.load_steps`), which cut the
     increment back and, after repeated failures, try the displacement iteration.
     """
-    free = model.free.ravel()
     test = Criteria(model, lam, opts, U)
     budget = min(opts.max_iterations, MIXED_ITERATIONS)
     max_iterations = 2 * budget if lam >= 1.0 else budget
-    cand, modes = ws.candidates, ws.modes
     U = U.copy()
     S = model.membrane_stress(U) if stress is None else np.array(stress, float)
-    r = model.residual(U, lam, candidates=cand, pairs=ws.pairs).ravel()[free]
-    rnorm = float(np.linalg.norm(r))
-    if not np.isfinite(rnorm):
-        return Iteration(False, U, 0, rnorm, "non-finite residual", scheme="mixed")
-    work, stable, hist = np.inf, None, []
-    for it in range(1, max_iterations + 1):
-        if it > 1 and test.met(U, r, work, ws.solver):
-            return Iteration(True, U, it - 1, rnorm, stable=stable, history=hist, stress=S, scheme="mixed")
+    r = model.residual(U, lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[model.free.ravel()]
+    x = Iterate(U, lam, r, float(np.linalg.norm(r)), stress=S)
+    if not np.isfinite(x.rnorm):
+        return Iteration(False, U, 0, x.rnorm, "non-finite residual", scheme="mixed")
+    find = MixedDirection(model, opts, ws)
+    out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, ws.solver), direction=find,
+                      globalise=CappedStep(model, ws, test, max_step), max_iterations=max_iterations)
+    x = out.x
+    if out.converged:
+        return Iteration(True, x.U, out.iterations, x.rnorm, stable=find.stable, history=out.history, stress=x.stress,
+                         scheme="mixed")
+    if out.reason is None:
+        ws.modes["mixed failed"] = ws.modes.get("mixed failed", 0) + 1
+    reason = out.reason or f"no convergence in {max_iterations} mixed iterations"
+    return Iteration(False, x.U, out.iterations, x.rnorm, reason, history=out.history, stress=x.stress, scheme="mixed")
+
+
+class MixedDirection:
+    """The MIP direction: the safeguarded Newton direction whose geometric stiffness takes the carried stress
+    (:func:`~rftstatic.solvers.iteration.direction` with ``stress``); ``stable``: the last tangent was the
+    exact one and positive definite (None when the solver cannot tell)."""
+
+    def __init__(self, model, opts, ws):
+        self.model, self.opts, self.ws = model, opts, ws
+        self.stable = None
+
+    def __call__(self, x: Iterate) -> Direction:
         try:
-            d, mode, _ = direction(model, U, lam, r, opts, ws, stress=S)
+            d, mode, _ = direction(self.model, x.U, x.lam, x.r, self.opts, self.ws, stress=x.stress)
         except LinearSolveError as exc:
-            return Iteration(False, U, it, rnorm, f"linear solve failed ({exc})", history=hist, stress=S,
-                             scheme="mixed")
-        stable = mode == "exact" if ws.solver.detects_indefinite else None
-        step, cap = capped_step(model, d, max_step)
-        step, frac = self_contact_limited(model, U, step, ws)
+            raise StepFailure(f"linear solve failed ({exc})") from None
+        self.stable = mode == "exact" if self.ws.solver.detects_indefinite else None
+        return Direction(d, mode)
+
+
+class CappedStep:
+    """The MIP globalisation: the step as it is, capped (``max_step`` [m]) and bounded by the self-contact
+    collision test; the carried stress updated to that of the linearised strain; the first step sets the
+    energy scale of the convergence test (the work of the load on it)."""
+
+    def __init__(self, model, ws, test: Criteria, max_step: float):
+        self.model, self.ws, self.test, self.max_step = model, ws, test, max_step
+        self.free = model.free.ravel()
+        self.first = True
+
+    def __call__(self, x: Iterate, dn: Direction):
+        model, ws = self.model, self.ws
+        step, cap = capped_step(model, dn.d, self.max_step)
+        step, frac = self_contact_limited(model, x.U, step, ws)
         cap *= frac
-        if it == 1:
-            test.load_work(U, step)
-        S = model.mixed_stress(U, step)
-        U = U + step
-        hist.append({"residual": rnorm, "alpha": 1.0, "cap": cap, "mu": 0.0, "fresh": True, "mode": mode})
-        r = model.residual(U, lam, candidates=cand, pairs=ws.pairs).ravel()[free]
-        work = abs(float(step.ravel()[free] @ r))
-        rnorm = float(np.linalg.norm(r))
-        if not np.isfinite(rnorm):
-            return Iteration(False, U, it, rnorm, "non-finite residual", history=hist, stress=S, scheme="mixed")
-    if test.met(U, r, work, ws.solver):
-        return Iteration(True, U, max_iterations, rnorm, stable=stable, history=hist, stress=S, scheme="mixed")
-    modes["mixed failed"] = modes.get("mixed failed", 0) + 1
-    return Iteration(False, U, max_iterations, rnorm, f"no convergence in {max_iterations} mixed iterations",
-                   history=hist, stress=S, scheme="mixed")
+        if self.first:
+            self.test.load_work(x.U, step)
+            self.first = False
+        S = model.mixed_stress(x.U, step)
+        U = x.U + step
+        r = model.residual(U, x.lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[self.free]
+        new = Iterate(U, x.lam, r, float(np.linalg.norm(r)), work=abs(float(step.ravel()[self.free] @ r)), stress=S)
+        if not np.isfinite(new.rnorm):
+            raise StepFailure("non-finite residual", new)
+        return new, {"alpha": 1.0, "cap": cap, "mu": 0.0, "fresh": True, "mode": dn.mode}

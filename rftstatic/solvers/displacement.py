@@ -1,0 +1,210 @@
+"""Newton on the displacements alone: the parts it plugs into the Newton loop (:mod:`rftstatic.solvers.loop`).
+
+- direction (:class:`DisplacementDirection`): the safeguarded direct step
+  (:func:`~rftstatic.solvers.iteration.direction`: exact tangent, modified, projected, shifted), a reused
+  factorisation while the residual falls fast (modified Newton), or on large meshes the step by CG on the
+  exact tangent preconditioned with the last factorisation (:mod:`~rftstatic.solvers.krylov`);
+- globalisation (:class:`LineSearch`): the step cap ``max_step`` and the self-contact bound, an Armijo
+  backtracking line search on the total potential energy Pi, and Levenberg-Marquardt damping of the next
+  direction as a trust region (More's update of the ratio of actual to predicted decrease);
+- the convergence test :class:`~rftstatic.solvers.iteration.Criteria`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direction, self_contact_limited
+from rftstatic.solvers.krylov import forcing, krylov_direction, uses_krylov
+from rftstatic.solvers.linear import LinearSolveError
+from rftstatic.solvers.loop import Direction, Iterate, StepFailure, newton_loop
+
+
+class Damping:
+    """The Levenberg-Marquardt damping ``mu`` [-] (relative to the mean tangent diagonal) that the trust region
+    sets and the next direction uses."""
+
+    def __init__(self):
+        self.mu = 0.0
+
+
+class DisplacementDirection:
+    """The displacement iteration's direction at an iterate (module docstring); ``stable`` tells whether
+    the last fresh direct step's exact tangent was positive definite (None when the solver cannot tell)."""
+
+    def __init__(self, model, opts, ws, damping: Damping, first: Iterate):
+        self.model, self.opts, self.ws, self.damping = model, opts, ws, damping
+        self.krylov = uses_krylov(opts, len(first.r), ws.solver)
+        self.refresh = True  # krylov steps: the next step factorises the tangent anew
+        self.first_rnorm = first.rnorm
+        self.age = 0  # steps that reused the last factorisation
+        self.stable = None
+        self.curvature = 0.0  # d.K.d of the last fresh step [J]
+
+    def __call__(self, x: Iterate) -> Direction:
+        model, ws, solver, mu = self.model, self.ws, self.ws.solver, self.damping.mu
+        r = x.r
+        if self.krylov and not self.refresh:
+            d, dKd, self.refresh = krylov_direction(model, x.U, x.lam, r, ws, mu, forcing(x.rnorm, self.first_rnorm))
+            if d is not None:
+                self.curvature = dKd
+                return Direction(d, "krylov", fresh=True, curvature=dKd)
+        elif x.reusable and self.age < self.opts.reuse_factorisation and not self.krylov:
+            d = self._reused(r)
+            if d is not None:
+                ws.modes["reused"] = ws.modes.get("reused", 0) + 1
+                self.age += 1
+                return Direction(d, "reused", fresh=False, curvature=self.curvature)
+        try:
+            d, mode, shift = direction(model, x.U, x.lam, r, self.opts, ws, damping=mu)
+        except LinearSolveError as exc:
+            raise StepFailure(f"linear solve failed ({exc})") from None
+        self.stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
+        self.age = 0
+        self.refresh = False
+        # curvature of the quadratic model along d: (K + s I) d = -r  =>  d.K.d = -d.r - s d.d
+        self.curvature = -float(r @ d) - shift * float(d @ d)
+        return Direction(d, mode, fresh=True, curvature=self.curvature)
+
+    def _reused(self, r):
+        """The step with the last factorisation, if it is a finite descent direction (else None)."""
+        try:
+            d = self.ws.solver.resolve(-r)
+        except LinearSolveError:
+            return None
+        return d if (np.all(np.isfinite(d)) and float(r @ d) < 0.0) else None
+
+
+class LineSearch:
+    """The displacement iteration's globalisation (module docstring): capped, self-contact-bounded step,
+    Armijo backtracking on Pi, trust-region update of the damping. ``energies`` holds Pi after every step
+    (:meth:`progress`); the first step sets the energy scale of the convergence test."""
+
+    def __init__(self, model, opts, ws, damping: Damping, test: Criteria, max_step: float, start: Iterate):
+        self.model, self.opts, self.ws, self.damping, self.test = model, opts, ws, damping, test
+        self.max_step = max_step
+        self.free = model.free.ravel()
+        self.energies = [start.energy]
+        self.work0 = None
+
+    def __call__(self, x: Iterate, dn: Direction):
+        model, ws, free, mu = self.model, self.ws, self.free, self.damping.mu
+        step, cap = capped_step(model, dn.d, self.max_step)
+        step, frac = self_contact_limited(model, x.U, step, ws)
+        cap *= frac
+        slope = float(x.r @ step.ravel()[free])
+        alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, ws, x.energy_scale)
+        if alpha is None:
+            raise StepFailure("line search found no decrease of the energy")
+        U = x.U + alpha * step
+        Pi = parts["total"]
+        self.energies.append(Pi)
+        record = {"alpha": alpha, "cap": cap, "mu": mu, "fresh": dn.fresh, "mode": dn.mode}
+        if dn.fresh:
+            self._trust_region(x.energy, Pi, alpha, slope, cap, dn.curvature)
+        r = model.residual(U, x.lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[free]
+        work = abs(float(alpha * step.ravel()[free] @ r))
+        if self.work0 is None:
+            # energy scale: the first step's work or the work of the load so far, whichever is larger
+            # (a good predictor makes the first step tiny; round-off must not stall the criterion);
+            # ``parts``: the energies at the new U, from the line search
+            self.work0 = max(abs(alpha * slope), abs(x.lam * float(np.einsum("ni,ni->", self.test.P, U))),
+                             parts["bending"] + parts["membrane"], 1e-300)
+            self.test.work_ref = self.work0
+        rnorm = float(np.linalg.norm(r))
+        # modified Newton: keep the factorisation while it still cuts the residual fast
+        new = Iterate(U, x.lam, r, rnorm, work=work, energy=Pi, energy_scale=energy_scale(parts),
+                      reusable=alpha == 1.0 and rnorm < 0.3 * x.rnorm)
+        if not np.isfinite(rnorm):
+            raise StepFailure("non-finite residual", new)
+        return new, record
+
+    def _trust_region(self, Pi0, Pi, alpha, slope, cap, curvature) -> None:
+        """Levenberg-Marquardt damping as a trust region (More's update): the ratio of the actual to the
+        predicted energy decrease of a fresh Newton step decides; a step the line search had to shorten (a
+        near-singular or indefinite direction: a sheet balanced on a sphere, a fold forming) damps the next
+        one, good steps undo it, so the final iterations are pure Newton."""
+        mu = self.damping.mu
+        predicted = -(slope + 0.5 * cap * cap * curvature)
+        actual = Pi0 - Pi
+        tiny = 1e-10 * max(abs(Pi), abs(self.work0 or 0.0))
+        if alpha == 1.0 and abs(predicted) <= tiny:
+            rho = 1.0  # below what the energy resolves: the residual decides convergence
+        else:
+            rho = actual / predicted if (alpha == 1.0 and predicted > 0) else 0.0
+        if alpha < 1.0 or rho < 0.25:
+            mu = max(4.0 * mu, 1e-6)
+        elif rho > 0.75:
+            mu = mu / 3.0 if mu > 1e-9 else 0.0
+        self.damping.mu = mu
+
+    def progress(self, x: Iterate) -> float:
+        """Energy drop over the last third of the steps over the work scale [-]: still sliding downhill?"""
+        e = self.energies
+        k = max(2, len(e) // 3)
+        drop = e[-k] - e[-1]
+        return drop / max(self.work0 or 0.0, abs(x.lam * float(np.einsum("ni,ni->", self.test.P, x.U))), 1e-300)
+
+
+def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
+    """Newton on the displacements alone from ``U`` at load factor ``lam`` (module docstring), with the
+    :class:`~rftstatic.solvers.options.NewtonOptions` ``opts`` and the solve's workspace ``ws``."""
+    test = Criteria(model, lam, opts, U)
+    # the final increment converges to the tight tolerance and may need longer
+    max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
+    U = U.copy()
+    parts = model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs)
+    r = model.residual(U, lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[model.free.ravel()]
+    x = Iterate(U, lam, r, float(np.linalg.norm(r)), energy=parts["total"], energy_scale=energy_scale(parts))
+    if not np.isfinite(x.rnorm):
+        return Iteration(False, U, 0, x.rnorm, "non-finite residual")
+    damping = Damping()
+    find = DisplacementDirection(model, opts, ws, damping, x)
+    search = LineSearch(model, opts, ws, damping, test, max_step, x)
+    out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, ws.solver), direction=find,
+                      globalise=search, max_iterations=max_iterations)
+    x = out.x
+    if out.converged:
+        return Iteration(True, x.U, out.iterations, x.rnorm, stable=find.stable, history=out.history)
+    reason = out.reason or f"no convergence in {max_iterations} iterations"
+    return Iteration(False, x.U, out.iterations, x.rnorm, reason, progress=search.progress(x) if out.reason is None
+                     else 0.0, history=out.history)
+
+
+def line_search(model, U, step, lam, Pi0, slope, opts, ws, scale=None, max_trials=12):
+    """Armijo backtracking on Pi along ``step (N, 3)`` [m] from ``U`` with energy ``Pi0`` [J] and slope
+    ``r . step`` [J]: ``(alpha, parts)``, ``parts`` the energies (:meth:`~rftstatic.model.model.Model.energies`)
+    at ``U + alpha step``; ``(None, None)`` when no trial lowers the energy. ``scale`` [J]: :func:`energy_scale`
+    of the energies at ``U`` (computed when None)."""
+    def parts_at(alpha):
+        return model.energies(U + alpha * step, lam, candidates=ws.candidates, pairs=ws.pairs)
+
+    if not opts.line_search:
+        return 1.0, parts_at(1.0)
+    if scale is None:
+        scale = energy_scale(model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs))
+    if abs(slope) <= 1e-10 * scale:
+        # the predicted decrease is below what the energy can resolve: near the solution the Newton
+        # step is reliable, and the force residual (not the energy) decides convergence
+        return 1.0, parts_at(1.0)
+    roundoff = 1e-13 * scale
+    alpha = 1.0
+    for _ in range(max_trials):
+        parts = parts_at(alpha)
+        Pi = parts["total"]
+        if np.isfinite(Pi) and Pi <= Pi0 + 1e-4 * alpha * slope + roundoff:
+            return alpha, parts
+        # minimiser of the quadratic through Pi0, slope and Pi(alpha), safeguarded
+        if np.isfinite(Pi):
+            denom = 2.0 * (Pi - Pi0 - slope * alpha)
+            a_q = -slope * alpha * alpha / denom if denom > 0 else 0.5 * alpha
+            alpha = float(np.clip(a_q, 0.1 * alpha, 0.5 * alpha))
+        else:
+            alpha *= 0.1
+    return None, None
+
+
+def energy_scale(parts: dict) -> float:
+    """Magnitude of the energy [J] against which the line search judges round-off: the summed magnitudes
+    of bending, membrane, contact energies and the load's work."""
+    return abs(parts["bending"]) + abs(parts["membrane"]) + abs(parts["contact"]) + abs(parts["external_work"])
