@@ -4,8 +4,9 @@ For each scene of ``cases/`` (shrunk to a tiny mesh), and an isotropic shell bes
 the scene holds (scalars and the numbers of its lists) and the numeric keys of the schema that the scene's
 own tables may add (``contact.smoothing``, ``loads.pressure``, the keys of its obstacles' types...) is set
 to an extreme value: ``1e300``, ``-1e300``, ``-1``, ``0``, ``1e-300``, ``10^400`` (an integer Python's TOML
-reader takes) and, for integers, ``2^63 - 1`` and ``-2^63``. The scene layer then builds the model (:func:`rftstatic.scenes.build.build_model`), the options
-of its analysis, and evaluates the energies and the residual at the flat state. Either every number is
+reader takes) and, for integers, ``2^63 - 1`` and ``-2^63``. The scene layer then builds the model
+(:func:`rftstatic.scenes.build.build_model`) and the options of its analysis, and evaluates the energies
+and the residual at the flat state. Either every number is
 finite, or a :class:`~rftstatic.errors.SceneError` names the key (``scene: KEY: ...``, the key's name in
 the message of its table, or another value of the scene that the mutation moved: :func:`names_a_key`);
 anything else (an ``OverflowError``, a ``RecursionError``, a NaN, a
