@@ -287,12 +287,14 @@ def parse_override(text: str) -> tuple[str, object]:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's limit on int(str))
+        raise SceneError(f"--set {key}: {exc}; TOML's integers are 64-bit") from None
     except RecursionError:
         raise SceneError(f'--set {key}: the value nests arrays or tables too deeply for the TOML reader; a scene '
                          f'nests at most {MAX_NESTING} levels') from None
     if _nesting(value) > MAX_NESTING:
-        raise SceneError(f"--set {key}: the value nests arrays or tables {_nesting(value)} levels deep; a scene "
-                         f"nests at most {MAX_NESTING}")
+        raise SceneError(f"--set {key}: the value nests arrays or tables more than {MAX_NESTING} levels deep; a "
+                         "scene nests at most 5 (loads.point.0.at = [[x, y]])")
     return key, value
 
 
@@ -341,6 +343,8 @@ def load_scene(name_or_path: str, overrides=()) -> Scene:
                          "as UTF-8 TOML") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot be read ({exc.strerror})") from None
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's limit on int(str))
+        raise SceneError(f"{path}: {exc}; TOML's integers are 64-bit") from None
     _check_nesting(data, str(path))
     applied = {}
     for text in overrides:
@@ -458,6 +462,6 @@ def _check_table(scene, table, schema, prefix):
         if bad is not None:
             where = f" (in {value!r})" if isinstance(value, list) else ""
             if isinstance(bad, int):
-                raise scene.error(full, f"an integer of {len(str(abs(bad)))} digits is beyond TOML's 64-bit integers "
+                raise scene.error(full, f"an integer of {bad.bit_length()} bits is beyond TOML's 64-bit integers "
                                   "(at most 9223372036854775807 in magnitude); give a smaller value")
             raise scene.error(full, f"{bad!r} is not a finite number{where}; give a finite value")

@@ -393,4 +393,16 @@ def test_a_deeply_nested_override_is_an_input_error(capsys, tmp_path):
 def test_an_integer_beyond_64_bits_is_an_input_error(capsys, tmp_path):
     # was: internal error: OverflowError: int too large to convert to float (tomllib takes any integer)
     code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", f"mesh.size=[{10**400}, 1.0]"])
-    _assert_input_error(code, err, "mesh.size", "an integer of 401 digits is beyond TOML's 64-bit integers")
+    _assert_input_error(code, err, "mesh.size", "an integer of 1329 bits is beyond TOML's 64-bit integers")
+
+
+@pytest.mark.parametrize("where", ["file", "--set"])
+def test_an_integer_of_5000_digits_is_an_input_error(capsys, tmp_path, where):
+    # was: internal error: ValueError: Exceeds the limit (4300 digits) for integer string conversion (tomllib)
+    if where == "file":
+        code, err = _run(capsys, tmp_path, None, text=f"[mesh]\nz = {'9' * 5000}\n")
+        assert err.startswith(f"error: {tmp_path / 'scene.toml'}: Exceeds the limit (4300 digits)"), err
+    else:
+        code, err = _run(capsys, tmp_path, "strip", [f"mesh.z={'9' * 5000}"])
+        assert err.startswith("error: --set mesh.z: Exceeds the limit (4300 digits)"), err
+    assert code == 2 and err.endswith("TOML's integers are 64-bit"), err
