@@ -20,6 +20,7 @@ from rftstatic.scenes.ranges import (
     check_position,
     check_smoothing,
     check_thickness,
+    check_weight,
     sheet_size,
 )
 from rftstatic.scenes.schema import MESH_NODES, Scene
@@ -411,6 +412,7 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     if material.weight < 0:
         raise scene.error("material.weight", f"{material.weight!r} N/m^2 is negative; give the fabric's areal weight "
                           "(>= 0; upward loads are loads.pressure < 0)")
+    check_weight(scene, material.weight)
     if scene.get("analysis", "static") != "static" and not material.mass_per_area > 0:
         raise scene.error("material.weight", "an explicit (dynamic or relax) run needs a positive areal weight "
                           "(the mass); got 0")

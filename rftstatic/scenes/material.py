@@ -113,6 +113,9 @@ def build_material(scene) -> mat.Material:
     m = dict(scene.get("material", {"preset": "wool-kang-yu"}))
     units = scene.units
     angle = m.pop("warp_angle", 0.0)
+    if not -360.0 <= angle <= 360.0:
+        raise scene.error("material.warp_angle", f"{angle!r} must lie in [-360, 360] deg (the warp's angle from the x "
+                          "axis; 90: the weft along x)")
     try:
         if m.get("kind", "fabric") == "isotropic" and "preset" not in m:
             m.pop("kind")

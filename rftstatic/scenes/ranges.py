@@ -18,7 +18,8 @@ element size, in the scene's own length units, so that the ranges read the same 
   [:data:`MIN_OBSTACLE_SIZE` element sizes, :data:`MAX_OBSTACLE_SIZE` sheet sizes];
 * a shell's thickness (``material.thickness``): [:data:`MIN_THICKNESS` element sizes, the sheet's smaller
   side];
-* ``contact.smoothing``: [0, :data:`MAX_SMOOTHING`] element sizes.
+* ``contact.smoothing``: [0, :data:`MAX_SMOOTHING`] element sizes;
+* ``material.weight``: at most :data:`MAX_WEIGHT`.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from rftstatic.scenes.schema import Scene
 
 __all__ = ["MAX_OBSTACLE_SIZE", "MAX_OFFSET", "MAX_SMOOTHING", "MIN_INNER_RADIUS", "MIN_NODES",
            "MIN_OBSTACLE_SIZE", "MIN_THICKNESS", "SHEET_RANGE_M", "check_mesh_table", "check_obstacle_sizes",
-           "check_smoothing", "check_thickness", "check_position", "sheet_size"]
+           "check_smoothing", "check_thickness", "check_position", "check_weight", "MAX_WEIGHT", "sheet_size"]
 
 SHEET_RANGE_M = (1e-6, 1e6)
 """Smallest and largest side (or diameter) of a sheet [m]: 1 um to 1000 km, far beyond any specimen (a few
@@ -66,6 +67,20 @@ t^2 / (12 h^2), below 1e-13 at this bound, under the round-off of the membrane t
 MAX_SMOOTHING = 1.0
 """Widest C2 onset of the penalty contact, in mean element sizes (default 0.05): the sheet rests about this
 far above the obstacle, and a wider onset is no longer a contact (at 1e300 its energy overflows)."""
+
+
+MAX_WEIGHT = 1e6
+"""Heaviest sheet [N/m^2]: 100 t/m^2, a 13 m thick steel plate (fabrics weigh 0.5-10 N/m^2); at 1e300 the
+explicit step, which scales with sqrt(mass), collapses to 0."""
+
+
+def check_weight(scene: Scene, weight: float) -> None:
+    """Scene error unless the material's areal weight ``weight`` [N/m^2] is at most :data:`MAX_WEIGHT`."""
+    if not weight <= MAX_WEIGHT:
+        limit = MAX_WEIGHT / scene.units.pressure
+        raise scene.error("material.weight", f"{weight / scene.units.pressure!r} is heavier than {limit:.3g} (scene "
+                          f"units; {MAX_WEIGHT:g} N/m^2, a 13 m thick steel plate): give the areal weight in the "
+                          "scene's force/area unit")
 
 
 def sheet_size(mesh) -> float:

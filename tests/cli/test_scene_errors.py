@@ -347,6 +347,9 @@ def test_an_isotropic_shell_out_of_range_is_an_input_error(capsys, tmp_path, lin
     _assert_input_error(*_run(capsys, tmp_path, None, text=text), key, fragment)
 
 
+HANG_TINY = ["mesh.nodes=[5,5]", "dynamics.t_end=0.01", "dynamics.frames=[0.01]"]
+
+
 @pytest.mark.parametrize("scene, sets, key, fragment", [
     # was: internal error: OverflowError (the penalty's onset energy a^3 / (6 eps))
     ("pedestal-square-20", ["mesh.nodes=[5,5]", "contact.smoothing=1e300"], "contact.smoothing",
@@ -369,6 +372,12 @@ def test_an_isotropic_shell_out_of_range_is_an_input_error(capsys, tmp_path, lin
     ("cusick-30", ["mesh.inner_radius=1e-300"], "mesh.inner_radius", "must be 0 (a full disc) or lie in"),
     ("cusick-30", ["mesh.nodes=[3,0]"], "mesh.nodes", "needs [n_radial, n_circ] of at least [2, 3]"),
     ("strip", ["mesh.nodes=[5,3]", "material.C_warp=-1"], "material.C_warp", "must be > 0 (a fabric's tensile"),
+    # was: "dynamics.t_end: the explicit step dt = inf s (or 0.0 s) is not a positive finite number" (the wrong key)
+    ("hang-20", [*HANG_TINY, "dynamics.alpha=1e300"], "dynamics.alpha", "must lie in [0, 1e+06] (mass damping"),
+    ("hang-20", [*HANG_TINY, "dynamics.mass_scale=1e300"], "dynamics.mass_scale", "must lie in [1e-06, 1e+06]"),
+    ("hang-20", [*HANG_TINY, "material.weight=1e300"], "material.weight", "is heavier than 1.02e+04 (scene units"),
+    # was: accepted, a warp 1e300 degrees from x (cos of it has no digit left)
+    ("strip", ["mesh.nodes=[5,3]", "material.warp_angle=1e300"], "material.warp_angle", "must lie in [-360, 360] deg"),
 ])
 def test_an_extreme_number_is_an_input_error(capsys, tmp_path, scene, sets, key, fragment):
     _assert_input_error(*_run(capsys, tmp_path, scene, sets), key, fragment)
