@@ -107,20 +107,21 @@ def _study_parsers(sub, common) -> None:
 
 
 def _study_command(args) -> int:
+    from rftstatic.study.runner import Execution
+
+    execution = Execution(scheduler=args.scheduler, workers=args.workers, timeout=args.timeout, figures=args.figures)
     if args.command == "sweep":
         from rftstatic.study.sweep import run_sweep
 
         rows = run_sweep(args.scene, args.vary, samples=args.samples, seed=args.seed, sets=args.set, out=args.out,
-                          scheduler=args.scheduler, workers=args.workers, figures=args.figures,
-                          plots=not args.no_plots, retry_failed=args.retry_failed, timeout=args.timeout,
-                          argv=args.argv)
+                         execution=execution, plots=not args.no_plots, retry_failed=args.retry_failed,
+                         argv=args.argv)
         failed = sum(r.get("status") == "failed" for r in rows)
         return EXIT["done"] if not failed else EXIT["goal"]
     from rftstatic.study.fit import run_fit
 
     result = run_fit(args.scene, args.free, args.target, runs=args.run, sets=args.set, out=args.out,
-                     scheduler=args.scheduler, workers=args.workers, figures=args.figures,
-                     max_evaluations=args.max_evaluations, timeout=args.timeout, argv=args.argv)
+                     execution=execution, max_evaluations=args.max_evaluations, argv=args.argv)
     return EXIT["done"] if result["success"] else EXIT["goal"]
 
 

@@ -15,6 +15,15 @@ from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
 from rftstatic.scenes.material import build_material
 from rftstatic.scenes.options import declared_run_options
+from rftstatic.scenes.ranges import (
+    check_mesh_table,
+    check_obstacle_sizes,
+    check_position,
+    check_smoothing,
+    check_thickness,
+    check_weight,
+    sheet_size,
+)
 from rftstatic.scenes.schema import MESH_NODES, Scene
 from rftstatic.scenes.self_contact import build_self_contact
 
@@ -41,6 +50,7 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
         if extra:
             raise scene.error(f"mesh.{extra[0]}", f"does not apply to a {kind} mesh (it reads "
                               f"{', '.join(sorted(MESH_KEYS[kind]))}, kind and z); remove it")
+    check_mesh_table(scene, m, kind)
     z0 = m.get("z", 0.0) * u
     nodes = m.get("nodes") if kind in ("rectangle", "polar", "square-polar") else None
     if (isinstance(nodes, list) and len(nodes) == 2 and all(isinstance(n, int) for n in nodes)
@@ -175,6 +185,8 @@ def _within_radius(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
     radius, centre = spec["radius"], spec.get("centre", [0.0, 0.0])
     if not radius > 0:
         raise scene.error(f"{key}.radius", f"{radius!r} must be > 0 (the clamping disc's radius, scene length units)")
+    middle = 0.5 * (mesh.X.min(axis=0) + mesh.X.max(axis=0)) / u
+    check_position(scene, f"{key}.centre", centre, [*middle, 0.0], sheet_size(mesh) / u, "the sheet's centre")
     r = np.linalg.norm(mesh.X - np.asarray(centre, float) * u, axis=1)
     nodes = np.flatnonzero(r <= radius * u * (1.0 + 1e-9))
     if len(nodes) == 0:
@@ -188,17 +200,21 @@ def _within_radius(scene: Scene, mesh, spec: dict, key: str) -> np.ndarray:
 def check_on_sheet(scene: Scene, mesh, pts: np.ndarray, key: str) -> None:
     """Scene error unless every reference point ``pts (P, 2)`` [m] lies on the sheet: inside an element,
     or within half the largest element size of a node (a boundary point the point location misses)."""
-    elem, _ = mesh.locate(pts)
-    off = elem < 0
-    if off.any():
-        d = np.linalg.norm(mesh.X[mesh.nearest_node(pts[off])] - pts[off], axis=1)
-        far = d > 0.5 * float(mesh.element_size.max())
-        if far.any():
-            u = scene.units.length
-            p = pts[off][far][0] / u
-            lo, hi = mesh.X.min(axis=0) / u, mesh.X.max(axis=0) / u
-            raise scene.error(key, f"[{p[0]:g}, {p[1]:g}] is not on the sheet (reference coordinates, scene "
-                              f"units; the sheet spans x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
+    margin = 0.5 * float(mesh.element_size.max())
+    lo, hi = mesh.X.min(axis=0), mesh.X.max(axis=0)
+    beyond = np.any((pts < lo - margin) | (pts > hi + margin), axis=1)  # before locate: 1e300 overflows there
+    if beyond.any():
+        far_points = pts[beyond]
+    else:
+        elem, _ = mesh.locate(pts)
+        off = elem < 0
+        d = np.linalg.norm(mesh.X[mesh.nearest_node(pts[off])] - pts[off], axis=1) if off.any() else np.zeros(0)
+        far_points = pts[off][d > margin]
+    if len(far_points):
+        u = scene.units.length
+        p, lo, hi = far_points[0] / u, lo / u, hi / u
+        raise scene.error(key, f"[{p[0]:g}, {p[1]:g}] is not on the sheet (reference coordinates, scene "
+                          f"units; the sheet spans x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
 
 
 def build_supports(scene: Scene, mesh) -> Supports:
@@ -283,6 +299,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     if law not in CONTACT_LAWS:
         raise ValueError(f'contact law "{law}" is unknown; use one of {", ".join(CONTACT_LAWS)}')
     check_obstacle_positions(scene, mesh)
+    check_obstacle_sizes(scene, mesh, OBSTACLE_POSITION_KEYS)
     obstacles = build_obstacles(scene)
     if not obstacles:
         return None, []
@@ -308,7 +325,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
         raise scene.error("contact.penalty", f'expected "auto" or a positive number, got {penalty!r}')
     if hold:
         hold_inplane_rigid_modes(mesh, supports)
-    smoothing = c.get("smoothing", 0.05) * h
+    smoothing = check_smoothing(scene, c.get("smoothing", 0.05)) * h
     return PenaltyContact(obstacles, mesh.node_area, k, smoothing=smoothing), obstacles
 
 
@@ -392,9 +409,11 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     """
     mesh = build_mesh(scene) if mesh is None else mesh
     material = build_material(scene).membrane_scaled(membrane_scale)
+    check_thickness(scene, mesh, material.info.get("thickness"))
     if material.weight < 0:
         raise scene.error("material.weight", f"{material.weight!r} N/m^2 is negative; give the fabric's areal weight "
                           "(>= 0; upward loads are loads.pressure < 0)")
+    check_weight(scene, material.weight)
     if scene.get("analysis", "static") != "static" and not material.mass_per_area > 0:
         raise scene.error("material.weight", "an explicit (dynamic or relax) run needs a positive areal weight "
                           "(the mass); got 0")

@@ -16,6 +16,7 @@ from rftstatic import material as mat
 from rftstatic.errors import ParameterError
 from rftstatic.fabrics.lab import LAB_KEYS, QUANTITY_KEYS, default_twist, lab_to_si, sources_of
 from rftstatic.fabrics.library import FABRICS, bending_lengths
+from rftstatic.scenes.ranges import SHEET_RANGE_M
 from rftstatic.units import UnitSystem, unit_system
 
 __all__ = ["build_material", "material_summary", "FABRIC_KEYS"]
@@ -24,6 +25,16 @@ FABRIC_KEYS = set(mat._FABRIC_KINDS) | {"thickness"} | set(LAB_KEYS)
 """Keys of a fabric ``[material]`` table besides ``preset``, ``kind`` and ``warp_angle``."""
 
 _REQUIRED = ("C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "weight")
+_POSITIVE = ("C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "B_twist")
+"""Rigidities a fabric needs positive (the couplings C12, B12 may have either sign, within a positive
+semi-definite matrix)."""
+
+MAX_E_PA = 1e13
+"""Largest Young's modulus of an isotropic shell [Pa]: ten times diamond's (1.2e12 Pa), the stiffest solid."""
+
+MAX_THICKNESS_M = SHEET_RANGE_M[1]
+"""Largest thickness [m] before the mesh is known (the largest sheet): E t^3 stays finite. The scene's model
+then bounds it by the sheet itself (:func:`rftstatic.scenes.ranges.check_thickness`)."""
 
 
 def _to_si(values: dict, units: UnitSystem) -> tuple[dict, dict]:
@@ -75,9 +86,19 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
     if "B_twist" not in si:
         si["B_twist"] = default_twist(si["B_warp"], si["B_weft"])
         record["B_twist"] = {"rule": "sqrt(B_warp B_weft) / 2 (not measured: orthotropic plate, zero Poisson ratio)"}
+    for key in _POSITIVE:
+        if key in m and not m[key] > 0:
+            kind = "tensile or shear" if key[0] == "C" else "bending or twisting"
+            raise ParameterError(key, f"{m[key]!r} must be > 0 (a fabric's {kind} rigidity, scene units)")
     label = (name or "fabric") + (" (modified)" if name and m else "")
-    material = mat.fabric(**{k: si[k] for k in mat._FABRIC_KINDS if k in si}, warp_angle=np.radians(angle),
-                          name=label)
+    try:
+        material = mat.fabric(**{k: si[k] for k in mat._FABRIC_KINDS if k in si}, warp_angle=np.radians(angle),
+                              name=label)
+    except ValueError as exc:  # a matrix not positive semi-definite: its coupling term is too large
+        coupling = "C12" if "Dm" in str(exc) else "B12"
+        if coupling in m:
+            raise ParameterError(coupling, f"{m[coupling]!r} is too large for the other rigidities: {exc}") from None
+        raise
     if "thickness" in si:
         material.info["thickness"] = si["thickness"]
     for q, rec in record.items():
@@ -92,6 +113,9 @@ def build_material(scene) -> mat.Material:
     m = dict(scene.get("material", {"preset": "wool-kang-yu"}))
     units = scene.units
     angle = m.pop("warp_angle", 0.0)
+    if not -360.0 <= angle <= 360.0:
+        raise scene.error("material.warp_angle", f"{angle!r} must lie in [-360, 360] deg (the warp's angle from the x "
+                          "axis; 90: the weft along x)")
     try:
         if m.get("kind", "fabric") == "isotropic" and "preset" not in m:
             m.pop("kind")
@@ -101,8 +125,9 @@ def build_material(scene) -> mat.Material:
             extra = set(m) - {"E", "nu", "thickness", "weight"}
             if extra:
                 raise scene.error("material", f"keys {sorted(extra)} do not apply to an isotropic shell")
-            return mat.isotropic_shell(E=units.to_si(m["E"], "pressure"), nu=m["nu"],
-                                       thickness=units.to_si(m["thickness"], "length"),
+            E, thickness = units.to_si(m["E"], "pressure"), units.to_si(m["thickness"], "length")
+            _check_isotropic(m, E, thickness, units)
+            return mat.isotropic_shell(E=E, nu=m["nu"], thickness=thickness,
                                        weight=units.to_si(m.get("weight", 0.0), "pressure"))
         if m.get("kind", "fabric") not in ("fabric", "isotropic"):
             raise scene.error("material.kind", f'"{m["kind"]}" is not a material kind; use fabric or isotropic')
@@ -113,6 +138,21 @@ def build_material(scene) -> mat.Material:
         if isinstance(exc, type(scene.error("", ""))):
             raise
         raise scene.error("material", str(exc)) from None
+
+
+def _check_isotropic(m: dict, E: float, thickness: float, units: UnitSystem) -> None:
+    """ParameterError unless an isotropic shell's Poisson ratio lies in (-1, 0.5), its Young's modulus ``E``
+    [Pa] in (0, :data:`MAX_E_PA`] and its ``thickness`` [m] in (0, :data:`MAX_THICKNESS_M`]."""
+    if not -1.0 < m["nu"] < 0.5:
+        raise ParameterError("nu", f"{m['nu']!r} must lie in (-1, 0.5) (the Poisson ratio of an isotropic solid: 0.5 "
+                             "is incompressible, -1 has no shear stiffness)")
+    if not 0 < E <= MAX_E_PA:
+        raise ParameterError("E", f"{m['E']!r} must lie in (0, {MAX_E_PA / units.pressure:.3g}] (Young's modulus, "
+                             f"scene units; up to {MAX_E_PA:g} Pa, ten times diamond's)")
+    if not 0 < thickness <= MAX_THICKNESS_M:
+        raise ParameterError("thickness", f"{m['thickness']!r} must lie in (0, {MAX_THICKNESS_M / units.length:g}] "
+                             f"scene length units ({MAX_THICKNESS_M:g} m, the largest sheet; the model then bounds "
+                             "it by the sheet's smaller side)")
 
 
 def material_summary(scene, material: mat.Material) -> dict:

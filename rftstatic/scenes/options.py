@@ -109,6 +109,14 @@ class DynamicsOptions:
         return int(self.max_steps) if self.max_steps is not None else default_max_steps(n_nodes)
 
 
+DYNAMICS_RANGES = {
+    "alpha": (0.0, 1e6, "mass damping [1/time]: up to 1e6 /s, a damping time of a microsecond; the stable step "
+                        "2/alpha would be shorter still, and at 1e300 alpha^2 overflows"),
+    "mass_scale": (1e-6, 1e6, "mass-scaling factor: 1 is true dynamics, relaxation uses 100; the stable step scales "
+                              "with its square root, and beyond 1e6 either way it collapses"),
+}
+"""``[dynamics]`` keys with a range (low, high, why), ``alpha`` in SI [1/s], beyond ``positive``."""
+
 MAX_SAMPLES = 1000
 """Most regular states ``dynamics.samples`` a run may save (a VTU file and a GIF frame each)."""
 
@@ -138,6 +146,10 @@ def dynamics_options(scene) -> DynamicsOptions:
     for key in ("t_end", "mass_scale", "rest_tolerance", "force_tolerance", "checkpoint_every"):
         positive(key)
     positive("alpha", strict=False)
+    for key, (lo, hi, why) in DYNAMICS_RANGES.items():
+        scale = u.time if key == "alpha" else 1.0  # alpha's bounds are in 1/s, the scene's in 1/(its time unit)
+        if not lo * scale <= opts[key] <= hi * scale:
+            raise scene.error(f"dynamics.{key}", f"{opts[key]!r} must lie in [{lo * scale:g}, {hi * scale:g}] ({why})")
     if opts["max_steps"] is not None and not (isinstance(opts["max_steps"], int) and opts["max_steps"] >= 1):
         raise scene.error("dynamics.max_steps", f"must be a positive integer, got {opts['max_steps']!r}")
     if opts.get("dt") is not None:

@@ -263,6 +263,14 @@ def parse_override(text: str) -> tuple[str, object]:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's limit on int(str))
+        raise SceneError(f"--set {key}: {exc}; TOML's integers are 64-bit") from None
+    except RecursionError:
+        raise SceneError(f'--set {key}: the value nests arrays or tables too deeply for the TOML reader; a scene '
+                         f'nests at most {MAX_NESTING} levels') from None
+    if _nesting(value) > MAX_NESTING:
+        raise SceneError(f"--set {key}: the value nests arrays or tables more than {MAX_NESTING} levels deep; a "
+                         "scene nests at most 5 (loads.point.0.at = [[x, y]])")
     return key, value
 
 
@@ -303,11 +311,17 @@ def load_scene(name_or_path: str, overrides=()) -> Scene:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise SceneError(f"{path}: {_deep_key(path)}nests tables or arrays too deeply for the TOML reader (it "
+                         f"recurses once per level); a scene nests at most {MAX_NESTING} levels: flatten it") from None
     except UnicodeDecodeError as exc:
         raise SceneError(f"{path}: not a text file in UTF-8 (byte {exc.start}: {exc.reason}); save the scene "
                          "as UTF-8 TOML") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot be read ({exc.strerror})") from None
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's limit on int(str))
+        raise SceneError(f"{path}: {exc}; TOML's integers are 64-bit") from None
+    _check_nesting(data, str(path))
     applied = {}
     for text in overrides:
         key, value = parse_override(text)
@@ -319,9 +333,47 @@ def load_scene(name_or_path: str, overrides=()) -> Scene:
 
 
 def scene_from_dict(data: dict, name="scene") -> Scene:
+    _check_nesting(data, name)
     scene = Scene(copy.deepcopy(data), None, name)
     validate(scene)
     return scene
+
+
+MAX_NESTING = 16
+"""Deepest nesting of tables and arrays in a scene: the schema's deepest value is 5 levels down
+(``loads.point.0.at = [[x, y]]``); a deeper one is no scene, and a few thousand levels exhaust the
+recursion of the TOML reader, of ``copy.deepcopy`` and of ``repr``."""
+
+
+def _nesting(value) -> int:
+    """Levels of tables and arrays in ``value`` (0: a scalar), without recursion."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if isinstance(node, (dict, list)):
+            deepest = max(deepest, depth + 1)
+            if depth + 1 <= MAX_NESTING:  # deeper is refused anyway: stop counting there
+                stack.extend((v, depth + 1) for v in (node.values() if isinstance(node, dict) else node))
+    return deepest
+
+
+def _deep_key(path: Path) -> str:
+    """``"KEY: "`` of the first line of a scene file that opens more than :data:`MAX_NESTING` arrays or inline
+    tables (``""`` when no single line does)."""
+    for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
+        if "=" in line and line.count("[") + line.count("{") > MAX_NESTING:
+            return line.split("=", 1)[0].strip().strip('"') + ": "
+    return ""
+
+
+def _check_nesting(data, where: str) -> None:
+    """Scene error naming the top-level key whose value nests tables or arrays deeper than :data:`MAX_NESTING`."""
+    if not isinstance(data, dict):
+        return
+    for key, value in data.items():
+        if _nesting(value) > MAX_NESTING:
+            raise SceneError(f"{where}: {key}: nests tables or arrays more than {MAX_NESTING} levels deep; a scene "
+                             "nests at most 5 (loads.point.0.at = [[x, y]]): flatten it")
 
 
 def validate(scene: Scene) -> None:
@@ -335,9 +387,17 @@ def validate(scene: Scene) -> None:
                           f'{", ".join(SCENE_ANALYSES)}')
 
 
+INT64 = (-(2**63), 2**63 - 1)
+"""TOML's integers are 64-bit (its specification); Python's reader takes any size, and an integer beyond a
+float's range (``1`` followed by 400 zeros) overflows where a length or a count is computed from it."""
+
+
 def _non_finite(value):
-    """The first NaN or infinite number in ``value`` (a number or nested lists), else None."""
+    """The first NaN or infinite number, or integer beyond :data:`INT64`, in ``value`` (a number or nested
+    lists), else None."""
     if isinstance(value, float) and not math.isfinite(value):
+        return value
+    if isinstance(value, int) and not isinstance(value, bool) and not INT64[0] <= value <= INT64[1]:
         return value
     if isinstance(value, list):
         for item in value:
@@ -377,4 +437,7 @@ def _check_table(scene, table, schema, prefix):
         bad = _non_finite(value)
         if bad is not None:
             where = f" (in {value!r})" if isinstance(value, list) else ""
+            if isinstance(bad, int):
+                raise scene.error(full, f"an integer of {bad.bit_length()} bits is beyond TOML's 64-bit integers "
+                                  "(at most 9223372036854775807 in magnitude); give a smaller value")
             raise scene.error(full, f"{bad!r} is not a finite number{where}; give a finite value")

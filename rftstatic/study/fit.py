@@ -37,7 +37,7 @@ from rftstatic import api
 from rftstatic.io.files import write_json
 from rftstatic.study import identify
 from rftstatic.study.measures import check_measure, standard_columns
-from rftstatic.study.runner import Engine
+from rftstatic.study.runner import Engine, Execution
 from rftstatic.study.space import StudyError, parse_free, parse_value, split_values
 from rftstatic.study.store import Store, record_run
 from rftstatic.study.sweep import Study, load_base
@@ -269,21 +269,22 @@ def _setup(scene: str, sets, runs: list[Run], out, figures, target_texts):
     return bases, studies, targets
 
 
-def run_fit(scene: str, free_texts, target_texts, *, runs=(), sets=(), out=None, scheduler=None, workers=None,
-            figures=False, max_evaluations=100, timeout=None, argv=None) -> dict:
-    """The ``fit`` command (module docstring); returns what ``fit.json`` holds."""
+def run_fit(scene: str, free_texts, target_texts, *, runs=(), sets=(), out=None, execution: Execution = Execution(),
+            max_evaluations=100, argv=None) -> dict:
+    """The ``fit`` command (module docstring); returns what ``fit.json`` holds. ``execution``: where its
+    points run (:class:`~rftstatic.study.runner.Execution`)."""
     t0 = time.perf_counter()
     base = load_base(scene, sets)
     free = parse_free(free_texts)
     run_list = parse_runs(runs, free)
     out = Path(out) if out else Path("out") / f"fit-{base.name}"
-    bases, studies, targets = _setup(scene, list(sets), run_list, out, figures, target_texts)
+    bases, studies, targets = _setup(scene, list(sets), run_list, out, execution.figures, target_texts)
     for r in free:  # each key alone first, so that the error names its --free argument
         for study in studies.values():
             study.spec({r.key: r.lo}, arg="--free")
     measures = list(dict.fromkeys(m for s in studies.values() for m in s.measures))
     store = Store(out, (["run"] if run_list[0].label else []) + [r.key for r in free] + measures)
-    engine = Engine(scheduler, workers, timeout=timeout)
+    engine = execution.engine()
     ev = Evaluator(studies, store, engine, free, targets)
     try:
         res = minimise(ev, max_evaluations=max_evaluations)

@@ -29,6 +29,7 @@ import logging
 import os
 import sys
 import time
+from dataclasses import dataclass
 
 from rftstatic.study.space import StudyError
 from rftstatic.study.worker import started_marker
@@ -59,6 +60,29 @@ dynamic mmap threshold, so every array above 128 kB is a fresh mmap whose pages 
 strip at 51 x 11 solved 35 % slower with it (6 points, 4.0-4.1 s against 5.4-5.7 s, in-process). The
 LocalCluster's workers start without it (this key set to None); ``dask worker`` processes of an
 external cluster get it unless their configuration unsets it (README)."""
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where and how the points of a study run: the ``--scheduler``, ``--workers``, ``--timeout`` and
+    ``--figures`` options that ``sweep`` and ``fit`` share.
+
+    Attributes
+    ----------
+    scheduler : address of a running Dask scheduler (``tcp://HOST:PORT``), or None for a LocalCluster
+    workers : LocalCluster: its worker processes (None: the cores); with a scheduler: how many to wait for
+    timeout : longest run of one point [s] (None: no limit; module docstring)
+    figures : each point writes its PNG views (off: faster)
+    """
+
+    scheduler: str | None = None
+    workers: int | None = None
+    timeout: float | None = None
+    figures: bool = False
+
+    def engine(self) -> Engine:
+        """The :class:`Engine` that runs the points (its cluster starts on first use)."""
+        return Engine(self.scheduler, self.workers, timeout=self.timeout)
 
 
 class StudyProgress:

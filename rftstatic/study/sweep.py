@@ -18,7 +18,7 @@ from pathlib import Path
 from rftstatic import api
 from rftstatic.provenance import code_fingerprint
 from rftstatic.study.measures import standard_columns
-from rftstatic.study.runner import Engine
+from rftstatic.study.runner import Execution
 from rftstatic.study.space import StudyError, format_override, parse_vary
 from rftstatic.study.store import Store, point_key, record_run
 
@@ -54,9 +54,14 @@ def load_base(scene: str, sets) -> object:
     return api.load_scene(scene, list(sets))
 
 
-def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, scheduler=None, workers=None,
-              figures=False, plots=True, retry_failed=False, timeout=None, argv=None) -> list[dict]:
-    """The ``sweep`` command (module docstring); returns the rows of its points, in their order."""
+def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, execution: Execution = Execution(),
+              plots=True, retry_failed=False, argv=None) -> list[dict]:
+    """The ``sweep`` command (module docstring); returns the rows of its points, in their order.
+
+    ``vary``: the ``--vary`` texts; ``samples``, ``seed``: a Latin hypercube of their ranges; ``sets``: the
+    ``--set`` overrides of every point; ``out``: the study folder (default ``out/sweep-NAME``);
+    ``execution``: where the points run; ``plots``: draw each measure against each key; ``retry_failed``:
+    run the failed points again; ``argv``: the command line recorded in ``study.json``."""
     t0 = time.perf_counter()
     base = load_base(scene, sets)
     space = parse_vary(vary, samples)
@@ -65,7 +70,7 @@ def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, sche
     for r in space.ranges:
         _check_key(scene, sets, r.key, r.lo)
     out = Path(out) if out else Path("out") / f"sweep-{base.name}"
-    study = Study(scene, list(sets), out, standard_columns(base), figures)
+    study = Study(scene, list(sets), out, standard_columns(base), execution.figures)
     specs = [study.spec(values) for values in space.points(samples, seed)]
     store = Store(out, space.keys + study.measures)
     store.recover([s["key"] for s in specs])
@@ -73,7 +78,7 @@ def run_sweep(scene: str, vary, *, samples=None, seed=0, sets=(), out=None, sche
     print(f"sweep {base.name}: {len(specs)} points, {len(specs) - len(todo)} done"
           f"{f' ({store.recovered} recovered from their folders)' if store.recovered else ''}, {len(todo)} to run; "
           f"results in {out}/results.csv", flush=True)
-    engine = Engine(scheduler, workers, timeout=timeout)
+    engine = execution.engine()
     try:
         engine.run(todo, store.add, label="sweep")
         info = engine.info()

@@ -57,11 +57,14 @@ def test_a_negative_seed_is_an_input_error(capsys, tmp_path):
 
 @pytest.mark.parametrize("scene, obstacle", [("pedestal-square-20", "half_width=1e300"),
                                              ("pedestal-round-50", "radius=1e300")])
-def test_a_huge_pedestal_is_no_internal_error(capsys, tmp_path, scene, obstacle):
-    # was: RuntimeWarning: overflow in the footprint's area (an error under the test suite's warning filter)
+def test_a_huge_pedestal_is_an_input_error(capsys, tmp_path, scene, obstacle):
+    # was: RuntimeWarning: overflow in the footprint's area (an error under the test suite's warning filter); then
+    # a run that ended (exit 0 or 3) on a pedestal 1e300 wide. Now beyond 1000 sheet sizes is refused.
     nodes = "[5,5]" if scene == "pedestal-square-20" else "[3,8]"
     code, err = _run(capsys, tmp_path, scene, [f"mesh.nodes={nodes}", f"obstacles.0.{obstacle}"])
-    assert code in (0, 3) and "internal error" not in err, err
+    key = obstacle.split("=")[0]
+    _assert_input_error(code, err, f"obstacles.0.{key}", "1e+300 must be 0 (where the obstacle takes it) or lie in")
+    assert "1000 sheet sizes (a larger one is a plane: use a floor)" in err, err
 
 
 @pytest.mark.parametrize("pattern", ["RIGHT", "union-jack"])
@@ -308,3 +311,106 @@ def test_an_empty_or_truncated_vtu_is_an_input_error_naming_the_scene(capsys, tm
     path.write_text(content)
     code, err = _run(capsys, tmp_path, "strip", ["mesh.kind=file", f"mesh.path={path}", "supports=[]"])
     assert code == 2 and "strip.toml" in err and "mesh" in err and "sheet.vtu" in err, err
+
+
+SHELL = """units = "SI"
+[mesh]
+kind = "rectangle"
+size = [1.0, 0.2]
+nodes = [5, 3]
+origin = [0.0, -0.1]
+[material]
+kind = "isotropic"
+E = 1e6
+nu = 0.3
+thickness = 1e-3
+weight = 1.0
+[[supports]]
+kind = "clamped"
+box = [0.0, 0.0, -0.1, 0.1]
+"""
+"""An isotropic shell strip clamped at x = 0 (SI): issue 33's first input mutates its material."""
+
+
+@pytest.mark.parametrize("line, key, fragment", [
+    # was: internal error: OverflowError (E t^3 in rftstatic.material.isotropic_shell)
+    ("thickness = 1e300", "material.thickness", "1e+300 must lie in (0, 1e+06] scene length units"),
+    ("thickness = 5.0", "material.thickness", "to the sheet's smaller side (thicker is a block, not a shell)"),
+    ("thickness = 1e-300", "material.thickness", "from 1e-06 mean element sizes"),
+    ("E = 1e300", "material.E", "must lie in (0, 1e+13] (Young's modulus"),
+    ("nu = 0.5", "material.nu", "must lie in (-1, 0.5)"),
+])
+def test_an_isotropic_shell_out_of_range_is_an_input_error(capsys, tmp_path, line, key, fragment):
+    name = line.split(" = ")[0]
+    text = "\n".join(line if row.startswith(f"{name} = ") else row for row in SHELL.splitlines())
+    _assert_input_error(*_run(capsys, tmp_path, None, text=text), key, fragment)
+
+
+HANG_TINY = ["mesh.nodes=[5,5]", "dynamics.t_end=0.01", "dynamics.frames=[0.01]"]
+
+
+@pytest.mark.parametrize("scene, sets, key, fragment", [
+    # was: internal error: OverflowError (the penalty's onset energy a^3 / (6 eps))
+    ("pedestal-square-20", ["mesh.nodes=[5,5]", "contact.smoothing=1e300"], "contact.smoothing",
+     "1e+300 must lie in [0, 1] mean element sizes"),
+    # was: internal error: ValueError: smoothing must be a finite number >= 0 (PenaltyContact)
+    ("pedestal-square-20", ["mesh.nodes=[5,5]", "contact.smoothing=-1"], "contact.smoothing",
+     "-1 must lie in [0, 1] mean element sizes"),
+    # was: internal error: ValueError: cannot convert float NaN to integer (the mesher's area estimate)
+    ("pedestal-round-50", ["mesh.radius=1e300"], "mesh.radius",
+     "the diameter (2 x radius) of the sheet must lie in [0.0001, 1e+08] (cm-gf-s length units"),
+    # was: "the model has no stiffness on its free dofs" (exit 1), or 1e145 explicit steps refused (exit 3)
+    ("sphere-30", ["mesh.nodes=[5,5]", "obstacles.0.radius=1e300"], "obstacles.0.radius",
+     "to 1000 sheet sizes (a larger one is a plane: use a floor)"),
+    # found by tests/app/test_scene_extremes.py: overflow in the distances to the clamping disc's centre
+    ("cusick-30", ["mesh.nodes=[3,12]", "supports.0.centre=[1e300, 0.0]"], "supports.0.centre",
+     "lies more than 1000 sheet sizes"),
+    # found likewise: IndexError from the nearest-node search of a point at 1e300
+    ("strip", ["mesh.nodes=[5,3]", "probes.0.at=[1e300, 0.0]"], "probes.0.at", "is not on the sheet"),
+    ("pedestal-square-20", ["mesh.origin=[1e300, 0.0]"], "mesh.origin", "lies more than 1000 sheet sizes"),
+    ("cusick-30", ["mesh.inner_radius=1e-300"], "mesh.inner_radius", "must be 0 (a full disc) or lie in"),
+    ("cusick-30", ["mesh.nodes=[3,0]"], "mesh.nodes", "needs [n_radial, n_circ] of at least [2, 3]"),
+    ("strip", ["mesh.nodes=[5,3]", "material.C_warp=-1"], "material.C_warp", "must be > 0 (a fabric's tensile"),
+    # was: "dynamics.t_end: the explicit step dt = inf s (or 0.0 s) is not a positive finite number" (the wrong key)
+    ("hang-20", [*HANG_TINY, "dynamics.alpha=1e300"], "dynamics.alpha", "must lie in [0, 1e+06] (mass damping"),
+    ("hang-20", [*HANG_TINY, "dynamics.mass_scale=1e300"], "dynamics.mass_scale", "must lie in [1e-06, 1e+06]"),
+    ("hang-20", [*HANG_TINY, "material.weight=1e300"], "material.weight", "is heavier than 1.02e+04 (scene units"),
+    # was: accepted, a warp 1e300 degrees from x (cos of it has no digit left)
+    ("strip", ["mesh.nodes=[5,3]", "material.warp_angle=1e300"], "material.warp_angle", "must lie in [-360, 360] deg"),
+])
+def test_an_extreme_number_is_an_input_error(capsys, tmp_path, scene, sets, key, fragment):
+    _assert_input_error(*_run(capsys, tmp_path, scene, sets), key, fragment)
+
+
+@pytest.mark.parametrize("text, key", [
+    ("x = " + "[" * 3000 + "]" * 3000 + "\n", "x"),  # was: internal error: RecursionError (tomllib)
+    ("x = " + "{a = " * 3000 + "1" + "}" * 3000 + "\n", "x"),
+    ("[" + ".".join(["a"] * 3000) + "]\nb = 1\n", "a"),  # was: RecursionError in repr (the unknown key's message)
+])
+def test_a_deeply_nested_scene_is_an_input_error(capsys, tmp_path, text, key):
+    code, err = _run(capsys, tmp_path, None, text=text)
+    _assert_input_error(code, err, key, "nests tables or arrays")
+    assert err.startswith(f"error: {tmp_path / 'scene.toml'}: {key}: "), err
+
+
+def test_a_deeply_nested_override_is_an_input_error(capsys, tmp_path):
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.size=" + "[" * 3000 + "]" * 3000])
+    assert code == 2 and err.startswith("error: --set mesh.size: the value nests arrays or tables"), err
+
+
+def test_an_integer_beyond_64_bits_is_an_input_error(capsys, tmp_path):
+    # was: internal error: OverflowError: int too large to convert to float (tomllib takes any integer)
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[5,3]", f"mesh.size=[{10**400}, 1.0]"])
+    _assert_input_error(code, err, "mesh.size", "an integer of 1329 bits is beyond TOML's 64-bit integers")
+
+
+@pytest.mark.parametrize("where", ["file", "--set"])
+def test_an_integer_of_5000_digits_is_an_input_error(capsys, tmp_path, where):
+    # was: internal error: ValueError: Exceeds the limit (4300 digits) for integer string conversion (tomllib)
+    if where == "file":
+        code, err = _run(capsys, tmp_path, None, text=f"[mesh]\nz = {'9' * 5000}\n")
+        assert err.startswith(f"error: {tmp_path / 'scene.toml'}: Exceeds the limit (4300 digits)"), err
+    else:
+        code, err = _run(capsys, tmp_path, "strip", [f"mesh.z={'9' * 5000}"])
+        assert err.startswith("error: --set mesh.z: Exceeds the limit (4300 digits)"), err
+    assert code == 2 and err.endswith("TOML's integers are 64-bit"), err

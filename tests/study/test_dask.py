@@ -250,7 +250,8 @@ def test_a_failed_point_is_a_row_with_its_error_and_can_be_retried(tmp_path, cap
     assert cli.main(argv) == cli.EXIT["goal"]  # the study ran; one of its points failed
     rows = {r["mesh.nodes"]: r for r in _rows(out)}
     assert rows["[9, 3]"]["status"] == "ok"
-    assert rows["[1, 3]"]["status"] == "failed" and "at least 2 x 2 nodes" in rows["[1, 3]"]["error"]
+    assert rows["[1, 3]"]["status"] == "failed"
+    assert "mesh.nodes: [1, 3]: a rectangle mesh needs [nx, ny] of at least [2, 2]" in rows["[1, 3]"]["error"]
     assert "failed" in capsys.readouterr().err
     assert cli.main([*argv, "--retry-failed"]) == cli.EXIT["goal"]
     assert "1 to run" in capsys.readouterr().out  # only the failed point ran again

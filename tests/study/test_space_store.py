@@ -210,3 +210,20 @@ def test_progress_lines_off_a_terminal_every_tenth_or_once_when_brief():
         lines = stream.getvalue().splitlines()
         assert len(lines) == expected
         assert lines[-1].startswith("fit evaluation 1: 6/6 done, 0 running, 1 failed")
+
+
+def test_an_execution_passes_its_options_to_the_engine():
+    """``sweep`` and ``fit`` take where their points run as one :class:`~rftstatic.study.runner.Execution`."""
+    import dataclasses
+
+    from rftstatic.study.runner import Execution
+    from rftstatic.study.space import StudyError
+
+    engine = Execution(scheduler="tcp://127.0.0.1:1", workers=3, timeout=2.5, figures=True).engine()
+    assert (engine.scheduler, engine.workers, engine.timeout, engine.started) == ("tcp://127.0.0.1:1", 3, 2.5, False)
+    with pytest.raises(StudyError, match="--workers 0: must be >= 1"):
+        Execution(workers=0).engine()
+    with pytest.raises(StudyError, match="--timeout -1: must be > 0 seconds"):
+        Execution(timeout=-1.0).engine()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        Execution().workers = 2
