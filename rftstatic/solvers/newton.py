@@ -230,6 +230,8 @@ class StaticResult:
         empty for the other routes
     levels : mesh sequencing (:mod:`rftstatic.app.levels`): one record per mesh, coarsest first (nodes,
         route, iterations, residual, energy, wall time); empty for a single mesh
+    self_contact_stiffenings, self_contact_scale : raises of the self-contact stiffness after convergence and
+        the factor on it the equilibrium holds with (:func:`~rftstatic.solvers.static.solve_static`)
     """
 
     U: np.ndarray
@@ -253,6 +255,8 @@ class StaticResult:
     state: State | None = None
     path: dict = field(default_factory=dict)
     levels: list = field(default_factory=list)
+    self_contact_stiffenings: int = 0
+    self_contact_scale: float = 1.0
 
 @dataclass
 class NewtonWorkspace:
@@ -317,7 +321,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
     free = model.free.ravel()
     U = U.copy()
-    parts = model.energies(U, lam, candidates=cand, pairs=ws.pairs)
+    parts = model.energies(U, lam, candidates=cand, pairs=ws.pairs, branches=ws.state.load_branches)
     Pi, scale = parts["total"], _energy_scale(parts)
     r = (model.residual(U, lam, candidates=cand, pairs=ws.pairs)).ravel()[free]
     rnorm = float(np.linalg.norm(r))
@@ -369,7 +373,8 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
         step, frac = self_contact_limited(model, U, step, ws)
         cap *= frac
         slope = float(r @ step.ravel()[free])
-        alpha, parts = _line_search(model, U, step, lam, Pi, slope, opts, cand, ws.pairs, scale)
+        alpha, parts = _line_search(model, U, step, lam, Pi, slope, opts, cand, ws.pairs, scale,
+                                    branches=ws.state.load_branches)
         if alpha is None:
             return Iteration(False, U, it, rnorm, "line search found no decrease of the energy")
         Pi_new, scale = parts["total"], _energy_scale(parts)
@@ -421,18 +426,19 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
                      progress=progress, history=hist)
 
 
-def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, scale=None, max_trials=12):
+def _line_search(model, U, step, lam, Pi0, slope, opts, candidates=None, pairs=None, scale=None, max_trials=12,
+                 branches=None):
     """Armijo backtracking on Pi along ``step``: ``(alpha, parts)``, ``parts`` the energies
     (:meth:`~rftstatic.model.model.Model.energies`) at ``U + alpha step``; ``(None, None)`` when no trial
     lowers the energy. ``scale`` [J]: :func:`_energy_scale` of the energies at ``U`` (computed when None;
     the caller passes the last accepted step's, which saves an evaluation per iteration)."""
     def parts_at(alpha):
-        return model.energies(U + alpha * step, lam, candidates=candidates, pairs=pairs)
+        return model.energies(U + alpha * step, lam, candidates=candidates, pairs=pairs, branches=branches)
 
     if not opts.line_search:
         return 1.0, parts_at(1.0)
     if scale is None:
-        scale = _energy_scale(model.energies(U, lam, candidates=candidates, pairs=pairs))
+        scale = _energy_scale(model.energies(U, lam, candidates=candidates, pairs=pairs, branches=branches))
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence
@@ -482,6 +488,7 @@ def route_outcome(model, result: StaticResult, ws: NewtonWorkspace, t0: float, b
         if extra is not None:
             extra(result)
         result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs)
+        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs,
+                                         branches=ws.state.load_branches)
         ws.state.U, ws.state.lam = result.U, result.lam
         result.state = ws.state

@@ -256,17 +256,23 @@ class PairCache:
     """The pairs within ``radius = thickness + margin`` at the last build, reused until some node has
     moved more than ``margin / 2`` since (then every pair closer than the thickness is in the list:
     each of its two primitives moved less than ``margin / 2``). A cache of one solve (kept in the
-    :class:`~rftstatic.model.state.State`); results never depend on it.
+    :class:`~rftstatic.model.state.State`); results never depend on its pairs. It also carries the solve's
+    :attr:`stiffness_scale` (``State.self_contact_scale``), which they do depend on.
 
     Parameters
     ----------
     margin : [m], > 0
+
+    Attributes
+    ----------
+    stiffness_scale : factor on the law's stiffness in this solve [-] (1 until the static route raises it)
     """
 
     def __init__(self, margin: float):
         if not (np.isfinite(margin) and margin > 0):
             raise ValueError(f"margin must be a finite number > 0, got {margin!r}")
         self.margin = float(margin)
+        self.stiffness_scale = 1.0
         self.builds = 0
         self._x = None
         self._pairs = None

@@ -67,6 +67,7 @@ from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distan
                                                      point_triangle_distance2)
 from rftstatic.contact.self_contact.law_kernels import additive_ccd_nodes, psd_project
 from rftstatic.contact.self_contact.near_pairs import NearPairCache, SelfContactStats, pair_nodes
+from rftstatic.model.frozen import Frozen
 
 __all__ = ["SelfContact", "SelfContactState", "auto_stiffness", "pair_law"]
 
@@ -157,21 +158,24 @@ def auto_stiffness(*, weight: float, node_area: float, thickness: float, pressur
     return float(factor * 4.0 * pressure_factor * weight * node_area / thickness)
 
 
-class SelfContact:
-    """Penalty self-contact of a sheet (module docstring).
+class SelfContact(Frozen):
+    """Penalty self-contact of a sheet (module docstring), read-only once built: a solve that raises the
+    stiffness does so through its pair cache (``cache.stiffness_scale``, ``State.self_contact_scale``).
 
     Parameters
     ----------
     mesh : the reference :class:`~rftstatic.mesh.trimesh.TriMesh` [m]
     thickness : ``d`` [m], below half the smallest edge of the mesh
-    stiffness : ``k`` [N/m] (:func:`auto_stiffness`)
+    stiffness : ``k`` [N/m] (:func:`auto_stiffness`), the stiffness at scale 1
     margin : broad-phase margin [m] (default ``max(2 d, h / 4)``, h the mean edge length): pairs are
         listed within ``d + margin`` and the list is rebuilt once a node moved ``margin / 2``
     min_fraction : of the step bound, in (0, 1)
+    sweep_limit : longest relative motion of a step that one swept broad phase covers [m] (default from the
+        :data:`SWEEP_PAIRS` budget)
     """
 
     def __init__(self, mesh, thickness: float, stiffness: float, *, margin: float | None = None,
-                 min_fraction: float = MIN_FRACTION):
+                 min_fraction: float = MIN_FRACTION, sweep_limit: float | None = None):
         self.prims = SheetPrimitives.of_mesh(mesh)
         X = mesh.X3
         e = self.prims.edges
@@ -191,13 +195,15 @@ class SelfContact:
         self.stiffness = float(stiffness)
         self.min_fraction = float(min_fraction)
         self.margin = float(margin) if margin is not None else max(2.0 * thickness, 0.25 * float(length.mean()))
-        self.sweep_limit = float(length.mean()) * float(np.sqrt(SWEEP_PAIRS / max(len(mesh.tri), 1)))
+        self.sweep_limit = (float(sweep_limit) if sweep_limit is not None
+                            else float(length.mean()) * float(np.sqrt(SWEEP_PAIRS / max(len(mesh.tri), 1))))
         self.stats = SelfContactStats()
         ref = self.evaluate(X, tangent=False)
         if ref.n_active:
             raise ValueError(f"the flat reference mesh has {ref.n_active} self-contact pairs closer than the "
                              f"thickness {thickness:.6g} m (smallest distance {ref.min_distance:.6g} m, e.g. a "
                              "skinny triangle's height); use a thinner thickness")
+        self._freeze()
 
     @property
     def n_nodes(self) -> int:
@@ -227,23 +233,25 @@ class SelfContact:
     def evaluate(self, x, *, tangent: bool = True, cache: PairCache | None = None,
                  project: bool = True) -> SelfContactState:
         """Energy, force and pair blocks at positions ``x (N, 3)`` [m] over the pairs within ``d + margin``
-        (:meth:`pairs`); ``project``: the blocks projected to PSD (False: the exact Hessian blocks, for tests)."""
+        (:meth:`pairs`), the stiffness times the solve's ``cache.stiffness_scale`` (1 without a cache);
+        ``project``: the blocks projected to PSD (False: the exact Hessian blocks, for tests)."""
         x = self._check_x(x)
         pairs = self.pairs(x, cache)
         if isinstance(cache, NearPairCache):
             npt, nee = cache.npt, cache.nee
         else:
             npt, nee = self._x4(x, pairs)
-        return self.evaluate_pairs(x, npt, nee, tangent=tangent, project=project)
+        return self.evaluate_pairs(x, npt, nee, tangent=tangent, project=project, scale=_scale(cache))
 
-    def evaluate_pairs(self, x, npt, nee, *, tangent: bool = True, project: bool = True) -> SelfContactState:
+    def evaluate_pairs(self, x, npt, nee, *, tangent: bool = True, project: bool = True,
+                       scale: float = 1.0) -> SelfContactState:
         """The law (module docstring) summed over the given pairs: ``npt (Q, 4)`` point-triangle rows
         (node, triangle), ``nee (R, 4)`` edge-edge rows (edge, edge), at ``x (N, 3)`` [m]. The one source
         of the energy ``sum e(delta)`` [J] (:func:`pair_law`), its gradient ``(N, 3)`` [N] and the pair blocks,
         for the static solver (:meth:`evaluate`) and the explicit one
-        (:meth:`near_force`)."""
+        (:meth:`near_force`); the stiffness times ``scale`` [-]."""
         t0 = time.perf_counter()
-        d, k = self.thickness, self.stiffness
+        d, k = self.thickness, self.stiffness * scale
         s_pt = point_triangle_distance2(x[npt]) if len(npt) else np.zeros(0)
         s_ee = edge_edge_distance2(x[nee]) if len(nee) else np.zeros(0)
         smin = min(float(s_pt.min(initial=np.inf)), float(s_ee.min(initial=np.inf)))
@@ -300,7 +308,7 @@ class SelfContact:
             return (f, 0.0) if energy else f
         live = cache.lower_bounds(m) < d
         q = len(cache.npt)
-        st = self.evaluate_pairs(x, cache.npt[live[:q]], cache.nee[live[q:]], tangent=False)
+        st = self.evaluate_pairs(x, cache.npt[live[:q]], cache.nee[live[q:]], tangent=False, scale=_scale(cache))
         return (st.force, st.energy) if energy else st.force
 
     def energy(self, x, *, cache: PairCache | None = None) -> float:
@@ -358,3 +366,9 @@ class SelfContact:
         t_pt = additive_ccd_nodes(x, scale * dx, npt, 0, eta, max_rounds)
         t_ee = additive_ccd_nodes(x, scale * dx, nee, 1, eta, max_rounds)
         return float(scale * min(1.0, t_pt, t_ee))
+
+
+def _scale(cache) -> float:
+    """The solve's factor on the stiffness carried by its pair cache (:attr:`.broad_phase.PairCache.stiffness_scale`),
+    1 without a cache."""
+    return 1.0 if cache is None else cache.stiffness_scale
