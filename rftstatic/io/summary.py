@@ -27,8 +27,10 @@ log = logging.getLogger(__name__)
 
 def summary_header(scene, model, analysis: str) -> dict:
     """Keys every summary starts with: scene, title, figure, units, overrides, element, analysis, nodes,
-    elements, mesh, software, warnings, peak_memory_mb and ``resolved_scene`` (the scene's data after
-    the overrides, scene units)."""
+    elements, mesh, ``kernels`` (the model's kernel back end, ``"numpy"`` or ``"compiled"``,
+    :func:`rftstatic.compiled.choose_kernels`: the static solves' membrane and every self-contact loop; an
+    explicit run's force loop records its own, ``backend``), software, warnings, peak_memory_mb and ``resolved_scene``
+    (the scene's data after the overrides, scene units)."""
     return {
         "scene": scene.name,
         "title": scene.get("title", ""),
@@ -40,6 +42,7 @@ def summary_header(scene, model, analysis: str) -> dict:
         "nodes": model.mesh.n_nodes,
         "elements": model.mesh.n_elements,
         "mesh": model.mesh.summary(),
+        "kernels": model.kernels,
         "software": software(),
         "warnings": list(model.warnings),
         "peak_memory_mb": peak_memory_mb(),

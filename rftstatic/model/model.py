@@ -23,6 +23,7 @@ from functools import cached_property
 
 import numpy as np
 
+from rftstatic.compiled import choose_kernels
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
@@ -118,10 +119,13 @@ class Model(Frozen):
         ``tangent_blocks``, ``branch(x, previous)``; the branches live in the State)
     quiet : log the model's warnings (``warnings``: membrane locking) at debug level, not warning
         level (a remeshed run builds one model per mesh and warns once)
+    kernels : the kernel back end of every solve of the model, ``"numpy"`` or ``"compiled"``
+        (:func:`rftstatic.compiled.choose_kernels`); default: the self-contact law's, else the choice for
+        this mesh. A constant of the run, recorded in its summary (``kernels``).
     """
 
     def __init__(self, mesh: TriMesh, material: Material, *, element="RFT6", supports=None, load=None,
-                 contact=None, membrane=True, load_terms=(), quiet=False, self_contact=None):
+                 contact=None, membrane=True, load_terms=(), quiet=False, self_contact=None, kernels=None):
         if element not in ELEMENTS:
             raise ValueError(f'unknown element "{element}"; use one of {", ".join(ELEMENTS)}')
         self.mesh = mesh
@@ -133,6 +137,11 @@ class Model(Frozen):
             raise ValueError(f"load must have shape ({mesh.n_nodes}, 3), got {self.load.shape}")
         self.contact = contact
         self.self_contact = self_contact
+        if self_contact is not None and kernels not in (None, self_contact.kernels):
+            raise ValueError(f"kernels {kernels!r} differ from the self-contact law's {self_contact.kernels!r}: "
+                             "build the law with the same kernels")
+        self.kernels = (self_contact.kernels if self_contact is not None
+                        else choose_kernels(mesh.n_elements, requested=kernels))
         self.load_terms = tuple(load_terms)
         self.with_membrane = bool(membrane)
         self.fixed = self.supports.fixed_mask()
@@ -179,6 +188,11 @@ class Model(Frozen):
     def positions(self, U) -> np.ndarray:
         return self.X3 + U
 
+    @property
+    def membrane_backend(self) -> str:
+        """The membrane operator's name of :attr:`kernels` (``"numba"`` or ``"numpy"``)."""
+        return "numba" if self.kernels == "compiled" else "numpy"
+
     # --- energy and its derivatives -------------------------------------------------------------
     # ``candidates``: the solve's contact candidate list (a cache held in its State; results do not
     # depend on it), or None to evaluate the contact at every node; ``pairs``: likewise the solve's
@@ -188,7 +202,7 @@ class Model(Frozen):
     def energies(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None) -> dict:
         """Parts of the total potential [J]: bending, membrane, contact, self-contact, external work, total."""
         Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
-        Em = self.membrane.energy(U, self.material.Dm) if self.with_membrane else 0.0
+        Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
         Es = (self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).energy
               if self.self_contact is not None else 0.0)
@@ -217,7 +231,7 @@ class Model(Frozen):
         the stored energy."""
         f = self.Kb @ U
         if self.with_membrane:
-            fe = self.membrane.element_forces(U, self.material.Dm)
+            fe = self.membrane.element_forces(U, self.material.Dm, backend=self.membrane_backend)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             f += self.contact.force(self.positions(U), candidates=candidates)
@@ -249,7 +263,8 @@ class Model(Frozen):
         f = self.Kb @ U
         x = self.positions(U)
         if self.with_membrane:
-            fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress)
+            fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress,
+                                             backend=self.membrane_backend)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             cs = self.contact.evaluate(x, candidates=candidates)
@@ -303,7 +318,7 @@ class Model(Frozen):
     def mixed_stress(self, U, dU) -> np.ndarray:
         """(E, 3) stress of the linearised strain ``D^m (eps(U) + Bbar(U) dU)`` [N/m]: the membrane stress
         that MIP Newton carries from ``U`` over the step ``dU (N, 3)`` [m] (:mod:`rftstatic.solvers.newton`)."""
-        return self.membrane.linearised_strain(U, dU) @ self.material.Dm.T
+        return self.membrane.linearised_strain(U, dU, backend=self.membrane_backend) @ self.material.Dm.T
 
     def relative_curvature(self, U) -> np.ndarray:
         """(E,) |kappa| h, the relative curvature of §2.2 and §5.1 [-].

@@ -62,6 +62,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rftstatic.compiled import choose_kernels
 from rftstatic.contact.self_contact.broad_phase import PairCache, Pairs, SheetPrimitives, find_pairs
 from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distance2, point_triangle,
                                                      point_triangle_distance2)
@@ -172,10 +173,12 @@ class SelfContact(Frozen):
     min_fraction : of the step bound, in (0, 1)
     sweep_limit : longest relative motion of a step that one swept broad phase covers [m] (default from the
         :data:`SWEEP_PAIRS` budget)
+    kernels : ``"numpy"`` or ``"compiled"``, the kernels of every loop of the law and its pair caches
+        (:func:`rftstatic.compiled.choose_kernels`; default: its choice for a self-contact run on this mesh)
     """
 
     def __init__(self, mesh, thickness: float, stiffness: float, *, margin: float | None = None,
-                 min_fraction: float = MIN_FRACTION, sweep_limit: float | None = None):
+                 min_fraction: float = MIN_FRACTION, sweep_limit: float | None = None, kernels: str | None = None):
         self.prims = SheetPrimitives.of_mesh(mesh)
         X = mesh.X3
         e = self.prims.edges
@@ -198,6 +201,8 @@ class SelfContact(Frozen):
         self.sweep_limit = (float(sweep_limit) if sweep_limit is not None
                             else float(length.mean()) * float(np.sqrt(SWEEP_PAIRS / max(len(mesh.tri), 1))))
         self.stats = SelfContactStats()
+        self.kernels = choose_kernels(len(mesh.tri), self_contact=True, requested=kernels)
+        self.compiled = self.kernels == "compiled"
         ref = self.evaluate(X, tangent=False)
         if ref.n_active:
             raise ValueError(f"the flat reference mesh has {ref.n_active} self-contact pairs closer than the "
@@ -212,13 +217,13 @@ class SelfContact(Frozen):
     def new_pairs(self) -> NearPairCache:
         """A fresh pair cache for a solve (kept in :attr:`rftstatic.model.state.State.self_pairs`): the
         pairs within ``d + margin`` by exact distance (:mod:`.near_pairs`), counted in :attr:`stats`."""
-        return NearPairCache(self.margin, self.stats)
+        return NearPairCache(self.margin, self.stats, compiled=self.compiled)
 
     def pairs(self, x, cache: PairCache | None = None) -> Pairs:
         """Pairs within ``d + margin`` of ``x (N, 3)`` [m] (from ``cache`` when still valid)."""
         if cache is not None:
             return cache.pairs(self.prims, x, self.thickness)
-        return find_pairs(self.prims, x, self.thickness + self.margin)
+        return find_pairs(self.prims, x, self.thickness + self.margin, compiled=self.compiled)
 
     def _x4(self, x, pairs: Pairs):
         """Nodes ``(Q, 4)`` of the point-triangle and ``(R, 4)`` of the edge-edge pairs."""
@@ -252,15 +257,15 @@ class SelfContact(Frozen):
         (:meth:`near_force`); the stiffness times ``scale`` [-]."""
         t0 = time.perf_counter()
         d, k = self.thickness, self.stiffness * scale
-        s_pt = point_triangle_distance2(x[npt]) if len(npt) else np.zeros(0)
-        s_ee = edge_edge_distance2(x[nee]) if len(nee) else np.zeros(0)
+        s_pt = point_triangle_distance2(x[npt], compiled=self.compiled) if len(npt) else np.zeros(0)
+        s_ee = edge_edge_distance2(x[nee], compiled=self.compiled) if len(nee) else np.zeros(0)
         smin = min(float(s_pt.min(initial=np.inf)), float(s_ee.min(initial=np.inf)))
         nodes_list, grads, hess, dist = [], [], [], []
         for nodes, s, fun in ((npt, s_pt, point_triangle), (nee, s_ee, edge_edge)):
             act = s < d * d
             if not np.any(act):
                 continue
-            s2, g, H, _ = fun(x[nodes[act]], hessian=tangent)
+            s2, g, H, _ = fun(x[nodes[act]], hessian=tangent, compiled=self.compiled)
             nodes_list.append(nodes[act])
             grads.append(g.reshape(-1, 12))
             hess.append(H)
@@ -284,7 +289,7 @@ class SelfContact(Frozen):
             hd = Hs / (2.0 * delta[:, None, None]) - np.einsum("am,an->amn", gs, gs) / (4.0 * delta[:, None, None] ** 3)
             blocks = e2[:, None, None] * np.einsum("am,an->amn", gd, gd) + e1[:, None, None] * hd
             if project:
-                blocks = psd_project(blocks)
+                blocks = psd_project(blocks, compiled=self.compiled)
         self._count(t0)
         return SelfContactState(energy, force, nodes, blocks, float(np.sqrt(smin)), len(nodes))
 
@@ -360,11 +365,11 @@ class SelfContact(Frozen):
             if spread > self.sweep_limit:  # a step too long to sweep within the pair budget: test its start
                 scale = self.sweep_limit / spread
                 self.stats.sweeps_limited += 1
-            swept = find_pairs(self.prims, x, d, x + scale * dx)
+            swept = find_pairs(self.prims, x, d, x + scale * dx, compiled=self.compiled)
             s_pt, s_ee = self._x4(x, swept)
             npt, nee = np.concatenate([npt, s_pt]), np.concatenate([nee, s_ee])
-        t_pt = additive_ccd_nodes(x, scale * dx, npt, 0, eta, max_rounds)
-        t_ee = additive_ccd_nodes(x, scale * dx, nee, 1, eta, max_rounds)
+        t_pt = additive_ccd_nodes(x, scale * dx, npt, 0, eta, max_rounds, compiled=self.compiled)
+        t_ee = additive_ccd_nodes(x, scale * dx, nee, 1, eta, max_rounds, compiled=self.compiled)
         return float(scale * min(1.0, t_pt, t_ee))
 
 
