@@ -36,6 +36,15 @@ def test_assigning_to_a_built_model_raises():
     assert model.plan is model.plan  # built on first use, then constant
 
 
+def test_the_penalty_contact_law_is_read_only():
+    from rftstatic.contact.obstacles import Floor
+    from rftstatic.contact.penalty import PenaltyContact
+
+    law = PenaltyContact([Floor(0.0)], np.ones(4), 1e3)
+    with pytest.raises(FrozenError, match="PenaltyContact is read-only once built: cannot set 'stiffness'"):
+        law.stiffness = 2e3
+
+
 def test_a_lever_moment_is_read_only_and_its_branch_is_handed_in():
     term = LeverMoment([0], [1], [2.0])
     with pytest.raises(FrozenError):

@@ -175,6 +175,12 @@ class SelfContact(Frozen):
         :data:`SWEEP_PAIRS` budget)
     kernels : ``"numpy"`` or ``"compiled"``, the kernels of every loop of the law and its pair caches
         (:func:`rftstatic.compiled.choose_kernels`; default: its choice for a self-contact run on this mesh)
+
+    Attributes
+    ----------
+    stats : :class:`~.near_pairs.SelfContactStats`, counts and timings of the law's work, added to by every
+        solve (shared with the pair caches it makes) and summed over a run in its summary; no evaluation
+        reads them. The one part of the law that changes after it is built: its attributes cannot be set.
     """
 
     def __init__(self, mesh, thickness: float, stiffness: float, *, margin: float | None = None,
