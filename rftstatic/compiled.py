@@ -1,5 +1,5 @@
 """Whether the optional compiled kernels (numba: ``element/_kernels_numba.py``, the compiled twins of
-``element/kernels.py``) can be used, and on how many threads."""
+``element/kernels.py``) can be used, which a run uses (:func:`choose_kernels`), and on how many threads."""
 
 import os
 from functools import cache
@@ -10,11 +10,16 @@ costs more than the work."""
 
 
 STATIC_COMPILED_MIN_ELEMENTS = 3000
-"""Smallest mesh whose static membrane kernels (energy, force, tangent) run compiled when numba has not
-been loaded yet: importing numba and loading the first cached kernel cost about 1 s, more than the numpy
-twins lose on a small mesh in a whole solve (measured, fresh processes, the §4.1 strip in 38 Newton
-iterations: 51 x 11 nodes, 1000 RFT6 elements, 2.95 s numpy against 4.3 s compiled; 101 x 5, 800
-elements, 2.3 s against 3.2 s; 101 x 21, 4000 elements, 8.5 s against 6.0 s)."""
+"""Smallest mesh whose run uses the compiled kernels (:func:`choose_kernels`): importing numba and loading
+the first cached kernel cost about 1 s, more than the numpy twins lose on a small mesh in a whole solve
+(measured, fresh processes, the §4.1 strip in 38 Newton iterations: 51 x 11 nodes, 1000 RFT6 elements,
+2.95 s numpy against 4.3 s compiled; 101 x 5, 800 elements, 2.3 s against 3.2 s; 101 x 21, 4000
+elements, 8.5 s against 6.0 s)."""
+
+KERNELS = ("numpy", "compiled")
+"""The kernel back ends of a run: the numpy twins (vectorised over elements or pairs) or the compiled
+ones (numba). They agree to round-off only, so a run uses one, chosen before it starts
+(:func:`choose_kernels`), whatever ran before it in the process."""
 
 
 @cache
@@ -26,82 +31,26 @@ def numba_available() -> bool:
     return find_spec("numba") is not None
 
 
-def compiled_loaded() -> bool:
-    """Whether the compiled kernels are already loaded in this process (then they cost nothing more)."""
-    import sys
+def choose_kernels(n_elements: int, *, self_contact: bool = False, requested: str | None = None) -> str:
+    """The kernel back end (one of :data:`KERNELS`) of a run on a mesh of ``n_elements`` triangles.
 
-    return "rftstatic.element._kernels_numba" in sys.modules
-
-
-NUMPY_BUDGET_S = 1.0
-"""Seconds the "auto" back end may spend in the numpy twins before it loads the compiled kernels (about
-what loading costs): a process that solves one small scene never pays for numba, one that solves many
-(a validation report, a study) pays at most twice the cheaper choice (the ski-rental rule). The
-sze2004 report's small cantilevers took 0.37 s instead of 0.04 s each on the numpy twins alone.
-
-The seconds are modelled, not read from the clock: each numpy call charges its rows (elements, pairs,
-nodes) times a cost per row measured once (:func:`charged_numpy`), so the switch to the compiled twins
-falls at the same call in every run of the same command. The twins agree to round-off only, and a
-clock-charged budget made runs of one command differ there: pedestal-square-20 on 33 x 33 by
-arc-length, three runs each (2026-12-02, the machine loaded by two other jobs): total energy
--9.770568309163982, ...4037, ...4005 gf cm with the clock, ...4037 three times with the numpy twins
-throughout, ...3998 three times with this budget; on the 7,800-step path of the 31 x 240 round
-pedestal such a difference picked another fold branch."""
-
-_numpy_seconds = [0.0]
-
-
-def charge_numpy(seconds: float) -> None:
-    """Count ``seconds`` (modelled: rows times a cost per row, :data:`NUMPY_BUDGET_S`) spent in a numpy
-    twin chosen by the "auto" back end."""
-    _numpy_seconds[0] += seconds
-
-
-def numpy_budget_spent() -> bool:
-    """Whether the numpy twins chosen by "auto" back ends have used up :data:`NUMPY_BUDGET_S` in this process."""
-    return _numpy_seconds[0] > NUMPY_BUDGET_S
-
-
-def charged_numpy(loaded, per_row: float):
-    """Decorator: a call of the wrapped function charges ``per_row`` seconds [s] per row of its first array
-    argument to the numpy budget (:func:`charge_numpy`) when ``loaded()`` (whether the compiled twins are
-    in this process) is false before and after the call, i.e. when it ran the numpy twin. Nested charged
-    calls count once."""
-    import functools
-
-    import numpy as np
-
-    def rows(args, kwargs) -> int:
-        for a in (*args, *kwargs.values()):
-            if isinstance(a, np.ndarray):
-                return len(a) if a.ndim else 1
-        return 0
-
-    def wrap(f):
-        @functools.wraps(f)
-        def charged(*args, **kwargs):
-            if _depth[0] or loaded():
-                return f(*args, **kwargs)
-            _depth[0] += 1
-            try:
-                return f(*args, **kwargs)
-            finally:
-                _depth[0] -= 1
-                if not loaded():
-                    charge_numpy(per_row * rows(args, kwargs))
-        return charged
-    return wrap
-
-
-_depth = [0]
-
-
-def static_kernels_compiled(n_elements: int) -> bool:
-    """Whether the static membrane kernels of a mesh of ``n_elements`` run compiled ("auto" back end):
-    numba installed, and the mesh large enough to repay loading it (:data:`STATIC_COMPILED_MIN_ELEMENTS`),
-    the kernels loaded already, or the numpy twins used up :data:`NUMPY_BUDGET_S` in this process."""
-    return numba_available() and (n_elements >= STATIC_COMPILED_MIN_ELEMENTS or compiled_loaded()
-                                  or _numpy_seconds[0] > NUMPY_BUDGET_S)
+    ``requested`` (``"numpy"`` or ``"compiled"``) decides when given (``"compiled"`` needs numba).
+    Otherwise ``"compiled"`` when numba is installed and either the mesh has at least
+    :data:`STATIC_COMPILED_MIN_ELEMENTS` elements or the run has self-contact (its pair kernels: a 12 x 12
+    PSD projection costs 87 us per pair in numpy, so a fold of a few thousand pairs repays loading numba
+    within a few tangents, and an explicit run calls them about ten times a step); ``"numpy"`` else.
+    A function of the scene alone: the same scene runs on the same kernels in any process, after any
+    other run (a process-wide budget of numpy seconds, which switched to the compiled twins part-way,
+    made a result depend on what had run before it)."""
+    if requested is not None:
+        if requested not in KERNELS:
+            raise ValueError(f'kernels must be one of {", ".join(KERNELS)}, got {requested!r}')
+        if requested == "compiled" and not numba_available():
+            raise ValueError('kernels "compiled" need numba: pip install "rftstatic[fast]"')
+        return requested
+    if numba_available() and (n_elements >= STATIC_COMPILED_MIN_ELEMENTS or self_contact):
+        return "compiled"
+    return "numpy"
 
 
 def force_threads(n_elements: int) -> int:

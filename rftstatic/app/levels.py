@@ -216,8 +216,8 @@ def _sequence_outcome(res, records, totals) -> None:
     """``res`` (the finest level's result) as the sequence's: its route, levels and counters over all levels."""
     res.route = f"{records[0]['route']}+levels"
     res.levels = records
-    for key, value in totals.items():
-        setattr(res, key, value)
+    res.iterations, res.factorisations = totals["iterations"], totals["factorisations"]
+    res.cutbacks, res.retries = totals["cutbacks"], totals["retries"]
 
 
 def _add_counts(totals: dict, res) -> None:

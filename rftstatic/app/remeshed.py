@@ -199,6 +199,7 @@ def _static(scene, opts, checkpoint=None, restart=None) -> dict:
     meshes[-1]["U"] = res.result.U
     return {"route": "remesh_static", "model": res.model, "extras": res.extras, "U": res.result.U,
             "records": res.records, "converged": bool(res.converged and res.result.converged),
+            "self_contact_scale": res.result.self_contact_scale,
             "meshes": meshes, "t": None, "steps": None, "skipped": 0}
 
 
@@ -317,7 +318,7 @@ def summarize(scene, opts, solved) -> dict:
         "self_intersections": self_intersection_summary(scene, model, U),
     })
     if model.self_contact is not None:  # the counters of the last mesh's model (each remesh builds its own)
-        summary["self_contact"] = self_contact_summary(scene, model)
+        summary["self_contact"] = self_contact_summary(scene, model, scale=solved.get("self_contact_scale", 1.0))
     if solved["route"] == "remesh_relax":
         d = solved["dynamics"]
         summary.update(t=solved["t"] / u.time, steps=solved["steps"], skipped_remeshes=solved["skipped"],

@@ -120,7 +120,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "levels": result.levels,
         "relax": result.relax,
         "stable_minimum": result.stable,
-        "self_contact_stiffenings": getattr(result, "self_contact_stiffenings", 0),
+        "self_contact_stiffenings": result.self_contact_stiffenings,
         "perturbation_seed": result.seed,
         "residual": result.residual / u.force,
         "wall_time_s": result.wall_time,
@@ -131,7 +131,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "self_intersections": self_intersection_summary(scene, model, U),
     })
     if model.self_contact is not None:
-        summary["self_contact"] = self_contact_summary(scene, model)
+        summary["self_contact"] = self_contact_summary(scene, model, scale=result.self_contact_scale)
         crossing = summary["self_intersections"].get("pairs", 0)
         if crossing:  # the law failed to keep the layers apart: say so beside the converged flag
             text = (f"{crossing} triangle pairs of the final state cross although self-contact is on: the "

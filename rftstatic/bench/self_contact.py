@@ -68,7 +68,7 @@ def main(argv=None):
     from rftstatic.contact.self_contact import distance, law_kernels
 
     if a.numpy:
-        distance.compiled_for = lambda n: False
+        distance.compiled_for = lambda n, compiled=None: False
     print(f"load average {os.getloadavg()}, {'numpy' if a.numpy else 'compiled where numba is installed'}"
           )
     for n in a.n:

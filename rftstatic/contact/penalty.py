@@ -38,6 +38,7 @@ from rftstatic.contact.common import as_list as _as_list
 from rftstatic.contact.common import as_points as _as_points
 from rftstatic.contact.common import positive as _positive
 from rftstatic.contact.obstacles import Obstacle
+from rftstatic.model.frozen import Frozen
 
 __all__ = [
     "PenaltyContact",
@@ -77,8 +78,8 @@ class ContactState:
         return int(np.count_nonzero(self.active))
 
 
-class PenaltyContact:
-    """Node-to-obstacle penalty contact, ``E = sum 1/2 k A_n min(phi, 0)^2``.
+class PenaltyContact(Frozen):
+    """Node-to-obstacle penalty contact, ``E = sum 1/2 k A_n min(phi, 0)^2`` (read-only once built).
 
     Parameters
     ----------
@@ -125,6 +126,7 @@ class PenaltyContact:
         # list margin [m]: a few onset widths, and half a node spacing so explicit runs refresh seldom
         spacing = float(np.sqrt(np.mean(area))) if area.size and np.mean(area) > 0 else 0.0
         self.margin = max(4.0 * self.smoothing, 0.5 * spacing)
+        self._freeze()
 
     def new_candidates(self) -> CandidateList:
         """An empty candidate list with this contact's margin (for a solver's State)."""

@@ -23,7 +23,7 @@ from functools import cached_property
 
 import numpy as np
 
-from rftstatic.compiled import charge_numpy, numba_available, static_kernels_compiled
+from rftstatic.compiled import choose_kernels, numba_available
 from rftstatic.element.kernels import (
     element_last,
     energies_numpy,
@@ -98,17 +98,17 @@ class MembraneOperator:
         """
         return strains_numpy(self.G_last, self.nodes, U)[0]
 
-    def linearised_strain(self, U: np.ndarray, dU: np.ndarray) -> np.ndarray:
+    def linearised_strain(self, U: np.ndarray, dU: np.ndarray, *, backend="auto") -> np.ndarray:
         """``eps(U) + Bbar(U) dU (E, 3)`` [-]: the averaged strain of Eq. 14 linearised about ``U (N, 3)``
         along ``dU (N, 3)`` [m] (exact to first order; the Green strain's quadratic term in dU left out)."""
         U, dU = _as_float(U), _as_float(dU)
-        if _compiled("auto", len(self.nodes)):
+        if _compiled(backend, len(self.nodes)):
             from rftstatic.element._kernels_numba import membrane_linearised_strains
 
             out = np.empty((len(self.nodes), 3))
             membrane_linearised_strains(self._compiled_args[0], self._compiled_args[1], U, dU, out)
             return out
-        return _numpy_path("auto", linearised_strain_numpy, self.G_last, self.nodes, U, dU)
+        return linearised_strain_numpy(self.G_last, self.nodes, U, dU)
 
     def force_roundoff(self, U: np.ndarray, Dm: np.ndarray) -> np.ndarray:
         """``(E, A)`` [N]: the size of the round-off in the element forces at ``U (N, 3)`` [m], per unit
@@ -136,7 +136,7 @@ class MembraneOperator:
             We = np.empty(len(self.nodes))
             membrane_energies(*self._compiled_args, Dm, U, We)
             return We
-        return _numpy_path(backend, energies_numpy, self.G_last, self.nodes, self.area, Dm, U)
+        return energies_numpy(self.G_last, self.nodes, self.area, Dm, U)
 
     def element_forces(self, U, Dm, *, backend="auto") -> np.ndarray:
         """Internal membrane forces ``(E, A, 3)`` [N], the gradient of :meth:`energy`."""
@@ -147,7 +147,7 @@ class MembraneOperator:
             fe = np.empty(self.nodes.shape + (3,))
             membrane_forces(*self._compiled_args, Dm, U, fe, 0, len(fe))
             return fe
-        return np.moveaxis(_numpy_path(backend, forces_numpy, self.G_last, self.nodes, self.area, Dm, U)[0], -1, 0)
+        return np.moveaxis(forces_numpy(self.G_last, self.nodes, self.area, Dm, U)[0], -1, 0)
 
     def element_tangents(self, U, Dm, *, psd=False, stress=None, backend="auto"):
         """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m].
@@ -159,7 +159,8 @@ class MembraneOperator:
         stress of MIP Newton, :mod:`rftstatic.solvers.newton`); None: the exact Hessian.
         ``backend`` (here and in the other methods): ``"numba"`` (the kernels of
         :mod:`rftstatic.element.kernels` compiled, one element at a time), ``"numpy"`` (the same
-        kernels vectorised over the elements), ``"auto"``: numba when installed.
+        kernels vectorised over the elements), ``"auto"``: the choice of
+        :func:`rftstatic.compiled.choose_kernels` for this many elements (a Model passes its own, ``kernels``).
         """
         U, Dm = _as_float(U), _as_float(Dm)
         if _compiled(backend, len(self.nodes)):
@@ -171,7 +172,7 @@ class MembraneOperator:
             S = np.zeros((0, 3)) if stress is None else _as_float(stress)
             membrane_tangents(*self._compiled_args, Dm, U, bool(psd), S, f, K)
             return f, K
-        return _numpy_path(backend, tangents_numpy, self.G_last, self.nodes, self.area, Dm, U, bool(psd), stress)
+        return tangents_numpy(self.G_last, self.nodes, self.area, Dm, U, bool(psd), stress)
 
 
     def tangents_into(self, U, Dm, emap, data, *, psd=False, stress=None, backend="auto") -> np.ndarray:
@@ -192,30 +193,14 @@ class MembraneOperator:
         return fe
 
 
-NUMPY_SECONDS_PER_ELEMENT = {"energies_numpy": 0.7e-6, "forces_numpy": 1.3e-6, "tangents_numpy": 12e-6,
-                             "linearised_strain_numpy": 1.3e-6}
-"""Modelled cost [s] of one element in each numpy twin, charged to the "auto" back end's budget
-(:data:`rftstatic.compiled.NUMPY_BUDGET_S`: modelled, so that runs are reproducible); measured on the
-33 x 33 sheet's 2,048 RFT6 elements (2026-12-02, best of 5, the machine loaded by two other jobs)."""
-
-
-def _numpy_path(backend, kernel, *args):
-    """``kernel(*args)``, a numpy twin (``args[1]`` the elements' nodes); its modelled time is charged to
-    the "auto" back end's budget (:func:`rftstatic.compiled.static_kernels_compiled`) when "auto" chose it."""
-    out = kernel(*args)
-    if backend == "auto":
-        charge_numpy(len(args[1]) * NUMPY_SECONDS_PER_ELEMENT[kernel.__name__])
-    return out
-
-
 def _compiled(backend: str, n_elements: int) -> bool:
     """Whether ``backend`` (``"auto"``, ``"numpy"`` or ``"numba"``) means the compiled kernels for a mesh
-    of ``n_elements`` (``"auto"``: :func:`rftstatic.compiled.static_kernels_compiled`)."""
+    of ``n_elements`` (``"auto"``: :func:`rftstatic.compiled.choose_kernels`, a function of the size alone)."""
     if backend not in BACKENDS:
         raise ValueError(f'membrane backend must be one of {", ".join(BACKENDS)}, got "{backend}"')
     if backend == "numba" and not numba_available():
         raise ValueError('membrane backend "numba" needs numba: pip install "rftstatic[fast]"')
-    return backend == "numba" or (backend == "auto" and static_kernels_compiled(n_elements))
+    return backend == "numba" or (backend == "auto" and choose_kernels(n_elements) == "compiled")
 
 
 def _as_float(a) -> np.ndarray:

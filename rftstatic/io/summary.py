@@ -27,8 +27,10 @@ log = logging.getLogger(__name__)
 
 def summary_header(scene, model, analysis: str) -> dict:
     """Keys every summary starts with: scene, title, figure, units, overrides, element, analysis, nodes,
-    elements, mesh, software, warnings, peak_memory_mb and ``resolved_scene`` (the scene's data after
-    the overrides, scene units)."""
+    elements, mesh, ``kernels`` (the model's kernel back end, ``"numpy"`` or ``"compiled"``,
+    :func:`rftstatic.compiled.choose_kernels`: the static solves' membrane and every self-contact loop; an
+    explicit run's force loop records its own, ``backend``), software, warnings, peak_memory_mb and ``resolved_scene``
+    (the scene's data after the overrides, scene units)."""
     return {
         "scene": scene.name,
         "title": scene.get("title", ""),
@@ -40,6 +42,7 @@ def summary_header(scene, model, analysis: str) -> dict:
         "nodes": model.mesh.n_nodes,
         "elements": model.mesh.n_elements,
         "mesh": model.mesh.summary(),
+        "kernels": model.kernels,
         "software": software(),
         "warnings": list(model.warnings),
         "peak_memory_mb": peak_memory_mb(),
@@ -107,9 +110,11 @@ def probe_summary(scene, model, probes: dict, U) -> dict:
             for name, p in probe_positions(model, probes, U).items()}
 
 
-def self_contact_summary(scene, model) -> dict | None:
+def self_contact_summary(scene, model, *, scale: float = 1.0) -> dict | None:
     """The self-contact's settings and counters (:class:`~rftstatic.contact.self_contact.near_pairs.SelfContactStats`,
-    summed over the run's solves), lengths in scene units; None without self-contact. ``pairs``: the near
+    summed over the run's solves), lengths in scene units; None without self-contact. ``stiffness``: the one the
+    result holds with, the law's times ``scale`` (the solve's ``self_contact_scale``, raised after convergence
+    by the static route; ``stiffness_scale`` gives it). ``pairs``: the near
     pairs (within thickness + margin) of the last broad phase, ``max_pairs`` the most of any;
     ``broad_phase_s`` the builds' wall time, ``force_s`` that of the energy/force/tangent evaluations,
     ``filter_s`` that of the explicit step filter."""
@@ -118,7 +123,7 @@ def self_contact_summary(scene, model) -> dict | None:
         return None
     u = scene.units
     out = {"thickness": sc.thickness / u.length, "margin": sc.margin / u.length,
-           "stiffness": sc.stiffness / (u.force / u.length)}
+           "stiffness": sc.stiffness * scale / (u.force / u.length), "stiffness_scale": scale}
     out.update(sc.stats.as_dict())
     return out
 

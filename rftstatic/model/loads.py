@@ -10,17 +10,20 @@ element beyond the tip (the strip extended by one element): the work of a moment
 Its gradient is the follower couple M/|r| perpendicular to r (exactly M on [0, L]), and its Hessian
 is the load stiffness, so the moment enters the Newton solver, its energy line search and its
 safeguards like any other term. phi is tracked continuously through full turns (the roll-up of Sze
-et al. 2004 rotates the end by 2 pi): :meth:`LeverMoment.commit` stores the branch after every
-converged increment.
+et al. 2004 rotates the end by 2 pi): :meth:`LeverMoment.branch` gives the branch at every converged
+increment, which the solve keeps in its State (``State.load_branches``) and hands back to
+:meth:`LeverMoment.potential`; the load itself is read-only once built.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from rftstatic.model.frozen import Frozen
 
-class LeverMoment:
-    """Conservative end moment about +y on ``(tip, lever)`` node pairs.
+
+class LeverMoment(Frozen):
+    """Conservative end moment about +y on ``(tip, lever)`` node pairs (read-only once built).
 
     Parameters
     ----------
@@ -29,29 +32,33 @@ class LeverMoment:
     """
 
     def __init__(self, tip, lever, moments):
-        self.tip = np.asarray(tip, dtype=np.int64)
-        self.lever = np.asarray(lever, dtype=np.int64)
-        self.moments = np.asarray(moments, dtype=float)
+        self.tip = np.array(tip, dtype=np.int64)
+        self.lever = np.array(lever, dtype=np.int64)
+        self.moments = np.array(moments, dtype=float)
         if not (self.tip.shape == self.lever.shape == self.moments.shape):
             raise ValueError(f"tip, lever and moments must have one entry per pair, got "
                              f"{self.tip.shape}, {self.lever.shape}, {self.moments.shape}")
-        self.reference = None  # committed angles (K,) [rad]
+        for a in (self.tip, self.lever, self.moments):
+            a.flags.writeable = False
+        self._freeze()
 
-    def angles(self, x: np.ndarray) -> np.ndarray:
-        """Continuous lever angles ``phi (K,)`` [rad] at positions ``x (N, 3)`` [m]."""
+    def angles(self, x: np.ndarray, branch: np.ndarray | None = None) -> np.ndarray:
+        """Lever angles ``phi (K,)`` [rad] at positions ``x (N, 3)`` [m], each within pi of ``branch (K,)``
+        [rad] (the committed angles, :meth:`branch`; None: the principal values in (-pi, pi])."""
         r = x[self.lever] - x[self.tip]
         raw = np.arctan2(r[:, 2], r[:, 0])
-        if self.reference is None:
+        if branch is None:
             return raw
-        return self.reference + np.angle(np.exp(1j * (raw - self.reference)))
+        return branch + np.angle(np.exp(1j * (raw - branch)))
 
-    def commit(self, x: np.ndarray) -> None:
-        """Fix the branch of the angles at a converged state."""
-        self.reference = self.angles(x)
+    def branch(self, x: np.ndarray, previous: np.ndarray | None = None) -> np.ndarray:
+        """The branch ``(K,)`` [rad] to commit at a converged state ``x (N, 3)`` [m]: its angles, continuous
+        from the ``previous`` branch (None: the principal values)."""
+        return self.angles(x, previous)
 
-    def potential(self, x: np.ndarray) -> float:
-        """Potential per unit load factor, ``-sum M_k phi_k`` [J]."""
-        return -float(self.moments @ self.angles(x))
+    def potential(self, x: np.ndarray, branch: np.ndarray | None = None) -> float:
+        """Potential per unit load factor, ``-sum M_k phi_k`` [J], the angles on ``branch`` (:meth:`angles`)."""
+        return -float(self.moments @ self.angles(x, branch))
 
     def _grad_hess(self, x):
         r = x[self.lever] - x[self.tip]

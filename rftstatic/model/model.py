@@ -10,7 +10,9 @@ contact term. Its methods evaluate, for a displacement field ``U (N, 3)`` [m] an
 ``E_s`` the self-contact energy (:class:`rftstatic.contact.self_contact.law.SelfContact`, optional),
 
 its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
-The state is only ``U``; solvers are functions of (model, U).
+A Model is read-only once built (:class:`~rftstatic.model.frozen.Frozen`): what a solve advances or
+caches (``U``, the contact caches, the self-contact stiffness scale, the potential loads' branches)
+lives in its :class:`~rftstatic.model.state.State` and reaches these methods as keywords.
 """
 
 from __future__ import annotations
@@ -21,12 +23,14 @@ from functools import cached_property
 
 import numpy as np
 
+from rftstatic.compiled import choose_kernels
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
 from rftstatic.material import Material
 from rftstatic.mesh.trimesh import TriMesh
 from rftstatic.model.assembly import AssemblyPlan, scatter_forces, scatter_matrices
+from rftstatic.model.frozen import Frozen
 
 log = logging.getLogger(__name__)
 
@@ -95,8 +99,8 @@ def edge_load(mesh: TriMesh, edges: np.ndarray, force_per_length) -> np.ndarray:
     return P + np.outer(share, np.asarray(force_per_length, float))
 
 
-class Model:
-    """An RF triangle model of a flat fabric sheet (see module docstring).
+class Model(Frozen):
+    """An RF triangle model of a flat fabric sheet (see module docstring), read-only once built.
 
     Parameters
     ----------
@@ -111,33 +115,41 @@ class Model:
         ``max_step_fraction(x, dx, cache=)``: :class:`rftstatic.contact.self_contact.law.SelfContact`), or None
     membrane : include the membrane energy (``False`` gives the linear Kirchhoff plate)
     load_terms : loads with a potential scaled by the load factor, e.g.
-        :class:`rftstatic.loads.LeverMoment` (methods ``potential``, ``force``, ``tangent_blocks``,
-        ``commit``)
+        :class:`rftstatic.model.loads.LeverMoment` (methods ``potential(x, branch)``, ``force``,
+        ``tangent_blocks``, ``branch(x, previous)``; the branches live in the State)
     quiet : log the model's warnings (``warnings``: membrane locking) at debug level, not warning
         level (a remeshed run builds one model per mesh and warns once)
+    kernels : the kernel back end of every solve of the model, ``"numpy"`` or ``"compiled"``
+        (:func:`rftstatic.compiled.choose_kernels`); default: the self-contact law's, else the choice for
+        this mesh. A constant of the run, recorded in its summary (``kernels``).
     """
 
     def __init__(self, mesh: TriMesh, material: Material, *, element="RFT6", supports=None, load=None,
-                 contact=None, membrane=True, load_terms=(), quiet=False, self_contact=None):
+                 contact=None, membrane=True, load_terms=(), quiet=False, self_contact=None, kernels=None):
         if element not in ELEMENTS:
             raise ValueError(f'unknown element "{element}"; use one of {", ".join(ELEMENTS)}')
         self.mesh = mesh
         self.material = material
         self.element = element
         self.supports = supports if supports is not None else Supports.none(mesh.n_nodes)
-        self.load = np.zeros((mesh.n_nodes, 3)) if load is None else np.asarray(load, float)
+        self.load = np.zeros((mesh.n_nodes, 3)) if load is None else np.array(load, float)
         if self.load.shape != (mesh.n_nodes, 3):
             raise ValueError(f"load must have shape ({mesh.n_nodes}, 3), got {self.load.shape}")
         self.contact = contact
         self.self_contact = self_contact
-        self.load_terms = list(load_terms)
+        if self_contact is not None and kernels not in (None, self_contact.kernels):
+            raise ValueError(f"kernels {kernels!r} differ from the self-contact law's {self_contact.kernels!r}: "
+                             "build the law with the same kernels")
+        self.kernels = (self_contact.kernels if self_contact is not None
+                        else choose_kernels(mesh.n_elements, requested=kernels))
+        self.load_terms = tuple(load_terms)
         self.with_membrane = bool(membrane)
         self.fixed = self.supports.fixed_mask()
         self.free = ~self.fixed
         self.patches = build_patches(mesh, clamped_nodes=self.supports.clamped)
         self.Kb = bending_stiffness(mesh, self.patches, material.Db)
         self.membrane = membrane_operator(element, mesh, self.patches)
-        self.warnings: list[str] = []
+        warnings = []
         if element == "RFT6" and self.with_membrane:
             lock = locking_number(mesh, material)
             if lock > LOCKING_WARN:
@@ -146,9 +158,13 @@ class Model:
                         f"mid-side strains stiffen bending on this mesh (the wool strip of §4.1 bends 0.5 % too "
                         f"little at 2e4, 3.3 % at 8e4, 8 % at 8e5). Refine to a mean element size below {h_ok:.3g} m or use "
                         f'element = "RFT3"')
-                self.warnings.append(text)
+                warnings.append(text)
                 # quiet: the caller has said it already (a remeshed run builds a model per remesh)
                 log.log(logging.DEBUG if quiet else logging.WARNING, text)
+        self.warnings = tuple(warnings)
+        for a in (self.load, self.fixed, self.free):
+            a.flags.writeable = False
+        self._freeze()
 
     # --- constant structures, built on first use ------------------------------------------------
     @cached_property
@@ -172,34 +188,50 @@ class Model:
     def positions(self, U) -> np.ndarray:
         return self.X3 + U
 
+    @property
+    def membrane_backend(self) -> str:
+        """The membrane operator's name of :attr:`kernels` (``"numba"`` or ``"numpy"``)."""
+        return "numba" if self.kernels == "compiled" else "numpy"
+
     # --- energy and its derivatives -------------------------------------------------------------
     # ``candidates``: the solve's contact candidate list (a cache held in its State; results do not
     # depend on it), or None to evaluate the contact at every node; ``pairs``: likewise the solve's
-    # self-contact pair cache (State.self_pairs), or None to find the pairs afresh.
-    def energies(self, U, lam=1.0, *, candidates=None, pairs=None) -> dict:
+    # self-contact pair cache (State.self_pairs), or None to find the pairs afresh; it also carries the
+    # solve's factor on the self-contact stiffness (State.self_contact_scale; 1 without a cache), which
+    # results do depend on; ``branches``: the potential loads' committed branches (State.load_branches).
+    def energies(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None) -> dict:
         """Parts of the total potential [J]: bending, membrane, contact, self-contact, external work, total."""
         Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
-        Em = self.membrane.energy(U, self.material.Dm) if self.with_membrane else 0.0
+        Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
         Es = (self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).energy
               if self.self_contact is not None else 0.0)
         W = lam * float(np.einsum("ni,ni->", self.load, U))
         if self.load_terms:
             x = self.positions(U)
-            W -= lam * sum(t.potential(x) for t in self.load_terms)
+            held = branches or (None,) * len(self.load_terms)
+            W -= lam * sum(t.potential(x, b) for t, b in zip(self.load_terms, held))
         return {"bending": Eb, "membrane": Em, "contact": Ec, "self_contact": Es, "external_work": W,
                 "total": Eb + Em + Ec + Es - W}
 
-    def potential(self, U, lam=1.0, *, candidates=None, pairs=None) -> float:
+    def potential(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None) -> float:
         """Total potential energy Pi(U) [J]."""
-        return self.energies(U, lam, candidates=candidates, pairs=pairs)["total"]
+        return self.energies(U, lam, candidates=candidates, pairs=pairs, branches=branches)["total"]
+
+    def load_branches(self, U, previous=None) -> tuple:
+        """The branch of each potential load at the converged ``U (N, 3)`` [m], continuous from ``previous``
+        (None: the principal branches): what a solve commits to its ``State.load_branches`` after every
+        converged increment (e.g. :meth:`rftstatic.model.loads.LeverMoment.branch`: angles tracked through
+        full turns)."""
+        x = self.positions(U)
+        return tuple(t.branch(x, b) for t, b in zip(self.load_terms, previous or (None,) * len(self.load_terms)))
 
     def internal_force(self, U, *, candidates=None, pairs=None) -> np.ndarray:
         """Internal (bending + membrane + contact + self-contact) force ``(N, 3)`` [N], the gradient of
         the stored energy."""
         f = self.Kb @ U
         if self.with_membrane:
-            fe = self.membrane.element_forces(U, self.material.Dm)
+            fe = self.membrane.element_forces(U, self.material.Dm, backend=self.membrane_backend)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             f += self.contact.force(self.positions(U), candidates=candidates)
@@ -231,7 +263,8 @@ class Model:
         f = self.Kb @ U
         x = self.positions(U)
         if self.with_membrane:
-            fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress)
+            fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress,
+                                             backend=self.membrane_backend)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             cs = self.contact.evaluate(x, candidates=candidates)
@@ -285,7 +318,7 @@ class Model:
     def mixed_stress(self, U, dU) -> np.ndarray:
         """(E, 3) stress of the linearised strain ``D^m (eps(U) + Bbar(U) dU)`` [N/m]: the membrane stress
         that MIP Newton carries from ``U`` over the step ``dU (N, 3)`` [m] (:mod:`rftstatic.solvers.newton`)."""
-        return self.membrane.linearised_strain(U, dU) @ self.material.Dm.T
+        return self.membrane.linearised_strain(U, dU, backend=self.membrane_backend) @ self.material.Dm.T
 
     def relative_curvature(self, U) -> np.ndarray:
         """(E,) |kappa| h, the relative curvature of §2.2 and §5.1 [-].

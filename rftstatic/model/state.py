@@ -26,7 +26,12 @@ class State:
     candidates : contact candidate list (:class:`~rftstatic.contact.candidates.CandidateList`), a
         cache of the contact law (results never depend on it); None without penalty contact
     self_pairs : self-contact pair cache (:class:`~rftstatic.contact.self_contact.broad_phase.PairCache`),
-        likewise a cache; None without self-contact
+        likewise a cache; None without self-contact. It also carries :attr:`self_contact_scale`, which is
+        not a cache: it travels with the pairs to every self-contact evaluation (``pairs=``)
+    load_branches : the committed branch of each of the model's potential loads (one entry per
+        ``model.load_terms``, e.g. a :class:`~rftstatic.model.loads.LeverMoment`'s angles (K,) [rad]), set
+        after every converged increment (:meth:`~rftstatic.model.model.Model.load_branches`); None before
+        the first (the principal branches)
     contact_history : per-contact history carried from step to step (e.g. friction anchors), keyed
         by the contact law's name; empty for frictionless contact
     """
@@ -39,6 +44,7 @@ class State:
     candidates: object | None = None
     self_pairs: object | None = None
     contact_history: dict = field(default_factory=dict)
+    load_branches: tuple | None = None
 
     @classmethod
     def initial(cls, model, U=None, V=None, *, t: float = 0.0, step: int = 0, lam: float = 1.0) -> State:
@@ -53,6 +59,21 @@ class State:
         sc = getattr(model, "self_contact", None)
         pairs = sc.new_pairs() if sc is not None else None
         return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates, self_pairs=pairs)
+
+    @property
+    def self_contact_scale(self) -> float:
+        """Factor on the self-contact law's stiffness in this solve [-] (1 without self-contact): raised by the
+        static route's continuation (:func:`rftstatic.solvers.static.solve_static`), never the law itself.
+        Kept on the pair cache :attr:`self_pairs`, which every self-contact evaluation receives."""
+        return 1.0 if self.self_pairs is None else self.self_pairs.stiffness_scale
+
+    @self_contact_scale.setter
+    def self_contact_scale(self, value: float) -> None:
+        if self.self_pairs is None:
+            raise ValueError("this state has no self-contact: its stiffness scale stays 1")
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"self-contact stiffness scale must be a finite number > 0, got {value!r}")
+        self.self_pairs.stiffness_scale = float(value)
 
     @property
     def V_half(self) -> np.ndarray:

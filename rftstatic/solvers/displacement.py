@@ -153,7 +153,7 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
     # the final increment converges to the tight tolerance and may need longer
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
     U = U.copy()
-    parts = model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs)
+    parts = model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs, branches=ws.state.load_branches)
     r = model.residual(U, lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[model.free.ravel()]
     x = Iterate(U, lam, r, float(np.linalg.norm(r)), energy=parts["total"], energy_scale=energy_scale(parts))
     if not np.isfinite(x.rnorm):
@@ -177,12 +177,14 @@ def line_search(model, U, step, lam, Pi0, slope, opts, ws, scale=None, max_trial
     at ``U + alpha step``; ``(None, None)`` when no trial lowers the energy. ``scale`` [J]: :func:`energy_scale`
     of the energies at ``U`` (computed when None)."""
     def parts_at(alpha):
-        return model.energies(U + alpha * step, lam, candidates=ws.candidates, pairs=ws.pairs)
+        return model.energies(U + alpha * step, lam, candidates=ws.candidates, pairs=ws.pairs,
+                              branches=ws.state.load_branches)
 
     if not opts.line_search:
         return 1.0, parts_at(1.0)
     if scale is None:
-        scale = energy_scale(model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs))
+        scale = energy_scale(model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs,
+                                            branches=ws.state.load_branches))
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence

@@ -99,7 +99,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
     else:
         lam, dlam, target, U_prev, lam_prev = resume.lam, resume.dlam, resume.target, resume.U_prev, resume.lam_prev
-        _continue_result(model, result, resume)
+        _continue_result(model, result, resume, ws)
     continuing = None  # Newton state of an increment that is still snapping through
     continuations = 0
     failures = 0  # mixed iterations failed in a row at this load level
@@ -139,8 +139,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                 continuations = 0
                 U_prev, lam_prev = U, lam
                 lam, U = lam_next, nt.U
-                for term in model.load_terms:  # fix the branch of angle-type potentials
-                    term.commit(model.positions(U))
+                ws.state.load_branches = model.load_branches(U, ws.state.load_branches)  # angle-type potentials
                 result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
                                           "increment": dlam, "scheme": nt.scheme})
                 result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
@@ -196,14 +195,14 @@ of an unconverged Newton call at full load from a given state at which the call 
 well above the energy's round-off (1e-16 of its terms, each about the load's work)."""
 
 
-def _continue_result(model, result, path: LoadPath) -> None:
-    """``result`` carries on from ``path.result`` (records, counts) at the equilibrium ``path.U``."""
+def _continue_result(model, result, path: LoadPath, ws) -> None:
+    """``result`` carries on from ``path.result`` (records, counts) at the equilibrium ``path.U``; the branches
+    of the potential loads in ``ws.state`` (as restored from the checkpoint) are committed there."""
     old = path.result
     result.load_steps = list(old.load_steps)
     result.iterations, result.cutbacks, result.retries = old.iterations, old.cutbacks, old.retries
     result.U, result.lam, result.residual = path.U, path.lam, old.residual
-    for term in model.load_terms:  # the branch of angle-type potentials, as committed at that increment
-        term.commit(model.positions(path.U))
+    ws.state.load_branches = model.load_branches(path.U, ws.state.load_branches)
 
 
 TARGET_SHARE = 0.1

@@ -71,6 +71,8 @@ class StaticResult:
         empty for the other routes
     levels : mesh sequencing (:mod:`rftstatic.app.levels`): one record per mesh, coarsest first (nodes,
         route, iterations, residual, energy, wall time); empty for a single mesh
+    self_contact_stiffenings, self_contact_scale : raises of the self-contact stiffness after convergence and
+        the factor on it the equilibrium holds with (:func:`~rftstatic.solvers.static.solve_static`)
     """
 
     U: np.ndarray
@@ -94,6 +96,8 @@ class StaticResult:
     state: State | None = None
     path: dict = field(default_factory=dict)
     levels: list = field(default_factory=list)
+    self_contact_stiffenings: int = 0
+    self_contact_scale: float = 1.0
 
 @dataclass
 class NewtonWorkspace:
@@ -170,6 +174,7 @@ def route_outcome(model, result: StaticResult, ws: NewtonWorkspace, t0: float, b
         if extra is not None:
             extra(result)
         result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs)
+        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs,
+                                         branches=ws.state.load_branches)
         ws.state.U, ws.state.lam = result.U, result.lam
         result.state = ws.state

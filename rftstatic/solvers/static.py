@@ -104,10 +104,11 @@ def _stiffen_self_contact(model, result, opts, ws):
     """Continuation on the self-contact stiffness (as IPC adapts its barrier stiffness): while the
     converged state has a pair closer than :data:`SELF_CONTACT_MIN_GAP` times the thickness d (folds pinched harder than the automatic
     stiffness's design load, ten times the sheet's weight), raise the stiffness and converge again from
-    that state (its steps bounded by the collision test, so no pair crosses on the way). The model's law
-    keeps the raised stiffness (its summary reports it); ``result.self_contact_stiffenings`` counts them."""
-    sc = getattr(model, "self_contact", None)
-    result.self_contact_stiffenings = 0
+    that state (its steps bounded by the collision test, so no pair crosses on the way). The raised
+    stiffness is the solve's State's (``ws.state.self_contact_scale``; the model's law stays as built):
+    ``result.self_contact_stiffenings`` counts the raises, ``result.self_contact_scale`` is the factor
+    the equilibrium holds with (its summary reports the stiffness)."""
+    sc = model.self_contact
     if sc is None or not result.converged:
         return result
     polish = opts.from_state(relax_fallback=False).replace(max_continuations=0)
@@ -115,17 +116,18 @@ def _stiffen_self_contact(model, result, opts, ws):
         gap = sc.min_distance(model.positions(result.U))
         if not gap < SELF_CONTACT_MIN_GAP * sc.thickness:
             break
-        sc.stiffness *= SELF_CONTACT_STIFFENING
+        ws.state.self_contact_scale *= SELF_CONTACT_STIFFENING
         log.info("self-contact: a pair %.3g d apart; stiffness x %g, Newton again", gap / sc.thickness,
                  SELF_CONTACT_STIFFENING)
         try:
             res = solve_load_steps(model, U0=result.U, options=polish, workspace=ws)
         except ConvergenceError as exc:
-            sc.stiffness /= SELF_CONTACT_STIFFENING
+            ws.state.self_contact_scale /= SELF_CONTACT_STIFFENING
             log.warning("self-contact: Newton with the raised stiffness did not converge (%s); the equilibrium "
                         "of the last stiffness stands", exc)
             break
         result.self_contact_stiffenings += 1
+        result.self_contact_scale = ws.state.self_contact_scale
         result.U, result.residual, result.energies = res.U, res.residual, res.energies
         result.iterations += res.iterations
         result.factorisations += res.factorisations
@@ -135,14 +137,16 @@ def _stiffen_self_contact(model, result, opts, ws):
 
 def _finish(model, result, opts, ws):
     """The self-contact continuation (:func:`_stiffen_self_contact`), then the stability check."""
-    return _check_stability(model, _stiffen_self_contact(model, result, opts, ws), opts)
+    return _check_stability(model, _stiffen_self_contact(model, result, opts, ws), opts, pairs=ws.pairs)
 
 
-def _check_stability(model, result, opts):
+def _check_stability(model, result, opts, pairs=None):
     """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact
-    tangent positive definite, one Cholesky factorisation)? None when the linear solver cannot tell."""
+    tangent positive definite, one Cholesky factorisation)? None when the linear solver cannot tell.
+    ``pairs``: the solve's self-contact pair cache, with the stiffness scale it converged with."""
     solver = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
-    result.stable = _positive_definite(model, result.U, solver, lam=result.lam) if solver.detects_indefinite else None
+    result.stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=pairs)
+                     if solver.detects_indefinite else None)
     return result
 
 
@@ -410,11 +414,12 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, checkpoint
         checkpoint.route(route)
 
 
-def _positive_definite(model, U, solver, lam=1.0) -> bool:
-    """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation)."""
+def _positive_definite(model, U, solver, lam=1.0, pairs=None) -> bool:
+    """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation);
+    ``pairs``: a self-contact pair cache (:meth:`~rftstatic.model.model.Model.tangent`)."""
     if not solver.detects_indefinite:
         return True
-    _, K = model.tangent(U, lam=lam)
+    _, K = model.tangent(U, lam=lam, pairs=pairs)
     try:
         solver.solve(K, np.zeros(K.shape[0]))
     except (NotPositiveDefinite, LinearSolveError):

@@ -141,7 +141,7 @@ class StaticCheckpointer(ThrottledWriter):
 
     def _common(self, phase) -> dict:
         ws = self.workspace
-        branches = [getattr(t, "reference", None) for t in self.model.load_terms]  # committed angle branches
+        branches = list(ws.state.load_branches or ()) if ws is not None else []  # committed angle branches
         return {"static_format": np.array(FORMAT), "static_header": _json(self.header), "phase": np.array(phase),
                 "workspace": _json({"factorisations": 0 if ws is None else ws.factorisations,
                                     "lm_scale": None if ws is None else ws.lm_scale, "load_terms": branches})}
@@ -209,7 +209,7 @@ class StaticRestart:
     segment : the explicit state inside a relaxation segment (:func:`load_checkpoint`), or None
     result : the finished solve's result (phase ``"done"``)
     factorisations, lm_scale : the Newton workspace's counts (:class:`NewtonWorkspace`)
-    load_terms : the committed branch (``reference``) of each of the model's potential loads
+    load_terms : the committed branch of each of the model's potential loads (``State.load_branches``)
     where : where the saved solve stood (for ``summary.json``): phase, load factor and load steps, or
         relaxation time [s]
     """
@@ -226,12 +226,11 @@ class StaticRestart:
     where: dict | None = None
 
     def restore(self, model, ws) -> None:
-        """Give the Newton workspace ``ws`` its saved counts and ``model``'s potential loads their saved
-        branches, before the solve continues."""
+        """Give the Newton workspace ``ws`` its saved counts and its State the saved branches of ``model``'s
+        potential loads, before the solve continues."""
         ws.factorisations, ws.lm_scale = self.factorisations, self.lm_scale
-        for term, reference in zip(model.load_terms, self.load_terms or []):
-            if reference is not None:
-                term.reference = np.asarray(reference, dtype=float)
+        if self.load_terms and len(self.load_terms) == len(model.load_terms):
+            ws.state.load_branches = tuple(None if b is None else np.asarray(b, dtype=float) for b in self.load_terms)
 
     def _where(self) -> dict:
         out = {"phase": self.phase}

@@ -92,7 +92,7 @@ def element_bound(model, U=None, *, mass_scale: float = 1.0) -> float:
     row = np.bincount(patches.nodes.ravel(), np.abs(kb).sum(axis=2).ravel(), minlength=N)
     row = np.repeat(row[:, None], 3, axis=1)  # (N, 3) Gershgorin row sums per dof
     if model.with_membrane:
-        _, ke = model.membrane.element_tangents(U, model.material.Dm, psd=True)
+        _, ke = model.membrane.element_tangents(U, model.material.Dm, psd=True, backend=model.membrane_backend)
         E, A = model.membrane.nodes.shape
         ke = ke.reshape(E, 3 * A, 3 * A)
         lam_m = np.linalg.eigvalsh(ke)[:, -1]

@@ -126,7 +126,7 @@ class _VonMisesTruss:
     def positions(self, U):
         return self.X3 + U
 
-    def energies(self, U, lam=1.0, *, candidates=None, pairs=None):
+    def energies(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None):
         L = np.hypot(self.a, self.h + U[2, 2])
         E = self.EA / self.L0 * (L - self.L0) ** 2
         W = lam * float(np.sum(self.load * U))

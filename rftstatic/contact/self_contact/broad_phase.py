@@ -133,8 +133,8 @@ def _unique_pairs(a, b, nb):
     return np.stack([key // nb, key % nb], axis=1)
 
 
-@distance.numpy_charged(1.9e-5)
-def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.ndarray | None = None) -> Pairs:
+def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.ndarray | None = None, *,
+               compiled: bool | None = None) -> Pairs:
     """Point-triangle and edge-edge pairs whose primitives may be closer than ``radius``.
 
     Parameters
@@ -144,6 +144,7 @@ def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.nda
     radius : pair radius ``r`` [m] (thickness plus margin); > 0
     x1 : (N, 3) end positions of a step [m] (swept boxes: the pairs that may come closer than
         ``radius`` somewhere on the straight path ``x0 -> x1``), or None
+    compiled : the compiled cell list or the numpy one (None: :func:`.distance.compiled_for` by size)
 
     Returns
     -------
@@ -157,7 +158,7 @@ def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.nda
     if not (np.isfinite(radius) and radius > 0):
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
     tri, edges = prims.tri, prims.edges
-    if distance.compiled_for(len(tri) + len(edges)):
+    if distance.compiled_for(len(tri) + len(edges), compiled):
         return _find_pairs_compiled(prims, x0, radius, x1)
     return _find_pairs_numpy(prims, x0, radius, x1)
 
@@ -256,17 +257,25 @@ class PairCache:
     """The pairs within ``radius = thickness + margin`` at the last build, reused until some node has
     moved more than ``margin / 2`` since (then every pair closer than the thickness is in the list:
     each of its two primitives moved less than ``margin / 2``). A cache of one solve (kept in the
-    :class:`~rftstatic.model.state.State`); results never depend on it.
+    :class:`~rftstatic.model.state.State`); results never depend on its pairs. It also carries the solve's
+    :attr:`stiffness_scale` (``State.self_contact_scale``), which they do depend on.
 
     Parameters
     ----------
     margin : [m], > 0
+    compiled : the kernels of its broad phase (the law's, :attr:`.law.SelfContact.kernels`; None: by size)
+
+    Attributes
+    ----------
+    stiffness_scale : factor on the law's stiffness in this solve [-] (1 until the static route raises it)
     """
 
-    def __init__(self, margin: float):
+    def __init__(self, margin: float, *, compiled: bool | None = None):
         if not (np.isfinite(margin) and margin > 0):
             raise ValueError(f"margin must be a finite number > 0, got {margin!r}")
         self.margin = float(margin)
+        self.compiled = compiled
+        self.stiffness_scale = 1.0
         self.builds = 0
         self._x = None
         self._pairs = None
@@ -285,7 +294,7 @@ class PairCache:
         """The pairs for positions ``x (N, 3)`` [m], rebuilt when needed."""
         if self._moved(x) <= 0.5 * self.margin:
             return self._pairs
-        self._pairs = find_pairs(prims, x, thickness + self.margin)
+        self._pairs = find_pairs(prims, x, thickness + self.margin, compiled=self.compiled)
         self._x = np.array(x, dtype=float, copy=True)
         self._radius = thickness + self.margin
         self.builds += 1

@@ -50,7 +50,7 @@ import sys
 
 import numpy as np
 
-from rftstatic.compiled import charged_numpy, numba_available, numpy_budget_spent
+from rftstatic.compiled import numba_available
 from rftstatic.contact.self_contact.kernels import PARALLEL_TOL
 
 __all__ = [
@@ -73,27 +73,18 @@ pairs' Hessians; once loaded they serve every size."""
 _COMPILED = "rftstatic.contact.self_contact._kernels_numba"
 
 
-def compiled_for(n: int) -> bool:
-    """Whether the self-contact loops over ``n`` pairs or boxes run compiled: numba installed and
-    either ``n >= COMPILED_MIN_PAIRS``, the compiled twins already loaded in this process, or the numpy
-    twins having used up the process's budget (:func:`rftstatic.compiled.numpy_budget_spent`, the
-    ski-rental rule: a long explicit run of a tiny sheet calls them ~10 times a step)."""
-    return numba_available() and (n >= COMPILED_MIN_PAIRS or compiled_loaded() or numpy_budget_spent())
+def compiled_for(n: int, compiled: bool | None = None) -> bool:
+    """Whether the self-contact loops over ``n`` pairs or boxes run compiled: ``compiled`` when given (the
+    run's choice, :attr:`.law.SelfContact.kernels`: a law passes it to every loop it calls), else numba
+    installed and ``n >= COMPILED_MIN_PAIRS`` (a call outside a run). Never what ran before in the process."""
+    if compiled is not None:
+        return compiled
+    return numba_available() and n >= COMPILED_MIN_PAIRS
 
 
 def compiled_loaded() -> bool:
     """Whether the compiled self-contact twins are loaded in this process."""
     return _COMPILED in sys.modules
-
-
-def numpy_charged(per_row: float):
-    """Decorator of a self-contact function with a numpy twin: each numpy call charges ``per_row`` seconds
-    per row of its first array argument (pairs, blocks, nodes) to the process's budget
-    (:func:`rftstatic.compiled.charged_numpy`). The costs per row were measured on random pairs and an
-    81 x 81 sheet (2026-12-02, the machine loaded): distance and derivatives 1.3-1.6 us, distance only
-    0.1 us, a 12 x 12 PSD projection 87 us, a continuous-collision round 0.2 us, a node's relative
-    motion 0.25 us, a node of the broad phase 19 us."""
-    return charged_numpy(compiled_loaded, per_row)
 
 
 def _compiled_derivatives(x4, kind, hessian):
@@ -266,14 +257,14 @@ def pair_derivatives(x4, W, D, act, *, hessian=True):
     return s, grad, H
 
 
-@numpy_charged(1.3e-6)
-def point_triangle(x4, *, hessian=True):
+def point_triangle(x4, *, hessian=True, compiled=None):
     """Point-triangle squared distance, gradient, Hessian and closest feature.
 
     Parameters
     ----------
     x4 : (P, 4, 3) rows ``(p, t_0, t_1, t_2)`` [m]: a point and a triangle that does not contain it
     hessian : also compute the Hessian
+    compiled : the compiled twin or the numpy path (None: :func:`compiled_for` by size)
 
     Returns
     -------
@@ -282,17 +273,17 @@ def point_triangle(x4, *, hessian=True):
     hess : (P, 12, 12) ``d^2 s/dX^2`` [-], or None
     feature : (P,) int8, 0 face, 1 edge, 2 vertex (:data:`FEATURES`)
     """
-    return _derivatives(x4, 0, hessian, "point_triangle")
+    return _derivatives(x4, 0, hessian, "point_triangle", compiled)
 
 
-@numpy_charged(1.6e-6)
-def edge_edge(x4, *, hessian=True):
+def edge_edge(x4, *, hessian=True, compiled=None):
     """Edge-edge (segment-segment) squared distance, gradient, Hessian and closest feature.
 
     Parameters
     ----------
     x4 : (P, 4, 3) rows ``(a_0, a_1, b_0, b_1)`` [m]: two edges that share no node
     hessian : also compute the Hessian
+    compiled : as for :func:`point_triangle`
 
     Returns
     -------
@@ -301,32 +292,31 @@ def edge_edge(x4, *, hessian=True):
     hess : (P, 12, 12) ``d^2 s/dX^2`` [-], or None
     feature : (P,) int8, 0 interior-interior, 1 end point-edge, 2 end point-end point
     """
-    return _derivatives(x4, 1, hessian, "edge_edge")
+    return _derivatives(x4, 1, hessian, "edge_edge", compiled)
 
 
-def _derivatives(x4, kind: int, hessian: bool, who: str):
+def _derivatives(x4, kind: int, hessian: bool, who: str, compiled: bool | None):
     """:func:`point_triangle` (``kind`` 0) or :func:`edge_edge` (1): compiled, or classified and derived in numpy."""
     x4 = _check(x4, who)
-    if compiled_for(len(x4)):
+    if compiled_for(len(x4), compiled):
         return _compiled_derivatives(x4, kind, hessian)
     W, D, act, _, code = (_pt_classify if kind == 0 else _ee_classify)(x4)
     s, g, H = pair_derivatives(x4, W, D, act, hessian=hessian)
     return s, g, H, code
 
 
-@numpy_charged(1e-7)
-def point_triangle_distance2(x4) -> np.ndarray:
-    """Point-triangle squared distance ``(P,)`` [m^2] only (the continuous-collision loop's call)."""
+def point_triangle_distance2(x4, *, compiled=None) -> np.ndarray:
+    """Point-triangle squared distance ``(P,)`` [m^2] only (the continuous-collision loop's call); ``compiled``
+    as for :func:`point_triangle`."""
     x4 = _check(x4, "point_triangle_distance2")
-    if compiled_for(len(x4)):
+    if compiled_for(len(x4), compiled):
         return _compiled_distance2(x4, 0)
     return _pt_classify(x4)[3]
 
 
-@numpy_charged(1.1e-7)
-def edge_edge_distance2(x4) -> np.ndarray:
-    """Edge-edge squared distance ``(P,)`` [m^2] only."""
+def edge_edge_distance2(x4, *, compiled=None) -> np.ndarray:
+    """Edge-edge squared distance ``(P,)`` [m^2] only; ``compiled`` as for :func:`point_triangle`."""
     x4 = _check(x4, "edge_edge_distance2")
-    if compiled_for(len(x4)):
+    if compiled_for(len(x4), compiled):
         return _compiled_distance2(x4, 1)
     return _ee_classify(x4)[3]

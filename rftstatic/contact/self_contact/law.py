@@ -62,11 +62,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rftstatic.compiled import choose_kernels
 from rftstatic.contact.self_contact.broad_phase import PairCache, Pairs, SheetPrimitives, find_pairs
 from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distance2, point_triangle,
                                                      point_triangle_distance2)
 from rftstatic.contact.self_contact.law_kernels import additive_ccd_nodes, psd_project
 from rftstatic.contact.self_contact.near_pairs import NearPairCache, SelfContactStats, pair_nodes
+from rftstatic.model.frozen import Frozen
 
 __all__ = ["SelfContact", "SelfContactState", "auto_stiffness", "pair_law"]
 
@@ -157,21 +159,32 @@ def auto_stiffness(*, weight: float, node_area: float, thickness: float, pressur
     return float(factor * 4.0 * pressure_factor * weight * node_area / thickness)
 
 
-class SelfContact:
-    """Penalty self-contact of a sheet (module docstring).
+class SelfContact(Frozen):
+    """Penalty self-contact of a sheet (module docstring), read-only once built: a solve that raises the
+    stiffness does so through its pair cache (``cache.stiffness_scale``, ``State.self_contact_scale``).
 
     Parameters
     ----------
     mesh : the reference :class:`~rftstatic.mesh.trimesh.TriMesh` [m]
     thickness : ``d`` [m], below half the smallest edge of the mesh
-    stiffness : ``k`` [N/m] (:func:`auto_stiffness`)
+    stiffness : ``k`` [N/m] (:func:`auto_stiffness`), the stiffness at scale 1
     margin : broad-phase margin [m] (default ``max(2 d, h / 4)``, h the mean edge length): pairs are
         listed within ``d + margin`` and the list is rebuilt once a node moved ``margin / 2``
     min_fraction : of the step bound, in (0, 1)
+    sweep_limit : longest relative motion of a step that one swept broad phase covers [m] (default from the
+        :data:`SWEEP_PAIRS` budget)
+    kernels : ``"numpy"`` or ``"compiled"``, the kernels of every loop of the law and its pair caches
+        (:func:`rftstatic.compiled.choose_kernels`; default: its choice for a self-contact run on this mesh)
+
+    Attributes
+    ----------
+    stats : :class:`~.near_pairs.SelfContactStats`, counts and timings of the law's work, added to by every
+        solve (shared with the pair caches it makes) and summed over a run in its summary; no evaluation
+        reads them. The one part of the law that changes after it is built: its attributes cannot be set.
     """
 
     def __init__(self, mesh, thickness: float, stiffness: float, *, margin: float | None = None,
-                 min_fraction: float = MIN_FRACTION):
+                 min_fraction: float = MIN_FRACTION, sweep_limit: float | None = None, kernels: str | None = None):
         self.prims = SheetPrimitives.of_mesh(mesh)
         X = mesh.X3
         e = self.prims.edges
@@ -191,13 +204,17 @@ class SelfContact:
         self.stiffness = float(stiffness)
         self.min_fraction = float(min_fraction)
         self.margin = float(margin) if margin is not None else max(2.0 * thickness, 0.25 * float(length.mean()))
-        self.sweep_limit = float(length.mean()) * float(np.sqrt(SWEEP_PAIRS / max(len(mesh.tri), 1)))
+        self.sweep_limit = (float(sweep_limit) if sweep_limit is not None
+                            else float(length.mean()) * float(np.sqrt(SWEEP_PAIRS / max(len(mesh.tri), 1))))
         self.stats = SelfContactStats()
+        self.kernels = choose_kernels(len(mesh.tri), self_contact=True, requested=kernels)
+        self.compiled = self.kernels == "compiled"
         ref = self.evaluate(X, tangent=False)
         if ref.n_active:
             raise ValueError(f"the flat reference mesh has {ref.n_active} self-contact pairs closer than the "
                              f"thickness {thickness:.6g} m (smallest distance {ref.min_distance:.6g} m, e.g. a "
                              "skinny triangle's height); use a thinner thickness")
+        self._freeze()
 
     @property
     def n_nodes(self) -> int:
@@ -206,13 +223,13 @@ class SelfContact:
     def new_pairs(self) -> NearPairCache:
         """A fresh pair cache for a solve (kept in :attr:`rftstatic.model.state.State.self_pairs`): the
         pairs within ``d + margin`` by exact distance (:mod:`.near_pairs`), counted in :attr:`stats`."""
-        return NearPairCache(self.margin, self.stats)
+        return NearPairCache(self.margin, self.stats, compiled=self.compiled)
 
     def pairs(self, x, cache: PairCache | None = None) -> Pairs:
         """Pairs within ``d + margin`` of ``x (N, 3)`` [m] (from ``cache`` when still valid)."""
         if cache is not None:
             return cache.pairs(self.prims, x, self.thickness)
-        return find_pairs(self.prims, x, self.thickness + self.margin)
+        return find_pairs(self.prims, x, self.thickness + self.margin, compiled=self.compiled)
 
     def _x4(self, x, pairs: Pairs):
         """Nodes ``(Q, 4)`` of the point-triangle and ``(R, 4)`` of the edge-edge pairs."""
@@ -227,32 +244,34 @@ class SelfContact:
     def evaluate(self, x, *, tangent: bool = True, cache: PairCache | None = None,
                  project: bool = True) -> SelfContactState:
         """Energy, force and pair blocks at positions ``x (N, 3)`` [m] over the pairs within ``d + margin``
-        (:meth:`pairs`); ``project``: the blocks projected to PSD (False: the exact Hessian blocks, for tests)."""
+        (:meth:`pairs`), the stiffness times the solve's ``cache.stiffness_scale`` (1 without a cache);
+        ``project``: the blocks projected to PSD (False: the exact Hessian blocks, for tests)."""
         x = self._check_x(x)
         pairs = self.pairs(x, cache)
         if isinstance(cache, NearPairCache):
             npt, nee = cache.npt, cache.nee
         else:
             npt, nee = self._x4(x, pairs)
-        return self.evaluate_pairs(x, npt, nee, tangent=tangent, project=project)
+        return self.evaluate_pairs(x, npt, nee, tangent=tangent, project=project, scale=_scale(cache))
 
-    def evaluate_pairs(self, x, npt, nee, *, tangent: bool = True, project: bool = True) -> SelfContactState:
+    def evaluate_pairs(self, x, npt, nee, *, tangent: bool = True, project: bool = True,
+                       scale: float = 1.0) -> SelfContactState:
         """The law (module docstring) summed over the given pairs: ``npt (Q, 4)`` point-triangle rows
         (node, triangle), ``nee (R, 4)`` edge-edge rows (edge, edge), at ``x (N, 3)`` [m]. The one source
         of the energy ``sum e(delta)`` [J] (:func:`pair_law`), its gradient ``(N, 3)`` [N] and the pair blocks,
         for the static solver (:meth:`evaluate`) and the explicit one
-        (:meth:`near_force`)."""
+        (:meth:`near_force`); the stiffness times ``scale`` [-]."""
         t0 = time.perf_counter()
-        d, k = self.thickness, self.stiffness
-        s_pt = point_triangle_distance2(x[npt]) if len(npt) else np.zeros(0)
-        s_ee = edge_edge_distance2(x[nee]) if len(nee) else np.zeros(0)
+        d, k = self.thickness, self.stiffness * scale
+        s_pt = point_triangle_distance2(x[npt], compiled=self.compiled) if len(npt) else np.zeros(0)
+        s_ee = edge_edge_distance2(x[nee], compiled=self.compiled) if len(nee) else np.zeros(0)
         smin = min(float(s_pt.min(initial=np.inf)), float(s_ee.min(initial=np.inf)))
         nodes_list, grads, hess, dist = [], [], [], []
         for nodes, s, fun in ((npt, s_pt, point_triangle), (nee, s_ee, edge_edge)):
             act = s < d * d
             if not np.any(act):
                 continue
-            s2, g, H, _ = fun(x[nodes[act]], hessian=tangent)
+            s2, g, H, _ = fun(x[nodes[act]], hessian=tangent, compiled=self.compiled)
             nodes_list.append(nodes[act])
             grads.append(g.reshape(-1, 12))
             hess.append(H)
@@ -276,7 +295,7 @@ class SelfContact:
             hd = Hs / (2.0 * delta[:, None, None]) - np.einsum("am,an->amn", gs, gs) / (4.0 * delta[:, None, None] ** 3)
             blocks = e2[:, None, None] * np.einsum("am,an->amn", gd, gd) + e1[:, None, None] * hd
             if project:
-                blocks = psd_project(blocks)
+                blocks = psd_project(blocks, compiled=self.compiled)
         self._count(t0)
         return SelfContactState(energy, force, nodes, blocks, float(np.sqrt(smin)), len(nodes))
 
@@ -300,7 +319,7 @@ class SelfContact:
             return (f, 0.0) if energy else f
         live = cache.lower_bounds(m) < d
         q = len(cache.npt)
-        st = self.evaluate_pairs(x, cache.npt[live[:q]], cache.nee[live[q:]], tangent=False)
+        st = self.evaluate_pairs(x, cache.npt[live[:q]], cache.nee[live[q:]], tangent=False, scale=_scale(cache))
         return (st.force, st.energy) if energy else st.force
 
     def energy(self, x, *, cache: PairCache | None = None) -> float:
@@ -352,9 +371,15 @@ class SelfContact:
             if spread > self.sweep_limit:  # a step too long to sweep within the pair budget: test its start
                 scale = self.sweep_limit / spread
                 self.stats.sweeps_limited += 1
-            swept = find_pairs(self.prims, x, d, x + scale * dx)
+            swept = find_pairs(self.prims, x, d, x + scale * dx, compiled=self.compiled)
             s_pt, s_ee = self._x4(x, swept)
             npt, nee = np.concatenate([npt, s_pt]), np.concatenate([nee, s_ee])
-        t_pt = additive_ccd_nodes(x, scale * dx, npt, 0, eta, max_rounds)
-        t_ee = additive_ccd_nodes(x, scale * dx, nee, 1, eta, max_rounds)
+        t_pt = additive_ccd_nodes(x, scale * dx, npt, 0, eta, max_rounds, compiled=self.compiled)
+        t_ee = additive_ccd_nodes(x, scale * dx, nee, 1, eta, max_rounds, compiled=self.compiled)
         return float(scale * min(1.0, t_pt, t_ee))
+
+
+def _scale(cache) -> float:
+    """The solve's factor on the stiffness carried by its pair cache (:attr:`.broad_phase.PairCache.stiffness_scale`),
+    1 without a cache."""
+    return 1.0 if cache is None else cache.stiffness_scale

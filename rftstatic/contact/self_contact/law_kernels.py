@@ -24,15 +24,15 @@ __all__ = ["psd_project", "additive_ccd", "additive_ccd_nodes"]
 _SIDES = (((0,), (1, 2, 3)), ((0, 1), (2, 3)))
 
 
-@distance.numpy_charged(8.7e-5)
-def psd_project(H: np.ndarray) -> np.ndarray:
+def psd_project(H: np.ndarray, *, compiled: bool | None = None) -> np.ndarray:
     """Symmetric ``(A, n, n)`` matrices projected onto the PSD cone (eigenvalues clamped at 0).
 
-    Compiled: a range basis and Jacobi rotations per block (:mod:`.kernels`); numpy: ``eigh``."""
+    Compiled: a range basis and Jacobi rotations per block (:mod:`.kernels`); numpy: ``eigh``; ``compiled``:
+    which (None: :func:`.distance.compiled_for` by size)."""
     H = np.asarray(H, dtype=float)
     if not len(H):
         return H
-    if distance.compiled_for(len(H)):
+    if distance.compiled_for(len(H), compiled):
         from rftstatic.contact.self_contact._kernels_numba import psd_project_all
 
         out = np.empty_like(H)
@@ -43,17 +43,16 @@ def psd_project(H: np.ndarray) -> np.ndarray:
     return np.einsum("aij,aj,akj->aik", Q, np.maximum(lam, 0.0), Q)
 
 
-@distance.numpy_charged(2e-7)
 def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rounds: int,
-                 floor: float = 0.0) -> float:
+                 floor: float = 0.0, *, compiled: bool | None = None) -> float:
     """Smallest safe time in [0, 1] over pairs ``x4, dx4 (P, 4, 3)`` [m] (``kind`` 0 point-triangle,
     1 edge-edge): the first time any pair comes within its target ``g`` (``eta`` times its starting
     distance ``delta_0``, raised to ``floor`` [m] for a pair that starts above it), found by advancing
     each pair by ``(delta - g) / l`` (``l`` its relative speed bound) for at most ``max_rounds`` rounds;
-    1 if none (:mod:`.law`)."""
+    1 if none (:mod:`.law`); ``compiled`` as for :func:`psd_project`."""
     if not len(x4):
         return 1.0
-    if distance.compiled_for(len(x4)):
+    if distance.compiled_for(len(x4), compiled):
         from rftstatic.contact.self_contact._kernels_numba import ccd_all
 
         P = len(x4)
@@ -61,7 +60,10 @@ def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rou
                              np.ascontiguousarray(dx4, dtype=float).reshape(4 * P, 3),
                              np.arange(4 * P, dtype=np.int64).reshape(P, 4), kind, float(eta), int(max_rounds),
                              float(floor)))
-    dist2 = distance.point_triangle_distance2 if kind == 0 else distance.edge_edge_distance2
+    d2 = distance.point_triangle_distance2 if kind == 0 else distance.edge_edge_distance2
+
+    def dist2(y4):
+        return d2(y4, compiled=compiled)
     a, b = _SIDES[kind]
     rel = dx4[:, list(a)][:, :, None, :] - dx4[:, list(b)][:, None, :, :]
     ell = np.sqrt(np.max(np.einsum("pabi,pabi->pab", rel, rel), axis=(1, 2)))  # (P,) relative speed bound
@@ -93,19 +95,19 @@ def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rou
 
 
 def additive_ccd_nodes(x: np.ndarray, dx: np.ndarray, nodes: np.ndarray, kind: int, eta: float,
-                       max_rounds: int, floor: float = 0.0) -> float:
+                       max_rounds: int, floor: float = 0.0, *, compiled: bool | None = None) -> float:
     """:func:`additive_ccd` of the pairs ``nodes (P, 4)`` of positions ``x (N, 3)`` [m] and step
     ``dx (N, 3)`` [m], without gathering ``x[nodes]`` (the compiled loop reads the nodes itself: on the
     824,000 swept pairs of a 1 cm step of the 81 x 81 fold the gather cost as much as the loop)."""
     nodes = np.asarray(nodes, dtype=np.int64)
     if not len(nodes):
         return 1.0
-    if distance.compiled_for(len(nodes)):
+    if distance.compiled_for(len(nodes), compiled):
         from rftstatic.contact.self_contact._kernels_numba import ccd_all
 
         return float(ccd_all(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(dx, dtype=float),
                              np.ascontiguousarray(nodes), kind, float(eta), int(max_rounds), float(floor)))
-    return additive_ccd(x[nodes], dx[nodes], kind, eta, max_rounds, floor)
+    return additive_ccd(x[nodes], dx[nodes], kind, eta, max_rounds, floor, compiled=compiled)
 
 
 def load_compiled() -> bool:
@@ -125,21 +127,16 @@ def load_compiled() -> bool:
     x[fold, 0], x[fold, 2] = 2.0 - x[fold, 0], 0.1  # the right half laid over the left one
     dx = np.zeros_like(x)
     dx[fold, 2] = -0.2  # and pushed through it
-    saved = distance.compiled_for
-    distance.compiled_for = lambda n: True
-    try:
-        pairs = find_pairs(SheetPrimitives.of_mesh(mesh), x, 0.2)
-        find_pairs(SheetPrimitives.of_mesh(mesh), x, 0.2, x + dx)
-        tri, edges = mesh.tri, mesh.topology.edges
-        npt = np.column_stack([pairs.pt[:, 0], tri[pairs.pt[:, 1]]]).astype(np.int64)
-        nee = np.column_stack([edges[pairs.ee[:, 0]], edges[pairs.ee[:, 1]]]).astype(np.int64)
-        for kind, nodes, full, d2 in ((0, npt, distance.point_triangle, distance.point_triangle_distance2),
-                                      (1, nee, distance.edge_edge, distance.edge_edge_distance2)):
-            H = full(x[nodes], hessian=True)[2]
-            d2(x[nodes])
-            psd_project(H)
-            additive_ccd(x[nodes], dx[nodes], kind, 0.2, 10)
-            additive_ccd_nodes(x, dx, nodes, kind, 0.2, 10)
-    finally:
-        distance.compiled_for = saved
+    pairs = find_pairs(SheetPrimitives.of_mesh(mesh), x, 0.2, compiled=True)
+    find_pairs(SheetPrimitives.of_mesh(mesh), x, 0.2, x + dx, compiled=True)
+    tri, edges = mesh.tri, mesh.topology.edges
+    npt = np.column_stack([pairs.pt[:, 0], tri[pairs.pt[:, 1]]]).astype(np.int64)
+    nee = np.column_stack([edges[pairs.ee[:, 0]], edges[pairs.ee[:, 1]]]).astype(np.int64)
+    for kind, nodes, full, d2 in ((0, npt, distance.point_triangle, distance.point_triangle_distance2),
+                                  (1, nee, distance.edge_edge, distance.edge_edge_distance2)):
+        H = full(x[nodes], hessian=True, compiled=True)[2]
+        d2(x[nodes], compiled=True)
+        psd_project(H, compiled=True)
+        additive_ccd(x[nodes], dx[nodes], kind, 0.2, 10, compiled=True)
+        additive_ccd_nodes(x, dx, nodes, kind, 0.2, 10, compiled=True)
     return True

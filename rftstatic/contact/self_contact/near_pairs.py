@@ -85,11 +85,12 @@ def pair_nodes(prims: SheetPrimitives, pairs: Pairs) -> tuple[np.ndarray, np.nda
     return npt, nee
 
 
-def _distances(prims: SheetPrimitives, x: np.ndarray, pairs: Pairs) -> tuple[np.ndarray, np.ndarray]:
+def _distances(prims: SheetPrimitives, x: np.ndarray, pairs: Pairs,
+               compiled: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Distances ``(Q,)`` and ``(R,)`` [m] of the point-triangle and edge-edge ``pairs`` at ``x (N, 3)`` [m].
     Compiled: read from ``x`` by index (:func:`.kernels.distances_by_index`; the gather ``x[nodes]`` of
     the ~14,000 box pairs of hang-20's 41 x 41 sheet cost as much as the distances, 700 times a run)."""
-    if distance.compiled_for(len(pairs)):
+    if distance.compiled_for(len(pairs), compiled):
         from rftstatic.contact.self_contact._kernels_numba import distances_by_index
 
         out = []
@@ -99,20 +100,21 @@ def _distances(prims: SheetPrimitives, x: np.ndarray, pairs: Pairs) -> tuple[np.
             out.append(np.sqrt(s))
         return out[0], out[1]
     npt, nee = pair_nodes(prims, pairs)
-    dpt = np.sqrt(point_triangle_distance2(x[npt])) if len(npt) else np.zeros(0)
-    dee = np.sqrt(edge_edge_distance2(x[nee])) if len(nee) else np.zeros(0)
+    dpt = np.sqrt(point_triangle_distance2(x[npt], compiled=compiled)) if len(npt) else np.zeros(0)
+    dee = np.sqrt(edge_edge_distance2(x[nee], compiled=compiled)) if len(nee) else np.zeros(0)
     return dpt, dee
 
 
 def translation_free_motion(a: np.ndarray, c: np.ndarray, *, b: np.ndarray | None = None,
-                            s: float = 0.0) -> tuple[np.ndarray, float]:
+                            s: float = 0.0, compiled: bool | None = None) -> tuple[np.ndarray, float]:
     """``|w_k - m| (N,)`` [m] and its largest value for ``w = a + s b - c`` (``a, b, c (N, 3)`` [m]) and
     ``m`` the midrange of ``w`` (Eq. 1): the motion since a build (``a = x``, ``c = x_build``), at the
     end of a step (``b = dx``, ``s = 1``), or a step's own spread (``a = dx``, ``c = 0``). Compiled
-    (:func:`.kernels.midrange_motion`, two passes, no temporaries) when the self-contact twins are chosen:
+    (:func:`.kernels.midrange_motion`, two passes, no temporaries) when the self-contact twins are chosen
+    (``compiled``; None: by size, :func:`.distance.compiled_for`):
     numpy's axis reductions of ``(N, 3)`` arrays took 130 us for the 1,681 nodes of hang-20, twice a step."""
     out = np.empty(len(a))
-    if distance.compiled_for(len(a)):
+    if distance.compiled_for(len(a), compiled):
         from rftstatic.contact.self_contact._kernels_numba import midrange_motion
 
         big = midrange_motion(a, a if b is None else b, float(s), c, out)
@@ -120,7 +122,6 @@ def translation_free_motion(a: np.ndarray, c: np.ndarray, *, b: np.ndarray | Non
     return _motion_numpy(a, c, b, s, out)
 
 
-@distance.numpy_charged(2.5e-7)
 def _motion_numpy(a, c, b, s, out):
     w = a - c if b is None or s == 0.0 else a + s * b - c
     w -= 0.5 * (w.max(axis=0) + w.min(axis=0))
@@ -136,6 +137,7 @@ class NearPairCache(PairCache):
     ----------
     margin : [m], > 0
     stats : counters to add to (shared by the caches of one model), or None
+    compiled : the kernels of its loops (the law's choice; None: by size)
 
     Attributes (after a build)
     --------------------------
@@ -143,19 +145,19 @@ class NearPairCache(PairCache):
     dist_pt : (Q,) and dist_ee : (R,) their distances at the build [m]
     """
 
-    def __init__(self, margin: float, stats: SelfContactStats | None = None):
-        super().__init__(margin)
+    def __init__(self, margin: float, stats: SelfContactStats | None = None, *, compiled: bool | None = None):
+        super().__init__(margin, compiled=compiled)
         self.stats = stats if stats is not None else SelfContactStats()
 
     def _moved(self, x) -> float:
         if self._x is None or self._x.shape != x.shape:
             return np.inf
-        return translation_free_motion(x, self._x)[1]
+        return translation_free_motion(x, self._x, compiled=self.compiled)[1]
 
     def motion(self, x: np.ndarray, dx: np.ndarray | None = None) -> tuple[np.ndarray, float]:
         """``|u_k - c| (N,)`` [m], the translation-free motion of every node since the build (Eq. 1) at
         ``x (N, 3)`` [m] (or at ``x + dx``), and its largest value [m]."""
-        return translation_free_motion(x, self._x, b=dx, s=0.0 if dx is None else 1.0)
+        return translation_free_motion(x, self._x, b=dx, s=0.0 if dx is None else 1.0, compiled=self.compiled)
 
     def pairs(self, prims: SheetPrimitives, x: np.ndarray, thickness: float) -> Pairs:
         """The near pairs for positions ``x (N, 3)`` [m], rebuilt when needed."""
@@ -180,8 +182,8 @@ class NearPairCache(PairCache):
         """Build the list at ``x (N, 3)`` [m] now."""
         t0 = time.perf_counter()
         radius = thickness + self.margin
-        raw = find_pairs(prims, x, radius)
-        dpt, dee = _distances(prims, x, raw)
+        raw = find_pairs(prims, x, radius, compiled=self.compiled)
+        dpt, dee = _distances(prims, x, raw, self.compiled)
         kp, ke = dpt < radius, dee < radius
         self._pairs = Pairs(raw.pt[kp], raw.ee[ke])
         self.npt, self.nee = pair_nodes(prims, self._pairs)

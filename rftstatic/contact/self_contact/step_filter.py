@@ -166,14 +166,14 @@ class StepFilter:
         d, half = sc.thickness, 0.5 * cache.margin
         m, m_max = cache.current(sc.prims, x, d)  # m_max <= margin / 2 now
         dx = dt * v
-        spread, spread_max = translation_free_motion(dx, self._zero(dx))
+        spread, spread_max = translation_free_motion(dx, self._zero(dx), compiled=sc.compiled)
         if cache.motion(x, dx)[1] > half:
             cache.rebuild(sc.prims, x, d)  # 1. the list must cover the whole step
             m, m_max = np.zeros(len(x)), 0.0
         extra = None
         if spread_max > half:
             stats.swept += 1
-            extra = find_pairs(sc.prims, x, d, x + dx)
+            extra = find_pairs(sc.prims, x, d, x + dx, compiled=sc.compiled)
         lb_min = cache.min_dist - 2.0 * m_max
         beta, g = 1.0 - self.approach, self.gap_floor
         if extra is None and 2.0 * spread_max <= beta * (lb_min - g):  # 2. quick test
@@ -214,9 +214,9 @@ class StepFilter:
         x4 = x[nodes]
         g = np.empty((len(nodes), 4, 3))
         if np.any(is_pt):
-            g[is_pt] = point_triangle(x4[is_pt], hessian=False)[1]
+            g[is_pt] = point_triangle(x4[is_pt], hessian=False, compiled=self.sc.compiled)[1]
         if not np.all(is_pt):
-            g[~is_pt] = edge_edge(x4[~is_pt], hessian=False)[1]
+            g[~is_pt] = edge_edge(x4[~is_pt], hessian=False, compiled=self.sc.compiled)[1]
         r, w = _weights(g, is_pt)
         delta = np.sqrt(np.einsum("pi,pi->p", r, r))
         n = r / np.where(delta > 0, delta, 1.0)[:, None]
@@ -280,7 +280,7 @@ class StepFilter:
     def _fail_safe(self, cache, x, v, dt, m, nodes_checked, is_pt_checked, swept, stats):
         """4. Additive CCD on the pairs that the per-pair test picks for the filtered step."""
         dx = dt * v
-        spread = translation_free_motion(dx, self._zero(dx))[0]
+        spread = translation_free_motion(dx, self._zero(dx), compiled=self.sc.compiled)[0]
         lb = cache.lower_bounds(m)
         floor = self.ccd_floor  # a pair's target is max(eta delta_0, floor) when it starts above the floor
         pick = 2.0 * spread[cache.nodes].max(axis=1) > lb - np.maximum(self.eta * lb, floor)
@@ -290,8 +290,8 @@ class StepFilter:
         if swept:  # the swept pairs are not in the list: check them all
             pt_rows = np.concatenate([pt_rows, nodes_checked[is_pt_checked]])
             ee_rows = np.concatenate([ee_rows, nodes_checked[~is_pt_checked]])
-        t_pt = additive_ccd_nodes(x, dx, pt_rows, 0, self.eta, 200, floor)
-        t_ee = additive_ccd_nodes(x, dx, ee_rows, 1, self.eta, 200, floor)
+        t_pt = additive_ccd_nodes(x, dx, pt_rows, 0, self.eta, 200, floor, compiled=self.sc.compiled)
+        t_ee = additive_ccd_nodes(x, dx, ee_rows, 1, self.eta, 200, floor, compiled=self.sc.compiled)
         t = min(1.0, t_pt, t_ee)
         if t < 1.0:
             v *= t

@@ -11,5 +11,5 @@ def backend(request, monkeypatch):
     if request.param == "numba":
         pytest.importorskip("numba")
     compiled = request.param == "numba"
-    monkeypatch.setattr(distance, "compiled_for", lambda n: compiled)
+    monkeypatch.setattr(distance, "compiled_for", lambda n, choice=None: compiled)
     return request.param

@@ -12,7 +12,7 @@ pytest.importorskip("numba")
 
 
 def _on(monkeypatch, compiled):
-    monkeypatch.setattr(distance, "compiled_for", lambda n: compiled)
+    monkeypatch.setattr(distance, "compiled_for", lambda n, choice=None: compiled)
 
 
 def _both(monkeypatch, f, *args, **kw):
@@ -111,9 +111,7 @@ def test_broad_phase_agrees_on_a_folded_crumpled_sheet(monkeypatch):
         np.testing.assert_array_equal(b.ee, a.ee)
 
 
-def test_load_compiled_loads_the_twins_and_the_budget_switches_to_them(monkeypatch):
-    import sys
-
+def test_load_compiled_loads_the_twins_and_what_is_loaded_never_decides():
     from rftstatic import compiled
     from rftstatic.contact.self_contact import distance, law_kernels
 
@@ -121,19 +119,10 @@ def test_load_compiled_loads_the_twins_and_the_budget_switches_to_them(monkeypat
         assert law_kernels.load_compiled() is False
         return
     assert law_kernels.load_compiled() and distance.compiled_loaded()
-    # the ski-rental rule: with the twins not loaded, small calls go compiled once the numpy budget is spent
-    monkeypatch.delitem(sys.modules, "rftstatic.contact.self_contact._kernels_numba")
-    monkeypatch.setattr(compiled, "_numpy_seconds", [0.0])
-    assert not distance.compiled_for(10)
-    x4 = np.random.default_rng(1).normal(size=(50, 4, 3))
-    distance.point_triangle(x4)
-    # the numpy twin's modelled time was charged: its 50 rows at 1.3 us, not the clock, so that every run
-    # of a command switches at the same call (compiled.NUMPY_BUDGET_S)
-    assert compiled._numpy_seconds[0] == pytest.approx(50 * 1.3e-6, rel=1e-12)
-    distance.point_triangle(x4)
-    assert compiled._numpy_seconds[0] == pytest.approx(100 * 1.3e-6, rel=1e-12)
-    compiled._numpy_seconds[0] = 2 * compiled.NUMPY_BUDGET_S
-    assert distance.compiled_for(10)
+    # loaded or not, a call outside a run chooses by its size alone, and a run's choice decides
+    n = distance.COMPILED_MIN_PAIRS
+    assert not distance.compiled_for(n - 1) and distance.compiled_for(n)
+    assert distance.compiled_for(1, True) and not distance.compiled_for(10 * n, False)
 
 
 @pytest.mark.parametrize("s", [0.0, 1.0])
@@ -181,26 +170,3 @@ def test_near_pair_distances_by_index_agree(monkeypatch):
     assert len(pa) == len(pairs.pt) and len(eb) == len(pairs.ee) and len(pa) and len(ea)
     np.testing.assert_allclose(pb, pa, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(eb, ea, rtol=1e-12, atol=1e-15)
-
-
-def test_the_membrane_numpy_twins_charge_a_modelled_time(monkeypatch):
-    # the membrane's numpy twins under the "auto" back end charge rows x a cost per element, the same in
-    # every run (a clock-charged budget made runs of one command differ at round-off: README)
-    from rftstatic import compiled
-    from rftstatic.element import membrane
-    from rftstatic.material import preset
-    from rftstatic.mesh.trimesh import rectangle
-    from rftstatic.model.model import Model
-
-    model = Model(rectangle(0.2, 0.1, 5, 3), preset("wool-kang-yu"), element="RFT6", quiet=True)
-    mem, E = model.membrane, len(model.membrane.nodes)
-    U = 1e-3 * np.random.default_rng(0).standard_normal((model.mesh.n_nodes, 3))
-    monkeypatch.setattr(compiled, "_numpy_seconds", [0.0])
-    monkeypatch.setattr(compiled, "static_kernels_compiled", lambda n: False)
-    monkeypatch.setattr(membrane, "static_kernels_compiled", lambda n: False)
-    mem.element_energy(U, model.material.Dm)
-    mem.element_tangents(U, model.material.Dm)
-    cost = membrane.NUMPY_SECONDS_PER_ELEMENT
-    assert compiled._numpy_seconds[0] == pytest.approx(E * (cost["energies_numpy"] + cost["tangents_numpy"]), rel=1e-12)
-    mem.element_energy(U, model.material.Dm, backend="numpy")  # an explicit choice is not charged
-    assert compiled._numpy_seconds[0] == pytest.approx(E * (cost["energies_numpy"] + cost["tangents_numpy"]), rel=1e-12)

@@ -179,12 +179,13 @@ def test_a_step_too_long_to_sweep_is_bounded_to_the_sweep_limit():
     dx = np.zeros_like(X)
     dx[24] = [0, 0, -0.6]
     free = sc.max_step_fraction(X, dx)
-    sc.sweep_limit = 0.1  # [m]: the relative motion of the step (2 x its largest departure from the
-    # midrange motion, 2 x 0.3 m) is 0.6 m
+    sc = SelfContact(mesh, 0.05, 1.0, sweep_limit=0.1)  # [m]: the relative motion of the step (2 x its
+    # largest departure from the midrange motion, 2 x 0.3 m) is 0.6 m
     alpha = sc.max_step_fraction(X, dx)
     assert alpha == pytest.approx(0.1 / 0.6, rel=1e-12) and alpha < free
     assert sc.stats.sweeps_limited == 1
-    sc.sweep_limit = 0.5  # the bounded part reaches the triangle: the collision bound still holds
+    sc = SelfContact(mesh, 0.05, 1.0, sweep_limit=0.5)  # the bounded part reaches the triangle: the
+    # collision bound still holds
     alpha = sc.max_step_fraction(X, dx)
     assert alpha == pytest.approx(free, rel=1e-9)
     assert X[24, 2] + alpha * dx[24, 2] >= sc.min_fraction * 0.3 * (1 - 1e-6)

@@ -145,6 +145,9 @@ def test_a_pair_below_half_the_thickness_raises_the_stiffness(tmp_path):
             figures=False).summary
     assert s["converged"] and s["stable_minimum"] and s["self_intersections"]["pairs"] == 0
     assert 1 <= s["self_contact_stiffenings"] <= static.SELF_CONTACT_STIFFENINGS
+    # the raised stiffness is the solve's (its State's scale), reported with the law's own unchanged
+    scale = static.SELF_CONTACT_STIFFENING ** s["self_contact_stiffenings"]
+    assert s["self_contact"]["stiffness_scale"] == scale
     d = s["self_contact"]["thickness"]
     assert s["self_intersections"]["smallest_distance"] >= 0.5 * d
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["self_contact_stiffenings"] == s["self_contact_stiffenings"]
