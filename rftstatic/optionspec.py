@@ -9,8 +9,9 @@ of a scene table and the ``python -m rftstatic options`` listing are generated f
 declarations (:func:`schema_entries`, :func:`from_table`, :func:`describe`), so a key, its default and its
 range are written once.
 
-Units: ``unit`` names the kind of quantity (``"length"``, ``"time"``); a scene gives the value in its own
-units (:class:`~rftstatic.units.UnitSystem`), the options hold SI. ``""`` is a pure number.
+Units: ``unit`` names the kind of quantity (``"length"``, ``"time"``, ``"angle"``); a scene gives the value in
+its own units (:class:`~rftstatic.units.UnitSystem`; angles in degrees), the options hold SI, and the declared
+range is in SI (shown in the scene's units). ``""`` is a pure number.
 """
 
 from __future__ import annotations
@@ -28,8 +29,18 @@ _KINDS = {"bool": (bool,), "int": (int,), "float": (int, float), "str": (str,)}
 AUTO = "auto"
 """How a scene says None ("automatic") for a nullable option."""
 
-UNIT_LABELS = {"": "-", "length": "length", "time": "time", "count": "count"}
-"""How a unit kind is shown in the listings (scene units: the scene's ``units`` decide which)."""
+UNIT_LABELS = {"": "-", "length": "length", "time": "time", "angle": "deg"}
+"""How a unit kind is shown in the listings (lengths and times in the scene's ``units``, angles in degrees)."""
+
+
+def scene_factor(unit: str, units=None) -> float:
+    """SI value of one scene unit of the quantity ``unit`` [SI / scene unit]: a length or time by the scene's
+    :class:`~rftstatic.units.UnitSystem` ``units`` (None: SI), an angle from degrees to radians, else 1."""
+    if unit == "angle":
+        return math.pi / 180.0
+    if unit in ("length", "time") and units is not None:
+        return float(getattr(units, unit))
+    return 1.0
 
 
 @dataclass(frozen=True)
@@ -58,11 +69,13 @@ class OptionSpec:
     nullable: bool = False
     scene: bool = True
 
-    def range_text(self) -> str:
-        """The range in words: ``"in (0, 1]"``, ``">= 1"``, ``"one of a, b"``, or ``""``."""
+    def range_text(self, factor: float = 1.0) -> str:
+        """The range in words: ``"in (0, 1]"``, ``">= 1"``, ``"one of a, b"``, or ``""``; ``factor``: SI value of
+        one unit the range is shown in (:func:`scene_factor`)."""
         if self.choices:
             return "one of " + ", ".join(self.choices)
-        lo, hi = self.low, self.high
+        lo = None if self.low is None else self.low / factor
+        hi = None if self.high is None else self.high / factor
         show = (lambda v: f"{int(v):,}") if self.kind == "int" else (lambda v: f"{v:g}")
         if lo is not None and hi is not None:
             return f"in {'(' if self.open_low else '['}{show(lo)}, {show(hi)}{')' if self.open_high else ']'}"
@@ -72,8 +85,10 @@ class OptionSpec:
             return f"{'<' if self.open_high else '<='} {show(hi)}"
         return ""
 
-    def problem(self, value) -> str | None:
-        """What is wrong with ``value`` for this option (None: nothing)."""
+    def problem(self, value, *, shown=None, factor: float = 1.0) -> str | None:
+        """What is wrong with ``value`` (SI) for this option (None: nothing); a message shows ``shown`` (the value
+        as the user gave it, default ``value``) and the range in units of ``factor`` [SI per unit]."""
+        shown = value if shown is None else shown
         if value is None:
             return None if self.nullable else "must be given (None is not allowed)"
         types = _KINDS[self.kind]
@@ -81,18 +96,18 @@ class OptionSpec:
             noun = {"bool": "true or false", "int": "an integer", "float": "a number", "str": "a string"}[self.kind]
             if self.nullable:
                 noun += f' or "{AUTO}"'
-            return f"must be {noun}, got {value!r} ({type(value).__name__})"
+            return f"must be {noun}, got {shown!r} ({type(value).__name__})"
         if self.kind == "str" and self.choices and value not in self.choices:
             near = difflib.get_close_matches(value, self.choices, n=1)
             hint = f' (did you mean "{near[0]}"?)' if near else ""
             return f'"{value}" is not one of {", ".join(self.choices)}{hint}'
         if self.kind in ("int", "float"):
             if not math.isfinite(value):
-                return f"must be a finite number, got {value!r}"
+                return f"must be a finite number, got {shown!r}"
             below = self.low is not None and (value <= self.low if self.open_low else value < self.low)
             above = self.high is not None and (value >= self.high if self.open_high else value > self.high)
             if below or above:
-                return f"{value!r} is out of range: must be {self.range_text()}"
+                return f"{shown!r} is out of range: must be {self.range_text(factor)}"
         return None
 
 
@@ -160,12 +175,12 @@ def from_table(classes, table: dict, section: str, units=None) -> dict:
         cls, spec = owner[key]
         if spec.nullable and value == AUTO:
             value = None
-        bad = spec.problem(value)  # in the scene's units, as the user wrote it (a unit's scale is positive)
+        shown, factor = value, scene_factor(spec.unit, units)
+        if factor != 1.0 and isinstance(value, (int, float)) and not isinstance(value, bool):
+            value = value * factor
+        bad = spec.problem(value, shown=shown, factor=factor)  # the message in the user's own units
         if bad is not None:
             raise ParameterError(f"{section}.{key}", bad)
-        if units is not None and spec.unit in ("length", "time") and isinstance(value, (int, float)) \
-                and not isinstance(value, bool):
-            value = value * getattr(units, spec.unit)
         out[cls][key] = value
     return out
 
@@ -175,7 +190,7 @@ def _help_line(spec: OptionSpec, default) -> str:
     if spec.unit:
         parts.append(f"[{UNIT_LABELS.get(spec.unit, spec.unit)}]")
     if spec.range_text() and not spec.choices:
-        parts.append(spec.range_text())
+        parts.append(spec.range_text(scene_factor(spec.unit)))
     return " ".join(parts)
 
 
@@ -187,7 +202,9 @@ def describe(classes, section: str) -> list[dict]:
         for name, spec, default in declared(cls):
             if not spec.scene:
                 continue
+            factor = scene_factor(spec.unit)
+            shown = default / factor if factor != 1.0 and isinstance(default, float) else default
             rows.append({"key": f"{section}.{name}", "type": spec.kind, "unit": UNIT_LABELS.get(spec.unit, spec.unit),
-                         "range": spec.range_text(), "default": AUTO if default is None else default,
+                         "range": spec.range_text(factor), "default": AUTO if default is None else shown,
                          "help": spec.help, "group": cls.__name__})
     return rows

@@ -15,7 +15,7 @@ import numpy as np
 from rftstatic.errors import ParameterError, SceneError
 from rftstatic.optionspec import from_table
 from rftstatic.remesh.adapt import check_remesh_parameters
-from rftstatic.scenes.run_options import SOLVER_GROUPS, RunOptions
+from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions, RunOptions
 from rftstatic.solvers.explicit import default_max_steps
 from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
@@ -218,24 +218,6 @@ def remesh_options(scene) -> RemeshOptions:
     return RemeshOptions(**{k: (v * u if k in REMESH_LENGTH_KEYS and v is not None else v) for k, v in r.items()})
 
 
-@dataclass(frozen=True)
-class CantileverOptions:
-    """``[cantilever]`` of a cantilever-tester scene (Peirce; ASTM D1388, BS 3356).
-
-    Attributes
-    ----------
-    angle : the tester's plane below the horizontal [rad] (41.5 deg)
-    growth : overhang factor per step while the tip is above the plane [-]
-    tolerance : relative change of the overhang at which the root find stops [-]
-    max_solves : most static solves (growth steps and root-find steps together)
-    """
-
-    angle: float = float(np.radians(41.5))
-    growth: float = 1.15
-    tolerance: float = 1e-7
-    max_solves: int = 60
-
-
 def seed_count(scene) -> int:
     """``solver.seeds``: how many seeded starts a static drape runs (a lab's specimens), checked; 1 by default.
     More than one needs a seeded start (``solver.perturbation`` > 0)."""
@@ -249,20 +231,13 @@ def seed_count(scene) -> int:
 
 
 def cantilever_options(scene) -> CantileverOptions:
-    """The scene's ``[cantilever]`` table checked, angles in radians."""
-    c = dict(scene.get("cantilever", {}))
-    if "angle" in c and not 1.0 <= c["angle"] <= 80.0:
-        raise scene.error("cantilever.angle", f"{c['angle']!r} must lie in [1, 80] deg (the tester's plane below "
-                          "the horizontal: 41.5 in ASTM D1388 and BS 3356)")
-    if "growth" in c and not 1.0 < c["growth"] <= 2.0:
-        raise scene.error("cantilever.growth", f"{c['growth']!r} must lie in (1, 2] (overhang factor per step)")
-    if "tolerance" in c and not 1e-12 <= c["tolerance"] <= 1e-2:
-        raise scene.error("cantilever.tolerance", f"{c['tolerance']!r} must lie in [1e-12, 1e-2]")
-    if "max_solves" in c and not c["max_solves"] >= 3:
-        raise scene.error("cantilever.max_solves", f"{c['max_solves']!r} must be an integer >= 3")
-    if "angle" in c:
-        c["angle"] = float(np.radians(c["angle"]))
-    return CantileverOptions(**c)
+    """The scene's ``[cantilever]`` table checked (:class:`~rftstatic.scenes.run_options.CantileverOptions`), the
+    angle in radians."""
+    try:
+        table = from_table((CantileverOptions,), dict(scene.get("cantilever", {})), "cantilever", scene.units)
+        return CantileverOptions(**table[CantileverOptions])
+    except ParameterError as exc:
+        raise scene.error(exc.key, exc.detail) from None
 
 
 __all__ = ["run_options", "declared_run_options", "seed_count", "cantilever_options", "CantileverOptions",

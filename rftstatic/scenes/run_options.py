@@ -1,5 +1,6 @@
-"""The ``[solver]`` keys that the app reads rather than the solver: the mesh sequence, the seeded specimens
-and the membrane switch of the model, declared once (:mod:`rftstatic.optionspec`).
+"""The options the app reads rather than a solver, declared once (:mod:`rftstatic.optionspec`): the
+``[solver]`` table's mesh sequence, seeded specimens and membrane switch (:class:`RunOptions`), and the
+cantilever tester's ``[cantilever]`` table (:class:`CantileverOptions`).
 
 The static solver's own keys are :mod:`rftstatic.solvers.options`; the scene's ``[solver]`` table holds
 both (:data:`SOLVER_GROUPS`), each key declared in exactly one group.
@@ -7,12 +8,13 @@ both (:data:`SOLVER_GROUPS`), each key declared in exactly one group.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from rftstatic.optionspec import check, option
 from rftstatic.solvers.options import GROUPS
 
-__all__ = ["MAX_LEVELS", "MAX_SEEDS", "RunOptions", "SOLVER_GROUPS"]
+__all__ = ["CantileverOptions", "MAX_LEVELS", "MAX_SEEDS", "RunOptions", "SOLVER_GROUPS"]
 
 MAX_LEVELS = 6
 """Most meshes of a sequence (the finest 2^5 = 32 times finer than the coarsest)."""
@@ -42,3 +44,20 @@ class RunOptions:
 
 SOLVER_GROUPS = (*GROUPS, RunOptions)
 """Every declared group of the scene's ``[solver]`` table."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class CantileverOptions:
+    """``[cantilever]`` of a cantilever-tester scene (Peirce; ASTM D1388, BS 3356); ``angle`` in SI [rad]."""
+
+    angle: float = option(math.radians(41.5), "the tester's plane below the horizontal (41.5 deg in ASTM D1388 and "
+                          "BS 3356)", unit="angle", low=math.radians(1.0), high=math.radians(80.0))
+    growth: float = option(1.15, "overhang factor per step while the tip is above the plane", low=1.0, high=2.0,
+                           open_low=True)
+    tolerance: float = option(1e-7, "relative change of the overhang at which the root find stops", low=1e-12,
+                              high=1e-2)
+    max_solves: int = option(60, "most static solves (growth steps and root-find steps together)", low=3,
+                             high=10_000)
+
+    def __post_init__(self):
+        check(self, "cantilever")

@@ -21,7 +21,7 @@ from rftstatic.errors import SceneError
 from rftstatic.fabrics.lab import LAB_KEYS
 from rftstatic.optionspec import schema_entries
 from rftstatic.scenes.analyses import SCENE_ANALYSES
-from rftstatic.scenes.run_options import SOLVER_GROUPS
+from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
@@ -186,12 +186,8 @@ SCHEMA = {
         "damping": (str, "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's slowest "
                          "swing, at most dynamics.alpha)"),
     }, "global adaptive remeshing (§5)"),
-    "cantilever": ({
-        "angle": (NUM, "the tester's plane below the horizontal [deg] (41.5: ASTM D1388, BS 3356)"),
-        "growth": (NUM, "overhang factor per step while the tip is above the plane"),
-        "tolerance": (NUM, "relative change of the overhang at which the root find stops"),
-        "max_solves": (int, "most static solves"),
-    }, "cantilever bending tester (analysis = \"cantilever\"): the strip's mesh.size[0] is the first overhang"),
+    "cantilever": (schema_entries(CantileverOptions), "cantilever bending tester (analysis = \"cantilever\"): the "
+                   "strip's mesh.size[0] is the first overhang; python -m rftstatic options cantilever"),
     "probes": ([{"name": (str, "probe name"), "at": (XY, "[x, y] reference point")}], "tracked points"),
     "output": ({
         "views": (ListOf(str, choices=("side", "top", "iso")), "PNG views: side, top, iso"),

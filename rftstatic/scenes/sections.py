@@ -9,11 +9,11 @@ from __future__ import annotations
 
 from rftstatic.errors import SceneError
 from rftstatic.optionspec import describe
-from rftstatic.scenes.run_options import SOLVER_GROUPS
+from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 
 __all__ = ["SECTIONS", "option_rows", "format_rows"]
 
-SECTIONS = {"solver": SOLVER_GROUPS}
+SECTIONS = {"solver": SOLVER_GROUPS, "cantilever": (CantileverOptions,)}
 """Scene table -> its declared option groups."""
 
 

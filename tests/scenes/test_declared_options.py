@@ -81,6 +81,16 @@ def test_flat_keys_reach_their_groups_and_an_unknown_one_is_named():
         load_scene("strip", ["solver.rtoll=1e-9"])
 
 
+def test_an_angle_is_given_in_degrees_checked_in_degrees_and_held_in_radians():
+    from rftstatic.scenes.options import cantilever_options
+
+    opts = cantilever_options(load_scene("cantilever-warp", ["cantilever.angle=30"]))
+    assert opts.angle == pytest.approx(math.pi / 6, rel=1e-15)
+    with pytest.raises(SceneError, match=r"cantilever\.angle: 85 is out of range: must be in \[1, 80\]"):
+        cantilever_options(load_scene("cantilever-warp", ["cantilever.angle=85"]))
+    assert option_rows("cantilever")[0]["default"] == pytest.approx(41.5)
+
+
 def test_the_app_keys_resolve_auto_levels():
     assert run_options(load_scene("strip")).levels == 1
     assert run_options(load_scene("strip", ["solver.levels=2"])).levels == 2
