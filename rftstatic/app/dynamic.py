@@ -74,7 +74,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False) -> RunRe
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
     """Continue the dynamic run of ``scene`` from ``out_dir/checkpoint.npz`` (``case NAME --resume``)."""
-    if scene.get("analysis", "static") == "static":
+    if scene.analysis == "static":
         raise scene.error("analysis", "--resume continues a dynamic or relax run; this scene is static")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -108,7 +108,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    analysis = scene.get("analysis", "dynamic")
+    analysis = scene.analysis
     o = dynamics_options(scene)
     obstacles = tuple(extras.get("obstacles", ()))
     names, pnodes, pw = probe_interpolation(model.mesh, extras.get("probes", {}))

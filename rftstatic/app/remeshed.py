@@ -150,7 +150,7 @@ def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 def checkpoint_header(scene) -> dict:
     """What a remeshed run's checkpoint is keyed to: the scene's name, analysis and its data after the ``--set``
     overrides (but the ``[output]`` table, which does not change the run)."""
-    return {"scene": scene.name, "analysis": scene.get("analysis", "static"),
+    return {"scene": scene.name, "analysis": scene.analysis,
             "data": {k: v for k, v in scene.data.items() if k != "output"}}
 
 
@@ -168,7 +168,7 @@ def solve_remesh_scene(scene, opts=None, *, checkpoint=None, restart=None) -> di
     ``checkpoint``: a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`; ``restart``: a
     :class:`~rftstatic.remesh.checkpoint.RemeshRestart` to continue from."""
     opts = remesh_options(scene) if opts is None else opts
-    analysis = scene.get("analysis", "static")
+    analysis = scene.analysis
     t0 = time.perf_counter()
     if analysis not in ("static", "relax"):
         raise scene.error("analysis", f'"{analysis}" cannot be remeshed; use "static" or "relax" with [remesh]')
@@ -308,7 +308,7 @@ def summarize(scene, opts, solved) -> dict:
         records.append(d)
     settings = {k: (v / u.length if k in REMESH_LENGTH_KEYS and v is not None else v)
                 for k, v in dataclasses.asdict(opts).items()}
-    summary = summary_header(scene, model, scene.get("analysis", "static"))
+    summary = summary_header(scene, model, scene.analysis)
     summary.update({
         "route": solved["route"], "initial_nodes": records[0]["nodes"],
         "remeshes": len(records) - 1, "converged": solved["converged"], "wall_time_s": solved["wall_time_s"],

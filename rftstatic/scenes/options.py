@@ -130,7 +130,7 @@ CHECKPOINT_EVERY_S = 0.2
 
 def dynamics_options(scene) -> DynamicsOptions:
     """The scene's ``[dynamics]`` table checked and converted to SI, with the defaults filled in."""
-    analysis = scene.get("analysis", "static")
+    analysis = scene.analysis
     if analysis not in DYNAMICS_DEFAULTS:
         raise scene.error("analysis", f'"{analysis}" has no [dynamics]; use "dynamic" or "relax"')
     d = dict(scene.get("dynamics", {}))
@@ -245,7 +245,7 @@ def seed_count(scene) -> int:
     if n > 1 and not scene.get("solver.perturbation", 0.0) > 0:
         raise scene.error("solver.seeds", f"{n} seeded starts need a seeded lift: give solver.perturbation > 0 "
                           "(e.g. 0.01 element sizes), or every start is the same")
-    if n > 1 and scene.get("analysis", "static") != "static":
+    if n > 1 and scene.analysis != "static":
         raise scene.error("solver.seeds", f"{n!r}: seeded starts are run by the static analysis only")
     return n
 
