@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rftstatic.mesh import GRADATION
 from rftstatic.contact.candidates import CandidateList
 from rftstatic.remesh.adapt import (
     DAMPING,
@@ -222,7 +223,7 @@ def _initial_state(model, U0, V0) -> RelaxState:
 
 def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, mass_scale=RELAX_MASS_SCALE,
                  damping="fixed", every=None, kappa_h2_max=None, chunk=200, max_steps=100_000, max_remesh=50,
-                 tol=0.05, tol_force=1e-4, tol_kinetic=1e-8, skip_settled=True, gradation=1.3, transfer="mesh",
+                 tol=0.05, tol_force=1e-4, tol_kinetic=1e-8, skip_settled=True, gradation=GRADATION, transfer="mesh",
                  domain=None, U0=None, V0=None, residual=None, checkpoint=None, restart=None) -> RemeshRelaxResult:
     """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6).
 

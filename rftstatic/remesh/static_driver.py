@@ -9,6 +9,7 @@ import logging
 import time
 from dataclasses import dataclass, field
 
+from rftstatic.mesh import GRADATION
 from rftstatic.remesh.adapt import (
     RemeshRecord,
     _check_extent,
@@ -54,7 +55,7 @@ def _continuation(options):
 
 
 def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, kappa_h_max=None,
-                  gradation=1.3, transfer="mesh", options=None, domain=None, checkpoint=None,
+                  gradation=GRADATION, transfer="mesh", options=None, domain=None, checkpoint=None,
                   restart=None) -> RemeshStaticResult:
     """Static solution with global adaptive remeshing (module docstring).
 

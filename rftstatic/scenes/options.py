@@ -12,6 +12,7 @@ from dataclasses import MISSING, dataclass, fields
 
 import numpy as np
 
+from rftstatic.mesh import GRADATION
 from rftstatic.errors import ParameterError, SceneError
 from rftstatic.remesh.adapt import check_remesh_parameters
 from rftstatic.solvers.explicit import default_max_steps
@@ -190,7 +191,7 @@ class RemeshOptions:
     const: float
     h_lower: float
     h_upper: float
-    gradation: float = 1.3
+    gradation: float = GRADATION
     max_cycles: int = 5
     tol: float = 0.05
     kappa_h_max: float | None = None
