@@ -43,7 +43,7 @@ from rftstatic.scenes.options import dynamics_options, static_options
 from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
 from rftstatic.solvers.checkpoint import resume as resume_run
 from rftstatic.solvers.explicit import STEPS_PER_SIDE_NODE, default_max_steps, run_explicit, step_count
-from rftstatic.solvers.relaxation import AtRest
+from rftstatic.solvers.rest import AtRest, RestCriterion
 from rftstatic.solvers.static import compare_with_static, solve_static
 from rftstatic.solvers.timestep import stable_time_step
 
@@ -117,7 +117,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     save_times = np.unique(np.concatenate([o.frames, regular]))
 
     free_load = float(np.linalg.norm(np.where(model.free, model.load, 0.0)))
-    rest = AtRest(tol_kinetic=o.rest_tolerance, tol_force=o.force_tolerance, load_norm=free_load)
+    rest = AtRest(RestCriterion(o.rest_tolerance, o.force_tolerance), load_norm=free_load)
 
     def watch(state, rec):
         at_rest = rest(state, rec)  # tracks the peak kinetic energy at every sample
@@ -141,10 +141,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         if not np.array_equal(np.asarray(saved["frame_times"], float), save_times):
             raise scene.error("dynamics.frames", f"the checkpoint {ckpt_path} saved other frame times; run "
                               "without --resume")
-        hist_k = np.asarray(data["history"]["kinetic"], float)
-        rest.peak_kinetic = float(hist_k.max()) if hist_k.size else 0.0
-        hist_r = np.asarray(data["history"]["residual"], float)
-        rest.peak_residual = float(hist_r.max()) if hist_r.size else 0.0
+        rest.resume_from(data["history"])
         dt = data["dt"]
         ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, dt))
         resumed_from = data["t"]

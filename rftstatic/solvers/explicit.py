@@ -45,6 +45,7 @@ from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.errors import InstabilityError, StepLimitError
 from rftstatic.model.state import State
 from rftstatic.progress import Progress
+from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.timestep import StepEstimate, lumped_mass, stable_time_step
 
 log = logging.getLogger(__name__)
@@ -179,7 +180,7 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
     return ExplicitResult(
         U=state.U, V=state.V, t=state.t, steps=state.step, dt=dt, estimate=estimate, history=history,
         probes=np.asarray(loop.probe_hist, dtype=float).reshape(len(loop.probe_hist), len(probes), 3),
-        frames=loop.frames, time_at_rest=_time_at_rest(history, rest_tol), stopped=stopped,
+        frames=loop.frames, time_at_rest=RestCriterion(rest_tol).time_at_rest(history), stopped=stopped,
         contact_nodes=loop.n_contact, wall_time=wall,
         element_steps_per_second=model.mesh.n_elements * state.step / max(wall, 1e-12), state=state)
 
@@ -460,15 +461,4 @@ def _contact(model, obstacles, U, V, mass, acc) -> int:
         np.subtract(x_new, X3, out=U)
         V[...] = v_new
     return n_active
-
-
-def _time_at_rest(history, rest_tol):
-    kin = history["kinetic"]
-    if len(kin) < 2 or not np.isfinite(kin).all() or kin.max() <= 0:
-        return None
-    moving = np.flatnonzero(kin > rest_tol * kin.max())
-    if len(moving) == 0 or moving[-1] == len(kin) - 1:
-        return None
-    return float(history["time"][moving[-1] + 1])
-
 

@@ -12,38 +12,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from rftstatic.solvers.explicit import ExplicitResult, run_explicit
+from rftstatic.solvers.rest import AtRest, RestCriterion
 
 log = logging.getLogger(__name__)
 
 RELAX_MASS_SCALE = 100.0
 """Mass-scaling factor s of dynamic relaxation (§6 uses 100): the stable step grows by sqrt(s)."""
-
-
-@dataclass
-class AtRest:
-    """The rest test of dynamic relaxation, as an explicit-run callback ``(state, sample) -> bool``.
-
-    At rest: kinetic energy <= ``tol_kinetic`` times the peak kinetic energy and the out-of-balance force on
-    the free dofs <= ``tol_force`` times ``load_norm`` [N]. ``peak_kinetic`` [J] is the peak so far (updated
-    at every sample; start it from an earlier run's peak to resume). A sheet without load (``load_norm`` 0)
-    measures its force against the largest out-of-balance force it has had (``peak_residual`` [N], the
-    internal force of a perturbed start); one with neither motion nor out-of-balance force (zero kinetic
-    energy, zero residual: an unloaded flat sheet) is already at rest.
-    """
-
-    tol_kinetic: float
-    tol_force: float
-    load_norm: float
-    peak_kinetic: float = 0.0
-    peak_residual: float = 0.0
-
-    def __call__(self, state, rec) -> bool:
-        self.peak_kinetic = peak = max(self.peak_kinetic, rec["kinetic"])
-        self.peak_residual = max(self.peak_residual, rec["residual"])
-        force_scale = self.load_norm if self.load_norm > 0 else self.peak_residual
-        still = rec["kinetic"] <= self.tol_kinetic * peak if peak > 0 else rec["kinetic"] == 0.0
-        return bool(still and rec["residual"] <= self.tol_force * force_scale
-                    and (peak > 0 or rec["residual"] == 0.0))
 
 
 @dataclass
@@ -92,16 +66,9 @@ def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kine
     """
     P = model.load if load is None else load
     P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
-    if restart is not None:  # the peak of the samples before the interruption, as the rest test saw them
-        kinetic = np.asarray(restart["history"]["kinetic"], dtype=float)
-        peak_kinetic = max(peak_kinetic, float(kinetic.max())) if kinetic.size else peak_kinetic
-        residual = np.asarray(restart["history"]["residual"], dtype=float)
-        peak_residual = float(residual.max()) if residual.size else 0.0
-    else:
-        peak_residual = 0.0
-
-    at_rest = AtRest(tol_kinetic=tol_kinetic, tol_force=tol_force, load_norm=P_norm, peak_kinetic=peak_kinetic,
-                     peak_residual=peak_residual)
+    at_rest = AtRest(RestCriterion(tol_kinetic, tol_force), load_norm=P_norm, peak_kinetic=peak_kinetic)
+    if restart is not None:  # the peaks of the samples before the interruption, as the rest test saw them
+        at_rest.resume_from(restart["history"])
     run = run_explicit(model, t_end=max_time, dt=dt, alpha=alpha, mass_scale=mass_scale, obstacles=obstacles,
                        U0=U0, V0=V0, start="consistent" if V0 is None else "given", sample_every=sample_every,
                        callback=at_rest, progress=progress, backend=backend, load=load, checkpoint=checkpoint,

@@ -222,15 +222,15 @@ def test_an_unloaded_relaxation_is_at_rest(capsys, tmp_path):
 
 
 def test_the_rest_test_of_a_perturbed_unloaded_sheet_measures_its_own_peak_force():
-    from rftstatic.solvers.relaxation import AtRest
+    from rftstatic.solvers.rest import AtRest, RestCriterion
 
-    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    rest = AtRest(RestCriterion(1e-8, 1e-4), load_norm=0.0)
     assert rest(None, {"kinetic": 0.0, "residual": 0.0})  # no motion, no force: at rest
-    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    rest = AtRest(RestCriterion(1e-8, 1e-4), load_norm=0.0)
     assert not rest(None, {"kinetic": 0.0, "residual": 1.0})  # a perturbed start
     assert not rest(None, {"kinetic": 1.0, "residual": 0.5})
     assert rest(None, {"kinetic": 1e-9, "residual": 1e-5})
-    loaded = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=1.0)
+    loaded = AtRest(RestCriterion(1e-8, 1e-4), load_norm=1.0)
     assert not loaded(None, {"kinetic": 0.0, "residual": 1.0})  # the first sample of a loaded sheet
 
 
