@@ -48,13 +48,14 @@ from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_sum
                                    summary_header)
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.remesh.checkpoint import FIX, RemeshCheckpointer, load_remesh_checkpoint
+from rftstatic.remesh.options import RemeshRelaxOptions
 from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
 from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.scenes.build import MAX_MESH_NODES, build_model
 from rftstatic.scenes.options import REMESH_LENGTH_KEYS, dynamics_options, remesh_options, static_options
-from rftstatic.solvers.explicit import step_count
+from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.static_checkpoint import CHECKPOINT_SECONDS, remove_stale
-from rftstatic.solvers.timestep import stable_time_step
+from rftstatic.solvers.step_plan import plan_steps
 
 log = logging.getLogger(__name__)
 
@@ -190,10 +191,7 @@ def _static(scene, opts, checkpoint=None, restart=None) -> dict:
     if restart is not None and restart.phase != "cycle":
         raise CheckpointError(f"checkpoint {restart.path} is a remeshed relaxation's, this scene's route is static; "
                               f"{FIX}")
-    res = remesh_static(factory, const=opts.const, h_lower=opts.h_lower, h_upper=opts.h_upper,
-                        max_cycles=opts.max_cycles, tol=opts.tol, kappa_h_max=opts.kappa_h_max,
-                        gradation=opts.gradation, transfer=opts.transfer,
-                        options=static_options(scene, progress=False), checkpoint=checkpoint,
+    res = remesh_static(factory, opts, solver=static_options(scene, progress=False), checkpoint=checkpoint,
                         restart=None if restart is None else restart.state)
     meshes = [{"mesh": m, "U": None, "t": 0.0, "step": 0} for m in res.meshes]
     meshes[-1]["U"] = res.result.U
@@ -233,12 +231,10 @@ def _relax(scene, opts, checkpoint=None, restart=None) -> dict:
         return contact_reaction_residual(model, obstacles, U)
 
     try:
-        res = remesh_relax(make, const=opts.const, h_lower=opts.h_lower, h_upper=opts.h_upper,
-                           advance=track, mass_scale=d.mass_scale, every=opts.every,
-                           kappa_h2_max=opts.kappa_h2_max, max_steps=max_steps, tol=opts.tol,
-                           tol_force=d.force_tolerance, tol_kinetic=d.rest_tolerance,
-                           gradation=opts.gradation, transfer=opts.transfer, residual=residual,
-                           checkpoint=checkpoint, restart=None if restart is None else restart.state)
+        motion = RemeshRelaxOptions(mass_scale=d.mass_scale, max_steps=max_steps,
+                                    rest=RestCriterion(d.rest_tolerance, d.force_tolerance))
+        res = remesh_relax(make, opts, motion, advance=track, residual=residual, checkpoint=checkpoint,
+                           restart=None if restart is None else restart.state)
         model, U, records, converged, skipped = res.model, res.U, res.records, res.converged, res.skipped
         t, steps = res.t, res.steps
         stopped_by = "rest" if converged else "max_steps" if steps >= max_steps else "max_remesh"
@@ -286,10 +282,9 @@ def _check_node_budget(scene, opts, mesh) -> float:
 def _check_step_budget(scene, d, model, max_steps) -> None:
     """Refuse, before it starts, a remeshed relaxation whose first mesh needs more than ``max_steps`` (the step
     limit, ``dynamics.max_steps`` or its default for the finest mesh ``remesh.h_lower`` allows) explicit steps to reach ``t_end`` (the run also stops at ``max_steps`` on the later meshes)."""
-    dt = d.dt if d.dt is not None else stable_time_step(model, mass_scale=d.mass_scale, alpha=d.alpha,
-                                                        safety=SAFETY).dt
     try:
-        step_count(d.t_end, dt, max_steps)
+        plan_steps(model, t_end=d.t_end, dt=d.dt, alpha=d.alpha, mass_scale=d.mass_scale, safety=SAFETY,
+                   max_steps=max_steps, check_dt=False)
     except ValueError as exc:
         raise scene.error("dynamics.dt" if d.dt is not None else "dynamics.t_end", f"{exc} (on the first "
                           "mesh)") from None
@@ -327,6 +322,7 @@ def summarize(scene, opts, solved) -> dict:
         P = np.where(model.free, model.load, 0.0)
         r = np.where(model.free, contact_reaction_residual(model, solved["extras"].get("obstacles", ()), U), 0.0)
         summary["residual_relative"] = float(np.linalg.norm(r) / max(np.linalg.norm(P), 1e-300))
+        summary["rest_test"] = RestCriterion(d.rest_tolerance, d.force_tolerance).record()
     else:
         summary["newton_iterations"] = int(solved["records"][-1].solve.get("iterations", 0))
     if solved["extras"].get("obstacles"):

@@ -230,9 +230,10 @@ def refinable_maxima(mesh, kappa, *, const, h_lower):
     return float((mag * h)[keep].max(initial=0.0)), float((mag * h * h)[keep].max(initial=0.0))
 
 
-def check_remesh_parameters(*, const, h_lower, h_upper, gradation=GRADATION, max_cycles=5, tol=0.05, kappa_h_max=None,
-                            transfer="mesh", every=None, kappa_h2_max=None, damping="fixed") -> None:
-    """Check the options of :func:`remesh_static` and :func:`remesh_relax` (any consistent units).
+def check_remesh_parameters(*, const, h_lower, h_upper, gradation, max_cycles, tol, kappa_h_max, transfer, every,
+                            kappa_h2_max, damping) -> None:
+    """Check the fields of :class:`~rftstatic.remesh.options.RemeshOptions` (any consistent units; the
+    defaults are that class's).
 
     Raises :class:`~rftstatic.errors.ParameterError` whose ``key`` names the parameter: const, h_lower,
     h_upper, gradation, tol must be positive finite numbers (kappa_h_max too unless None), h_lower <=

@@ -2,8 +2,8 @@
 
 Every default is written once: the static solver's in :class:`~rftstatic.solvers.newton.StaticOptions`,
 the explicit and relaxation runs' in :data:`DYNAMICS_DEFAULTS` (per analysis type), the remeshing
-drivers' in :class:`RemeshOptions`. A bad value raises :class:`~rftstatic.errors.SceneError` naming the
-file, the key and the value.
+drivers' in :class:`~rftstatic.remesh.options.RemeshOptions`. A bad value raises
+:class:`~rftstatic.errors.SceneError` naming the file, the key and the value.
 """
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ from dataclasses import MISSING, dataclass, fields
 
 import numpy as np
 
-from rftstatic.mesh import GRADATION
 from rftstatic.errors import ParameterError, SceneError
-from rftstatic.remesh.adapt import check_remesh_parameters
-from rftstatic.solvers.explicit import default_max_steps
+from rftstatic.remesh.options import RemeshOptions
 from rftstatic.solvers.newton import StaticOptions
-from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RELAX_REST
+from rftstatic.solvers.rest import RestCriterion
+from rftstatic.solvers.step_plan import default_max_steps
 
 _STATIC_KEYS = {f.name for f in fields(StaticOptions)} - {"progress"}
 _STATIC_LENGTH_KEYS = ("max_step", "increment_displacement")
@@ -78,7 +78,7 @@ DYNAMICS_DEFAULTS = {
     # true dynamics (§4.6): the real mass, no damping unless the scene asks, rest at 1e-3 of the peak
     "dynamic": {"alpha": 0.0, "mass_scale": 1.0, "rest_tolerance": 1e-3},
     # dynamic relaxation (§6): alpha = 5/s with mass scaling s = 100, rest at 1e-8 of the peak
-    "relax": {"alpha": 5.0, "mass_scale": RELAX_MASS_SCALE, "rest_tolerance": 1e-8},
+    "relax": {"alpha": 5.0, "mass_scale": RELAX_MASS_SCALE, "rest_tolerance": RELAX_REST.tol_kinetic},
 }
 """Defaults of ``[dynamics]`` that depend on the analysis type (scene units); the others are in
 :class:`DynamicsOptions`."""
@@ -112,7 +112,7 @@ class DynamicsOptions:
     frames: np.ndarray
     checkpoint_every: float
     rest_tolerance: float
-    force_tolerance: float = 1e-4
+    force_tolerance: float = RELAX_REST.tol_force
     samples: int = 30
     compare_static: bool = False
     max_steps: int | None = None
@@ -151,6 +151,11 @@ def dynamics_options(scene) -> DynamicsOptions:
     for key in ("t_end", "mass_scale", "rest_tolerance", "force_tolerance", "checkpoint_every"):
         positive(key)
     positive("alpha", strict=False)
+    try:
+        RestCriterion(opts["rest_tolerance"], opts["force_tolerance"])
+    except ParameterError as exc:
+        key = {"tol_kinetic": "rest_tolerance", "tol_force": "force_tolerance"}[exc.key]
+        raise scene.error(f"dynamics.{key}", exc.detail) from None
     if opts["max_steps"] is not None and not (isinstance(opts["max_steps"], int) and opts["max_steps"] >= 1):
         raise scene.error("dynamics.max_steps", f"must be a positive integer, got {opts['max_steps']!r}")
     if opts.get("dt") is not None:
@@ -171,50 +176,23 @@ def dynamics_options(scene) -> DynamicsOptions:
         max_steps=None if opts["max_steps"] is None else int(opts["max_steps"]))
 
 
-@dataclass(frozen=True)
-class RemeshOptions:
-    """``[remesh]`` of a scene, in SI (Eq. 29: h_new = sqrt(const / |kappa|) in [h_lower, h_upper]).
-
-    Attributes
-    ----------
-    const : [m]; h_lower, h_upper : element size bounds [m]
-    gradation : largest size ratio between neighbours one element apart [-]
-    max_cycles : static route: most remeshing cycles
-    tol : stop when the node count changes by less than this fraction [-]
-    kappa_h_max : static route: largest |kappa| h accepted without remeshing [-] (None: node count alone)
-    transfer : "mesh", "patch" or "grid" (:mod:`rftstatic.remesh.transfer`)
-    every : relax route: remesh every this many steps (None: on the curvature trigger)
-    kappa_h2_max : relax route: remesh when max |kappa| h^2 exceeds this [m]
-    damping : relax route: "fixed" (dynamics.alpha) or "critical"
-    """
-
-    const: float
-    h_lower: float
-    h_upper: float
-    gradation: float = GRADATION
-    max_cycles: int = 5
-    tol: float = 0.05
-    kappa_h_max: float | None = None
-    transfer: str = "mesh"
-    every: int | None = None
-    kappa_h2_max: float | None = None
-    damping: str = "fixed"
-
-
 REMESH_LENGTH_KEYS = ("const", "h_lower", "h_upper", "kappa_h2_max")
 """``[remesh]`` keys that are lengths (scene units in the file, SI in :class:`RemeshOptions`)."""
 
 
 def remesh_options(scene) -> RemeshOptions:
-    """The scene's ``[remesh]`` table with defaults, checked (:func:`check_remesh_parameters`), in SI."""
+    """The scene's ``[remesh]`` table with defaults, checked, as :class:`~rftstatic.remesh.options.RemeshOptions`
+    in SI."""
     r = dict(scene.get("remesh", {}))
     for key in ("const", "h_lower", "h_upper"):
         if key not in r:
             raise scene.error(f"remesh.{key}", f"a [remesh] table needs {key} (Eq. 29, scene length units)")
     try:
-        check_remesh_parameters(**r)
+        RemeshOptions(**r)  # checked in the scene's units, which its messages then quote
     except ParameterError as exc:
         raise scene.error(f"remesh.{exc.key}", exc.detail) from None
+    except TypeError as exc:  # a key the schema let through that the options do not know
+        raise scene.error("remesh", str(exc)) from None
     u = scene.units.length
     return RemeshOptions(**{k: (v * u if k in REMESH_LENGTH_KEYS and v is not None else v) for k, v in r.items()})
 
@@ -268,5 +246,6 @@ def cantilever_options(scene) -> CantileverOptions:
     return CantileverOptions(**c)
 
 
-__all__ = ["seed_count", "cantilever_options", "CantileverOptions", "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
+__all__ = ["seed_count", "cantilever_options", "CantileverOptions", "static_options", "dynamics_options",
+           "remesh_options", "DynamicsOptions",
            "DYNAMICS_DEFAULTS", "SceneError"]

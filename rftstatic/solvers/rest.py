@@ -11,7 +11,7 @@ and, where the criterion asks for the force too (``tol_force`` not None),
     r <= tol_force |P|                       (|P|: the external load on the free dofs)
 
 with ``|P|`` replaced by the largest ``r`` so far for a sheet without load (the internal force of a perturbed
-start), and, while nothing has moved yet (T_peak = 0), only ``r = 0`` at rest (an unloaded flat sheet).
+start); an unloaded sheet that has not moved (T_peak = 0) is at rest only at ``r = 0`` (a flat sheet).
 
 :class:`AtRest` applies the test at every sample of a running motion (tracking the peaks; an explicit-run
 callback); :meth:`RestCriterion.time_at_rest` reads a finished history. What velocity gives ``T`` is the
@@ -60,16 +60,20 @@ class RestCriterion:
         """What a run's summary says of its rest test: criterion and tolerances."""
         return {"criterion": self.name, "tol_kinetic": self.tol_kinetic, "tol_force": self.tol_force}
 
-    def holds(self, kinetic, peak_kinetic, residual=0.0, force_scale=0.0):
+    def holds(self, kinetic, peak_kinetic, residual=0.0, load_norm=0.0, peak_residual=0.0):
         """Whether samples are at rest: ``kinetic`` [J] against ``peak_kinetic`` [J] (the peak up to each
-        sample), ``residual`` [N] against ``force_scale`` [N] (:func:`force_scale`). Scalars or arrays of
-        samples (element-wise)."""
+        sample), ``residual`` [N] against ``load_norm`` [N] (|P| on the free dofs), or for an unloaded sheet
+        (``load_norm`` 0) against ``peak_residual`` [N] (the largest residual up to each sample). Scalars or
+        arrays of samples (element-wise)."""
         kinetic, peak = np.asarray(kinetic, dtype=float), np.asarray(peak_kinetic, dtype=float)
         still = np.where(peak > 0, kinetic <= self.tol_kinetic * peak, kinetic == 0.0)
         if self.tol_force is not None:
             residual = np.asarray(residual, dtype=float)
-            still = still & (residual <= self.tol_force * np.asarray(force_scale, dtype=float)) & (
-                (peak > 0) | (residual == 0.0))
+            if load_norm > 0:
+                still = still & (residual <= self.tol_force * load_norm)
+            else:  # its own peak force measures an unloaded sheet; one that has not moved must have none
+                still = still & (residual <= self.tol_force * np.asarray(peak_residual, dtype=float)) & (
+                    (peak > 0) | (residual == 0.0))
         return bool(still) if still.ndim == 0 else still
 
     def time_at_rest(self, history, load_norm: float = 0.0) -> float | None:
@@ -81,18 +85,11 @@ class RestCriterion:
         if len(kin) < 2 or not np.isfinite(kin).all() or kin.max() <= 0:
             return None
         res = np.asarray(history["residual"], dtype=float)
-        scale = load_norm if load_norm > 0 else np.maximum.accumulate(res)
-        rest = self.holds(kin, np.maximum.accumulate(kin), res, scale)
+        rest = self.holds(kin, np.maximum.accumulate(kin), res, load_norm, np.maximum.accumulate(res))
         moving = np.flatnonzero(~rest)
         if len(moving) == 0 or moving[-1] == len(kin) - 1:
             return None
         return float(history["time"][moving[-1] + 1])
-
-
-def force_scale(load_norm: float, peak_residual: float) -> float:
-    """The force [N] the out-of-balance force is measured against: the load |P| on the free dofs, or for a
-    sheet without load the largest out-of-balance force it has had."""
-    return load_norm if load_norm > 0 else peak_residual
 
 
 @dataclass
@@ -112,8 +109,8 @@ class AtRest:
     def __call__(self, state, rec) -> bool:
         self.peak_kinetic = max(self.peak_kinetic, rec["kinetic"])
         self.peak_residual = max(self.peak_residual, rec["residual"])
-        return self.criterion.holds(rec["kinetic"], self.peak_kinetic, rec["residual"],
-                                    force_scale(self.load_norm, self.peak_residual))
+        return self.criterion.holds(rec["kinetic"], self.peak_kinetic, rec["residual"], self.load_norm,
+                                    self.peak_residual)
 
     def resume_from(self, history) -> None:
         """Take the peaks of the samples of an interrupted run (``history``: its ``kinetic``, ``residual``)."""

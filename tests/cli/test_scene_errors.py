@@ -174,7 +174,7 @@ def test_a_collapsed_explicit_step_is_a_step_limit_error():
     import numpy as np
 
     from rftstatic.errors import StepLimitError
-    from rftstatic.solvers.explicit import step_count
+    from rftstatic.solvers.step_plan import step_count
 
     for dt in (0.0, np.nan, -1.0, np.inf):
         with pytest.raises(StepLimitError, match="not a positive finite number"):
@@ -198,7 +198,7 @@ def test_a_relaxation_that_cannot_come_to_rest_stops_at_its_default_step_limit(c
 
 
 def test_the_default_step_limit_grows_with_the_nodes_along_a_side():
-    from rftstatic.solvers.explicit import MAX_STEPS, default_max_steps
+    from rftstatic.solvers.step_plan import MAX_STEPS, default_max_steps
 
     assert default_max_steps(25) == 50_000 and default_max_steps(41 * 41) == 410_000
     assert default_max_steps(1e15) == MAX_STEPS
@@ -309,3 +309,9 @@ def test_an_empty_or_truncated_vtu_is_an_input_error_naming_the_scene(capsys, tm
     path.write_text(content)
     code, err = _run(capsys, tmp_path, "strip", ["mesh.kind=file", f"mesh.path={path}", "supports=[]"])
     assert code == 2 and "strip.toml" in err and "mesh" in err and "sheet.vtu" in err, err
+
+
+def test_a_rest_tolerance_of_one_or_more_is_an_input_error(capsys, tmp_path):
+    # the kinetic-energy ratio of the at-rest test (rftstatic.solvers.rest) lies in (0, 1)
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "dynamics.rest_tolerance=1.5"])
+    _assert_input_error(code, err, "dynamics.rest_tolerance", "must lie in (0, 1)")
