@@ -16,8 +16,12 @@ Outputs in the run folder, every number in the scene's units:
 * ``series/state_<k>.vtu`` (the frames and ``samples`` regular states) indexed by ``series.pvd``;
 * ``animation.gif`` (the sampled states, isometric view), ``energy.png`` (kinetic and potential
   energy against time);
-* ``summary.json``: counts, step and its estimate, steps, wall time, element-steps per second,
-  probe trajectories (t, x, y, z), time at rest, energies, flags, the self-intersection check of the
+* ``summary.json`` (written once, at the end): counts, step, its estimate and why it was chosen (``dt_reason``,
+  :func:`~rftstatic.solvers.step_plan.plan_steps`), steps, wall time, element-steps per second, probe
+  trajectories (t, x, y, z), time at rest and the at-rest test's criterion and tolerances (``rest_test``:
+  ``at_rest`` of a relax run is the kinetic energy and the force, ``time_at_rest`` and a dynamic run's
+  ``at_rest`` the kinetic energy alone, :class:`~rftstatic.solvers.rest.RestCriterion`), energies, flags,
+  the self-intersection check of the
   final state and of every saved state (:func:`rftstatic.io.summary.self_intersection_summary`);
 * ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
   continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.checkpoint`).

@@ -2,7 +2,8 @@
 
 An explicit run of central differences (Eq. 20-22) to ``t_end`` [s] takes ``n = ceil(t_end / dt)`` steps of
 ``t_end / n`` (a step shortened slightly so that a whole number of them ends at ``t_end``). ``dt`` is the
-caller's, or ``safety`` times the critical step of the damped scheme (:func:`~rftstatic.solvers.timestep.stable_time_step`).
+caller's, or ``safety`` times the critical step of the damped scheme
+(:func:`~rftstatic.solvers.timestep.stable_time_step`).
 A run of more than the step limit is refused before it starts (:class:`~rftstatic.errors.StepLimitError`, a
 ValueError naming the option that sets the limit), or, when asked (a relaxation, which stops at rest), ends
 after the limit's steps. :func:`plan_steps` returns a :class:`StepPlan`; the explicit solver and the apps
@@ -86,7 +87,7 @@ class StepPlan:
     reason: str
 
 
-def plan_steps(model, *, t_end: float, dt: float | None = None, U=None, alpha: float = 0.0, mass_scale: float = 1.0,
+def plan_steps(model, *, t_end: float, alpha: float, mass_scale: float, dt: float | None = None, U=None,
                safety: float = SAFETY, max_steps: int | None = None, limit_name: str = MAX_STEPS_KEY,
                check_dt: bool = True, stop_at_limit: bool = False) -> StepPlan:
     """Plan the step and the horizon of an explicit run of ``model`` (module docstring).

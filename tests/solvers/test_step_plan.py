@@ -16,6 +16,7 @@ from rftstatic.solvers.step_plan import plan_steps
 from rftstatic.solvers.timestep import stable_time_step
 
 WOOL = preset("wool-kang-yu")
+FREE = {"alpha": 0.0, "mass_scale": 1.0}  # undamped, real mass
 
 
 @pytest.fixture(scope="module")
@@ -27,10 +28,10 @@ def model():
 
 
 def test_a_given_step_is_shortened_to_end_at_t_end(model):
-    plan = plan_steps(model, t_end=1.0, dt=0.003, check_dt=False)
+    plan = plan_steps(model, t_end=1.0, dt=0.003, **FREE, check_dt=False)
     assert plan.steps == 334 and plan.dt == 1.0 / 334 and plan.t_end == 1.0  # ceil(333.3)
     assert plan.estimate is None and plan.reason == "the given step"
-    assert plan_steps(model, t_end=1.0, dt=0.25, check_dt=False).steps == 4  # a whole number: no extra step
+    assert plan_steps(model, t_end=1.0, dt=0.25, **FREE, check_dt=False).steps == 4  # a whole number: no extra step
 
 
 def test_without_a_step_the_plan_takes_the_stable_estimate(model):
@@ -43,7 +44,7 @@ def test_without_a_step_the_plan_takes_the_stable_estimate(model):
 
 def test_a_step_above_the_estimate_is_planned_with_a_warning(model, caplog):
     est = stable_time_step(model)
-    plan = plan_steps(model, t_end=100 * est.dt, dt=2 * est.dt)
+    plan = plan_steps(model, t_end=100 * est.dt, dt=2 * est.dt, **FREE)
     assert plan.steps == 50 and "above the stable estimate" in plan.reason
     assert "exceeds the stable estimate" in caplog.text
 
@@ -51,14 +52,14 @@ def test_a_step_above_the_estimate_is_planned_with_a_warning(model, caplog):
 def test_a_run_over_the_step_limit_is_refused_naming_the_key(model):
     with pytest.raises(StepLimitError, match=r"needs 1e\+03 explicit steps, more than the limit of 999 "
                                              r"\(dynamics.max_steps\); shorten t_end or lengthen dt"):
-        plan_steps(model, t_end=1.0, dt=1e-3, max_steps=999, check_dt=False)
+        plan_steps(model, t_end=1.0, dt=1e-3, **FREE, max_steps=999, check_dt=False)
     with pytest.raises(StepLimitError, match=r"\(the segment limit\)"):
-        plan_steps(model, t_end=1.0, dt=1e-3, max_steps=10, limit_name="the segment limit", check_dt=False)
-    assert plan_steps(model, t_end=1.0, dt=1e-3, max_steps=1000, check_dt=False).steps == 1000  # at the limit
+        plan_steps(model, t_end=1.0, dt=1e-3, **FREE, max_steps=10, limit_name="the segment limit", check_dt=False)
+    assert plan_steps(model, t_end=1.0, dt=1e-3, **FREE, max_steps=1000, check_dt=False).steps == 1000  # at the limit
 
 
 def test_a_relaxation_over_the_step_limit_stops_there(model):
-    plan = plan_steps(model, t_end=1.0, dt=1e-3, max_steps=400, check_dt=False, stop_at_limit=True)
+    plan = plan_steps(model, t_end=1.0, dt=1e-3, **FREE, max_steps=400, check_dt=False, stop_at_limit=True)
     assert plan.steps == 400 and plan.t_end == pytest.approx(0.4, rel=1e-11) and plan.t_end < 0.4
     assert plan.dt == pytest.approx(1e-3, rel=1e-11) and "stops there" in plan.reason
 
@@ -66,7 +67,7 @@ def test_a_relaxation_over_the_step_limit_stops_there(model):
 @pytest.mark.parametrize("kw, key", [({"t_end": 0.0}, "t_end"), ({"t_end": 1.0, "dt": -1e-3}, "dt")])
 def test_the_planner_names_a_bad_time(model, kw, key):
     with pytest.raises(ParameterError, match=key):
-        plan_steps(model, check_dt=False, **kw)
+        plan_steps(model, check_dt=False, **FREE, **kw)
 
 
 @pytest.mark.parametrize("kw, key", [
