@@ -21,8 +21,8 @@ Outputs in the run folder, every number in the scene's units:
   trajectories (t, x, y, z), time at rest and the at-rest test's criterion and tolerances (``rest_test``:
   ``at_rest`` of a relax run is the kinetic energy and the force, ``time_at_rest`` and a dynamic run's
   ``at_rest`` the kinetic energy alone, :class:`~rftstatic.solvers.rest.RestCriterion`), energies, flags,
-  the self-intersection check of the
-  final state and of every saved state (:func:`rftstatic.io.summary.self_intersection_summary`);
+  the self-intersection check of the final state and of every saved state
+  (:func:`rftstatic.io.summary.self_intersection_summary`);
 * ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
   continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.checkpoint`).
 
