@@ -40,9 +40,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rftstatic.mesh import GRADATION
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.errors import ParameterError
+from rftstatic.mesh import GRADATION
 from rftstatic.remesh.sizefield import check_size_bounds, size_field
 from rftstatic.remesh.transfer import METHODS, transfer_fields
 

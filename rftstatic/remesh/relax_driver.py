@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rftstatic.contact.candidates import CandidateList
+from rftstatic.element.explicit_force import BACKENDS
+from rftstatic.errors import ParameterError
 from rftstatic.remesh.adapt import (
     DAMPING,
     RemeshRecord,
@@ -23,8 +25,6 @@ from rftstatic.remesh.adapt import (
     refinable_maxima,
     transfer_state,
 )
-from rftstatic.element.explicit_force import BACKENDS
-from rftstatic.errors import ParameterError
 from rftstatic.remesh.checkpoint import RelaxState
 from rftstatic.remesh.options import RemeshOptions, RemeshRelaxOptions
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE

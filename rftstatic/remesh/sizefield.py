@@ -26,9 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from rftstatic.mesh import GRADATION
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.errors import ParameterError
+from rftstatic.mesh import GRADATION
 
 __all__ = ["check_size_bounds", "size_field", "target_sizes"]
 

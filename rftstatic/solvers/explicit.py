@@ -42,11 +42,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.element.explicit_force import ForceKernel
-from rftstatic.errors import InstabilityError
+from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.model.state import State
 from rftstatic.progress import Progress
-from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.explicit_options import ExplicitOptions
+from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.step_plan import StepPlan, plan_steps
 from rftstatic.solvers.timestep import StepEstimate, lumped_mass, stable_time_step
 
@@ -131,6 +131,8 @@ def run_explicit(model, options: ExplicitOptions, *, U0=None, V0=None, obstacles
     if _restart is None:
         state = State.initial(model, U0, V0)
         state.V *= model.free
+        if plan is not None and plan.t_end != o.t_end:
+            raise ParameterError("plan", f"planned to t_end = {plan.t_end!r} s, the options ask {o.t_end!r} s")
         if plan is None:
             plan = plan_steps(model, t_end=o.t_end, dt=o.dt, U=state.U, alpha=o.alpha, mass_scale=o.mass_scale,
                               safety=o.safety, max_steps=o.max_steps, limit_name=o.max_steps_name,

@@ -15,8 +15,8 @@ from rftstatic.element.explicit_force import BACKENDS
 from rftstatic.errors import ParameterError
 from rftstatic.solvers.explicit import ExplicitResult, run_explicit
 from rftstatic.solvers.explicit_options import ExplicitOptions
-from rftstatic.solvers.step_plan import MAX_STEPS_KEY
 from rftstatic.solvers.rest import AtRest, RestCriterion
+from rftstatic.solvers.step_plan import MAX_STEPS_KEY
 
 log = logging.getLogger(__name__)
 

@@ -5,10 +5,10 @@ import pytest
 
 from rftstatic import material
 from rftstatic.element.curvature import curvature_norm
+from rftstatic.errors import ParameterError
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.mesh.mesher import Domain, generate
 from rftstatic.model import model
-from rftstatic.errors import ParameterError
 from rftstatic.remesh.adapt import adapt_mesh, reference_domain, refinable_maxima, transfer_state
 from rftstatic.remesh.options import RemeshOptions, RemeshRelaxOptions
 from rftstatic.remesh.relax_driver import NearObstacle, critical_damping, explicit_advance, remesh_relax

@@ -99,3 +99,13 @@ def test_options_are_keyword_only_and_frozen():
         o.alpha = 1.0
     run = o.explicit(given_velocity=True)
     assert (run.t_end, run.alpha, run.mass_scale, run.start, run.sample_every) == (10.0, 5.0, 100.0, "given", 20)
+
+
+def test_run_explicit_takes_the_callers_plan_and_refuses_one_for_another_end_time(model):
+    from rftstatic.solvers.explicit import run_explicit
+
+    plan = plan_steps(model, t_end=0.01, dt=1e-4, **FREE, check_dt=False)
+    run = run_explicit(model, ExplicitOptions(t_end=0.01, dt=1e-4, energy_check=False, progress=False), plan=plan)
+    assert run.steps == plan.steps == 100 and run.dt == plan.dt and run.t == pytest.approx(0.01)
+    with pytest.raises(ParameterError, match="plan"):
+        run_explicit(model, ExplicitOptions(t_end=0.02, progress=False), plan=plan)
