@@ -14,6 +14,7 @@ import numpy as np
 
 from rftstatic.errors import ParameterError, SceneError
 from rftstatic.remesh.options import RemeshOptions
+from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.newton import StaticOptions
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RELAX_REST
 from rftstatic.solvers.rest import RestCriterion
@@ -76,7 +77,7 @@ def static_options(scene, *, progress=True) -> StaticOptions:
 
 DYNAMICS_DEFAULTS = {
     # true dynamics (§4.6): the real mass, no damping unless the scene asks, rest at 1e-3 of the peak
-    "dynamic": {"alpha": 0.0, "mass_scale": 1.0, "rest_tolerance": 1e-3},
+    "dynamic": {"alpha": ExplicitOptions.alpha, "mass_scale": ExplicitOptions.mass_scale, "rest_tolerance": 1e-3},
     # dynamic relaxation (§6): alpha = 5/s with mass scaling s = 100, rest at 1e-8 of the peak
     "relax": {"alpha": 5.0, "mass_scale": RELAX_MASS_SCALE, "rest_tolerance": RELAX_REST.tol_kinetic},
 }
