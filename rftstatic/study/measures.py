@@ -49,7 +49,7 @@ def check_measure(path: str, scene, arg: str = "--target") -> None:
         elif parts[1] not in probes:
             problem = f'the scene has no probe "{parts[1]}" (its probes: {", ".join(probes) or "none"})'
     elif parts[0] == "cantilever":
-        tester = scene.analysis == "cantilever"
+        tester = scene.get("analysis") == "cantilever"
         if len(parts) != 2 or not parts[1]:
             problem = "a cantilever measure is cantilever.KEY, e.g. cantilever.bending_length"
         elif not tester and parts[1] != "bending_length":
