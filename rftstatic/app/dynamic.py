@@ -16,9 +16,13 @@ Outputs in the run folder, every number in the scene's units:
 * ``series/state_<k>.vtu`` (the frames and ``samples`` regular states) indexed by ``series.pvd``;
 * ``animation.gif`` (the sampled states, isometric view), ``energy.png`` (kinetic and potential
   energy against time);
-* ``summary.json``: counts, step and its estimate, steps, wall time, element-steps per second,
-  probe trajectories (t, x, y, z), time at rest, energies, flags, the self-intersection check of the
-  final state and of every saved state (:func:`rftstatic.io.summary.self_intersection_summary`);
+* ``summary.json`` (written once, at the end): counts, step, its estimate and why it was chosen (``dt_reason``,
+  :func:`~rftstatic.solvers.step_plan.plan_steps`), steps, wall time, element-steps per second, probe
+  trajectories (t, x, y, z), time at rest and the at-rest test's criterion and tolerances (``rest_test``:
+  ``at_rest`` of a relax run is the kinetic energy and the force, ``time_at_rest`` and a dynamic run's
+  ``at_rest`` the kinetic energy alone, :class:`~rftstatic.solvers.rest.RestCriterion`), energies, flags,
+  the self-intersection check of the final state and of every saved state
+  (:func:`rftstatic.io.summary.self_intersection_summary`);
 * ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
   continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.checkpoint`).
 
@@ -42,10 +46,11 @@ from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import dynamics_options, static_options
 from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
 from rftstatic.solvers.checkpoint import resume as resume_run
-from rftstatic.solvers.explicit import STEPS_PER_SIDE_NODE, default_max_steps, run_explicit, step_count
-from rftstatic.solvers.relaxation import AtRest
+from rftstatic.solvers.explicit import run_explicit
+from rftstatic.solvers.explicit_options import ExplicitOptions
+from rftstatic.solvers.rest import AtRest, RestCriterion
 from rftstatic.solvers.static import compare_with_static, solve_static
-from rftstatic.solvers.timestep import stable_time_step
+from rftstatic.solvers.step_plan import STEPS_PER_SIDE_NODE, default_max_steps, plan_steps
 
 log = logging.getLogger(__name__)
 
@@ -74,7 +79,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False) -> RunRe
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
     """Continue the dynamic run of ``scene`` from ``out_dir/checkpoint.npz`` (``case NAME --resume``)."""
-    if scene.get("analysis", "static") == "static":
+    if scene.analysis == "static":
         raise scene.error("analysis", "--resume continues a dynamic or relax run; this scene is static")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -108,7 +113,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    analysis = scene.get("analysis", "dynamic")
+    analysis = scene.analysis
     o = dynamics_options(scene)
     obstacles = tuple(extras.get("obstacles", ()))
     names, pnodes, pw = probe_interpolation(model.mesh, extras.get("probes", {}))
@@ -117,7 +122,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     save_times = np.unique(np.concatenate([o.frames, regular]))
 
     free_load = float(np.linalg.norm(np.where(model.free, model.load, 0.0)))
-    rest = AtRest(tol_kinetic=o.rest_tolerance, tol_force=o.force_tolerance, load_norm=free_load)
+    rest = AtRest(RestCriterion(o.rest_tolerance, o.force_tolerance), load_norm=free_load)
 
     def watch(state, rec):
         at_rest = rest(state, rec)  # tracks the peak kinetic energy at every sample
@@ -133,7 +138,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     if resume and ckpt_path.exists():
         data = load_checkpoint(ckpt_path)
         saved = data["options"]
-        horizon = _horizon(scene, analysis, t_end, float(data["dt"]), limit, _limit_name(o, model.mesh.n_nodes))
+        horizon = _plan(scene, model, o, float(data["dt"]), check_dt=False).t_end
         for key, want in (("t_end", horizon), ("alpha", o.alpha), ("mass_scale", o.mass_scale)):
             if not np.isclose(float(saved[key]), want, rtol=1e-12, atol=0.0):
                 raise scene.error(f"dynamics.{key}", f"the checkpoint {ckpt_path} was written with {key} = "
@@ -141,42 +146,38 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         if not np.array_equal(np.asarray(saved["frame_times"], float), save_times):
             raise scene.error("dynamics.frames", f"the checkpoint {ckpt_path} saved other frame times; run "
                               "without --resume")
-        hist_k = np.asarray(data["history"]["kinetic"], float)
-        rest.peak_kinetic = float(hist_k.max()) if hist_k.size else 0.0
-        hist_r = np.asarray(data["history"]["residual"], float)
-        rest.peak_residual = float(hist_r.max()) if hist_r.size else 0.0
-        dt = data["dt"]
-        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, dt))
-        resumed_from = data["t"]
+        rest.resume_from(data["history"])
+        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, data["dt"]))
+        resumed_from, reason = data["t"], "the step of the checkpoint's run"
         try:
             run = resume_run(ckpt_path, model, obstacles=obstacles, callback=watch, checkpoint=ckpt,
                              progress=progress)
         except CheckpointError as exc:
             raise scene.error("--resume", f"{exc}") from None
-        estimate = run.estimate
     else:
         if resume:
             log.warning("no checkpoint %s: starting the run from t = 0", ckpt_path)
-        estimate = stable_time_step(model, mass_scale=o.mass_scale, alpha=o.alpha)
-        dt = o.dt if o.dt is not None else estimate.dt
-        if dt > estimate.dt * (1 + 1e-3):
-            log.warning("dynamics.dt = %.4g s exceeds the stable estimate %.4g s", dt, estimate.dt)
-        horizon = _horizon(scene, analysis, t_end, dt, limit, _limit_name(o, model.mesh.n_nodes))
-        if dt < MIN_DT_SHARE * estimate.dt:  # the velocity update dt M^-1 (P - F) would lose the force to round-off
-            raise scene.error("dynamics.dt", f"{dt / scene.units.time:.4g} is below {MIN_DT_SHARE:g} of the stable step "
-                              f"estimate {estimate.dt / scene.units.time:.4g} (scene time units): the steps would not "
-                              "move the sheet; give a dt near the estimate or leave dynamics.dt out")
-        dt = horizon / step_count(horizon, dt, limit)
-        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, dt))
-        run = run_explicit(model, t_end=horizon, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
-                           obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(), callback=watch,
-                           checkpoint=ckpt, progress=progress, rest_tol=o.rest_tolerance, backend=backend,
-                           max_steps=limit)
-        run.estimate = run.estimate or estimate
+        plan = _plan(scene, model, o, o.dt, check_dt=True)
+        if o.dt is not None and o.dt < MIN_DT_SHARE * plan.estimate.dt:
+            # the velocity update dt M^-1 (P - F) would lose the force to round-off
+            raise scene.error("dynamics.dt", f"{o.dt / scene.units.time:.4g} is below {MIN_DT_SHARE:g} of the stable "
+                              f"step estimate {plan.estimate.dt / scene.units.time:.4g} (scene time units): the steps "
+                              "would not move the sheet; give a dt near the estimate or leave dynamics.dt out")
+        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, plan.dt))
+        options = ExplicitOptions(t_end=plan.t_end, dt=plan.dt, alpha=o.alpha, mass_scale=o.mass_scale,
+                                  rest_tol=o.rest_tolerance, backend=backend, max_steps=limit,
+                                  max_steps_name=_limit_name(o, model.mesh.n_nodes), progress=progress)
+        run = run_explicit(model, options, obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(),
+                           callback=watch, checkpoint=ckpt, plan=plan)
+        reason = plan.reason
     wall = time.perf_counter() - wall0
 
     summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)
     summary["max_steps"] = limit
+    summary["dt_reason"] = reason
+    reading = RestCriterion(o.rest_tolerance).record()  # time_at_rest: the kinetic energy alone
+    summary["rest_test"] = {"at_rest": rest.criterion.record() if analysis == "relax" else reading,
+                            "time_at_rest": reading}
     if analysis == "relax":
         summary["converged"] = summary["at_rest"] = bool(run.stopped)
         summary["stopped_by"] = "rest" if run.stopped else "t_end" if run.t >= t_end * (1 - 1e-9) else "max_steps"
@@ -194,20 +195,18 @@ def _limit_name(o, n_nodes) -> str:
             f"for {n_nodes} nodes")
 
 
-def _horizon(scene, analysis, t_end, dt, limit, name="dynamics.max_steps") -> float:
-    """The time [s] the explicit run goes to: ``t_end``; for a relaxation whose ``t_end`` lies more than
-    ``limit`` steps of ``dt`` away, the time of those steps (it stops there, not at rest: exit status 3).
-    A dynamic run that needs more steps, or a step that is not a positive finite number, is a scene error."""
+def _plan(scene, model, o, dt, *, check_dt):
+    """The :class:`~rftstatic.solvers.step_plan.StepPlan` of the scene's run with step ``dt`` [s] (None: the stable
+    step): to ``t_end``; for a relaxation whose ``t_end`` lies more than the step limit away, to the time of those
+    steps (it stops there, not at rest: exit status 3). A dynamic run that needs more steps, or a step that is not
+    a positive finite number, is a scene error naming the key to change."""
     try:
-        step_count(t_end, dt, limit, limit_name=name)
-        return t_end
+        return plan_steps(model, t_end=o.t_end, dt=dt, alpha=o.alpha, mass_scale=o.mass_scale,
+                          max_steps=o.step_limit(model.mesh.n_nodes), limit_name=_limit_name(o, model.mesh.n_nodes),
+                          check_dt=check_dt, stop_at_limit=scene.analysis == "relax")
     except StepLimitError as exc:
-        if analysis != "relax" or not (np.isfinite(dt) and dt > 0) or not np.isfinite(limit * dt):
-            raise scene.error("dynamics.dt" if scene.get("dynamics.dt") is not None else "dynamics.t_end",
-                              str(exc)) from None
-    log.warning("the relaxation stops after dynamics.max_steps = %d steps of %.4g s (t = %.4g s) unless at rest "
-                "before; t_end = %.4g s is further", limit, dt, limit * dt, t_end)
-    return limit * dt * (1.0 - 1e-12)  # limit steps after step_count's rounding
+        raise scene.error("dynamics.dt" if scene.get("dynamics.dt") is not None else "dynamics.t_end",
+                          str(exc)) from None
 
 
 def _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from) -> dict:
@@ -296,9 +295,19 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
     idx = np.searchsorted(save_times, requested)
     summary["frames"] = [{"time": float(tr / u.time), "state_time": float(frames[i][0] / u.time)}
                          for tr, i in zip(requested, idx) if i < len(frames)]
-    write_json(out / "summary.json", summary)
-    if not figures:
-        return
+    try:
+        if figures:
+            _figures(scene, model, out, run, summary, o, save_times, idx)
+    finally:  # written once, with the figures drawn so far (a plot that fails leaves the numbers written)
+        write_json(out / "summary.json", summary)
+
+
+def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
+    """The PNG frames, the GIF and the energy plot; their files are entered in ``summary``."""
+    u = scene.units
+    tri = model.mesh.tri
+    X3 = model.X3
+    frames = run.frames
     from rftstatic.io.animation import animate
     from rftstatic.io.charts import plot_history
     from rftstatic.io.views import plot_views
@@ -325,4 +334,3 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
                  xlabel="time [s]", ylabel=f"energy [{u.name.split('-')[1] if '-' in u.name else 'J'}"
                  f"{' ' + lu if lu else ''}]", title=f"{scene.name}: energies (alpha = {o.alpha * u.time:g} /s)")
     summary["energy_plot"] = "energy.png"
-    write_json(out / "summary.json", summary)

@@ -36,7 +36,7 @@ def analysis_of(scene) -> str:
     ``analysis`` key (default ``static``)."""
     if scene.get("remesh") is not None:
         return "remeshed"
-    name = scene.get("analysis", "static")
+    name = scene.analysis
     if name not in ANALYSES:
         raise scene.error("analysis", f'"{name}" is not an analysis; use one of {", ".join(SCENE_ANALYSES)}')
     return name

@@ -48,13 +48,14 @@ from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_sum
                                    summary_header)
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.remesh.checkpoint import FIX, RemeshCheckpointer, load_remesh_checkpoint
+from rftstatic.remesh.options import RemeshRelaxOptions
 from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
 from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.scenes.build import MAX_MESH_NODES, build_model
 from rftstatic.scenes.options import REMESH_LENGTH_KEYS, dynamics_options, remesh_options, static_options
-from rftstatic.solvers.explicit import step_count
+from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.static_checkpoint import CHECKPOINT_SECONDS, remove_stale
-from rftstatic.solvers.timestep import stable_time_step
+from rftstatic.solvers.step_plan import plan_steps
 
 log = logging.getLogger(__name__)
 
@@ -150,7 +151,7 @@ def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 def checkpoint_header(scene) -> dict:
     """What a remeshed run's checkpoint is keyed to: the scene's name, analysis and its data after the ``--set``
     overrides (but the ``[output]`` table, which does not change the run)."""
-    return {"scene": scene.name, "analysis": scene.get("analysis", "static"),
+    return {"scene": scene.name, "analysis": scene.analysis,
             "data": {k: v for k, v in scene.data.items() if k != "output"}}
 
 
@@ -168,7 +169,7 @@ def solve_remesh_scene(scene, opts=None, *, checkpoint=None, restart=None) -> di
     ``checkpoint``: a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`; ``restart``: a
     :class:`~rftstatic.remesh.checkpoint.RemeshRestart` to continue from."""
     opts = remesh_options(scene) if opts is None else opts
-    analysis = scene.get("analysis", "static")
+    analysis = scene.analysis
     t0 = time.perf_counter()
     if analysis not in ("static", "relax"):
         raise scene.error("analysis", f'"{analysis}" cannot be remeshed; use "static" or "relax" with [remesh]')
@@ -190,10 +191,7 @@ def _static(scene, opts, checkpoint=None, restart=None) -> dict:
     if restart is not None and restart.phase != "cycle":
         raise CheckpointError(f"checkpoint {restart.path} is a remeshed relaxation's, this scene's route is static; "
                               f"{FIX}")
-    res = remesh_static(factory, const=opts.const, h_lower=opts.h_lower, h_upper=opts.h_upper,
-                        max_cycles=opts.max_cycles, tol=opts.tol, kappa_h_max=opts.kappa_h_max,
-                        gradation=opts.gradation, transfer=opts.transfer,
-                        options=static_options(scene, progress=False), checkpoint=checkpoint,
+    res = remesh_static(factory, opts, solver=static_options(scene, progress=False), checkpoint=checkpoint,
                         restart=None if restart is None else restart.state)
     meshes = [{"mesh": m, "U": None, "t": 0.0, "step": 0} for m in res.meshes]
     meshes[-1]["U"] = res.result.U
@@ -234,12 +232,10 @@ def _relax(scene, opts, checkpoint=None, restart=None) -> dict:
         return contact_reaction_residual(model, obstacles, U)
 
     try:
-        res = remesh_relax(make, const=opts.const, h_lower=opts.h_lower, h_upper=opts.h_upper,
-                           advance=track, mass_scale=d.mass_scale, every=opts.every,
-                           kappa_h2_max=opts.kappa_h2_max, max_steps=max_steps, tol=opts.tol,
-                           tol_force=d.force_tolerance, tol_kinetic=d.rest_tolerance,
-                           gradation=opts.gradation, transfer=opts.transfer, residual=residual,
-                           checkpoint=checkpoint, restart=None if restart is None else restart.state)
+        motion = RemeshRelaxOptions(mass_scale=d.mass_scale, max_steps=max_steps,
+                                    rest=RestCriterion(d.rest_tolerance, d.force_tolerance))
+        res = remesh_relax(make, opts, motion, advance=track, residual=residual, checkpoint=checkpoint,
+                           restart=None if restart is None else restart.state)
         model, U, records, converged, skipped = res.model, res.U, res.records, res.converged, res.skipped
         t, steps = res.t, res.steps
         stopped_by = "rest" if converged else "max_steps" if steps >= max_steps else "max_remesh"
@@ -287,10 +283,9 @@ def _check_node_budget(scene, opts, mesh) -> float:
 def _check_step_budget(scene, d, model, max_steps) -> None:
     """Refuse, before it starts, a remeshed relaxation whose first mesh needs more than ``max_steps`` (the step
     limit, ``dynamics.max_steps`` or its default for the finest mesh ``remesh.h_lower`` allows) explicit steps to reach ``t_end`` (the run also stops at ``max_steps`` on the later meshes)."""
-    dt = d.dt if d.dt is not None else stable_time_step(model, mass_scale=d.mass_scale, alpha=d.alpha,
-                                                        safety=SAFETY).dt
     try:
-        step_count(d.t_end, dt, max_steps)
+        plan_steps(model, t_end=d.t_end, dt=d.dt, alpha=d.alpha, mass_scale=d.mass_scale, safety=SAFETY,
+                   max_steps=max_steps, check_dt=False)
     except ValueError as exc:
         raise scene.error("dynamics.dt" if d.dt is not None else "dynamics.t_end", f"{exc} (on the first "
                           "mesh)") from None
@@ -309,7 +304,7 @@ def summarize(scene, opts, solved) -> dict:
         records.append(d)
     settings = {k: (v / u.length if k in REMESH_LENGTH_KEYS and v is not None else v)
                 for k, v in dataclasses.asdict(opts).items()}
-    summary = summary_header(scene, model, scene.get("analysis", "static"))
+    summary = summary_header(scene, model, scene.analysis)
     summary.update({
         "route": solved["route"], "initial_nodes": records[0]["nodes"],
         "remeshes": len(records) - 1, "converged": solved["converged"], "wall_time_s": solved["wall_time_s"],
@@ -328,6 +323,7 @@ def summarize(scene, opts, solved) -> dict:
         P = np.where(model.free, model.load, 0.0)
         r = np.where(model.free, contact_reaction_residual(model, solved["extras"].get("obstacles", ()), U), 0.0)
         summary["residual_relative"] = float(np.linalg.norm(r) / max(np.linalg.norm(P), 1e-300))
+        summary["rest_test"] = RestCriterion(d.rest_tolerance, d.force_tolerance).record()
     else:
         summary["newton_iterations"] = int(solved["records"][-1].solve.get("iterations", 0))
     if solved["extras"].get("obstacles"):

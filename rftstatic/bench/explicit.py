@@ -15,13 +15,14 @@ from rftstatic.bench.problems import sheet_model
 
 def measure(model, *, steps: int, backend: str) -> dict:
     from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit_options import ExplicitOptions
     from rftstatic.solvers.timestep import stable_time_step
 
     dt = stable_time_step(model).dt
-    run_explicit(model, t_end=5 * dt, dt=dt, alpha=5.0, backend=backend, progress=False)  # compile/warm up
+    run_explicit(model, ExplicitOptions(t_end=5 * dt, dt=dt, alpha=5.0, backend=backend, progress=False))  # warm up
     t0 = time.perf_counter()
-    r = run_explicit(model, t_end=steps * dt, dt=dt, alpha=5.0, backend=backend, progress=False,
-                     energy_check=False, sample_every=max(1, steps // 20))
+    r = run_explicit(model, ExplicitOptions(t_end=steps * dt, dt=dt, alpha=5.0, backend=backend, progress=False,
+                                            energy_check=False, sample_every=max(1, steps // 20)))
     wall = time.perf_counter() - t0
     return {"elements": model.mesh.n_elements, "steps": r.steps, "wall_s": wall,
             "element_steps_per_s": model.mesh.n_elements * r.steps / wall, "dt": dt}

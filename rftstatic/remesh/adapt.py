@@ -42,6 +42,7 @@ import numpy as np
 
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.errors import ParameterError
+from rftstatic.mesh import GRADATION
 from rftstatic.remesh.sizefield import check_size_bounds, size_field
 from rftstatic.remesh.transfer import METHODS, transfer_fields
 
@@ -90,7 +91,7 @@ def reference_domain(mesh, *, circle_tol=1e-6):
     return Domain(loops) if changed else dom
 
 
-def adapt_mesh(mesh, kappa, *, const, h_lower, h_upper, gradation=1.3, domain=None, spacing=None,
+def adapt_mesh(mesh, kappa, *, const, h_lower, h_upper, gradation=GRADATION, domain=None, spacing=None,
                smooth_iterations=4):
     """Steps e-g: a new mesh of ``mesh``'s sheet sized by Eq. 29 from the element curvature ``kappa``.
 
@@ -229,9 +230,10 @@ def refinable_maxima(mesh, kappa, *, const, h_lower):
     return float((mag * h)[keep].max(initial=0.0)), float((mag * h * h)[keep].max(initial=0.0))
 
 
-def check_remesh_parameters(*, const, h_lower, h_upper, gradation=1.3, max_cycles=5, tol=0.05, kappa_h_max=None,
-                            transfer="mesh", every=None, kappa_h2_max=None, damping="fixed") -> None:
-    """Check the options of :func:`remesh_static` and :func:`remesh_relax` (any consistent units).
+def check_remesh_parameters(*, const, h_lower, h_upper, gradation, max_cycles, tol, kappa_h_max, transfer, every,
+                            kappa_h2_max, damping) -> None:
+    """Check the fields of :class:`~rftstatic.remesh.options.RemeshOptions` (any consistent units; the
+    defaults are that class's).
 
     Raises :class:`~rftstatic.errors.ParameterError` whose ``key`` names the parameter: const, h_lower,
     h_upper, gradation, tol must be positive finite numbers (kappa_h_max too unless None), h_lower <=

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rftstatic.contact.candidates import CandidateList
+from rftstatic.element.explicit_force import BACKENDS
+from rftstatic.errors import ParameterError
 from rftstatic.remesh.adapt import (
     DAMPING,
     RemeshRecord,
@@ -19,13 +21,14 @@ from rftstatic.remesh.adapt import (
     _curvature_figures,
     _factory,
     adapt_mesh,
-    check_remesh_parameters,
     reference_domain,
     refinable_maxima,
     transfer_state,
 )
 from rftstatic.remesh.checkpoint import RelaxState
+from rftstatic.remesh.options import RemeshOptions, RemeshRelaxOptions
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
+from rftstatic.solvers.timestep import SAFETY
 
 log = logging.getLogger(__name__)
 
@@ -139,8 +142,8 @@ class ExplicitStepper:
     through :class:`NearObstacle` candidate lists (the same contact, fewer distance evaluations).
     """
 
-    def __init__(self, *, alpha, mass_scale=RELAX_MASS_SCALE, dt=None, obstacles=(), safety=0.9, backend="auto",
-                 energy_check=False, damping="fixed"):
+    def __init__(self, *, alpha, mass_scale=RELAX_MASS_SCALE, dt=None, obstacles=(), safety=SAFETY,
+                 backend=BACKENDS[0], energy_check=False, damping=DAMPING[0]):
         if damping not in DAMPING:
             raise ValueError(f'damping = "{damping}" is unknown; use one of {", ".join(DAMPING)}')
         obstacles = (obstacles,) if hasattr(obstacles, "signed_distance") else tuple(obstacles)
@@ -165,6 +168,7 @@ class ExplicitStepper:
         """Advance ``n_steps`` steps, or fewer (the last one shortened) that end at ``max_time`` [s] when
         ``n_steps`` would go beyond it; ``last_steps`` is the number taken."""
         from rftstatic.solvers.explicit import run_explicit
+        from rftstatic.solvers.explicit_options import ExplicitOptions
         from rftstatic.solvers.timestep import stable_time_step
 
         if self._model is not model:
@@ -182,9 +186,10 @@ class ExplicitStepper:
                                                                        alpha_max=self.alpha)
         self.alphas.append(a)
         span = n_steps * step if max_time is None or not max_time < n_steps * step else max_time
-        run = run_explicit(model, t_end=span, dt=step, alpha=a, mass_scale=self.mass_scale,
-                           obstacles=self.near, U0=U, V0=V, start="given", sample_every=max(1, n_steps),
-                           progress=False, energy_check=self.energy_check, backend=self.backend)
+        options = ExplicitOptions(t_end=span, dt=step, alpha=a, mass_scale=self.mass_scale, start="given",
+                                  sample_every=max(1, n_steps), progress=False, energy_check=self.energy_check,
+                                  backend=self.backend)
+        run = run_explicit(model, options, obstacles=self.near, U0=U, V0=V)
         self.last_steps = run.steps
         return run.U, run.V, run.t
 
@@ -220,41 +225,31 @@ def _initial_state(model, U0, V0) -> RelaxState:
     return RelaxState([model.mesh], U, V, t=0.0, steps=0, since=0, n_remesh=0, skipped=0, peak=0.0, records=[record])
 
 
-def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, mass_scale=RELAX_MASS_SCALE,
-                 damping="fixed", every=None, kappa_h2_max=None, chunk=200, max_steps=100_000, max_remesh=50,
-                 tol=0.05, tol_force=1e-4, tol_kinetic=1e-8, skip_settled=True, gradation=1.3, transfer="mesh",
+def remesh_relax(problem, options: RemeshOptions, motion: RemeshRelaxOptions = RemeshRelaxOptions(), *, advance=None,
                  domain=None, U0=None, V0=None, residual=None, checkpoint=None, restart=None) -> RemeshRelaxResult:
     """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6).
 
-    The motion is advanced ``chunk`` steps at a time. After each chunk (step d) the mesh is
-    remeshed when ``every`` steps have passed since the last remesh, or when the largest
-    |kappa| h^2 exceeds ``kappa_h2_max`` [m]; U and V are transferred (step h). When the sheet is
-    at rest (out-of-balance force on the free dofs < ``tol_force`` |P| and kinetic energy <
-    ``tol_kinetic`` times its peak on the present mesh, or zero), the mesh it would get is sized:
-    a node-count change below ``tol`` ends the run (converged), otherwise it remeshes and goes on.
+    The motion is advanced ``motion.chunk`` steps at a time. After each chunk (step d) the mesh is
+    remeshed when ``options.every`` steps have passed since the last remesh, or when the largest
+    |kappa| h^2 exceeds ``options.kappa_h2_max`` [m]; U and V are transferred (step h). When the sheet is
+    at rest (``motion.rest``, :class:`~rftstatic.solvers.rest.RestCriterion`: the out-of-balance force on the
+    free dofs against |P| and the kinetic energy of the half-step velocity against its peak on the present
+    mesh), the mesh it would get is sized: a node-count change below ``options.tol`` ends the run (converged),
+    otherwise it remeshes and goes on.
 
     Parameters
     ----------
     problem : ``factory(mesh) -> Model | (Model, extras)`` (as in :func:`remesh_static`)
-    const, h_lower, h_upper : Eq. 29 [m]
+    options : :class:`~rftstatic.remesh.options.RemeshOptions`; this route reads ``const``, ``h_lower``,
+        ``h_upper`` (Eq. 29 [m]), ``gradation``, ``transfer``, ``tol`` (relative node-count change below which
+        the mesh counts as settled, and, with ``kappa_h2_max``, max |kappa| h^2 <= kappa_h2_max), ``every``,
+        ``kappa_h2_max`` (over the elements not already at the size floor h_lower, :func:`refinable_maxima`)
+        and ``damping`` (of the default stepper: ``"fixed"`` or ``"critical"``, :func:`critical_damping`)
+    motion : :class:`~rftstatic.remesh.options.RemeshRelaxOptions` (damping, mass scaling, chunk, limits, rest
+        test, skipping of settled meshes)
     advance : ``advance(model, U, V, n_steps) -> (U, V, t_advanced)``; default
-        :func:`explicit_advance` with ``alpha``, ``mass_scale`` and the scene's obstacles
-    alpha : mass damping [1/s] of the default stepper (required without ``advance``; with
-        ``damping="critical"`` its upper bound)
-    mass_scale : mass scaling s of the default stepper and of the kinetic energy [-] (§6: 100)
-    damping : ``"fixed"`` or ``"critical"`` (:func:`critical_damping`), default stepper
-    every : remesh every this many steps (None: only on curvature or at rest)
-    kappa_h2_max : remesh when max |kappa| h^2 exceeds this [m] (None: never on curvature), over
-        the elements not already at the size floor h_lower (:func:`refinable_maxima`)
-    chunk : steps per call of ``advance``
-    max_steps, max_remesh : limits (the run returns ``converged=False`` at max_steps)
-    tol : relative node-count change below which the mesh counts as settled [-] (and, with
-        ``kappa_h2_max``, max |kappa| h^2 <= kappa_h2_max)
-    skip_settled : a remesh triggered by ``every`` or by the curvature is skipped when the mesh is
-        settled. Measured on the clamped strip (s = 100, alpha = 3/s): remeshing every 5000 steps
-        regardless kept the strip swinging for 200 000 steps (each new mesh differs by a few nodes
-        and the transfer restarts the oscillation, as §5 warns); skipping settled meshes, it came
-        to rest.
+        :func:`explicit_advance` with ``motion.alpha``, ``motion.mass_scale`` and the scene's obstacles
+    domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
     U0, V0 : (N, 3) start on the initial mesh (default zero)
     residual : ``residual(model, U) -> (N, 3)`` [N], the out-of-balance force of the rest test (default
         ``model.residual(U)``; with kinematic obstacles,
@@ -272,21 +267,21 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
     """
     from rftstatic.solvers.timestep import lumped_mass
 
+    o, m = options, motion
+    const, h_lower, h_upper, every, kappa_h2_max, tol = o.const, o.h_lower, o.h_upper, o.every, o.kappa_h2_max, o.tol
+    max_steps, mass_scale = m.max_steps, m.mass_scale
     make = _factory(problem)
-    if int(chunk) < 1:
-        raise ValueError(f"chunk = {chunk!r} must be a positive number of steps")
-    check_remesh_parameters(const=const, h_lower=h_lower, h_upper=h_upper, gradation=gradation, tol=tol,
-                            transfer=transfer, every=every, kappa_h2_max=kappa_h2_max, damping=damping)
     if residual is None:
         def residual(model, U):
             return model.residual(U)
     model, extras = make(None)
     _check_extent(model.mesh, const, h_lower, h_upper)
     if advance is None:
-        if alpha is None:
-            raise ValueError("alpha (mass damping [1/s]) is needed by the default explicit stepper; or pass advance=")
-        advance = explicit_advance(alpha=alpha, mass_scale=mass_scale, obstacles=extras.get("obstacles", ()),
-                                   damping=damping)
+        if m.alpha is None:
+            raise ParameterError("alpha", "the mass damping [1/s] is needed by the default explicit stepper; or pass "
+                                 "advance=")
+        advance = explicit_advance(alpha=m.alpha, mass_scale=mass_scale, obstacles=extras.get("obstacles", ()),
+                                   damping=o.damping)
     if domain is None:
         domain = reference_domain(model.mesh)
     wall = time.perf_counter()
@@ -305,7 +300,7 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         if checkpoint is not None and phase is not None:
             save(phase)  # every path through the loop ends here: the state the next chunk starts from
         phase = "chunk"
-        n = int(min(chunk, max_steps - steps))
+        n = int(min(m.chunk, max_steps - steps))
         U, V, dt_adv = advance(model, U, V, n)
         if not (np.isfinite(U).all() and np.isfinite(V).all()):
             raise FloatingPointError(f"remesh_relax: non-finite state after step {steps + n} (t = {t:.4g} s) on a "
@@ -320,17 +315,18 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         peak = max(peak, kinetic)
         P = np.where(model.free, model.load, 0.0)
         r = float(np.linalg.norm(np.where(model.free, residual(model, U), 0.0)))
-        rest = r <= tol_force * max(float(np.linalg.norm(P)), 1e-300) and (kinetic <= tol_kinetic * peak or kinetic == 0)
+        # no residual peak is kept across chunks: an unloaded sheet is at rest at r = 0 only
+        rest = m.rest.holds(kinetic, peak, r, float(np.linalg.norm(P)), r)
         reason = ("rest" if rest else "every" if every is not None and since >= every
                   else "curvature" if kappa_h2_max is not None and rkh2 > kappa_h2_max else None)
         if reason is None:
             continue
-        if n_remesh >= max_remesh:
+        if n_remesh >= m.max_remesh:
             if rest:
                 done, converged = True, False
             continue
         new_mesh, _ = adapt_mesh(model.mesh, kappa, const=const, h_lower=h_lower, h_upper=h_upper,
-                                 gradation=gradation, domain=domain)
+                                 gradation=o.gradation, domain=domain)
         rec = records[-1]
         rec.max_kappa_h, rec.max_kappa_h2 = kh, kh2
         rec.refinable_kappa_h, rec.refinable_kappa_h2 = rkh, rkh2
@@ -339,12 +335,12 @@ def remesh_relax(problem, *, const, h_lower, h_upper, advance=None, alpha=None, 
         if rest and settled:
             done, converged = True, True
             continue
-        if settled and skip_settled:
+        if settled and m.skip_settled:
             since = 0
             skipped += 1
             continue
         new_model, new_extras = make(new_mesh)
-        U, V = transfer_state(model, new_model, U, V, method=transfer)
+        U, V = transfer_state(model, new_model, U, V, method=o.transfer)
         model, extras = new_model, new_extras
         n_remesh += 1
         since, peak = 0, 0.0

@@ -28,6 +28,7 @@ import numpy as np
 
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.errors import ParameterError
+from rftstatic.mesh import GRADATION
 
 __all__ = ["check_size_bounds", "size_field", "target_sizes"]
 
@@ -72,7 +73,7 @@ def target_sizes(kappa, *, const, h_lower, h_upper) -> np.ndarray:
     return np.clip(h_new, h_lower, h_upper)
 
 
-def size_field(mesh, kappa, *, const, h_lower, h_upper, gradation=1.3, spacing=None, region=None):
+def size_field(mesh, kappa, *, const, h_lower, h_upper, gradation=GRADATION, spacing=None, region=None):
     """Steps e-f of §5.2: the background grid of h_target for a new mesh of ``mesh``'s sheet.
 
     Parameters

@@ -15,12 +15,12 @@ from rftstatic.remesh.adapt import (
     _curvature_figures,
     _factory,
     adapt_mesh,
-    check_remesh_parameters,
     reference_domain,
     refinable_maxima,
     transfer_state,
 )
 from rftstatic.remesh.checkpoint import StaticCycleState
+from rftstatic.remesh.options import RemeshOptions
 
 log = logging.getLogger(__name__)
 
@@ -53,8 +53,7 @@ def _continuation(options):
     return options.from_state()
 
 
-def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, kappa_h_max=None,
-                  gradation=1.3, transfer="mesh", options=None, domain=None, checkpoint=None,
+def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None, checkpoint=None,
                   restart=None) -> RemeshStaticResult:
     """Static solution with global adaptive remeshing (module docstring).
 
@@ -62,17 +61,15 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
     ----------
     problem : a callable ``factory(mesh) -> Model`` or ``-> (Model, extras)``; ``factory(None)`` gives
         the initial mesh's model (for a scene: :func:`rftstatic.scenes.build.model_factory`)
-    const, h_lower, h_upper : Eq. 29 [m]: h_new = sqrt(const / |kappa|) clipped to [h_lower, h_upper]
-    max_cycles : at most this many remeshes after the initial solve
-    tol : stop when the next mesh's node count differs by less than this fraction [-] ...
-    kappa_h_max : ... and the largest |kappa| h on the present mesh is at most this [-] (over the
-        elements not already at the size floor h_lower, :func:`refinable_maxima`); None: the node
-        count alone. An element at its Eq. 29 size has |kappa| h = sqrt(const |kappa|), up to
-        const / h_lower where the size reaches the floor, so a cap below that is never met (the §6
-        scenes: const / h_lower = 1, measured max |kappa| h 0.86-1.5 on settled meshes)
-    gradation : gradation limit of the size field (ratio >= 1)
-    transfer : ``"mesh"`` or ``"grid"`` (:mod:`rftstatic.transfer`)
-    options : :class:`rftstatic.solvers.newton.StaticOptions` of the first solve (default: the
+    options : :class:`~rftstatic.remesh.options.RemeshOptions`; this route reads ``const``, ``h_lower``,
+        ``h_upper`` (Eq. 29 [m]: h_new = sqrt(const / |kappa|) clipped to [h_lower, h_upper]), ``gradation``,
+        ``transfer``, ``max_cycles`` (at most this many remeshes after the initial solve), ``tol`` (stop when the
+        next mesh's node count differs by less than this fraction ...) and ``kappa_h_max`` (... and the largest
+        |kappa| h on the present mesh is at most this, over the elements not already at the size floor h_lower,
+        :func:`refinable_maxima`; None: the node count alone). An element at its Eq. 29 size has |kappa| h =
+        sqrt(const |kappa|), up to const / h_lower where the size reaches the floor, so a cap below that is never
+        met (the §6 scenes: const / h_lower = 1, measured max |kappa| h 0.86-1.5 on settled meshes)
+    solver : :class:`rftstatic.solvers.newton.StaticOptions` of the first solve (default: the
         defaults, without a progress bar); later solves start from the transferred state at
         full load (one load step) and fall back to the full load ramp from flat if that fails
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
@@ -87,26 +84,23 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
 
     Raises
     ------
-    ValueError
-        bad Eq. 29 parameters (named), ``tol`` or ``max_cycles``
     rftstatic.static.ConvergenceError
         when a solve fails even from flat (its ``.result`` is the last equilibrium)
     """
     from rftstatic.errors import ConvergenceError
     from rftstatic.solvers.static import StaticOptions, solve_static
 
-    check_remesh_parameters(const=const, h_lower=h_lower, h_upper=h_upper, gradation=gradation,
-                            max_cycles=max_cycles, tol=tol, kappa_h_max=kappa_h_max, transfer=transfer)
+    o = options
+    const, h_lower, h_upper = o.const, o.h_lower, o.h_upper
+    solver = StaticOptions(progress=False) if solver is None else solver
     make = _factory(problem)
-    if options is None:
-        options = StaticOptions(progress=False)
     t0 = time.perf_counter()
     model, extras = make(None)
     _check_extent(model.mesh, const, h_lower, h_upper)
     if domain is None:
         domain = reference_domain(model.mesh)
     if restart is None:
-        result = solve_static(model, options=options)
+        result = solve_static(model, options=solver)
         records = [RemeshRecord(0, model.mesh.n_nodes, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})),
                                 solve=_static_figures(result, restarted=False))]
         meshes, first = [model.mesh], 1
@@ -117,32 +111,32 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         if restart.cycle > 0:  # the initial model serves cycle 0
             model, extras = make(meshes[-1])
     converged = False
-    for cycle in range(first, int(max_cycles) + 1):
+    for cycle in range(first, int(o.max_cycles) + 1):
         kappa, kh, kh2 = _curvature_figures(model, result.U)
         rec = records[-1]
         rec.max_kappa_h, rec.max_kappa_h2 = kh, kh2
         rec.refinable_kappa_h, rec.refinable_kappa_h2 = refinable_maxima(model.mesh, kappa, const=const, h_lower=h_lower)
         t_mesh = time.perf_counter()
         new_mesh, _ = adapt_mesh(model.mesh, kappa, const=const, h_lower=h_lower, h_upper=h_upper,
-                                 gradation=gradation, domain=domain)
+                                 gradation=o.gradation, domain=domain)
         rec.node_change = abs(new_mesh.n_nodes - model.mesh.n_nodes) / model.mesh.n_nodes
         rec.wall_time = t_mesh - t0
         log.info("remesh_static cycle %d: %d nodes, max |kappa| h %.3g, next mesh %d nodes (change %.1f %%)",
                  rec.cycle, rec.nodes, kh, new_mesh.n_nodes, 100 * rec.node_change)
-        if rec.node_change < tol and (kappa_h_max is None or rec.refinable_kappa_h <= kappa_h_max):
+        if rec.node_change < o.tol and (o.kappa_h_max is None or rec.refinable_kappa_h <= o.kappa_h_max):
             converged = True
             break
         t0 = t_mesh
         new_model, new_extras = make(new_mesh)
-        U0, _ = transfer_state(model, new_model, result.U, method=transfer)
+        U0, _ = transfer_state(model, new_model, result.U, method=o.transfer)
         restarted = False
         try:
-            result = solve_static(new_model, U0=U0, options=_continuation(options))
+            result = solve_static(new_model, U0=U0, options=_continuation(solver))
         except ConvergenceError as exc:
             log.info("remesh_static cycle %d: no equilibrium from the transferred state (%s); solving from flat",
                      cycle, exc)
             restarted = True
-            result = solve_static(new_model, options=options)
+            result = solve_static(new_model, options=solver)
         model, extras = new_model, new_extras
         records.append(RemeshRecord(cycle, new_mesh.n_nodes, new_mesh.n_elements, new_mesh.info["quality"],
                                     reason="cycle", solve=_static_figures(result, restarted=restarted)))
@@ -155,7 +149,7 @@ def remesh_static(problem, *, const, h_lower, h_upper, max_cycles=5, tol=0.05, k
         rec.refinable_kappa_h, rec.refinable_kappa_h2 = refinable_maxima(model.mesh, kappa, const=const, h_lower=h_lower)
         rec.wall_time = time.perf_counter() - t0
         log.warning("remesh_static: the mesh still changes after %d cycles (max |kappa| h %.3g)",
-                    max_cycles, rec.max_kappa_h)
+                    o.max_cycles, rec.max_kappa_h)
     return RemeshStaticResult(result=result, model=model, extras=extras, records=records, converged=converged,
                               meshes=meshes)
 

@@ -274,7 +274,7 @@ CONTACT_LAWS = ("penalty", "kinematic")
 
 def contact_law(scene: Scene) -> str:
     """The contact law the scene's analysis uses: ``"penalty"`` for static, ``"kinematic"`` for dynamic/relax."""
-    return "penalty" if scene.get("analysis", "static") == "static" else "kinematic"
+    return "penalty" if scene.analysis == "static" else "kinematic"
 
 
 def build_obstacles(scene: Scene) -> list:
@@ -305,7 +305,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
         return None, []
     hold = scene.get("contact.hold_inplane", True)
     if law == "kinematic":
-        if hold and scene.get("analysis") == "relax":
+        if hold and scene.analysis == "relax":
             hold_inplane_rigid_modes(mesh, supports)
         return None, obstacles
     from rftstatic.contact.penalty import PenaltyContact, auto_penalty
@@ -414,13 +414,13 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
         raise scene.error("material.weight", f"{material.weight!r} N/m^2 is negative; give the fabric's areal weight "
                           "(>= 0; upward loads are loads.pressure < 0)")
     check_weight(scene, material.weight)
-    if scene.get("analysis", "static") != "static" and not material.mass_per_area > 0:
+    if scene.analysis != "static" and not material.mass_per_area > 0:
         raise scene.error("material.weight", "an explicit (dynamic or relax) run needs a positive areal weight "
                           "(the mass); got 0")
     supports = build_supports(scene, mesh)
     load = build_load(scene, mesh, material)
     contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
-    if scene.get("analysis", "static") == "static":
+    if scene.analysis == "static":
         check_static_scene(scene, material, supports, load, obstacles)
     membrane = declared_run_options(scene).membrane
     self_contact = build_self_contact(scene, mesh, material)

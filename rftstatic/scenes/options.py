@@ -2,8 +2,9 @@
 
 Every default is written once: the static solver's in :mod:`rftstatic.solvers.options` (the app's
 ``[solver]`` keys in :mod:`rftstatic.scenes.run_options`), the explicit and relaxation runs' in
-:data:`DYNAMICS_DEFAULTS` (per analysis type), the remeshing drivers' in :class:`RemeshOptions`. A bad value raises :class:`~rftstatic.errors.SceneError` naming the
-file, the key and the value.
+:data:`DYNAMICS_DEFAULTS` (per analysis type), the remeshing drivers' in
+:class:`~rftstatic.remesh.options.RemeshOptions`. A bad value raises :class:`~rftstatic.errors.SceneError`
+naming the file, the key and the value.
 """
 
 from __future__ import annotations
@@ -14,11 +15,13 @@ import numpy as np
 
 from rftstatic.errors import ParameterError, SceneError
 from rftstatic.optionspec import from_table
-from rftstatic.remesh.adapt import check_remesh_parameters
+from rftstatic.remesh.options import RemeshOptions
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions, RunOptions
-from rftstatic.solvers.explicit import default_max_steps
+from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
-from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RELAX_REST
+from rftstatic.solvers.rest import RestCriterion
+from rftstatic.solvers.step_plan import default_max_steps
 
 
 def _solver_table(scene) -> dict:
@@ -63,9 +66,9 @@ def run_options(scene) -> RunOptions:
 
 DYNAMICS_DEFAULTS = {
     # true dynamics (§4.6): the real mass, no damping unless the scene asks, rest at 1e-3 of the peak
-    "dynamic": {"alpha": 0.0, "mass_scale": 1.0, "rest_tolerance": 1e-3},
+    "dynamic": {"alpha": ExplicitOptions.alpha, "mass_scale": ExplicitOptions.mass_scale, "rest_tolerance": 1e-3},
     # dynamic relaxation (§6): alpha = 5/s with mass scaling s = 100, rest at 1e-8 of the peak
-    "relax": {"alpha": 5.0, "mass_scale": RELAX_MASS_SCALE, "rest_tolerance": 1e-8},
+    "relax": {"alpha": 5.0, "mass_scale": RELAX_MASS_SCALE, "rest_tolerance": RELAX_REST.tol_kinetic},
 }
 """Defaults of ``[dynamics]`` that depend on the analysis type (scene units); the others are in
 :class:`DynamicsOptions`."""
@@ -99,7 +102,7 @@ class DynamicsOptions:
     frames: np.ndarray
     checkpoint_every: float
     rest_tolerance: float
-    force_tolerance: float = 1e-4
+    force_tolerance: float = RELAX_REST.tol_force
     samples: int = 30
     compare_static: bool = False
     max_steps: int | None = None
@@ -126,7 +129,7 @@ CHECKPOINT_EVERY_S = 0.2
 
 def dynamics_options(scene) -> DynamicsOptions:
     """The scene's ``[dynamics]`` table checked and converted to SI, with the defaults filled in."""
-    analysis = scene.get("analysis", "static")
+    analysis = scene.analysis
     if analysis not in DYNAMICS_DEFAULTS:
         raise scene.error("analysis", f'"{analysis}" has no [dynamics]; use "dynamic" or "relax"')
     d = dict(scene.get("dynamics", {}))
@@ -150,6 +153,11 @@ def dynamics_options(scene) -> DynamicsOptions:
         scale = u.time if key == "alpha" else 1.0  # alpha's bounds are in 1/s, the scene's in 1/(its time unit)
         if not lo * scale <= opts[key] <= hi * scale:
             raise scene.error(f"dynamics.{key}", f"{opts[key]!r} must lie in [{lo * scale:g}, {hi * scale:g}] ({why})")
+    try:
+        RestCriterion(opts["rest_tolerance"], opts["force_tolerance"])
+    except ParameterError as exc:
+        key = {"tol_kinetic": "rest_tolerance", "tol_force": "force_tolerance"}[exc.key]
+        raise scene.error(f"dynamics.{key}", exc.detail) from None
     if opts["max_steps"] is not None and not (isinstance(opts["max_steps"], int) and opts["max_steps"] >= 1):
         raise scene.error("dynamics.max_steps", f"must be a positive integer, got {opts['max_steps']!r}")
     if opts.get("dt") is not None:
@@ -170,50 +178,23 @@ def dynamics_options(scene) -> DynamicsOptions:
         max_steps=None if opts["max_steps"] is None else int(opts["max_steps"]))
 
 
-@dataclass(frozen=True)
-class RemeshOptions:
-    """``[remesh]`` of a scene, in SI (Eq. 29: h_new = sqrt(const / |kappa|) in [h_lower, h_upper]).
-
-    Attributes
-    ----------
-    const : [m]; h_lower, h_upper : element size bounds [m]
-    gradation : largest size ratio between neighbours one element apart [-]
-    max_cycles : static route: most remeshing cycles
-    tol : stop when the node count changes by less than this fraction [-]
-    kappa_h_max : static route: largest |kappa| h accepted without remeshing [-] (None: node count alone)
-    transfer : "mesh", "patch" or "grid" (:mod:`rftstatic.remesh.transfer`)
-    every : relax route: remesh every this many steps (None: on the curvature trigger)
-    kappa_h2_max : relax route: remesh when max |kappa| h^2 exceeds this [m]
-    damping : relax route: "fixed" (dynamics.alpha) or "critical"
-    """
-
-    const: float
-    h_lower: float
-    h_upper: float
-    gradation: float = 1.3
-    max_cycles: int = 5
-    tol: float = 0.05
-    kappa_h_max: float | None = None
-    transfer: str = "mesh"
-    every: int | None = None
-    kappa_h2_max: float | None = None
-    damping: str = "fixed"
-
-
 REMESH_LENGTH_KEYS = ("const", "h_lower", "h_upper", "kappa_h2_max")
 """``[remesh]`` keys that are lengths (scene units in the file, SI in :class:`RemeshOptions`)."""
 
 
 def remesh_options(scene) -> RemeshOptions:
-    """The scene's ``[remesh]`` table with defaults, checked (:func:`check_remesh_parameters`), in SI."""
+    """The scene's ``[remesh]`` table with defaults, checked, as :class:`~rftstatic.remesh.options.RemeshOptions`
+    in SI."""
     r = dict(scene.get("remesh", {}))
     for key in ("const", "h_lower", "h_upper"):
         if key not in r:
             raise scene.error(f"remesh.{key}", f"a [remesh] table needs {key} (Eq. 29, scene length units)")
     try:
-        check_remesh_parameters(**r)
+        RemeshOptions(**r)  # checked in the scene's units, which its messages then quote
     except ParameterError as exc:
         raise scene.error(f"remesh.{exc.key}", exc.detail) from None
+    except TypeError as exc:  # a key the schema let through that the options do not know
+        raise scene.error("remesh", str(exc)) from None
     u = scene.units.length
     return RemeshOptions(**{k: (v * u if k in REMESH_LENGTH_KEYS and v is not None else v) for k, v in r.items()})
 
@@ -225,7 +206,7 @@ def seed_count(scene) -> int:
     if n > 1 and not static_options(scene).route.perturbation > 0:
         raise scene.error("solver.seeds", f"{n} seeded starts need a seeded lift: give solver.perturbation > 0 "
                           "(e.g. 0.01 element sizes), or every start is the same")
-    if n > 1 and scene.get("analysis", "static") != "static":
+    if n > 1 and scene.analysis != "static":
         raise scene.error("solver.seeds", f"{n!r}: seeded starts are run by the static analysis only")
     return n
 
@@ -241,5 +222,4 @@ def cantilever_options(scene) -> CantileverOptions:
 
 
 __all__ = ["run_options", "declared_run_options", "seed_count", "cantilever_options", "CantileverOptions",
-           "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "RemeshOptions",
-           "DYNAMICS_DEFAULTS", "SceneError"]
+           "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "DYNAMICS_DEFAULTS", "SceneError"]

@@ -210,6 +210,11 @@ class Scene:
     def units(self) -> UnitSystem:
         return unit_system(self.data.get("units", "cm-gf-s"))
 
+    @property
+    def analysis(self) -> str:
+        """The scene's ``analysis`` key; a scene without one is static (the one place this default is written)."""
+        return self.data.get("analysis", "static")
+
     def get(self, dotted: str, default=None):
         node = self.data
         for part in dotted.split("."):
@@ -378,7 +383,7 @@ def validate(scene: Scene) -> None:
         raise scene.error("units", f'unknown unit system "{scene.data["units"]}"; use one of {", ".join(UNIT_SYSTEMS)}')
     if scene.data.get("element", "RFT6") not in ("RFT3", "RFT6"):
         raise scene.error("element", f'"{scene.data["element"]}" is not an element; use RFT3 or RFT6')
-    if scene.data.get("analysis", "static") not in SCENE_ANALYSES:
+    if scene.analysis not in SCENE_ANALYSES:
         raise scene.error("analysis", f'"{scene.data["analysis"]}" is not an analysis; use one of '
                           f'{", ".join(SCENE_ANALYSES)}')
 

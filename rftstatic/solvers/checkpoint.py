@@ -222,6 +222,7 @@ def resume(path, model, *, obstacles=(), callback=None, checkpoint=None, progres
         if the model or the obstacles differ from those of the saved run.
     """
     from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit_options import ExplicitOptions
 
     data = load_checkpoint(path)
     if data["fingerprint"] != model_fingerprint(model):
@@ -232,9 +233,10 @@ def resume(path, model, *, obstacles=(), callback=None, checkpoint=None, progres
     if data["obstacles"] != _obstacles_spec(obstacles):
         raise CheckpointError(f"checkpoint {path}: obstacles differ from the saved run ({data['obstacles']})")
     o = data["options"]
-    return run_explicit(
-        model, t_end=float(o["t_end"]), dt=data["dt"], alpha=float(o["alpha"]), mass_scale=float(o["mass_scale"]),
-        obstacles=obstacles, frame_times=o["frame_times"], probes=o["probe_nodes"],
-        sample_every=int(o["sample_every"]), callback=callback, checkpoint=checkpoint, progress=progress,
-        energy_check=bool(o["energy_check"]), energy_tol=float(o["energy_tol"]), rest_tol=float(o["rest_tol"]),
-        safety=float(o["safety"]), backend=str(o["backend"]), _restart=data)
+    options = ExplicitOptions(t_end=float(o["t_end"]), dt=float(data["dt"]), alpha=float(o["alpha"]),
+                              mass_scale=float(o["mass_scale"]), sample_every=int(o["sample_every"]),
+                              energy_check=bool(o["energy_check"]), energy_tol=float(o["energy_tol"]),
+                              rest_tol=float(o["rest_tol"]), safety=float(o["safety"]), backend=str(o["backend"]),
+                              progress=progress)
+    return run_explicit(model, options, obstacles=obstacles, frame_times=o["frame_times"], probes=o["probe_nodes"],
+                        callback=callback, checkpoint=checkpoint, _restart=data)

@@ -42,9 +42,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.element.explicit_force import ForceKernel
-from rftstatic.errors import InstabilityError, StepLimitError
+from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.model.state import State
 from rftstatic.progress import Progress
+from rftstatic.solvers.explicit_options import ExplicitOptions
+from rftstatic.solvers.rest import RestCriterion
+from rftstatic.solvers.step_plan import StepPlan, plan_steps
 from rftstatic.solvers.timestep import StepEstimate, lumped_mass, stable_time_step
 
 log = logging.getLogger(__name__)
@@ -67,7 +70,8 @@ class ExplicitResult:
         dissipated, contact_loss, total [J], residual (out-of-balance force on the free dofs, 2-norm) [N]
     probes : (S, P, 3) displacements of the probe nodes at the samples [m]
     frames : list of (t [s], U (N, 3) [m]) at the requested frame times
-    time_at_rest : first sample time after which kinetic/peak kinetic stays below ``rest_tol``, or None
+    time_at_rest : first sample time [s] from which kinetic / peak kinetic energy stays at most ``options.rest_tol``
+        (:meth:`~rftstatic.solvers.rest.RestCriterion.time_at_rest`), or None
     stopped : True if a callback stopped the run before ``t_end``
     wall_time : [s]; element_steps_per_second : E * steps / wall time
     state : the final :class:`~rftstatic.model.state.State` (U, V, t, step, contact candidates)
@@ -90,84 +94,66 @@ class ExplicitResult:
     state: State | None = None
 
 
-def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float = 0.0, mass_scale: float = 1.0,
-                 obstacles=(), U0=None, V0=None, start: str = "consistent", frame_times=(), probes=None,
-                 sample_every: int | None = None, callback=None, checkpoint=None, progress: bool = True,
-                 energy_check: bool = True, energy_tol: float = 0.25, rest_tol: float = 1e-6,
-                 safety: float = 0.9, backend: str = "auto", load=None, max_steps: int = None,
-                 max_steps_name: str = "dynamics.max_steps", _restart: dict | None = None) -> ExplicitResult:
-    """Integrate the motion of ``model`` from t = 0 to ``t_end`` (module docstring).
+def run_explicit(model, options: ExplicitOptions, *, U0=None, V0=None, obstacles=(), load=None, frame_times=(),
+                 probes=None, callback=None, checkpoint=None, plan: StepPlan | None = None,
+                 _restart: dict | None = None) -> ExplicitResult:
+    """Integrate the motion of ``model`` from t = 0 to ``options.t_end`` (module docstring).
 
     Parameters
     ----------
     model : :class:`rftstatic.model.Model` (supports, gravity in ``model.load``)
-    t_end : end time [s]; the step is shortened slightly so that a whole number of steps ends there
-    dt : step [s]; ``None``: ``safety * dt_crit`` from :func:`rftstatic.timestep.stable_time_step`.
-        A step above that estimate runs with a logged warning.
-    alpha : mass damping factor [1/s] (§4.6 uses 5)
-    mass_scale : mass-scaling factor s [-] (§6 uses 100); the load is not scaled
-    load : (N, 3) external nodal load [N] to use instead of ``model.load`` (e.g. a guided stage)
-    obstacles : obstacles acting kinematically after every step (any type, §6.3)
+    options : :class:`~rftstatic.solvers.explicit_options.ExplicitOptions` (end time, step, damping, mass
+        scaling, start, sampling, checks, step limit)
     U0, V0 : (N, 3) initial displacements [m] and velocities [m/s] (default zero)
-    start : ``"consistent"`` (v_(-1/2) = V0 - a_0 dt/2) or ``"given"`` (v_(-1/2) = V0)
+    obstacles : obstacles acting kinematically after every step (any type, §6.3)
+    load : (N, 3) external nodal load [N] to use instead of ``model.load`` (e.g. a guided stage)
     frame_times : times [s] at which to store the displacement field (first step at or after each)
     probes : node indices (P,) whose displacements are recorded at every sample
-    sample_every : steps between history samples (default: about 2000 samples per run)
     callback : called as ``callback(state, sample)`` at every sample (``sample``: dict of the history
         values); returning True stops the run
     checkpoint : :class:`rftstatic.checkpoint.Checkpointer` saving the state at intervals
-    progress : show a progress bar
-    energy_check : raise :class:`InstabilityError` on energy growth or non-finite values
-    energy_tol : allowed growth of the total energy, relative to the run's energy scale [-]
-    rest_tol : kinetic / peak kinetic energy below which the sheet counts as at rest [-]
-    safety : safety factor on the critical step [-]
-    backend : force back end, ``"auto"``, ``"numpy"`` or ``"numba"``
-    max_steps : refuse (:class:`~rftstatic.errors.StepLimitError`, a ValueError, before the first step) a run
-        of more steps than this (default :data:`MAX_STEPS`), or whose stable step collapsed
-    max_steps_name : the option that sets ``max_steps``, named in that error
+    plan : the :class:`~rftstatic.solvers.step_plan.StepPlan` of this run, made by the caller with
+        :func:`~rftstatic.solvers.step_plan.plan_steps` from the same options (default: planned here)
 
     Returns
     -------
     ExplicitResult
     """
-    if not t_end > 0:
-        raise ValueError(f"t_end must be > 0 [s], got {t_end}")
-    if alpha < 0:
-        raise ValueError(f"mass damping alpha must be >= 0 [1/s], got {alpha}")
-    if start not in ("consistent", "given"):
-        raise ValueError(f'start must be "consistent" or "given", got "{start}"')
+    o = options
     wall0 = time.perf_counter()
     N = model.mesh.n_nodes
     obstacles = tuple(obstacles) if not hasattr(obstacles, "signed_distance") else (obstacles,)
     probes = np.zeros(0, dtype=np.int64) if probes is None else np.atleast_1d(np.asarray(probes, dtype=np.int64))
     if probes.size and (probes.min() < 0 or probes.max() >= N):
         raise ValueError(f"probe nodes must lie in 0..{N - 1}, got min {probes.min()}, max {probes.max()}")
-    loop = _Loop(model, obstacles, mass_scale=mass_scale, alpha=alpha, load=load, backend=backend, probes=probes,
-                 frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()))
+    loop = _Loop(model, obstacles, mass_scale=o.mass_scale, alpha=o.alpha, load=load, backend=o.backend,
+                 probes=probes, frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()))
     if _restart is None:
         state = State.initial(model, U0, V0)
         state.V *= model.free
-        estimate, dt = _choose_step(model, state.U, dt, alpha=alpha, mass_scale=mass_scale, safety=safety,
-                                    needed=energy_check or dt is None)
-        n_steps = step_count(t_end, dt, max_steps, limit_name=max_steps_name)
-        dt = t_end / n_steps
-        loop.begin(dt, start_consistent=start == "consistent", state=state)
+        if plan is not None and plan.t_end != o.t_end:
+            raise ParameterError("plan", f"planned to t_end = {plan.t_end!r} s, the options ask {o.t_end!r} s")
+        if plan is None:
+            plan = plan_steps(model, t_end=o.t_end, dt=o.dt, U=state.U, alpha=o.alpha, mass_scale=o.mass_scale,
+                              safety=o.safety, max_steps=o.max_steps, limit_name=o.max_steps_name,
+                              check_dt=o.energy_check)
+        dt, n_steps, estimate = plan.dt, plan.steps, plan.estimate
+        loop.begin(dt, start_consistent=o.start == "consistent", state=state)
     else:
         r = _restart
         state = State.initial(model, r["U"], r["V_half"], t=r["step"] * r["dt"], step=r["step"])
         dt, n_steps, estimate = r["dt"], r["n_steps"], r["estimate"]
         loop.resume(dt, r)
-    if sample_every is None:
-        sample_every = max(1, n_steps // 2000)
-    opts = {"t_end": t_end, "alpha": alpha, "mass_scale": mass_scale, "sample_every": int(sample_every),
-            "energy_check": energy_check, "energy_tol": energy_tol, "rest_tol": rest_tol, "safety": safety,
-            "frame_times": loop.frame_times, "probe_nodes": probes, "backend": loop.kernel.backend}
-    check = _EnergyCheck(model, estimate, mass_scale=mass_scale, alpha=alpha, safety=safety, tol=energy_tol,
-                         enabled=energy_check)
-    bar = Progress(t_end, "explicit", unit=" s", enabled=progress)
+    sample_every = max(1, n_steps // 2000) if o.sample_every is None else o.sample_every
+    saved = {"t_end": o.t_end, "alpha": o.alpha, "mass_scale": o.mass_scale, "sample_every": int(sample_every),
+             "energy_check": o.energy_check, "energy_tol": o.energy_tol, "rest_tol": o.rest_tol, "safety": o.safety,
+             "frame_times": loop.frame_times, "probe_nodes": probes, "backend": loop.kernel.backend}
+    check = _EnergyCheck(model, estimate, mass_scale=o.mass_scale, alpha=o.alpha, safety=o.safety, tol=o.energy_tol,
+                         enabled=o.energy_check)
+    bar = Progress(o.t_end, "explicit", unit=" s", enabled=o.progress)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            info = {"estimate": estimate, "options": opts}
+            info = {"estimate": estimate, "options": saved}
             with _StopOnInterrupt(loop, enabled=checkpoint is not None):
                 stopped = loop.advance(state, n_steps, int(sample_every), check, bar, callback=callback,
                                        checkpoint=checkpoint, checkpoint_info=info)
@@ -179,49 +165,9 @@ def run_explicit(model, *, t_end: float, dt: float | None = None, alpha: float =
     return ExplicitResult(
         U=state.U, V=state.V, t=state.t, steps=state.step, dt=dt, estimate=estimate, history=history,
         probes=np.asarray(loop.probe_hist, dtype=float).reshape(len(loop.probe_hist), len(probes), 3),
-        frames=loop.frames, time_at_rest=_time_at_rest(history, rest_tol), stopped=stopped,
+        frames=loop.frames, time_at_rest=RestCriterion(o.rest_tol).time_at_rest(history), stopped=stopped,
         contact_nodes=loop.n_contact, wall_time=wall,
         element_steps_per_second=model.mesh.n_elements * state.step / max(wall, 1e-12), state=state)
-
-
-MAX_STEPS = 10_000_000
-"""Largest step limit of one explicit run (hours of computing on a large sheet), and :func:`run_explicit`'s
-default ``max_steps``: a run that asks for more is refused before it starts, naming t_end, dt and the limit."""
-
-STEPS_PER_SIDE_NODE = 10_000
-"""Default step limit of a scene's explicit run (:func:`default_max_steps`) per node along a side of the sheet."""
-
-MIN_DEFAULT_STEPS = 50_000
-"""Least default step limit of a scene's explicit run, however small its mesh."""
-
-
-def default_max_steps(n_nodes: float) -> int:
-    """The default step limit of a scene's explicit run on a mesh of ``n_nodes`` nodes:
-    ``STEPS_PER_SIDE_NODE sqrt(n_nodes)``, at least :data:`MIN_DEFAULT_STEPS`, at most :data:`MAX_STEPS`.
-
-    The stable step shrinks with the element size h (dt ~ h for the membrane) and the time a sheet takes to
-    swing and come to rest does not, so the steps a run needs grow like the nodes along a side, sqrt(N):
-    hang-20 (t_end 2 s) took 4554 steps on 7 x 7 nodes and 30370 on 41 x 41 (6.7 x for 5.9 x the side);
-    the remeshed relaxations of ``validation/remesh_scenes.md`` 22,000-43,000 steps on 500-1900 nodes. The
-    limit leaves a factor 10 over these: 410,000 steps on 41 x 41 nodes, 70,000 (about 2 s at 31 us a step)
-    on 7 x 7, where a limit of 10^7 let a tiny relaxation that cannot come to rest run for minutes.
-    """
-    return int(min(MAX_STEPS, max(MIN_DEFAULT_STEPS, STEPS_PER_SIDE_NODE * float(np.sqrt(max(n_nodes, 0.0))))))
-
-
-def step_count(t_end: float, dt: float, max_steps: int | None = None, *, limit_name: str = "dynamics.max_steps") -> int:
-    """Steps of ``dt`` [s] (rounded up) that reach ``t_end`` [s]; :class:`StepLimitError` (a ValueError)
-    beyond ``max_steps`` (``limit_name``: the option that sets it, for the message) or for a step that is
-    not a positive finite number."""
-    limit = MAX_STEPS if max_steps is None else int(max_steps)
-    if not (np.isfinite(dt) and dt > 0):
-        raise StepLimitError(f"the explicit step dt = {dt!r} s is not a positive finite number (a stable step that "
-                             "collapsed: a stiffness without bound at this state)")
-    steps = t_end / dt - 1e-9
-    if not np.isfinite(steps) or steps > limit:
-        raise StepLimitError(f"t_end = {t_end:.6g} s with dt = {dt:.6g} s needs {steps:.3g} explicit steps, more "
-                             f"than the limit of {limit:d} ({limit_name}); shorten t_end or lengthen dt")
-    return max(1, int(np.ceil(steps)))
 
 
 class _StopOnInterrupt:
@@ -383,19 +329,6 @@ class _Loop:
             self._record(rec, U)
 
 
-def _choose_step(model, U, dt, *, alpha, mass_scale, safety, needed):
-    estimate = stable_time_step(model, U, mass_scale=mass_scale, alpha=alpha, safety=safety) if needed else None
-    if dt is None:
-        return estimate, estimate.dt
-    if not dt > 0:
-        raise ValueError(f"time step dt must be > 0 [s], got {dt}")
-    if estimate is not None and dt > estimate.dt * (1 + 1e-3):  # Lanczos digits vary run to run
-        log.warning("time step dt = %.4g s exceeds the stable estimate %.4g s (critical %.4g s, omega_max "
-                    "%.4g rad/s); the run may become unstable", dt, estimate.dt, estimate.dt_crit,
-                    estimate.omega_max)
-    return estimate, float(dt)
-
-
 def _sample(t, U, V, Vnew, W, P, g, dt, mass, minv, free, acc) -> dict:
     """History values at step n; ``g`` = dt M^-1 (P - F) on the free dofs."""
     vbar = 0.5 * (V + Vnew)
@@ -460,15 +393,4 @@ def _contact(model, obstacles, U, V, mass, acc) -> int:
         np.subtract(x_new, X3, out=U)
         V[...] = v_new
     return n_active
-
-
-def _time_at_rest(history, rest_tol):
-    kin = history["kinetic"]
-    if len(kin) < 2 or not np.isfinite(kin).all() or kin.max() <= 0:
-        return None
-    moving = np.flatnonzero(kin > rest_tol * kin.max())
-    if len(moving) == 0 or moving[-1] == len(kin) - 1:
-        return None
-    return float(history["time"][moving[-1] + 1])
-
 

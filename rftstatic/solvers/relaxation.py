@@ -11,39 +11,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rftstatic.element.explicit_force import BACKENDS
+from rftstatic.errors import ParameterError
 from rftstatic.solvers.explicit import ExplicitResult, run_explicit
+from rftstatic.solvers.explicit_options import ExplicitOptions
+from rftstatic.solvers.rest import AtRest, RestCriterion
+from rftstatic.solvers.step_plan import MAX_STEPS_KEY
 
 log = logging.getLogger(__name__)
 
 RELAX_MASS_SCALE = 100.0
 """Mass-scaling factor s of dynamic relaxation (§6 uses 100): the stable step grows by sqrt(s)."""
-
-
-@dataclass
-class AtRest:
-    """The rest test of dynamic relaxation, as an explicit-run callback ``(state, sample) -> bool``.
-
-    At rest: kinetic energy <= ``tol_kinetic`` times the peak kinetic energy and the out-of-balance force on
-    the free dofs <= ``tol_force`` times ``load_norm`` [N]. ``peak_kinetic`` [J] is the peak so far (updated
-    at every sample; start it from an earlier run's peak to resume). A sheet without load (``load_norm`` 0)
-    measures its force against the largest out-of-balance force it has had (``peak_residual`` [N], the
-    internal force of a perturbed start); one with neither motion nor out-of-balance force (zero kinetic
-    energy, zero residual: an unloaded flat sheet) is already at rest.
-    """
-
-    tol_kinetic: float
-    tol_force: float
-    load_norm: float
-    peak_kinetic: float = 0.0
-    peak_residual: float = 0.0
-
-    def __call__(self, state, rec) -> bool:
-        self.peak_kinetic = peak = max(self.peak_kinetic, rec["kinetic"])
-        self.peak_residual = max(self.peak_residual, rec["residual"])
-        force_scale = self.load_norm if self.load_norm > 0 else self.peak_residual
-        still = rec["kinetic"] <= self.tol_kinetic * peak if peak > 0 else rec["kinetic"] == 0.0
-        return bool(still and rec["residual"] <= self.tol_force * force_scale
-                    and (peak > 0 or rec["residual"] == 0.0))
 
 
 @dataclass
@@ -61,51 +39,88 @@ class RelaxResult:
     peak_kinetic: float = 0.0
 
 
-def relax(model, *, mass_scale: float = RELAX_MASS_SCALE, alpha: float, tol_kinetic: float = 1e-8, tol_force: float = 1e-4,
-          max_time: float, dt: float | None = None, U0=None, V0=None, obstacles=(), sample_every: int = 20,
-          peak_kinetic: float = 0.0, progress: bool = True, backend: str = "auto", load=None, checkpoint=None,
-          restart: dict | None = None, max_steps: int | None = None,
-          max_steps_name: str = "dynamics.max_steps") -> RelaxResult:
+RELAX_REST = RestCriterion(tol_kinetic=1e-8, tol_force=1e-4)
+"""The at-rest test of dynamic relaxation by default: kinetic energy 1e-8 of its peak, out-of-balance force 1e-4
+of the load."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class RelaxOptions:
+    """How :func:`relax` relaxes. A bad value raises :class:`~rftstatic.errors.ParameterError` naming the field.
+
+    Attributes
+    ----------
+    alpha : mass damping [1/s], >= 0; near ``2 omega_1 / sqrt(s)`` (critical for the lowest mode of the
+        scaled system) relaxes fastest
+    max_time : give up after this simulated time [s], > 0 (``converged=False``, logged)
+    mass_scale : mass-scaling factor s [-] (§6: 100); the load is not scaled
+    rest : when the sheet is at rest (:class:`~rftstatic.solvers.rest.RestCriterion`: kinetic energy / its
+        peak, out-of-balance force / load)
+    dt : step [s]; None: the stable step (:func:`~rftstatic.solvers.step_plan.plan_steps`)
+    sample_every : steps between rest tests (history samples) [-]
+    progress : show a progress bar
+    backend : force back end, ``"auto"``, ``"numpy"`` or ``"numba"``
+    max_steps : refuse a relaxation of more explicit steps than this, or whose stable step collapsed
+        (:class:`~rftstatic.errors.StepLimitError`, before the first step); None: the explicit solver's limit
+    max_steps_name : the option that sets ``max_steps``, named in that refusal
+    """
+
+    alpha: float
+    max_time: float
+    mass_scale: float = RELAX_MASS_SCALE
+    rest: RestCriterion = RELAX_REST
+    dt: float | None = None
+    sample_every: int = 20
+    progress: bool = True
+    backend: str = BACKENDS[0]
+    max_steps: int | None = None
+    max_steps_name: str = MAX_STEPS_KEY
+
+    def __post_init__(self):
+        if not (isinstance(self.max_time, (int, float)) and self.max_time > 0):
+            raise ParameterError("max_time", f"must be > 0 [s], got {self.max_time!r}")
+        if not isinstance(self.rest, RestCriterion):
+            raise ParameterError("rest", f"must be a RestCriterion, got {self.rest!r}")
+        self.explicit(given_velocity=False)  # the explicit run's checks, naming the same fields
+
+    def explicit(self, *, given_velocity: bool) -> ExplicitOptions:
+        """The explicit run of the relaxation: from a given half-step velocity, or consistent from rest."""
+        return ExplicitOptions(t_end=self.max_time, dt=self.dt, alpha=self.alpha, mass_scale=self.mass_scale,
+                               start="given" if given_velocity else "consistent", sample_every=self.sample_every,
+                               progress=self.progress, backend=self.backend, max_steps=self.max_steps,
+                               max_steps_name=self.max_steps_name)
+
+
+def relax(model, options: RelaxOptions, *, U0=None, V0=None, obstacles=(), load=None, peak_kinetic: float = 0.0,
+          checkpoint=None, restart: dict | None = None) -> RelaxResult:
     """Dynamic relaxation (§6): damped explicit motion until the sheet is at rest.
 
-    At rest means, at a sample, kinetic energy / peak kinetic energy < ``tol_kinetic`` *and* the
-    out-of-balance force on the free dofs ``|P - F(U)|`` < ``tol_force |P|``. Mass scaling (default
-    s = 100 as in §6) lengthens the stable step by sqrt(s); the load is not scaled, so the resting
+    At rest: ``options.rest`` (:class:`~rftstatic.solvers.rest.RestCriterion`) at a sample, kinetic energy
+    against its peak and the out-of-balance force on the free dofs ``|P - F(U)|`` against ``|P|``. Mass scaling
+    (default s = 100 as in §6) lengthens the stable step by sqrt(s); the load is not scaled, so the resting
     state is the static equilibrium.
 
     Parameters
     ----------
-    alpha : mass damping [1/s]; near ``2 omega_1 / sqrt(s)`` (critical for the lowest mode of the
-        scaled system) relaxes fastest
-    max_time : give up after this simulated time [s] (``converged=False``, logged)
+    options : :class:`RelaxOptions`
     U0, V0 : start [m] and half-step velocity v_(-1/2) [m/s] (default zero), e.g. to resume a
         relaxation from its :class:`RelaxResult` (``U``, ``V``)
-    peak_kinetic : peak kinetic energy [J] of the motion so far, when resuming (``RelaxResult.peak_kinetic``)
+    obstacles : obstacles acting kinematically (§6.3)
     load : (N, 3) external nodal load [N] instead of ``model.load`` (the resting state then balances it)
+    peak_kinetic : peak kinetic energy [J] of the motion so far, when resuming (``RelaxResult.peak_kinetic``)
     checkpoint : saves the explicit state during the run, as in :func:`~rftstatic.solvers.explicit.run_explicit`
         (and a Ctrl-C then stops at a whole step, saved)
     restart : the explicit state saved during an earlier call with the same arguments
         (:func:`~rftstatic.solvers.checkpoint.load_checkpoint`): the run continues from it, step for step as
         the uninterrupted one (``peak_kinetic`` is the peak before that call; ``U0``, ``V0``, ``dt`` are unused)
-    max_steps, max_steps_name : refuse a relaxation of more explicit steps than this, or whose stable step
-        collapsed (:class:`~rftstatic.errors.StepLimitError`, before the first step), naming that option
     """
     P = model.load if load is None else load
     P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
-    if restart is not None:  # the peak of the samples before the interruption, as the rest test saw them
-        kinetic = np.asarray(restart["history"]["kinetic"], dtype=float)
-        peak_kinetic = max(peak_kinetic, float(kinetic.max())) if kinetic.size else peak_kinetic
-        residual = np.asarray(restart["history"]["residual"], dtype=float)
-        peak_residual = float(residual.max()) if residual.size else 0.0
-    else:
-        peak_residual = 0.0
-
-    at_rest = AtRest(tol_kinetic=tol_kinetic, tol_force=tol_force, load_norm=P_norm, peak_kinetic=peak_kinetic,
-                     peak_residual=peak_residual)
-    run = run_explicit(model, t_end=max_time, dt=dt, alpha=alpha, mass_scale=mass_scale, obstacles=obstacles,
-                       U0=U0, V0=V0, start="consistent" if V0 is None else "given", sample_every=sample_every,
-                       callback=at_rest, progress=progress, backend=backend, load=load, checkpoint=checkpoint,
-                       max_steps=max_steps, max_steps_name=max_steps_name, _restart=restart)
+    at_rest = AtRest(options.rest, load_norm=P_norm, peak_kinetic=peak_kinetic)
+    if restart is not None:  # the peaks of the samples before the interruption, as the rest test saw them
+        at_rest.resume_from(restart["history"])
+    run = run_explicit(model, options.explicit(given_velocity=V0 is not None), U0=U0, V0=V0, obstacles=obstacles,
+                       load=load, callback=at_rest, checkpoint=checkpoint, _restart=restart)
     if not run.stopped:
         log.warning("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
                     run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])

@@ -22,7 +22,8 @@ from rftstatic.solvers.load_steps import solve_load_steps
 from rftstatic.solvers.newton import NewtonWorkspace, StaticResult
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
-from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, relax
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RelaxOptions, relax
+from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.units import STANDARD_GRAVITY
 
@@ -365,10 +366,12 @@ def _relax_segment(model, opts, plan, route, fail, checkpoint, restart, t0) -> N
     saver = None if checkpoint is None else checkpoint.segment(route)
     span = max(min(route.span, plan.max_time - route.t_used), plan.min_span)
     try:
-        rel = relax(model, mass_scale=plan.mass_scale, alpha=plan.alpha, tol_kinetic=1e-4, tol_force=route.tol_force,
-                    max_time=span if restart is None else float(restart["options"]["t_end"]), U0=route.U,
-                    V0=route.V, peak_kinetic=route.peak, progress=opts.progress, checkpoint=saver, restart=restart,
-                    max_steps=RELAX_SEGMENT_STEPS, max_steps_name="the relaxation route's segment limit")
+        rel = relax(model, RelaxOptions(mass_scale=plan.mass_scale, alpha=plan.alpha,
+                                        rest=RestCriterion(tol_kinetic=1e-4, tol_force=route.tol_force),
+                                        max_time=span if restart is None else float(restart["options"]["t_end"]),
+                                        progress=opts.progress, max_steps=RELAX_SEGMENT_STEPS,
+                                        max_steps_name="the relaxation route's segment limit"),
+                    U0=route.U, V0=route.V, peak_kinetic=route.peak, checkpoint=saver, restart=restart)
     except InstabilityError as exc:
         raise fail(f"dynamic relaxation became unstable ({exc})") from None
     except StepLimitError as exc:  # the stable step at this state collapsed (a stretched start)
@@ -397,10 +400,12 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, checkpoint
     route.phase = "guide"
     saver = None if checkpoint is None else checkpoint.segment(route)
     try:
-        rel = relax(model, mass_scale=plan.mass_scale, alpha=plan.alpha, tol_kinetic=1e-4, tol_force=1.0,
-                    max_time=GUIDE_DAMPING_TIMES / plan.alpha, U0=route.U, progress=opts.progress, load=guided,
-                    checkpoint=saver, restart=restart, max_steps=RELAX_SEGMENT_STEPS,
-                    max_steps_name="the relaxation route's segment limit")
+        rel = relax(model, RelaxOptions(mass_scale=plan.mass_scale, alpha=plan.alpha,
+                                        rest=RestCriterion(tol_kinetic=1e-4, tol_force=1.0),
+                                        max_time=GUIDE_DAMPING_TIMES / plan.alpha, progress=opts.progress,
+                                        max_steps=RELAX_SEGMENT_STEPS,
+                                        max_steps_name="the relaxation route's segment limit"),
+                    U0=route.U, load=guided, checkpoint=saver, restart=restart)
     except InstabilityError as exc:
         raise fail(f"the guided dynamic relaxation became unstable ({exc})") from None
     except StepLimitError as exc:

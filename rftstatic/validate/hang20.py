@@ -39,6 +39,7 @@ def _corner_positions(n, *, dt_factor=None, clamp=None):
     """Free-corner positions [m] at TIMES for an n x n mesh; dt = dt_factor x critical (None: auto);
     ``clamp``: edge [cm] of the square pinned at each held corner (None: the scene's single nodes)."""
     from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit_options import ExplicitOptions
     from rftstatic.solvers.timestep import stable_time_step
 
     scene = load_scene("hang-20", [f"mesh.nodes=[{n}, {n}]"])
@@ -56,7 +57,7 @@ def _corner_positions(n, *, dt_factor=None, clamp=None):
         dt = dt_factor * est.dt_crit
     out, steps = [], 0
     for t_end in TIMES:
-        res = run_explicit(model, t_end=t_end, dt=dt, alpha=alpha, progress=False, energy_check=True)
+        res = run_explicit(model, ExplicitOptions(t_end=t_end, dt=dt, alpha=alpha, progress=False, energy_check=True))
         out.append(model.X3[corner] + res.U[corner])
         steps += res.steps
     return np.array(out), time.perf_counter() - t0, steps, model.mesh.n_nodes

@@ -195,3 +195,22 @@ def test_an_interrupted_run_resumes_from_its_partial_folder(tmp_path):
     resumed = resume_scene(scene, out, progress=False, figures=False)
     assert not (tmp_path / "cut.partial").exists() and (out / "summary.json").exists()
     assert resumed["steps"] == full["steps"] and resumed["energies"] == full["energies"]
+
+
+@pytest.mark.parametrize("figures", [False, True])
+def test_the_summary_is_written_once_and_names_its_rest_test(tmp_path, monkeypatch, figures):
+    from rftstatic.app import dynamic
+    from rftstatic.scenes.build import build_model
+
+    written = []
+    real = dynamic.write_json
+    monkeypatch.setattr(dynamic, "write_json", lambda path, data: (written.append(path.name), real(path, data)))
+    scene = _tiny_scene(["analysis=relax", "dynamics.rest_tolerance=1e-3", "dynamics.force_tolerance=0.5"])
+    model, extras = build_model(scene)
+    summary = run_dynamic_scene(scene, model, extras, tmp_path, progress=False, figures=figures)
+    assert written == ["summary.json"]
+    on_disk = json.loads((tmp_path / "summary.json").read_text())
+    assert on_disk["rest_test"] == summary["rest_test"] == {
+        "at_rest": {"criterion": "kinetic+force", "tol_kinetic": 1e-3, "tol_force": 0.5},
+        "time_at_rest": {"criterion": "kinetic", "tol_kinetic": 1e-3, "tol_force": None}}
+    assert "critical step" in on_disk["dt_reason"] and ("energy_plot" in on_disk) == figures

@@ -15,7 +15,7 @@ from rftstatic.errors import CheckpointError
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import static_options
 from rftstatic.scenes.schema import load_scene
-from rftstatic.solvers import load_steps, relaxation
+from rftstatic.solvers import load_steps, rest
 from rftstatic.solvers.static_checkpoint import load_static_checkpoint
 
 STRIP = ["mesh.nodes=[21,5]"]  # 7 load increments in about 0.2 s
@@ -174,15 +174,15 @@ def test_a_dynamic_runs_checkpoint_is_not_taken_for_a_static_one(tmp_path, strip
 # ------------------------------------------------------------------------------------ relaxation route
 def _press_ctrl_c_at_sample(monkeypatch, k):
     """SIGINT at the k-th sample of the relaxation's rest test (the explicit loop then stops at a whole step)."""
-    rest, seen = relaxation.AtRest.__call__, []
+    test, seen = rest.AtRest.__call__, []
 
     def call(self, state, rec):
         seen.append(1)
         if len(seen) == k:
             signal.raise_signal(signal.SIGINT)
-        return rest(self, state, rec)
+        return test(self, state, rec)
 
-    monkeypatch.setattr(relaxation.AtRest, "__call__", call)
+    monkeypatch.setattr(rest.AtRest, "__call__", call)
 
 
 def test_a_relaxation_interrupted_mid_segment_resumes_step_for_step(tmp_path, monkeypatch, drape_full):

@@ -176,7 +176,7 @@ def test_a_collapsed_explicit_step_is_a_step_limit_error():
     import numpy as np
 
     from rftstatic.errors import StepLimitError
-    from rftstatic.solvers.explicit import step_count
+    from rftstatic.solvers.step_plan import step_count
 
     for dt in (0.0, np.nan, -1.0, np.inf):
         with pytest.raises(StepLimitError, match="not a positive finite number"):
@@ -200,7 +200,7 @@ def test_a_relaxation_that_cannot_come_to_rest_stops_at_its_default_step_limit(c
 
 
 def test_the_default_step_limit_grows_with_the_nodes_along_a_side():
-    from rftstatic.solvers.explicit import MAX_STEPS, default_max_steps
+    from rftstatic.solvers.step_plan import MAX_STEPS, default_max_steps
 
     assert default_max_steps(25) == 50_000 and default_max_steps(41 * 41) == 410_000
     assert default_max_steps(1e15) == MAX_STEPS
@@ -224,15 +224,15 @@ def test_an_unloaded_relaxation_is_at_rest(capsys, tmp_path):
 
 
 def test_the_rest_test_of_a_perturbed_unloaded_sheet_measures_its_own_peak_force():
-    from rftstatic.solvers.relaxation import AtRest
+    from rftstatic.solvers.rest import AtRest, RestCriterion
 
-    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    rest = AtRest(RestCriterion(1e-8, 1e-4), load_norm=0.0)
     assert rest(None, {"kinetic": 0.0, "residual": 0.0})  # no motion, no force: at rest
-    rest = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=0.0)
+    rest = AtRest(RestCriterion(1e-8, 1e-4), load_norm=0.0)
     assert not rest(None, {"kinetic": 0.0, "residual": 1.0})  # a perturbed start
     assert not rest(None, {"kinetic": 1.0, "residual": 0.5})
     assert rest(None, {"kinetic": 1e-9, "residual": 1e-5})
-    loaded = AtRest(tol_kinetic=1e-8, tol_force=1e-4, load_norm=1.0)
+    loaded = AtRest(RestCriterion(1e-8, 1e-4), load_norm=1.0)
     assert not loaded(None, {"kinetic": 0.0, "residual": 1.0})  # the first sample of a loaded sheet
 
 
@@ -417,3 +417,9 @@ def test_an_integer_of_5000_digits_is_an_input_error(capsys, tmp_path, where):
         code, err = _run(capsys, tmp_path, "strip", [f"mesh.z={'9' * 5000}"])
         assert err.startswith("error: --set mesh.z: Exceeds the limit (4300 digits)"), err
     assert code == 2 and err.endswith("TOML's integers are 64-bit"), err
+
+
+def test_a_rest_tolerance_of_one_or_more_is_an_input_error(capsys, tmp_path):
+    # the kinetic-energy ratio of the at-rest test (rftstatic.solvers.rest) lies in (0, 1)
+    code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "dynamics.rest_tolerance=1.5"])
+    _assert_input_error(code, err, "dynamics.rest_tolerance", "must lie in (0, 1)")

@@ -5,15 +5,18 @@ import pytest
 
 from rftstatic import material
 from rftstatic.element.curvature import curvature_norm
+from rftstatic.errors import ParameterError
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.mesh.mesher import Domain, generate
 from rftstatic.model import model
 from rftstatic.remesh.adapt import adapt_mesh, reference_domain, refinable_maxima, transfer_state
+from rftstatic.remesh.options import RemeshOptions, RemeshRelaxOptions
 from rftstatic.remesh.relax_driver import NearObstacle, critical_damping, explicit_advance, remesh_relax
 from rftstatic.remesh.sizefield import size_field, target_sizes
 from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.remesh.transfer import interpolate, locate, transfer_fields
 from rftstatic.scenes.schema import scene_from_dict
+from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.static import StaticOptions, solve_static
 
 # tip (x, z) of the 5 x 1 cm wool strip on the structured 81 x 17 RFT6 mesh [m]
@@ -261,8 +264,8 @@ def test_remesh_static_strip_reaches_structured_tip():
     from rftstatic.post.probes import probe_positions
     from rftstatic.scenes.build import model_factory
 
-    out = remesh_static(model_factory(_strip_scene()), const=4e-4, h_lower=1e-3, h_upper=4e-3, max_cycles=4, tol=0.05,
-                        kappa_h_max=0.3)
+    out = remesh_static(model_factory(_strip_scene()), RemeshOptions(const=4e-4, h_lower=1e-3, h_upper=4e-3,
+                                                                      max_cycles=4, tol=0.05, kappa_h_max=0.3))
     assert out.converged and out.result.converged
     recs = out.records
     # measured: 33 nodes (max |kappa| h 0.83) -> 71 (0.29) -> 67 (0.31) -> 68 nodes (0.30): the node
@@ -285,8 +288,8 @@ def test_remesh_relax_with_static_stepper_settles():
             progress=False, initial_increment=1.0, max_increment=1.0, increment_displacement=1e30)
         return solve_static(m, U0=U if U.any() else None, options=opts).U, np.zeros_like(V), 0.0
 
-    out = remesh_relax(_strip, const=4e-4, h_lower=1e-3, h_upper=4e-3, advance=advance, chunk=10,
-                       max_steps=200)
+    out = remesh_relax(_strip, RemeshOptions(const=4e-4, h_lower=1e-3, h_upper=4e-3),
+                       RemeshRelaxOptions(chunk=10, max_steps=200), advance=advance)
     reasons = [r.reason for r in out.records]
     assert out.converged and reasons[0] == "initial" and reasons[-1] == "rest" and len(reasons) <= 4
     assert out.records[-1].node_change < 0.05 and out.steps == 10 * len(reasons)
@@ -295,16 +298,17 @@ def test_remesh_relax_with_static_stepper_settles():
 
 
 def test_driver_input_errors():
-    with pytest.raises(ValueError, match="h_lower"):
-        remesh_static(_strip, const=1e-4, h_lower=2e-3, h_upper=1e-3)
-    with pytest.raises(ValueError, match="transfer"):
-        remesh_static(_strip, const=1e-4, h_lower=1e-3, h_upper=2e-3, transfer="spline")
-    with pytest.raises(ValueError, match="alpha"):
-        remesh_relax(_strip, const=1e-4, h_lower=1e-3, h_upper=2e-3)
-    with pytest.raises(ValueError, match="kappa_h2_max"):
-        remesh_relax(_strip, const=1e-4, h_lower=1e-3, h_upper=2e-3, alpha=3.0, kappa_h2_max=-1.0)
+    with pytest.raises(ParameterError, match="h_lower"):
+        RemeshOptions(const=1e-4, h_lower=2e-3, h_upper=1e-3)
+    with pytest.raises(ParameterError, match="transfer"):
+        RemeshOptions(const=1e-4, h_lower=1e-3, h_upper=2e-3, transfer="spline")
+    sizing = RemeshOptions(const=1e-4, h_lower=1e-3, h_upper=2e-3)
+    with pytest.raises(ParameterError, match="alpha"):
+        remesh_relax(_strip, sizing)
+    with pytest.raises(ParameterError, match="kappa_h2_max"):
+        RemeshOptions(const=1e-4, h_lower=1e-3, h_upper=2e-3, kappa_h2_max=-1.0)
     with pytest.raises(TypeError, match="callable mesh -> model"):
-        remesh_static(42, const=1e-4, h_lower=1e-3, h_upper=2e-3)
+        remesh_static(42, sizing)
     with pytest.raises(ValueError, match="transfer method"):
         transfer_fields(mesh.rectangle(1, 1, 3, 3), np.zeros((1, 2)), [np.zeros((9, 3))], method="rbf")
 
@@ -313,8 +317,8 @@ def test_driver_input_errors():
 def test_remesh_relax_explicit_strip_comes_to_rest():
     # §6: mass scaling 100, alpha = 3/s; measured: 33 -> 71 -> 67 -> 71 nodes, at rest after
     # 43 800 steps (t = 14.5 s), 5 settled remeshes skipped, tip 0.22 mm from TIP_REF, 8-20 s wall
-    out = remesh_relax(_strip, const=4e-4, h_lower=1e-3, h_upper=4e-3, alpha=3.0, every=5000,
-                       max_steps=100_000, tol_force=1e-3)
+    out = remesh_relax(_strip, RemeshOptions(const=4e-4, h_lower=1e-3, h_upper=4e-3, every=5000),
+                       RemeshRelaxOptions(alpha=3.0, max_steps=100_000, rest=RestCriterion(1e-8, tol_force=1e-3)))
     assert out.converged and len(out.records) >= 2
     tip = interpolate(out.model.mesh, out.U, np.array([[0.05, 0.0]]))[0]
     assert np.linalg.norm(tip[[0, 2]] - TIP_REF) < 0.01 * np.linalg.norm(TIP_REF)

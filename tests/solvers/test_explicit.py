@@ -13,7 +13,9 @@ from rftstatic.mesh.trimesh import rectangle
 from rftstatic.model.model import Model, Supports, gravity_load
 from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint, resume
 from rftstatic.solvers.explicit import run_explicit
-from rftstatic.solvers.relaxation import relax
+from rftstatic.solvers.explicit_options import ExplicitOptions
+from rftstatic.solvers.relaxation import RelaxOptions, relax
+from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.static import compare_with_static
 from rftstatic.solvers.timestep import element_bound, lanczos_omega, lumped_mass, stable_time_step
 
@@ -77,7 +79,7 @@ def test_free_fall_is_exact():
     """Consistent start v_(-1/2) = -a dt/2: central differences are exact for constant acceleration."""
     mesh = rectangle(0.05, 0.03, 6, 4, z0=0.2)
     model = Model(mesh, WOOL, load=gravity_load(mesh, WOOL.weight))
-    r = run_explicit(model, t_end=0.01, progress=False)
+    r = run_explicit(model, ExplicitOptions(t_end=0.01, progress=False))
     assert r.steps > 50
     assert np.abs(r.U[:, 2] + 0.5 * G * r.t**2).max() <= 1e-14
     assert np.abs(r.U[:, :2]).max() <= 1e-30  # rigid translation: membrane force is round-off only
@@ -89,7 +91,7 @@ def test_free_fall_is_exact():
 def test_undamped_energy_stays_bounded():
     """Strip released under gravity, no damping, ~6 periods of its first mode: total energy within 1e-4."""
     model = strip(STIFF)
-    r = run_explicit(model, t_end=0.4, progress=False)
+    r = run_explicit(model, ExplicitOptions(t_end=0.4, progress=False))
     h = r.history
     scale = np.abs(h["external_work"]).max()
     assert h["kinetic"].max() > 0.2 * scale  # it really vibrates
@@ -101,7 +103,7 @@ def test_cantilever_frequency_matches_beam_theory():
     L = 0.05
     model = strip(STIFF, nx=21, load_factor=0.01, L=L)
     n = tip(model)
-    r = run_explicit(model, t_end=0.25, probes=[n], sample_every=1, progress=False)
+    r = run_explicit(model, ExplicitOptions(t_end=0.25, sample_every=1, progress=False), probes=[n])
     z = r.probes[:, 0, 2]
     zc = z - 0.5 * (z.max() + z.min())
     t = r.history["time"]
@@ -129,7 +131,7 @@ def test_stable_step_estimates():
 
 def _blows_up(model, dt, V0, n=400):
     try:
-        run_explicit(model, t_end=n * dt, dt=dt, V0=V0, progress=False)
+        run_explicit(model, ExplicitOptions(t_end=n * dt, dt=dt, progress=False), V0=V0)
     except InstabilityError:
         return True
     return False
@@ -154,7 +156,7 @@ def test_too_large_step_warns_and_raises_with_suggestion(caplog):
     est = stable_time_step(model)
     with caplog.at_level(logging.WARNING, logger="rftstatic.solvers.explicit"):
         with pytest.raises(InstabilityError, match=r"use dt <= ") as err:
-            run_explicit(model, t_end=0.05, dt=2 * est.dt, progress=False)
+            run_explicit(model, ExplicitOptions(t_end=0.05, dt=2 * est.dt, progress=False))
     assert "exceeds the stable estimate" in caplog.text
     assert err.value.suggested_dt == pytest.approx(est.dt)
     assert err.value.step > 0 and err.value.t > 0
@@ -165,7 +167,7 @@ def test_kinematic_contact_for_every_obstacle_type():
     model = Model(mesh, WOOL, load=gravity_load(mesh, WOOL.weight))
     for ob in (Floor(0.0), Sphere([0, 0, -0.05], 0.05), SquarePedestal([0, 0], 0.01, top_z=0.0),
                RoundPedestal([0, 0], 0.01, top_z=0.0)):
-        r = run_explicit(model, t_end=0.05, alpha=5.0, obstacles=[ob], progress=False)
+        r = run_explicit(model, ExplicitOptions(t_end=0.05, alpha=5.0, progress=False), obstacles=[ob])
         phi, _ = ob.signed_distance(model.X3 + r.U)
         assert phi.min() >= -1e-12, type(ob).__name__
         assert r.contact_nodes > 0 and r.history["contact_loss"][-1] > 0
@@ -176,7 +178,8 @@ def test_relaxation_reaches_the_static_solution():
     model = strip()
     w1 = 1.875**2 / 0.05**2 * np.sqrt(WOOL.Db[0, 0] / WOOL.mass_per_area)
     s = 100.0
-    r = relax(model, mass_scale=s, alpha=2 * w1 / np.sqrt(s), max_time=100.0, tol_force=1e-5, progress=False)
+    r = relax(model, RelaxOptions(mass_scale=s, alpha=2 * w1 / np.sqrt(s), max_time=100.0,
+                                  rest=RestCriterion(1e-8, tol_force=1e-5), progress=False))
     assert r.converged
     cmp = compare_with_static(model, r.U)
     assert cmp["max_displacement"] > 0.04  # a large (nonlinear) drape
@@ -185,9 +188,9 @@ def test_relaxation_reaches_the_static_solution():
 
 def test_resume_reproduces_the_uninterrupted_run(tmp_path):
     model = strip(STIFF)
-    kw = dict(t_end=0.02, alpha=5.0, frame_times=[0.005, 0.015], probes=[tip(model)], sample_every=7,
-              progress=False)
-    full = run_explicit(model, **kw)
+    options = ExplicitOptions(t_end=0.02, alpha=5.0, sample_every=7, progress=False)
+    kw = dict(frame_times=[0.005, 0.015], probes=[tip(model)])
+    full = run_explicit(model, options, **kw)
     path = tmp_path / "run.npz"
 
     def interrupt(state, rec):
@@ -195,7 +198,7 @@ def test_resume_reproduces_the_uninterrupted_run(tmp_path):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        run_explicit(model, callback=interrupt, checkpoint=Checkpointer(path, every_steps=100), **kw)
+        run_explicit(model, options, callback=interrupt, checkpoint=Checkpointer(path, every_steps=100), **kw)
     assert load_checkpoint(path)["step"] == 200
     assert [p.name for p in tmp_path.iterdir()] == ["run.npz"]  # no temporary file left
     res = resume(path, model)
@@ -215,8 +218,8 @@ def test_ctrl_c_saves_a_whole_step_and_resume_reproduces_the_run(tmp_path):
     import signal
 
     model = strip(STIFF)
-    kw = dict(t_end=0.02, alpha=5.0, probes=[tip(model)], sample_every=7, progress=False)
-    full = run_explicit(model, **kw)
+    options = ExplicitOptions(t_end=0.02, alpha=5.0, sample_every=7, progress=False)
+    full = run_explicit(model, options, probes=[tip(model)])
     path = tmp_path / "run.npz"
 
     def press_ctrl_c(state, rec):
@@ -224,7 +227,8 @@ def test_ctrl_c_saves_a_whole_step_and_resume_reproduces_the_run(tmp_path):
             signal.raise_signal(signal.SIGINT)
 
     with pytest.raises(KeyboardInterrupt, match="checkpoint saved"):
-        run_explicit(model, callback=press_ctrl_c, checkpoint=Checkpointer(path, every_steps=100), **kw)
+        run_explicit(model, options, probes=[tip(model)], callback=press_ctrl_c,
+                     checkpoint=Checkpointer(path, every_steps=100))
     saved = load_checkpoint(path)["step"]
     assert 250 < saved < 260  # the step after the signal, not the last periodic checkpoint (200)
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the handler is restored
@@ -244,8 +248,8 @@ def test_a_corrupt_checkpoint_is_reported_as_such(tmp_path):
 def test_numpy_and_numba_runs_agree():
     pytest.importorskip("numba")
     model = strip(STIFF)
-    a = run_explicit(model, t_end=0.01, backend="numpy", progress=False)
-    b = run_explicit(model, t_end=0.01, backend="numba", progress=False)
+    a = run_explicit(model, ExplicitOptions(t_end=0.01, backend="numpy", progress=False))
+    b = run_explicit(model, ExplicitOptions(t_end=0.01, backend="numba", progress=False))
     assert np.abs(a.U - b.U).max() <= 1e-12 * np.abs(a.U).max()
 
 

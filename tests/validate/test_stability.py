@@ -6,6 +6,7 @@ import pytest
 from rftstatic.errors import InstabilityError, PatchError
 from rftstatic.solvers import static
 from rftstatic.solvers.explicit import run_explicit
+from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.validate import stability as st
 from rftstatic.validate.stability.cell_functions import _hang, _strip
@@ -42,10 +43,10 @@ def test_explicit_step_above_critical_raises_with_a_working_suggestion():
     est = stable_time_step(mod, alpha=5.0)
     t_end = 300 * est.dt
     with pytest.raises(InstabilityError) as info:
-        run_explicit(mod, t_end=t_end, dt=1.2 * est.dt, alpha=5.0, progress=False)
+        run_explicit(mod, ExplicitOptions(t_end=t_end, dt=1.2 * est.dt, alpha=5.0, progress=False))
     exc = info.value
     assert exc.suggested_dt <= est.dt * (1 + 1e-9) and f"{exc.suggested_dt:.4g}" in str(exc)
-    res = run_explicit(mod, t_end=t_end, dt=exc.suggested_dt, alpha=5.0, progress=False)
+    res = run_explicit(mod, ExplicitOptions(t_end=t_end, dt=exc.suggested_dt, alpha=5.0, progress=False))
     assert np.isfinite(res.U).all()
 
 

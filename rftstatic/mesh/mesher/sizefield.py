@@ -8,7 +8,7 @@ bilinearly.
 
 Gradation limit
 ---------------
-With ``gradation = g`` (a ratio, default 1.3) the stored field is lowered
+With ``gradation = g`` (a ratio, default :data:`rftstatic.mesh.GRADATION`) the stored field is lowered
 (never raised) to the largest field not above the input that satisfies, for
 every pair of 8-neighbouring grid nodes p, q::
 
@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from rftstatic.errors import MeshingError
+from rftstatic.mesh import GRADATION
 
 __all__ = ["BackgroundGrid", "limit_gradation"]
 
@@ -171,7 +172,7 @@ class BackgroundGrid:
         return cls(origin, spacing, np.full((nx, ny), float(h)))
 
     @classmethod
-    def from_function(cls, func, region, *, spacing=None, gradation=1.3, h_lower=None, h_upper=None):
+    def from_function(cls, func, region, *, spacing=None, gradation=GRADATION, h_lower=None, h_upper=None):
         """Sample a vectorised ``func(x, y) -> h`` [m] at the grid nodes.
 
         Parameters
@@ -192,7 +193,7 @@ class BackgroundGrid:
         return cls(origin, spacing, values, gradation=gradation)
 
     @classmethod
-    def from_samples(cls, points, sizes, region, *, spacing=None, gradation=1.3, h_lower=None, h_upper=None):
+    def from_samples(cls, points, sizes, region, *, spacing=None, gradation=GRADATION, h_lower=None, h_upper=None):
         """Grid from scattered size samples, e.g. per-triangle h_target of an old mesh.
 
         Each sample goes to its nearest grid node, which keeps the minimum of

@@ -188,6 +188,7 @@ def explicit_dt_cell(n=11, *, factor=1.0, steps=1500, alpha=5.0) -> dict:
     """
     from rftstatic.errors import InstabilityError
     from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit_options import ExplicitOptions
     from rftstatic.solvers.timestep import stable_time_step
 
     mod, corner = _hang(n)
@@ -195,14 +196,14 @@ def explicit_dt_cell(n=11, *, factor=1.0, steps=1500, alpha=5.0) -> dict:
     t_end = steps * est.dt
     out = {"dt_over_estimate": factor, "dt_over_critical": factor * est.dt / est.dt_crit, "estimate_dt": est.dt,
            "nodes": mod.mesh.n_nodes}
-    ref = run_explicit(mod, t_end=t_end, dt=0.5 * est.dt, alpha=alpha, progress=False)
+    ref = run_explicit(mod, ExplicitOptions(t_end=t_end, dt=0.5 * est.dt, alpha=alpha, progress=False))
     try:
-        res = run_explicit(mod, t_end=t_end, dt=factor * est.dt, alpha=alpha, progress=False)
+        res = run_explicit(mod, ExplicitOptions(t_end=t_end, dt=factor * est.dt, alpha=alpha, progress=False))
     except InstabilityError as exc:
         out.update(stopped="InstabilityError", message=str(exc), suggested_dt=exc.suggested_dt,
                    suggested_over_estimate=exc.suggested_dt / est.dt, t_stop=exc.t)
         try:  # is the suggestion right? rerun with it
-            again = run_explicit(mod, t_end=t_end, dt=exc.suggested_dt, alpha=alpha, progress=False)
+            again = run_explicit(mod, ExplicitOptions(t_end=t_end, dt=exc.suggested_dt, alpha=alpha, progress=False))
             d = np.linalg.norm(again.U[corner] - ref.U[corner]) / np.linalg.norm(ref.U[corner])
             out["suggested_run"] = f"ran to t = {again.t:.4g} s, corner error {fmt_err(d)}"
             out["right_behaviour"] = bool(exc.suggested_dt < factor * est.dt and d < 0.02)
@@ -219,6 +220,7 @@ def explicit_dt_cell(n=11, *, factor=1.0, steps=1500, alpha=5.0) -> dict:
 def mass_scale_cell(n=11, *, scale=1.0, steps=300) -> dict:
     """Stable step with mass scaling s against sqrt(s) x the unscaled one; a short run at that step."""
     from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit_options import ExplicitOptions
     from rftstatic.solvers.timestep import stable_time_step
 
     mod, _ = _hang(n)
@@ -228,7 +230,7 @@ def mass_scale_cell(n=11, *, scale=1.0, steps=300) -> dict:
     from rftstatic.solvers.timestep import critical_step
 
     expect = 0.9 * critical_step(base.omega_max / math.sqrt(scale), 5.0)
-    res = run_explicit(mod, t_end=steps * est.dt, mass_scale=scale, alpha=5.0, progress=False)
+    res = run_explicit(mod, ExplicitOptions(t_end=steps * est.dt, mass_scale=scale, alpha=5.0, progress=False))
     return {"converged": True, "value": est.dt / base.dt, "reference": expect / base.dt,
             "sqrt_s": math.sqrt(scale), "error": abs(est.dt / expect - 1), "iterations": res.steps,
             "nodes": mod.mesh.n_nodes, "omega_ratio": base.omega_max / est.omega_max}

@@ -17,6 +17,7 @@ from rftstatic.mesh.trimesh import TriMesh, rectangle
 from rftstatic.model.state import State
 from rftstatic.post.measures.intersections import intersecting_pairs, smallest_distance
 from rftstatic.solvers.explicit import run_explicit
+from rftstatic.solvers.explicit_options import ExplicitOptions
 
 from tests.contact.self_contact.test_static_fold import D, folded_strip
 
@@ -29,8 +30,8 @@ def _thrown(self_contact, speed=3.0, mass_scale=1.0):
     upper = model.positions(U0)[:, 2] > 0.015
     V0[upper, 2] = -speed
     times = np.linspace(0.0, 0.02, 41)
-    run = run_explicit(model, t_end=0.02, alpha=5.0, mass_scale=mass_scale, U0=U0, V0=V0, frame_times=times,
-                       progress=False, start="given")
+    run = run_explicit(model, ExplicitOptions(t_end=0.02, alpha=5.0, mass_scale=mass_scale, progress=False,
+                                              start="given"), U0=U0, V0=V0, frame_times=times)
     return model, run
 
 
