@@ -1,14 +1,11 @@
-"""Self-contact kernels written once as scalar loops over pairs, for the compiled (numba) twins of
-:mod:`.distance` and of the law's PSD projection and step bound (:mod:`._kernels_numba` compiles a copy
-of every function here; the numpy paths are those of the calling modules).
-
-The formulas are those of :mod:`.distance` (closest feature, envelope-theorem Hessian) in the same
-order of operations, so the two paths agree to round-off; ``x (4, 3)`` is one pair's points
-``(p, t_0, t_1, t_2)`` or ``(a_0, a_1, b_0, b_1)`` [m], ``W (4,)``, ``D (4, 2)`` and ``act (2,)`` the
-closest feature's weights, their parameter derivatives and the active parameters, filled in place.
+"""Self-contact loops written once as scalar loops, for the compiled (numba) twins of the law's PSD
+projection and step bound and of the near-pair cut (:mod:`._kernels_numba` compiles a copy of every
+function here; the numpy paths are those of the calling modules, :mod:`.law_kernels` and
+:mod:`.near_pairs`). The pair geometry they call (closest feature, squared distance) is that of
+:mod:`.geometry`, the one source of both back ends.
 
 PSD projection (:func:`psd_project_all`): a 12 x 12 block ``B`` of the law lies in the span of
-``w (x) e_i`` and ``dw/du_a (x) r`` (rank <= 5, :mod:`.distance`), so instead of a 12 x 12
+``w (x) e_i`` and ``dw/du_a (x) r`` (rank <= 5, :mod:`.geometry`), so instead of a 12 x 12
 eigen-decomposition the columns of ``B`` are reduced by a pivoted Gram-Schmidt (twice, for
 orthogonality to round-off) to an orthonormal basis ``U (12, m)`` of its range (columns whose
 residual is below ``RANK_TOL`` times the largest column are round-off), ``M = U^T B U`` is diagonalised
@@ -18,219 +15,11 @@ by cyclic Jacobi rotations and ``U V max(L, 0) V^T U^T`` returned. This is exact
 
 import numpy as np
 
-PARALLEL_TOL = 1e-12
-"""``sin^2`` of the angle between two edges below which they count as parallel (interior candidate
-dropped). The interior distance then differs from the end-point one by at most ``~1e-6`` of an edge
-length, and ``G`` of the interior feature stays well conditioned (``det G >= 1e-12 |e_a|^2 |e_b|^2``)."""
+from rftstatic.contact.self_contact.geometry import ee_closest, pt_closest
 
 RANK_TOL = 1e-14
 """Residual column norm, relative to the largest column of a block, below which a column adds no
 direction to the block's range in :func:`psd_project_all` (round-off of the Gram-Schmidt)."""
-
-_EDGES = ((1, 2), (2, 3), (3, 1))
-
-
-def segment_param(x, p, a, b):
-    """Parameter in [0, 1] of the point of segment ``x[a] x[b]`` closest to ``x[p]``."""
-    ee = 0.0
-    pe = 0.0
-    for i in range(3):
-        e = x[b, i] - x[a, i]
-        ee += e * e
-        pe += (x[p, i] - x[a, i]) * e
-    t = pe / ee if ee > 0 else 0.0
-    return min(max(t, 0.0), 1.0)
-
-
-def pt_classify(x, W, D, act):
-    """Closest feature of point ``x[0]`` and triangle ``x[1:]``: fills ``W, D, act``; returns the squared
-    distance [m^2] and the feature code (0 face, 1 edge, 2 vertex)."""
-    a11 = a12 = a22 = b1 = b2 = 0.0
-    for i in range(3):
-        e1, e2, w = x[2, i] - x[1, i], x[3, i] - x[1, i], x[0, i] - x[1, i]
-        a11 += e1 * e1
-        a12 += e1 * e2
-        a22 += e2 * e2
-        b1 += w * e1
-        b2 += w * e2
-    det = a11 * a22 - a12 * a12
-    W[:] = 0.0
-    D[:, :] = 0.0
-    act[:] = False
-    best = np.inf
-    code = 0
-    if det > 1e-14 * a11 * a22:
-        u = (a22 * b1 - a12 * b2) / det
-        v = (a11 * b2 - a12 * b1) / det
-        if u >= 0 and v >= 0 and u + v <= 1:
-            best = 0.0
-            for i in range(3):
-                r = (x[0, i] - x[1, i]) - u * (x[2, i] - x[1, i]) - v * (x[3, i] - x[1, i])
-                best += r * r
-            W[0], W[1], W[2], W[3] = 1.0, -(1 - u - v), -u, -v
-            D[1, 0], D[1, 1], D[2, 0], D[3, 1] = 1.0, 1.0, -1.0, -1.0
-            act[0] = act[1] = True
-    for i, j in _EDGES:
-        s = segment_param(x, 0, i, j)
-        d2 = 0.0
-        for k in range(3):
-            r = x[0, k] - x[i, k] - s * (x[j, k] - x[i, k])
-            d2 += r * r
-        if d2 < best:
-            best = d2
-            W[:] = 0.0
-            W[0], W[i], W[j] = 1.0, -(1 - s), -s
-            D[:, :] = 0.0
-            interior = s > 0 and s < 1
-            if interior:
-                D[i, 0], D[j, 0] = 1.0, -1.0
-            act[0], act[1] = interior, False
-            code = 1 if interior else 2
-    return best, code
-
-
-def ee_classify(x, W, D, act):
-    """Closest feature of edges ``x[0] x[1]`` and ``x[2] x[3]``: fills ``W, D, act``; returns the squared
-    distance [m^2] and the feature code (0 interior, 1 end point-edge, 2 end point-end point)."""
-    aa = ab = bb = ad = bd = 0.0
-    for i in range(3):
-        ea, eb, w0 = x[1, i] - x[0, i], x[3, i] - x[2, i], x[0, i] - x[2, i]
-        aa += ea * ea
-        ab += ea * eb
-        bb += eb * eb
-        ad += ea * w0
-        bd += eb * w0
-    det = aa * bb - ab * ab
-    best = np.inf
-    S = T = 0.0
-    act[:] = False
-    code = 0
-    if det > PARALLEL_TOL * aa * bb:
-        s = (ab * bd - bb * ad) / det
-        t = (aa * bd - ab * ad) / det
-        if s > 0 and s < 1 and t > 0 and t < 1:
-            best = 0.0
-            for i in range(3):
-                r = (x[0, i] - x[2, i]) + s * (x[1, i] - x[0, i]) - t * (x[3, i] - x[2, i])
-                best += r * r
-            S, T = s, t
-            act[0] = act[1] = True
-    for c in range(4):
-        # end point of one edge (a_0, a_1, b_0, b_1) against the other segment
-        value = 1.0 if c % 2 else 0.0
-        if c < 2:
-            pe = pp = 0.0
-            for i in range(3):
-                pt = x[0, i] + value * (x[1, i] - x[0, i])
-                e = x[3, i] - x[2, i]
-                pe += (pt - x[2, i]) * e
-                pp += e * e
-            q = pe / pp if pp > 0 else 0.0
-            q = min(max(q, 0.0), 1.0)
-            s_c, t_c = value, q
-        else:
-            pe = pp = 0.0
-            for i in range(3):
-                pt = x[2, i] + value * (x[3, i] - x[2, i])
-                e = x[1, i] - x[0, i]
-                pe += (pt - x[0, i]) * e
-                pp += e * e
-            q = pe / pp if pp > 0 else 0.0
-            q = min(max(q, 0.0), 1.0)
-            s_c, t_c = q, value
-        d2 = 0.0
-        for i in range(3):
-            r = (x[0, i] - x[2, i]) + s_c * (x[1, i] - x[0, i]) - t_c * (x[3, i] - x[2, i])
-            d2 += r * r
-        if d2 < best:
-            best = d2
-            S, T = s_c, t_c
-            interior = q > 0 and q < 1
-            act[0] = act[1] = False
-            act[1 if c < 2 else 0] = interior
-            code = 1 if interior else 2
-    W[0], W[1], W[2], W[3] = 1 - S, S, -(1 - T), -T
-    D[:, :] = 0.0
-    if act[0]:
-        D[0, 0], D[1, 0] = -1.0, 1.0
-    if act[1]:
-        D[2, 1], D[3, 1] = 1.0, -1.0
-    return best, code
-
-
-def pair_derivatives(x, W, D, act, grad, H, hessian):
-    """Squared distance [m^2] of ``|sum_k W_k x_k|^2``; fills ``grad (4, 3)`` [m] and, with ``hessian``,
-    ``H (12, 12)`` [-] minimised over the active parameters (:func:`.distance.pair_derivatives`)."""
-    r0 = r1 = r2 = 0.0
-    for k in range(4):
-        r0 += W[k] * x[k, 0]
-        r1 += W[k] * x[k, 1]
-        r2 += W[k] * x[k, 2]
-    s = r0 * r0 + r1 * r1 + r2 * r2
-    for k in range(4):
-        grad[k, 0], grad[k, 1], grad[k, 2] = 2.0 * W[k] * r0, 2.0 * W[k] * r1, 2.0 * W[k] * r2
-    if not hessian:
-        return s
-    H[:, :] = 0.0
-    for k in range(4):
-        for m in range(4):
-            h = 2.0 * W[k] * W[m]
-            for i in range(3):
-                H[3 * k + i, 3 * m + i] = h
-    if not (act[0] or act[1]):
-        return s
-    tv = np.zeros((2, 3))
-    for a in range(2):
-        for i in range(3):
-            t = 0.0
-            for k in range(4):
-                t += D[k, a] * x[k, i]
-            tv[a, i] = t
-    g00 = 2.0 * (tv[0, 0] * tv[0, 0] + tv[0, 1] * tv[0, 1] + tv[0, 2] * tv[0, 2]) if act[0] else 1.0
-    g11 = 2.0 * (tv[1, 0] * tv[1, 0] + tv[1, 1] * tv[1, 1] + tv[1, 2] * tv[1, 2]) if act[1] else 1.0
-    g01 = 2.0 * (tv[0, 0] * tv[1, 0] + tv[0, 1] * tv[1, 1] + tv[0, 2] * tv[1, 2]) if act[0] and act[1] else 0.0
-    det = g00 * g11 - g01 * g01
-    i00, i11, i01 = g11 / det, g00 / det, -g01 / det
-    F = np.zeros((12, 2))
-    r = (r0, r1, r2)
-    for a in range(2):
-        if act[a]:
-            for k in range(4):
-                for i in range(3):
-                    F[3 * k + i, a] = 2.0 * (D[k, a] * r[i] + W[k] * tv[a, i])
-    for m in range(12):
-        f0 = F[m, 0] * i00 + F[m, 1] * i01
-        f1 = F[m, 0] * i01 + F[m, 1] * i11
-        for n in range(12):
-            H[m, n] = H[m, n] - (f0 * F[n, 0] + f1 * F[n, 1])
-    return s
-
-
-def distances_all(x4, kind, s, code):
-    """Squared distances ``s (P,)`` [m^2] and feature codes ``code (P,)`` of all pairs ``x4 (P, 4, 3)``
-    [m]; ``kind`` 0 point-triangle, 1 edge-edge."""
-    W = np.zeros(4)
-    D = np.zeros((4, 2))
-    act = np.zeros(2, dtype=np.bool_)
-    for p in range(x4.shape[0]):
-        if kind == 0:
-            s[p], code[p] = pt_classify(x4[p], W, D, act)
-        else:
-            s[p], code[p] = ee_classify(x4[p], W, D, act)
-
-
-def derivatives_all(x4, kind, hessian, s, grad, H, code):
-    """Fill ``s (P,)`` [m^2], ``grad (P, 4, 3)`` [m], ``H (P, 12, 12)`` [-] (with ``hessian``) and
-    ``code (P,)`` of all pairs ``x4 (P, 4, 3)`` [m]; ``kind`` 0 point-triangle, 1 edge-edge."""
-    W = np.zeros(4)
-    D = np.zeros((4, 2))
-    act = np.zeros(2, dtype=np.bool_)
-    for p in range(x4.shape[0]):
-        if kind == 0:
-            _, code[p] = pt_classify(x4[p], W, D, act)
-        else:
-            _, code[p] = ee_classify(x4[p], W, D, act)
-        s[p] = pair_derivatives(x4[p], W, D, act, grad[p], H[p if hessian else 0], hessian)
 
 
 def jacobi_eigen(M, V, m):
@@ -375,9 +164,6 @@ def ccd_all(x, dx, nodes, kind, eta, max_rounds, floor):
     target distance is ``g = eta d0``, raised to ``floor`` [m] when it starts above it. A pair stops
     once its time passes the smallest one found (its time only grows), which leaves the minimum
     unchanged."""
-    W = np.zeros(4)
-    D = np.zeros((4, 2))
-    act = np.zeros(2, dtype=np.bool_)
     x4 = np.zeros((4, 3))
     dx4 = np.zeros((4, 3))
     y = np.zeros((4, 3))
@@ -400,9 +186,9 @@ def ccd_all(x, dx, nodes, kind, eta, max_rounds, floor):
         if not ell > 0:
             continue
         if kind == 0:
-            s0, _ = pt_classify(x4, W, D, act)
+            s0 = pt_closest(x4)[0]
         else:
-            s0, _ = ee_classify(x4, W, D, act)
+            s0 = ee_closest(x4)[0]
         d0 = np.sqrt(s0)
         g = eta * d0
         if d0 > floor:
@@ -423,9 +209,9 @@ def ccd_all(x, dx, nodes, kind, eta, max_rounds, floor):
                 for i in range(3):
                     y[k, i] = x4[k, i] + t * dx4[k, i]
             if kind == 0:
-                s, _ = pt_classify(y, W, D, act)
+                s = pt_closest(y)[0]
             else:
-                s, _ = ee_classify(y, W, D, act)
+                s = ee_closest(y)[0]
             dcur = np.sqrt(s)
             if dcur - g <= 1e-3 * (d0 - g):
                 break
@@ -464,9 +250,6 @@ def distances_by_index(x, pairs, tri, edges, kind, s):
     """Squared distances ``s (P,)`` [m^2] of the broad phase's pairs ``pairs (P, 2)`` read from positions
     ``x (N, 3)`` [m] without gathering them first: kind 0 (node, triangle of ``tri (T, 3)``), kind 1
     (edge, edge of ``edges (M, 2)``). The near-pair cut of every list build (:mod:`.near_pairs`)."""
-    W = np.zeros(4)
-    D = np.zeros((4, 2))
-    act = np.zeros(2, dtype=np.bool_)
     x4 = np.zeros((4, 3))
     for p in range(pairs.shape[0]):
         a, b = pairs[p, 0], pairs[p, 1]
@@ -482,6 +265,6 @@ def distances_by_index(x, pairs, tri, edges, kind, s):
                 x4[2, i] = x[edges[b, 0], i]
                 x4[3, i] = x[edges[b, 1], i]
         if kind == 0:
-            s[p], _ = pt_classify(x4, W, D, act)
+            s[p] = pt_closest(x4)[0]
         else:
-            s[p], _ = ee_classify(x4, W, D, act)
+            s[p] = ee_closest(x4)[0]
