@@ -51,7 +51,11 @@ Each function runs two ways from this one source, as the membrane's (:mod:`rftst
 Written for both: accumulators are rebound (``a = a + b``), values are combined by arithmetic, ufuncs
 and :func:`select` only (no ``if`` on a value), and branches are on loop indices and flags. The
 loops :func:`distances_all` and :func:`derivatives_all` are compiled only; their numpy twins are the
-``*_numpy`` functions.
+``*_numpy`` functions. So are the other loops that call the geometry, the additive continuous
+collision detection :func:`ccd_all` and the near-pair cut :func:`distances_by_index` (their numpy
+twins: :func:`.law_kernels.additive_ccd`, :func:`.near_pairs._distances`). They live here, with the
+geometry they inline, because numba's cache is keyed on a function's own file: a loop in another file
+would keep an old geometry compiled in after this one changed.
 """
 
 import numpy as np
@@ -312,6 +316,91 @@ def derivatives_all(x4, kind, hessian, s, grad, H, code):
             _, code[p] = ee_classify(x4[p], W, D, act)
         s[p] = pair_derivatives(x4[p], W, D, act, grad[p], H[p if hessian else 0], hessian, tv, F)
 
+
+def ccd_all(x, dx, nodes, kind, eta, max_rounds, floor):
+    """Smallest safe time in [0, 1] over all pairs ``nodes (P, 4)`` of positions ``x`` and step ``dx``
+    ``(N, 3)`` [m] of the additive continuous collision detection (:mod:`.law`); ``kind`` 0
+    point-triangle (sides ``{0}``, ``{1, 2, 3}``), 1 edge-edge (``{0, 1}``, ``{2, 3}``). A pair's
+    target distance is ``g = eta d0``, raised to ``floor`` [m] when it starts above it. A pair stops
+    once its time passes the smallest one found (its time only grows), which leaves the minimum
+    unchanged."""
+    x4 = np.zeros((4, 3))
+    dx4 = np.zeros((4, 3))
+    y = np.zeros((4, 3))
+    na = 1 if kind == 0 else 2
+    tmin = 1.0
+    for p in range(nodes.shape[0]):
+        for k in range(4):
+            for i in range(3):
+                x4[k, i] = x[nodes[p, k], i]
+                dx4[k, i] = dx[nodes[p, k], i]
+        ell2 = 0.0
+        for a in range(na):
+            for b in range(na, 4):
+                r = 0.0
+                for i in range(3):
+                    v = dx4[a, i] - dx4[b, i]
+                    r += v * v
+                ell2 = max(ell2, r)
+        ell = np.sqrt(ell2)
+        if not ell > 0:
+            continue
+        if kind == 0:
+            s0 = pt_closest(x4)[0]
+        else:
+            s0 = ee_closest(x4)[0]
+        d0 = np.sqrt(s0)
+        g = eta * d0
+        if d0 > floor:
+            g = max(g, floor)
+        if not ell > d0 - g:
+            continue
+        t = 0.0
+        dcur = d0
+        for _ in range(max_rounds):
+            tn = t + (dcur - g) / ell
+            if tn >= 1.0:
+                t = 1.0
+                break
+            t = tn
+            if t >= tmin:
+                break
+            for k in range(4):
+                for i in range(3):
+                    y[k, i] = x4[k, i] + t * dx4[k, i]
+            if kind == 0:
+                s = pt_closest(y)[0]
+            else:
+                s = ee_closest(y)[0]
+            dcur = np.sqrt(s)
+            if dcur - g <= 1e-3 * (d0 - g):
+                break
+        tmin = min(tmin, t)
+    return tmin
+
+
+def distances_by_index(x, pairs, tri, edges, kind, s):
+    """Squared distances ``s (P,)`` [m^2] of the broad phase's pairs ``pairs (P, 2)`` read from positions
+    ``x (N, 3)`` [m] without gathering them first: kind 0 (node, triangle of ``tri (T, 3)``), kind 1
+    (edge, edge of ``edges (M, 2)``). The near-pair cut of every list build (:mod:`.near_pairs`)."""
+    x4 = np.zeros((4, 3))
+    for p in range(pairs.shape[0]):
+        a, b = pairs[p, 0], pairs[p, 1]
+        for i in range(3):
+            if kind == 0:
+                x4[0, i] = x[a, i]
+                x4[1, i] = x[tri[b, 0], i]
+                x4[2, i] = x[tri[b, 1], i]
+                x4[3, i] = x[tri[b, 2], i]
+            else:
+                x4[0, i] = x[edges[a, 0], i]
+                x4[1, i] = x[edges[a, 1], i]
+                x4[2, i] = x[edges[b, 0], i]
+                x4[3, i] = x[edges[b, 1], i]
+        if kind == 0:
+            s[p] = pt_closest(x4)[0]
+        else:
+            s[p] = ee_closest(x4)[0]
 
 # --- the numpy twins of the loops: all pairs at once, pair axis last -------------------------------
 def distances_numpy(x4, kind):

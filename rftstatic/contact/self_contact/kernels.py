@@ -1,8 +1,8 @@
 """Self-contact loops written once as scalar loops, for the compiled (numba) twins of the law's PSD
-projection and step bound and of the near-pair cut (:mod:`._kernels_numba` compiles a copy of every
+projection and of the near-pair lists' node motion (:mod:`._kernels_numba` compiles a copy of every
 function here; the numpy paths are those of the calling modules, :mod:`.law_kernels` and
-:mod:`.near_pairs`). The pair geometry they call (closest feature, squared distance) is that of
-:mod:`.geometry`, the one source of both back ends.
+:mod:`.near_pairs`). None of them needs the pair geometry: the loops that do are in
+:mod:`.geometry`, with it.
 
 PSD projection (:func:`psd_project_all`): a 12 x 12 block ``B`` of the law lies in the span of
 ``w (x) e_i`` and ``dw/du_a (x) r`` (rank <= 5, :mod:`.geometry`), so instead of a 12 x 12
@@ -14,8 +14,6 @@ by cyclic Jacobi rotations and ``U V max(L, 0) V^T U^T`` returned. This is exact
 """
 
 import numpy as np
-
-from rftstatic.contact.self_contact.geometry import ee_closest, pt_closest
 
 RANK_TOL = 1e-14
 """Residual column norm, relative to the largest column of a block, below which a column adds no
@@ -157,68 +155,6 @@ def psd_project_all(H, out):
         psd_project_one(H[a], out[a], B, R, U, M, V)
 
 
-def ccd_all(x, dx, nodes, kind, eta, max_rounds, floor):
-    """Smallest safe time in [0, 1] over all pairs ``nodes (P, 4)`` of positions ``x`` and step ``dx``
-    ``(N, 3)`` [m] of the additive continuous collision detection (:mod:`.law`); ``kind`` 0
-    point-triangle (sides ``{0}``, ``{1, 2, 3}``), 1 edge-edge (``{0, 1}``, ``{2, 3}``). A pair's
-    target distance is ``g = eta d0``, raised to ``floor`` [m] when it starts above it. A pair stops
-    once its time passes the smallest one found (its time only grows), which leaves the minimum
-    unchanged."""
-    x4 = np.zeros((4, 3))
-    dx4 = np.zeros((4, 3))
-    y = np.zeros((4, 3))
-    na = 1 if kind == 0 else 2
-    tmin = 1.0
-    for p in range(nodes.shape[0]):
-        for k in range(4):
-            for i in range(3):
-                x4[k, i] = x[nodes[p, k], i]
-                dx4[k, i] = dx[nodes[p, k], i]
-        ell2 = 0.0
-        for a in range(na):
-            for b in range(na, 4):
-                r = 0.0
-                for i in range(3):
-                    v = dx4[a, i] - dx4[b, i]
-                    r += v * v
-                ell2 = max(ell2, r)
-        ell = np.sqrt(ell2)
-        if not ell > 0:
-            continue
-        if kind == 0:
-            s0 = pt_closest(x4)[0]
-        else:
-            s0 = ee_closest(x4)[0]
-        d0 = np.sqrt(s0)
-        g = eta * d0
-        if d0 > floor:
-            g = max(g, floor)
-        if not ell > d0 - g:
-            continue
-        t = 0.0
-        dcur = d0
-        for _ in range(max_rounds):
-            tn = t + (dcur - g) / ell
-            if tn >= 1.0:
-                t = 1.0
-                break
-            t = tn
-            if t >= tmin:
-                break
-            for k in range(4):
-                for i in range(3):
-                    y[k, i] = x4[k, i] + t * dx4[k, i]
-            if kind == 0:
-                s = pt_closest(y)[0]
-            else:
-                s = ee_closest(y)[0]
-            dcur = np.sqrt(s)
-            if dcur - g <= 1e-3 * (d0 - g):
-                break
-        tmin = min(tmin, t)
-    return tmin
-
-
 def midrange_motion(a, b, s, c, out):
     """Translation-free motion (Eq. 1 of :mod:`.near_pairs`) of ``w = a + s b - c`` (``a, b, c (N, 3)``
     [m], ``s`` a scalar): ``out[k] = |w_k - m|`` ``(N,)`` [m] with ``m`` the midrange of ``w`` over the
@@ -244,27 +180,3 @@ def midrange_motion(a, b, s, c, out):
         out[k] = r
         big = max(big, r)
     return big
-
-
-def distances_by_index(x, pairs, tri, edges, kind, s):
-    """Squared distances ``s (P,)`` [m^2] of the broad phase's pairs ``pairs (P, 2)`` read from positions
-    ``x (N, 3)`` [m] without gathering them first: kind 0 (node, triangle of ``tri (T, 3)``), kind 1
-    (edge, edge of ``edges (M, 2)``). The near-pair cut of every list build (:mod:`.near_pairs`)."""
-    x4 = np.zeros((4, 3))
-    for p in range(pairs.shape[0]):
-        a, b = pairs[p, 0], pairs[p, 1]
-        for i in range(3):
-            if kind == 0:
-                x4[0, i] = x[a, i]
-                x4[1, i] = x[tri[b, 0], i]
-                x4[2, i] = x[tri[b, 1], i]
-                x4[3, i] = x[tri[b, 2], i]
-            else:
-                x4[0, i] = x[edges[a, 0], i]
-                x4[1, i] = x[edges[a, 1], i]
-                x4[2, i] = x[edges[b, 0], i]
-                x4[3, i] = x[edges[b, 1], i]
-        if kind == 0:
-            s[p] = pt_closest(x4)[0]
-        else:
-            s[p] = ee_closest(x4)[0]
