@@ -1,48 +1,59 @@
-"""Compiled (numba) twins of the self-contact loops, made from their own code (:mod:`.kernels`:
-distances, derivatives, PSD projection, step bound; :mod:`.grid`: the broad phase's cell list).
+"""Compiled (numba) twins of the self-contact loops, made from their own code (:mod:`.geometry`: pair
+distances and derivatives, step bound, near-pair cut; :mod:`.kernels`: PSD projection, node motion;
+:mod:`.grid`: the broad phase's cell list).
 
 As :mod:`rftstatic.element._kernels_numba`: each function is handed to ``numba.njit`` as a copy whose
 global names resolve to the compiled twins, so the loops call the compiled per-pair functions
-(inlined) and the plain source stays plain Python. Serial: the machines share their cores, and the
-loops are short next to the solver's. Imported only when numba is installed and chosen
-(:func:`rftstatic.contact.self_contact.distance.compiled_for`).
+(inlined) and the plain source stays plain Python; the geometry's ``select`` resolves to the compiled
+:func:`.geometry.select_one` (``a if c else b``). Each loop inlines only functions of its own file, the
+one numba's cache is keyed on (its source hash), so that an edit of that file recompiles the loop.
+The key holds no compile options: after changing the ``njit`` options here, delete the index files
+``__pycache__/<module>.*.nbi`` of the three modules, or the old machine code is loaded again. Serial: the machines share their cores, and the loops are short next to the solver's. Imported only
+when numba is installed and chosen (:func:`rftstatic.contact.self_contact.distance.compiled_for`).
 """
 
 import types
 
 import numba as nb
 
-from rftstatic.contact.self_contact import grid, kernels
+from rftstatic.contact.self_contact import geometry, grid, kernels
 
-_INLINE = {kernels: ("segment_param", "pt_classify", "ee_classify", "pair_derivatives"), grid: ("_grow",)}
-_LOOPS = {kernels: ("distances_all", "derivatives_all", "jacobi_eigen", "psd_project_one", "psd_project_all",
-                    "ccd_all", "midrange_motion", "distances_by_index"),
+_INLINE = {geometry: ("_unit_clamp", "segment_param", "_end_point_param", "pt_closest", "ee_closest",
+                      "pt_classify", "ee_classify", "pair_derivatives"),
+           kernels: (), grid: ("_grow",)}
+_LOOPS = {geometry: ("distances_all", "derivatives_all", "ccd_all", "distances_by_index"),
+          kernels: ("jacobi_eigen", "psd_project_one", "psd_project_all", "midrange_motion"),
           grid: ("boxes", "cell_list", "join")}
 
 
-def _compile(module, names, scope, **options):
-    """Put a compiled copy of each ``module.<name>`` into ``scope`` (the copies' globals)."""
-    for name in names:
-        f = getattr(module, name)
-        copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
-        copy.__qualname__ = name
-        copy.__doc__ = f.__doc__
-        scope[name] = nb.njit(copy, cache=True, nogil=True, error_model="numpy", **options)
+def _compile(f, name, scope, **options):
+    """Put a compiled copy of ``f`` into ``scope`` (the copies' globals) as ``name``.
+
+    ``error_model="numpy"``: no zero-division checks (every division is by a value kept away from
+    zero: a selected 1.0, a determinant above a tolerance), as in the membrane's kernels."""
+    copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
+    copy.__qualname__ = name  # numba's cache entry is named after it
+    copy.__doc__ = f.__doc__
+    scope[name] = nb.njit(copy, cache=True, nogil=True, error_model="numpy", **options)
 
 
 _scopes = {}
-for _module in (kernels, grid):
+for _module in (geometry, kernels, grid):
     _scope = dict(vars(_module))
-    _compile(_module, _INLINE[_module], _scope, inline="always")
-    _compile(_module, _LOOPS[_module], _scope)
+    if _module is geometry:
+        _compile(geometry.select_one, "select", _scope, inline="always")
+    for _name in _INLINE[_module]:
+        _compile(getattr(_module, _name), _name, _scope, inline="always")
+    for _name in _LOOPS[_module]:
+        _compile(getattr(_module, _name), _name, _scope)
     _scopes[_module] = _scope
 
-distances_all = _scopes[kernels]["distances_all"]
-derivatives_all = _scopes[kernels]["derivatives_all"]
+distances_all = _scopes[geometry]["distances_all"]
+derivatives_all = _scopes[geometry]["derivatives_all"]
 psd_project_all = _scopes[kernels]["psd_project_all"]
-ccd_all = _scopes[kernels]["ccd_all"]
+ccd_all = _scopes[geometry]["ccd_all"]
 midrange_motion = _scopes[kernels]["midrange_motion"]
-distances_by_index = _scopes[kernels]["distances_by_index"]
+distances_by_index = _scopes[geometry]["distances_by_index"]
 boxes = _scopes[grid]["boxes"]
 cell_list = _scopes[grid]["cell_list"]
 join = _scopes[grid]["join"]

@@ -88,7 +88,7 @@ def pair_nodes(prims: SheetPrimitives, pairs: Pairs) -> tuple[np.ndarray, np.nda
 def _distances(prims: SheetPrimitives, x: np.ndarray, pairs: Pairs,
                compiled: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Distances ``(Q,)`` and ``(R,)`` [m] of the point-triangle and edge-edge ``pairs`` at ``x (N, 3)`` [m].
-    Compiled: read from ``x`` by index (:func:`.kernels.distances_by_index`; the gather ``x[nodes]`` of
+    Compiled: read from ``x`` by index (:func:`.geometry.distances_by_index`; the gather ``x[nodes]`` of
     the ~14,000 box pairs of hang-20's 41 x 41 sheet cost as much as the distances, 700 times a run)."""
     if distance.compiled_for(len(pairs), compiled):
         from rftstatic.contact.self_contact._kernels_numba import distances_by_index

@@ -1,6 +1,6 @@
-"""The compiled (numba) twins of the self-contact loops agree with the numpy path to round-off: the
-distances, gradients, Hessians and features of random pairs of every closest-feature type, the PSD
-projection of the law's blocks and of random symmetric matrices, the additive CCD, and the broad phase."""
+"""The compiled (numba) twins of the self-contact loops agree with the numpy path to round-off: the PSD
+projection of the law's blocks and of random symmetric matrices, the additive CCD, and the broad phase
+(the pair geometry's two back ends: test_geometry.py)."""
 
 import numpy as np
 import pytest
@@ -32,28 +32,6 @@ def _random_pairs(kind, n=3000, seed=0):
         x4[:m, 1] = x4[:m, 0] + d
         x4[:m, 3] = x4[:m, 2] + rng.choice([-1.0, 0.5, 2.0], size=(m, 1)) * d
     return x4
-
-
-@pytest.mark.parametrize("kind", ["pt", "ee"])
-def test_distances_and_derivatives_agree(monkeypatch, kind):
-    f = distance.point_triangle if kind == "pt" else distance.edge_edge
-    f2 = distance.point_triangle_distance2 if kind == "pt" else distance.edge_edge_distance2
-    x4 = _random_pairs(kind)
-    (s, g, H, code), (s_c, g_c, H_c, code_c) = _both(monkeypatch, f, x4)
-    assert np.bincount(code, minlength=3).min() > 50  # every feature, many times
-    np.testing.assert_array_equal(code_c, code)
-    np.testing.assert_allclose(s_c, s, rtol=1e-12, atol=1e-14)
-    # exactly parallel edges have ties of closest points (distance unique, gradient not): left out
-    smooth = slice(len(x4) // 6, None) if kind == "ee" else slice(None)
-    g, H, g_c, H_c = g[smooth], H[smooth], g_c[smooth], H_c[smooth]
-    np.testing.assert_allclose(g_c, g, rtol=1e-11, atol=1e-13)
-    scale = np.abs(H).max(axis=(1, 2), keepdims=True)
-    np.testing.assert_allclose(H_c / scale, H / scale, rtol=0, atol=1e-11)
-    a, b = _both(monkeypatch, f2, x4)
-    np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-14)
-    (_, _, none, _), (_, g2, none2, _) = _both(monkeypatch, f, x4, hessian=False)
-    assert none is None and none2 is None
-    np.testing.assert_allclose(g2[smooth], g_c, rtol=0, atol=0)
 
 
 def _law_blocks(seed=0):
