@@ -402,6 +402,7 @@ def distances_by_index(x, pairs, tri, edges, kind, s):
         else:
             s[p] = ee_closest(x4)[0]
 
+
 # --- the numpy twins of the loops: all pairs at once, pair axis last -------------------------------
 def distances_numpy(x4, kind):
     """Squared distances ``(P,)`` [m^2] of the pairs ``x4 (P, 4, 3)`` [m] (:func:`distances_all`)."""
