@@ -22,36 +22,24 @@ def _both(monkeypatch, f, *args, **kw):
     return a, f(*args, **kw)
 
 
-def _random_pairs(kind, n=3000, seed=0):
-    """Random pairs, a sixth of the edge pairs (anti-)parallel, so that every feature occurs."""
-    rng = np.random.default_rng(seed)
-    x4 = rng.standard_normal((n, 4, 3))
-    if kind == "ee":
-        m = n // 6
-        d = rng.standard_normal((m, 3))
-        x4[:m, 1] = x4[:m, 0] + d
-        x4[:m, 3] = x4[:m, 2] + rng.choice([-1.0, 0.5, 2.0], size=(m, 1)) * d
-    return x4
-
-
-def _law_blocks(seed=0):
+def _law_blocks(random_pairs, seed=0):
     """Law-like blocks ``c1 gg^T + c2 H`` of random pairs of both kinds, ``c2`` of either sign."""
     rng = np.random.default_rng(seed)
     out = []
     for kind, f in (("pt", distance.point_triangle), ("ee", distance.edge_edge)):
-        s, g, H, _ = f(_random_pairs(kind, 1000, seed))
+        s, g, H, _ = f(random_pairs(kind, 1000, seed, parallel_every=6))
         g = g.reshape(-1, 12)
         c1, c2 = rng.uniform(0, 2, (2, len(s), 1, 1)) * [[[[1.0]]], [[[-1.0]]]]
         out.append(c1 * np.einsum("pm,pn->pmn", g, g) + c2 * rng.choice([-1.0, 1.0], (len(s), 1, 1)) * H)
     return np.concatenate(out)
 
 
-def test_psd_projection_agrees(monkeypatch):
+def test_psd_projection_agrees(random_pairs, monkeypatch):
     rng = np.random.default_rng(1)
     full = rng.standard_normal((200, 12, 12))
     low = rng.standard_normal((200, 12, 4))
     sign = np.where(np.arange(4) % 2, -1.0, 1.0)
-    blocks = [_law_blocks(), full + full.transpose(0, 2, 1), np.einsum("pik,k,pjk->pij", low, sign, low),
+    blocks = [_law_blocks(random_pairs), full + full.transpose(0, 2, 1), np.einsum("pik,k,pjk->pij", low, sign, low),
               np.zeros((3, 12, 12))]
     for B in blocks:
         a, b = _both(monkeypatch, law_kernels.psd_project, B)
@@ -62,9 +50,9 @@ def test_psd_projection_agrees(monkeypatch):
 
 @pytest.mark.parametrize("kind", [0, 1])
 @pytest.mark.parametrize("size", [0.01, 0.3, 3.0])
-def test_additive_ccd_agrees(monkeypatch, kind, size):
+def test_additive_ccd_agrees(random_pairs, monkeypatch, kind, size):
     rng = np.random.default_rng(2)
-    x4 = _random_pairs("pt" if kind == 0 else "ee", 2000, seed=3)
+    x4 = random_pairs("pt" if kind == 0 else "ee", 2000, seed=3, parallel_every=6)
     dx4 = size * rng.standard_normal(x4.shape)
     a, b = _both(monkeypatch, law_kernels.additive_ccd, x4, dx4, kind, 0.2, 200)
     assert 0.0 < a < 1.0 or size == 0.01
@@ -121,9 +109,9 @@ def test_translation_free_motion_agrees_and_ignores_translation(monkeypatch, s):
 
 
 @pytest.mark.parametrize("kind", [0, 1])
-def test_additive_ccd_with_a_floor_agrees_and_stops_at_the_floor(monkeypatch, kind):
+def test_additive_ccd_with_a_floor_agrees_and_stops_at_the_floor(random_pairs, monkeypatch, kind):
     rng = np.random.default_rng(4)
-    x4 = _random_pairs("pt" if kind == 0 else "ee", 500, seed=6)
+    x4 = random_pairs("pt" if kind == 0 else "ee", 500, seed=6, parallel_every=6)
     dx4 = 0.3 * rng.standard_normal(x4.shape)
     dist2 = distance.point_triangle_distance2 if kind == 0 else distance.edge_edge_distance2
     floor = float(np.median(np.sqrt(dist2(x4))))

@@ -36,26 +36,14 @@ def _ee_configs():
     return np.array(out)
 
 
-def _fd(fun, x4, h=1e-6):
-    """Central differences of fun (P, 4, 3) -> (P, ...) along every coordinate: (P, 12, ...)."""
-    cols = []
-    for m in range(12):
-        k, i = divmod(m, 3)
-        xp, xm = x4.copy(), x4.copy()
-        xp[:, k, i] += h
-        xm[:, k, i] -= h
-        cols.append((fun(xp) - fun(xm)) / (2 * h))
-    return np.stack(cols, axis=1)
-
-
 @pytest.mark.parametrize("kind", ["pt", "ee"])
-def test_gradient_and_hessian_match_finite_differences(kind):
+def test_gradient_and_hessian_match_finite_differences(central_differences, kind):
     f, x4 = (point_triangle, _pt_configs()) if kind == "pt" else (edge_edge, _ee_configs())
     s, g, H, code = f(x4)
     assert set(code.tolist()) == {0, 1, 2}  # every feature is exercised
-    g_fd = _fd(lambda y: f(y, hessian=False)[0], x4)
+    g_fd = central_differences(lambda y: f(y, hessian=False)[0], x4)
     np.testing.assert_allclose(g.reshape(-1, 12), g_fd, rtol=1e-6, atol=1e-8)
-    H_fd = _fd(lambda y: f(y, hessian=False)[1].reshape(-1, 12), x4)
+    H_fd = central_differences(lambda y: f(y, hessian=False)[1].reshape(-1, 12), x4)
     np.testing.assert_allclose(H, H_fd, rtol=1e-5, atol=1e-6)
     np.testing.assert_allclose(H, H.transpose(0, 2, 1), atol=1e-12)
 

@@ -80,24 +80,12 @@ def degenerate_ee():
 DEGENERATE = {"pt": degenerate_pt, "ee": degenerate_ee}
 
 
-def _random(kind, n, seed):
-    """Random pairs, an eighth of the edge pairs exactly (anti-)parallel."""
-    rng = np.random.default_rng(seed)
-    x4 = rng.standard_normal((n, 4, 3))
-    if kind == "ee":
-        m = n // 8
-        d = rng.standard_normal((m, 3))
-        x4[:m, 1] = x4[:m, 0] + d
-        x4[:m, 3] = x4[:m, 2] + rng.choice([-1.0, 0.5, 2.0], size=(m, 1)) * d
-    return x4
-
-
 @pytest.mark.parametrize("kind", ["pt", "ee"])
-def test_both_back_ends_agree_to_round_off_including_degenerate_pairs(kind):
+def test_both_back_ends_agree_to_round_off_including_degenerate_pairs(random_pairs, kind):
     pytest.importorskip("numba")
     full, dist2, _ = FUNCS[kind]
     deg = DEGENERATE[kind]()[0]
-    x4 = np.concatenate([_random(kind, 3000, 0), deg, _rotated(deg, 1), _rotated(deg, 2)])
+    x4 = np.concatenate([random_pairs(kind, 3000, 0), deg, _rotated(deg, 1), _rotated(deg, 2)])
     for hessian in (True, False):
         s, g, H, code = full(x4, hessian=hessian, compiled=False)
         s_c, g_c, H_c, code_c = full(x4, hessian=hessian, compiled=True)
@@ -132,18 +120,6 @@ def test_degenerate_pairs_have_their_exact_distance_and_finite_symmetric_derivat
     np.testing.assert_allclose(full(x4)[1][touching], 0.0, atol=1e-15)  # the minimum of s >= 0
 
 
-def _fd(fun, x4, h):
-    """Central differences of ``fun (P, 4, 3) -> (P, ...)`` along every coordinate: ``(P, 12, ...)``."""
-    cols = []
-    for m in range(12):
-        k, i = divmod(m, 3)
-        xp, xm = x4.copy(), x4.copy()
-        xp[:, k, i] += h
-        xm[:, k, i] -= h
-        cols.append((fun(xp) - fun(xm)) / (2 * h))
-    return np.stack(cols, axis=1)
-
-
 def _feature(x4, kind):
     """A label of each pair's closest feature finer than its code: which edge (point-triangle), which
     end points and active parameters (edge-edge)."""
@@ -169,41 +145,41 @@ def _same_feature_around(x4, kind, h):
 
 @pytest.mark.usefixtures("backend")
 @pytest.mark.parametrize("kind", ["pt", "ee"])
-def test_gradient_and_hessian_are_finite_differences_on_random_pairs(kind):
+def test_gradient_and_hessian_are_finite_differences_on_random_pairs(central_differences, random_pairs, kind):
     full, _, _ = FUNCS[kind]
-    x4 = _random(kind, 400, 4)[50:]  # not the parallel edges: there the distance has a kink in the tilt
+    x4 = random_pairs(kind, 400, 4)[50:]  # not the parallel edges: there the distance has a kink in the tilt
     h = 1e-6
     same = _same_feature_around(x4, kind, h)
     assert same.sum() > 250
     s, g, H, code = full(x4)
     assert set(code[same].tolist()) == {0, 1, 2}
-    g_fd = _fd(lambda y: full(y, hessian=False)[0], x4, h)
+    g_fd = central_differences(lambda y: full(y, hessian=False)[0], x4, h)
     np.testing.assert_allclose(g.reshape(-1, 12), g_fd, rtol=1e-6, atol=1e-7)  # s is C1 everywhere
-    H_fd = _fd(lambda y: full(y, hessian=False)[1].reshape(-1, 12), x4, h)
+    H_fd = central_differences(lambda y: full(y, hessian=False)[1].reshape(-1, 12), x4, h)
     scale = np.abs(H).max(axis=(1, 2), keepdims=True)
     np.testing.assert_allclose(H[same] / scale[same], H_fd[same] / scale[same], rtol=0, atol=1e-6)
 
 
 @pytest.mark.usefixtures("backend")
 @pytest.mark.parametrize("kind", ["pt", "ee"])
-def test_gradient_is_the_finite_difference_on_degenerate_pairs(kind):
+def test_gradient_is_the_finite_difference_on_degenerate_pairs(central_differences, kind):
     full, _, _ = FUNCS[kind]
     x4, _, smooth = DEGENERATE[kind]()
     x4 = x4[smooth]
     for y in (x4, _rotated(x4, 5)):
         g = full(y)[1].reshape(-1, 12)
-        g_fd = _fd(lambda z: full(z, hessian=False)[0], y, 1e-7)
+        g_fd = central_differences(lambda z: full(z, hessian=False)[0], y, 1e-7)
         np.testing.assert_allclose(g, g_fd, rtol=0, atol=2e-6)  # central differences across a switch: O(h)
 
 
 @pytest.mark.usefixtures("backend")
 @pytest.mark.parametrize("kind", ["pt", "ee"])
-def test_the_law_energy_of_a_pair_has_the_chain_rule_gradient_and_hessian(kind):
+def test_the_law_energy_of_a_pair_has_the_chain_rule_gradient_and_hessian(central_differences, random_pairs, kind):
     """``E = e(delta)``, ``delta = sqrt(s)`` (the law's energy, its barrier included): gradient
     ``e' grad s / (2 delta)`` and Hessian ``e'' gd gd^T + e' (H / (2 delta) - g g^T / (4 delta^3))``
     against finite differences, as :meth:`.law.SelfContact.evaluate_pairs` assembles them."""
     full, _, _ = FUNCS[kind]
-    x4 = _random(kind, 300, 6)[40:]  # not the parallel edges
+    x4 = random_pairs(kind, 300, 6)[40:]  # not the parallel edges
     d, stiff = 3.0, 2.0
     s, g, H, _ = full(x4)
     x4 = x4[(s > 0.01) & (s < 0.8 * d * d)]
@@ -225,9 +201,9 @@ def test_the_law_energy_of_a_pair_has_the_chain_rule_gradient_and_hessian(kind):
     hess = (e2[:, None, None] * np.einsum("pm,pn->pmn", gd, gd)
             + e1[:, None, None] * (H / (2 * delta[:, None, None])
                                    - np.einsum("pm,pn->pmn", g, g) / (4 * delta[:, None, None] ** 3)))
-    np.testing.assert_allclose(gradient(x4), _fd(energy, x4, 1e-6), rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(gradient(x4), central_differences(energy, x4, 1e-6), rtol=1e-6, atol=1e-7)
     same = _same_feature_around(x4, kind, 1e-6)
     assert same.sum() > 0.8 * len(x4)
-    h_fd = _fd(gradient, x4, 1e-6)
+    h_fd = central_differences(gradient, x4, 1e-6)
     scale = np.abs(hess).max(axis=(1, 2), keepdims=True)
     np.testing.assert_allclose(hess[same] / scale[same], h_fd[same] / scale[same], rtol=0, atol=1e-6)
