@@ -10,11 +10,12 @@ import math
 
 import numpy as np
 
+from rftstatic.compiled import choose_kernels
 from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
 from rftstatic.scenes.material import build_material
-from rftstatic.scenes.options import declared_run_options
+from rftstatic.scenes.options import declared_run_options, static_options
 from rftstatic.scenes.ranges import (
     check_mesh_table,
     check_obstacle_sizes,
@@ -394,6 +395,21 @@ def check_static_scene(scene: Scene, material, supports: Supports, load: np.ndar
                               "components) or an obstacle")
 
 
+def run_kernels(scene: Scene, mesh) -> str:
+    """The kernel back end of the scene's run on ``mesh`` (:func:`rftstatic.compiled.choose_kernels`): the
+    scene's ``kernels`` when it is ``"numpy"`` or ``"compiled"``, else by the mesh's size, self-contact and
+    the length of the route (an explicit or relaxation run, or arc-length path following, evaluates the
+    model thousands of times). A function of the scene alone."""
+    requested = scene.get("kernels", "auto")
+    long_run = scene.analysis in ("dynamic", "relax") or (
+        scene.analysis == "static" and static_options(scene, progress=False).increments.continuation == "arc-length")
+    try:
+        return choose_kernels(mesh.n_elements, self_contact=bool(scene.get("contact.self", False)), long_run=long_run,
+                              requested=None if requested == "auto" else requested)
+    except ValueError as exc:
+        raise scene.error("kernels", f'"{requested}": {exc}') from None
+
+
 def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: bool = False,
                 membrane_scale: float = 1.0) -> tuple[Model, dict]:
     """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras.
@@ -423,9 +439,10 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     if scene.analysis == "static":
         check_static_scene(scene, material, supports, load, obstacles)
     membrane = declared_run_options(scene).membrane
-    self_contact = build_self_contact(scene, mesh, material)
+    kernels = run_kernels(scene, mesh)
+    self_contact = build_self_contact(scene, mesh, material, kernels=kernels)
     model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
-                  contact=contact, membrane=membrane, quiet=quiet, self_contact=self_contact)
+                  contact=contact, membrane=membrane, quiet=quiet, self_contact=self_contact, kernels=kernels)
     probes = {}
     u = scene.units.length
     for i, spec in enumerate(scene.get("probes", [])):

@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from rftstatic.compiled import KERNELS
 from rftstatic.contact.obstacles import scene_schema as obstacle_schema
 from rftstatic.errors import SceneError
 from rftstatic.fabrics.lab import LAB_KEYS
@@ -107,6 +108,8 @@ SCHEMA = {
     "element": (str, "RFT3 or RFT6"),
     "analysis": (str, "static (Newton), dynamic (explicit) or relax (dynamic relaxation): "
                       "rftstatic.scenes.analyses"),
+    "kernels": (str, "kernel back end of the run: auto (compiled with numba from 3,000 elements, with "
+                     "self-contact or on a long route; else numpy), numpy or compiled"),
     "mesh": ({
         "kind": (str, "rectangle, polar, square-polar, file or unstructured"),
         "size": (XY, "[lx, ly] of a rectangle"),
@@ -383,6 +386,9 @@ def validate(scene: Scene) -> None:
         raise scene.error("units", f'unknown unit system "{scene.data["units"]}"; use one of {", ".join(UNIT_SYSTEMS)}')
     if scene.data.get("element", "RFT6") not in ("RFT3", "RFT6"):
         raise scene.error("element", f'"{scene.data["element"]}" is not an element; use RFT3 or RFT6')
+    if scene.data.get("kernels", "auto") not in ("auto", *KERNELS):
+        raise scene.error("kernels", f'"{scene.data["kernels"]}" is not a kernel back end; use auto, '
+                          f'{", ".join(KERNELS)}')
     if scene.analysis not in SCENE_ANALYSES:
         raise scene.error("analysis", f'"{scene.data["analysis"]}" is not an analysis; use one of '
                           f'{", ".join(SCENE_ANALYSES)}')

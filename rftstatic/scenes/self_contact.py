@@ -22,11 +22,12 @@ REMESH_THICKNESS_SHARE = 0.25
 meshes' shortest edges are about half the target size, and the thickness must stay below half of those."""
 
 
-def build_self_contact(scene: Scene, mesh, material):
+def build_self_contact(scene: Scene, mesh, material, kernels: str | None = None):
     """The sheet's self-contact (:class:`~rftstatic.contact.self_contact.law.SelfContact`) when
     ``contact.self = true``, else None. Thickness ``contact.self_thickness`` [scene length] (default
     the material's thickness, else :data:`SELF_THICKNESS_M`); stiffness
-    :func:`~rftstatic.contact.self_contact.law.auto_stiffness` times ``contact.self_factor``."""
+    :func:`~rftstatic.contact.self_contact.law.auto_stiffness` times ``contact.self_factor``; ``kernels``: the
+    run's kernel back end (:func:`rftstatic.scenes.build.run_kernels`)."""
     if not scene.get("contact.self", False):
         return None
     from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
@@ -60,6 +61,6 @@ def build_self_contact(scene: Scene, mesh, material):
     k = auto_stiffness(weight=material.weight, node_area=float(mesh.node_area.mean()), thickness=d,
                        factor=float(factor))
     try:
-        return SelfContact(mesh, d, k)
+        return SelfContact(mesh, d, k, kernels=kernels)
     except ValueError as exc:
         raise scene.error(key, f"{shown!r}: {exc}") from None

@@ -23,6 +23,27 @@ def test_the_choice_depends_on_the_mesh_size_self_contact_and_numba_only(monkeyp
         compiled.choose_kernels(8, requested="numba")
 
 
+def test_a_scene_chooses_its_kernels_by_size_self_contact_and_route_or_says_which(monkeypatch):
+    from rftstatic.errors import SceneError
+    from rftstatic.scenes.build import build_model, run_kernels
+    from rftstatic.scenes.schema import load_scene
+
+    monkeypatch.setattr(compiled, "numba_available", lambda: True)
+    mesh = trimesh.rectangle(1.0, 1.0, 5, 5, pattern="right")  # 32 elements
+    assert run_kernels(load_scene("strip"), mesh) == "numpy"
+    assert run_kernels(load_scene("strip", ["solver.continuation=arc-length"]), mesh) == "compiled"  # a long route
+    assert run_kernels(load_scene("hang-20"), mesh) == "compiled"  # an explicit run
+    assert run_kernels(load_scene("strip", ["kernels=compiled"]), mesh) == "compiled"
+    assert run_kernels(load_scene("strip", ["solver.continuation=arc-length", "kernels=numpy"]), mesh) == "numpy"
+    assert build_model(load_scene("strip", ["kernels=numpy", "mesh.nodes=[5,3]"]))[0].kernels == "numpy"
+    with pytest.raises(SceneError, match=r'strip\.toml: kernels: "numba" is not a kernel back end; use auto, numpy, '
+                       r'compiled'):
+        load_scene("strip", ["kernels=numba"])
+    monkeypatch.setattr(compiled, "numba_available", lambda: False)
+    with pytest.raises(SceneError, match=r'kernels: "compiled": kernels "compiled" need numba'):
+        run_kernels(load_scene("strip", ["kernels=compiled"]), mesh)
+
+
 def test_a_model_holds_its_kernels_and_takes_the_self_contact_laws():
     mesh = trimesh.rectangle(1.0, 1.0, 5, 5, pattern="right")
     shell = material.isotropic_shell(E=1e6, nu=0.3, thickness=0.01, weight=1.0)
