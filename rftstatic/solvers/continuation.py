@@ -47,7 +47,7 @@ from rftstatic.progress import Progress
 from rftstatic.solvers.branches import switch_branch
 from rftstatic.solvers.inertia import InertiaSolver
 from rftstatic.solvers.iteration import capped_step, roundoff_floor, self_contact_limited
-from rftstatic.solvers.linear import LinearSolveError, make_solver
+from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.loop import Direction, Iterate, StepFailure, newton_loop
 from rftstatic.solvers.newton import NewtonWorkspace, StaticResult, newton, route_outcome
 from rftstatic.solvers.options import StaticOptions
@@ -258,9 +258,8 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
     if opts.route.perturbation and U0 is None:
         seed = opts.route.seed
         U[:, 2] += start_perturbation(model.mesh, opts.route) * model.free[:, 2]
-    ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
+    ws = workspace if workspace is not None else NewtonWorkspace.for_model(model, opts.newton.linear_solver)
     ws.modes = {"exact": 0, "psd": 0, "shift": 0}
-    ws.solver = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     path = _Path(model, opts, ws)
     result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=path.inertia.name, seed=seed,
                           route="arc-length")

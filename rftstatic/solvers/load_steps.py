@@ -23,7 +23,7 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
-from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
+from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 from rftstatic.solvers.newton import NewtonWorkspace, StaticResult, newton, route_outcome
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
@@ -83,10 +83,9 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         what = "the load (nodal forces)" if not np.isfinite(model.load).all() else "the start displacements"
         raise ConvergenceError(f"load factor 0: {what} are not finite (NaN or inf); check the scene's loads, "
                                "weight and mesh coordinates", None)
-    ws = workspace if workspace is not None else NewtonWorkspace.for_model(model)
+    ws = workspace if workspace is not None else NewtonWorkspace.for_model(model, opts.newton.linear_solver)
     ws.modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
-    solver = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
-    ws.solver = solver
+    solver = ws.solver
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
     max_step = opts.newton.max_step if opts.newton.max_step is not None else 0.1 * diagonal
     inc = opts.increments

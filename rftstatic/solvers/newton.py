@@ -45,6 +45,7 @@ from rftstatic.errors import ConvergenceError
 from rftstatic.model.state import State
 from rftstatic.solvers.displacement import displacement_iterations
 from rftstatic.solvers.iteration import Iteration
+from rftstatic.solvers.linear import make_solver
 from rftstatic.solvers.mixed import mixed_iterations
 
 log = logging.getLogger(__name__)
@@ -107,7 +108,8 @@ class NewtonWorkspace:
     ----------
     state : the solve's :class:`~rftstatic.model.state.State` (its contact candidate list is used by
         every energy, residual and tangent evaluation)
-    solver : the linear solver (symbolic analysis reused between factorisations)
+    solver : the solve's one linear solver (:func:`~rftstatic.solvers.linear.make_solver`, made with the
+        workspace): its symbolic analysis serves every phase while the tangent's pattern holds
     modes : counts of the tangents used: exact, psd, shift, reused, krylov (steps by preconditioned CG, and
         their "CG iterations")
     factorisations : numeric factorisations of a tangent (failed Cholesky attempts included)
@@ -125,9 +127,11 @@ class NewtonWorkspace:
     modified_shift: float = 0.0
 
     @classmethod
-    def for_model(cls, model) -> NewtonWorkspace:
-        """A fresh workspace: the flat state at load factor 0 (the solver is made by each phase)."""
-        return cls(State.initial(model, lam=0.0))
+    def for_model(cls, model, linear_solver: str = "auto") -> NewtonWorkspace:
+        """A fresh workspace: the flat state at load factor 0 and the solve's linear solver (``linear_solver``,
+        :class:`~rftstatic.solvers.options.NewtonOptions`)."""
+        solver = make_solver(linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+        return cls(State.initial(model, lam=0.0), solver=solver)
 
     @property
     def candidates(self):

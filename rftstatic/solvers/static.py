@@ -17,7 +17,7 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
 from rftstatic.solvers.continuation import solve_arc_length
-from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite, make_solver
+from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 from rftstatic.solvers.load_steps import solve_load_steps
 from rftstatic.solvers.newton import NewtonWorkspace, StaticResult
 from rftstatic.solvers.options import StaticOptions
@@ -60,13 +60,13 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         fails too); ``.result`` holds the last equilibrium (``converged=False``).
     """
     opts = options or StaticOptions()
-    ws = NewtonWorkspace.for_model(model)  # shared by the Newton phases of this solve
+    ws = NewtonWorkspace.for_model(model, opts.newton.linear_solver)  # shared by the phases of this solve
     if checkpoint is not None:
         checkpoint.workspace = ws
     if restart is not None:
         restart.restore(model, ws)
         if restart.phase == "done":
-            return _check_stability(model, restart.result, opts)
+            return _check_stability(model, restart.result, ws)
         if restart.route is not None:
             return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint,
                                                      route=restart.route, segment=restart.segment), opts, ws)
@@ -138,15 +138,15 @@ def _stiffen_self_contact(model, result, opts, ws):
 
 def _finish(model, result, opts, ws):
     """The self-contact continuation (:func:`_stiffen_self_contact`), then the stability check."""
-    return _check_stability(model, _stiffen_self_contact(model, result, opts, ws), opts, pairs=ws.pairs)
+    return _check_stability(model, _stiffen_self_contact(model, result, opts, ws), ws)
 
 
-def _check_stability(model, result, opts, pairs=None):
+def _check_stability(model, result, ws):
     """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact
-    tangent positive definite, one Cholesky factorisation)? None when the linear solver cannot tell.
-    ``pairs``: the solve's self-contact pair cache, with the stiffness scale it converged with."""
-    solver = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
-    result.stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=pairs)
+    tangent positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver
+    cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
+    solver = ws.solver
+    result.stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=ws.pairs)
                      if solver.detects_indefinite else None)
     return result
 
@@ -285,7 +285,6 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
     # in the basin of a stable minimum the line-searched displacement iteration gets there where the
     # mixed one (at most 2 x MIXED_ITERATIONS) wanders: the long try may fall back to it
     basin = short.replace(max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
-    checker = make_solver(opts.newton.linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
     info = route.info
 
     def fail(text, result=None):
@@ -305,7 +304,7 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
             _relax_segment(model, opts, plan, route, fail, checkpoint, segment, t0)
             segment = None
         final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
-        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, checker):
+        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, ws.solver):
             route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
         handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest}
