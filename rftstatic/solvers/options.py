@@ -88,9 +88,9 @@ class IncrementOptions:
     def __post_init__(self):
         check(self, SECTION)
         if not self.min_increment <= self.initial_increment <= self.max_increment:
-            raise ParameterError(f"{SECTION}.initial_increment", "need min_increment <= initial_increment <= "
-                                 f"max_increment, got {self.min_increment:g}, {self.initial_increment:g}, "
-                                 f"{self.max_increment:g}")
+            names = (f"{SECTION}.{k}" for k in ("min_increment", "initial_increment", "max_increment"))
+            raise ParameterError(f"{SECTION}.initial_increment", f"need {' <= '.join(names)}, got "
+                                 f"{self.min_increment:g}, {self.initial_increment:g}, {self.max_increment:g}")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -12,8 +12,9 @@ its table, or another value of the scene that the mutation moved: :func:`names_a
 ``OverflowError``, an ``IndexError``, a NaN, a RuntimeWarning of numpy) fails. Nothing is solved: 400
 sampled mutations of the ~5,800 take a few seconds (all of them ~40 s on a busy machine).
 
-The ``[solver]`` keys are left out: :func:`rftstatic.scenes.options.static_options` checks them when a
-static solve starts, not here. :mod:`tests.app.test_scene_property` runs whole scenes through the CLI.
+The ``[solver]`` keys are checked by their declarations (:mod:`rftstatic.solvers.options`,
+:mod:`rftstatic.scenes.run_options`) when the scene's options are made, here too.
+:mod:`tests.app.test_scene_property` runs whole scenes through the CLI.
 """
 
 from __future__ import annotations
@@ -31,14 +32,14 @@ from rftstatic.contact.obstacles import obstacle_class
 from rftstatic.errors import SceneError
 from rftstatic.material import _FABRIC_KINDS as FABRIC_KINDS
 from rftstatic.scenes.build import build_model
-from rftstatic.scenes.options import cantilever_options, dynamics_options, remesh_options
+from rftstatic.scenes.options import cantilever_options, dynamics_options, remesh_options, run_options, static_options
 from rftstatic.scenes.schema import CASES_DIR, SCHEMA, load_scene, scene_from_dict
 
 FLOATS = (1e300, -1e300, -1.0, 0.0, 1e-300, 10**400)
 """Values for every numeric key; ``10**400``: an integer that Python's TOML reader takes, beyond a float's range."""
 INTS = (2**63 - 1, -(2**63), -1, 0)
-SKIPPED = ("solver", "title", "figure", "units", "element", "analysis", "output")
-"""Top-level keys whose numbers are not mutated here (the solver options are checked when a solve starts)."""
+SKIPPED = ("title", "figure", "units", "element", "analysis", "output")
+"""Top-level keys whose numbers are not mutated here (they hold none)."""
 
 TINY_NODES = {"rectangle": [5, 5], "polar": [3, 12], "square-polar": [2, 16]}
 
@@ -88,7 +89,8 @@ def present_numbers(node, path=()):
 
 def added_numbers(data: dict):
     """Paths of the numeric schema keys a scene's own tables may take and do not hold."""
-    tables = {"contact": SCHEMA["contact"][0], "loads": {"pressure": SCHEMA["loads"][0]["pressure"]}}
+    tables = {"contact": SCHEMA["contact"][0], "loads": {"pressure": SCHEMA["loads"][0]["pressure"]},
+              "solver": SCHEMA["solver"][0]}
     for name in ("dynamics", "remesh", "cantilever"):
         if name in data:
             tables[name] = SCHEMA[name][0]
@@ -159,6 +161,8 @@ def evaluate(data: dict) -> list:
         remesh_options(scene)
     if analysis == "cantilever":
         cantilever_options(scene)
+    static_options(scene, progress=False)
+    run_options(scene)
     U = np.zeros_like(model.X3)
     return [*model.energies(U).values(), model.residual(U), model.material.Dm, model.material.Db]
 
