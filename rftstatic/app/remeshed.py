@@ -42,7 +42,7 @@ import numpy as np
 from rftstatic.app.result import RunResult
 from rftstatic.contact.kinematic import contact_reaction_residual
 from rftstatic.errors import CheckpointError, InstabilityError, ParameterError
-from rftstatic.io.files import to_jsonable, write_json
+from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_summary, self_intersection_summary,
                                    summary_header)
@@ -333,13 +333,12 @@ def summarize(scene, opts, solved) -> dict:
 
 
 def _write(scene, solved, out: Path, summary: dict, *, figures=True) -> None:
+    """The frames and node-count plot (with figures), then the final state and ``summary.json`` (once)."""
+    if figures:
+        summary["frames"] = _frames(scene, solved, out)
+        _node_plot(scene, summary, out)
+        summary["node_plot"] = "nodes.png"
     write_outputs(scene, solved["model"], solved["extras"], solved["U"], out, summary, figures=figures)
-    if not figures:
-        return
-    summary["frames"] = _frames(scene, solved, out)
-    _node_plot(scene, summary, out)
-    summary["node_plot"] = "nodes.png"
-    write_json(out / "summary.json", summary)
 
 
 def _frames(scene, run, out: Path) -> list:

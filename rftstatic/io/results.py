@@ -9,9 +9,9 @@ from rftstatic.io.files import write_json, write_vtu
 
 
 def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=True) -> None:
-    """Write ``summary`` and the deformed state ``U (N, 3)`` [m] of ``model`` into ``out``."""
+    """Write the deformed state ``U (N, 3)`` [m] of ``model`` (VTU, PNG views) and then ``summary`` into ``out``:
+    ``summary.json`` is written once, last, so a run folder with one is complete."""
     u = scene.units.length
-    write_json(out / "summary.json", summary)
     cell = {"curvature": model.curvature(U) * u, "relative_curvature": model.relative_curvature(U),
             "membrane_strain": model.membrane_strain(U)}
     if scene.get("output.vtu", True):
@@ -29,6 +29,7 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
         drape = summary.get("drape") or {}
         if extras.get("disc") is not None and drape.get("drape_coefficient") is not None:
             _shadow(scene, model, extras["disc"], U, out, drape)
+    write_json(out / "summary.json", summary)
 
 
 def _shadow(scene, model, disc, U, out: Path, drape: dict) -> None:

@@ -196,3 +196,21 @@ def test_a_remeshed_relaxation_with_self_contact_rebuilds_its_pairs_on_every_mes
     assert s["remeshes"] >= 1 and s["self_intersections"]["pairs"] == 0
     sc = s["self_contact"]
     assert sc["thickness"] == pytest.approx(0.05) and {"rebuilds", "filter_steps", "force_s"} <= set(sc)
+
+
+def test_a_remeshed_run_writes_its_summary_once_and_last(tmp_path, monkeypatch):
+    """summary.json is written once, after the frames, the node plot and the final state's files, and holds
+    their names (it used to be written, then rewritten after the figures)."""
+    from rftstatic.io import results
+
+    written = []
+    real = results.write_json
+    monkeypatch.setattr(results, "write_json", lambda path, data: (written.append(path.name), real(path, data)))
+    scene = load_scene("strip", ["mesh.kind=unstructured", "mesh.h=0.5", "remesh.const=0.08", "remesh.h_lower=0.2",
+                                 "remesh.h_upper=0.8", "remesh.max_cycles=2"])
+    s = run_remesh_scene(scene, tmp_path, progress=False, figures=True)
+    assert written == ["summary.json"]
+    on_disk = json.loads((tmp_path / "summary.json").read_text())
+    assert on_disk["node_plot"] == "nodes.png" and on_disk["frames"] == s["frames"] and len(s["frames"]) >= 2
+    newest = max(p.stat().st_mtime_ns for p in tmp_path.iterdir() if p.name != "summary.json")
+    assert (tmp_path / "summary.json").stat().st_mtime_ns >= newest
