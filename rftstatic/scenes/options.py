@@ -178,25 +178,14 @@ def dynamics_options(scene) -> DynamicsOptions:
         max_steps=None if opts["max_steps"] is None else int(opts["max_steps"]))
 
 
-REMESH_LENGTH_KEYS = ("const", "h_lower", "h_upper", "kappa_h2_max")
-"""``[remesh]`` keys that are lengths (scene units in the file, SI in :class:`RemeshOptions`)."""
-
-
 def remesh_options(scene) -> RemeshOptions:
-    """The scene's ``[remesh]`` table with defaults, checked, as :class:`~rftstatic.remesh.options.RemeshOptions`
-    in SI."""
-    r = dict(scene.get("remesh", {}))
-    for key in ("const", "h_lower", "h_upper"):
-        if key not in r:
-            raise scene.error(f"remesh.{key}", f"a [remesh] table needs {key} (Eq. 29, scene length units)")
+    """The scene's ``[remesh]`` table checked against its declarations (:class:`~rftstatic.remesh.options.RemeshOptions`)
+    and converted to SI (:func:`rftstatic.optionspec.from_table`)."""
     try:
-        RemeshOptions(**r)  # checked in the scene's units, which its messages then quote
+        table = from_table((RemeshOptions,), dict(scene.get("remesh", {})), "remesh", scene.units)
+        return RemeshOptions(**table[RemeshOptions])
     except ParameterError as exc:
-        raise scene.error(f"remesh.{exc.key}", exc.detail) from None
-    except TypeError as exc:  # a key the schema let through that the options do not know
-        raise scene.error("remesh", str(exc)) from None
-    u = scene.units.length
-    return RemeshOptions(**{k: (v * u if k in REMESH_LENGTH_KEYS and v is not None else v) for k, v in r.items()})
+        raise scene.error(exc.key, exc.detail) from None
 
 
 def seed_count(scene) -> int:

@@ -20,6 +20,7 @@ from rftstatic.contact.obstacles import scene_schema as obstacle_schema
 from rftstatic.errors import SceneError
 from rftstatic.fabrics.lab import LAB_KEYS
 from rftstatic.optionspec import schema_entries
+from rftstatic.remesh.options import RemeshOptions
 from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
@@ -172,20 +173,7 @@ SCHEMA = {
         "compare_static": (bool, "relax: report the difference from the static Newton solution"),
         "max_steps": (int, "step limit: a dynamic run needing more is refused, a relaxation stops there (default 10^4 sqrt(nodes), 5e4..1e7)"),
     }, "explicit dynamics options"),
-    "remesh": ({
-        "const": (NUM, "const of Eq. 29, |kappa| h^2 = const [length]"),
-        "h_lower": (NUM, "smallest element size [length]"), "h_upper": (NUM, "largest element size [length]"),
-        "gradation": (NUM, "largest size ratio between neighbours one element apart"),
-        "max_cycles": (int, "static route: most remeshing cycles"),
-        "tol": (NUM, "stop when the node count changes by less than this fraction"),
-        "kappa_h_max": (NUM, "static route: largest |kappa| h accepted without remeshing"),
-        "kappa_h2_max": (NUM, "relax route: remesh when max |kappa| h^2 exceeds this [length]"),
-        "every": (int, "relax route: remesh every this many steps"),
-        "transfer": (str, "mesh (interpolation on the old mesh), patch (its RF patch quadratics) or grid "
-                          "(background grid, as the paper)"),
-        "damping": (str, "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's slowest "
-                         "swing, at most dynamics.alpha)"),
-    }, "global adaptive remeshing (§5)"),
+    "remesh": (schema_entries(RemeshOptions), "global adaptive remeshing (§5): python -m rftstatic options remesh"),
     "cantilever": (schema_entries(CantileverOptions), "cantilever bending tester (analysis = \"cantilever\"): the "
                    "strip's mesh.size[0] is the first overhang; python -m rftstatic options cantilever"),
     "probes": ([{"name": (str, "probe name"), "at": (XY, "[x, y] reference point")}], "tracked points"),

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 from rftstatic.errors import SceneError
 from rftstatic.optionspec import describe
+from rftstatic.remesh.options import RemeshOptions
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 
 __all__ = ["SECTIONS", "option_rows", "format_rows"]
 
-SECTIONS = {"solver": SOLVER_GROUPS, "cantilever": (CantileverOptions,)}
+SECTIONS = {"solver": SOLVER_GROUPS, "remesh": (RemeshOptions,), "cantilever": (CantileverOptions,)}
 """Scene table -> its declared option groups."""
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from rftstatic.cli import main
 from rftstatic.errors import ParameterError, SceneError
-from rftstatic.optionspec import declared, describe, option
+from rftstatic.optionspec import REQUIRED, declared, describe, from_table, option
 from rftstatic.scenes.options import run_options, static_options
 from rftstatic.scenes.run_options import SOLVER_GROUPS, RunOptions
 from rftstatic.scenes.schema import SCHEMA, load_scene
@@ -15,17 +15,24 @@ from rftstatic.scenes.sections import SECTIONS, option_rows
 from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
 
 
-def _declared_keys():
-    return [(cls, name, spec, default) for cls in SOLVER_GROUPS for name, spec, default in declared(cls)]
+def _declared_keys(section=None):
+    return [(sec, cls, name, spec, default) for sec, groups in SECTIONS.items() if section in (None, sec)
+            for cls in groups for name, spec, default in declared(cls)]
 
 
-def test_each_solver_key_is_declared_once_and_the_schema_and_listing_are_generated_from_it():
-    names = [name for _, name, spec, _ in _declared_keys() if spec.scene]
-    assert len(names) == len(set(names)), "a [solver] key declared in two groups"
-    assert set(SCHEMA["solver"][0]) == set(names)
-    assert [r["key"] for r in option_rows("solver")] == [f"solver.{n}" for n in names]
-    for _, name, spec, default in _declared_keys():
-        assert spec.help and SCHEMA["solver"][0][name][1].startswith(spec.help)
+def _required(cls) -> dict:
+    """A valid value of each required option of ``cls`` (1 unit above its lower bound)."""
+    return {name: (spec.low or 0) + 1 for name, spec, default in declared(cls) if default is REQUIRED}
+
+
+@pytest.mark.parametrize("section", list(SECTIONS))
+def test_each_key_is_declared_once_and_the_schema_and_listing_are_generated_from_it(section):
+    names = [name for *_, name, spec, _ in _declared_keys(section) if spec.scene]
+    assert len(names) == len(set(names)), f"a [{section}] key declared in two groups"
+    assert set(SCHEMA[section][0]) == set(names)
+    assert [r["key"] for r in option_rows(section)] == [f"{section}.{n}" for n in names]
+    for *_, name, spec, default in _declared_keys(section):
+        assert spec.help and SCHEMA[section][0][name][1].startswith(spec.help)
 
 
 def test_the_groups_are_split_by_concern_and_none_is_over_fifteen_fields():
@@ -37,10 +44,10 @@ def test_the_groups_are_split_by_concern_and_none_is_over_fifteen_fields():
     assert {"levels", "seeds", "membrane"} == {n for n, _, _ in declared(RunOptions)} - {"level_membrane"}
 
 
-@pytest.mark.parametrize("cls, name, spec, default",
-                         [pytest.param(*k, id=f"{k[0].__name__}.{k[1]}") for k in _declared_keys()])
-def test_every_declared_range_is_enforced_with_the_key_named(cls, name, spec, default):
-    assert spec.problem(default) is None  # the default lies in its own range
+@pytest.mark.parametrize("section, cls, name, spec, default",
+                         [pytest.param(*k, id=f"{k[1].__name__}.{k[2]}") for k in _declared_keys()])
+def test_every_declared_range_is_enforced_with_the_key_named(section, cls, name, spec, default):
+    assert default is REQUIRED or spec.problem(default) is None  # the default lies in its own range
     bad = []
     if spec.kind in ("int", "float"):
         bad.append("seven" if not spec.nullable else [7])
@@ -57,8 +64,8 @@ def test_every_declared_range_is_enforced_with_the_key_named(cls, name, spec, de
     else:
         bad.append(1)
     for value in bad:
-        with pytest.raises(ParameterError, match=rf"^solver\.{name}: "):
-            cls(**{name: value})
+        with pytest.raises(ParameterError, match=rf"^{section}\.{name}: "):
+            cls(**{**_required(cls), name: value})
 
 
 def test_a_scene_value_is_checked_in_the_scenes_units_and_converted_to_si():
@@ -96,6 +103,34 @@ def test_the_app_keys_resolve_auto_levels():
     assert run_options(load_scene("strip", ["solver.levels=2"])).levels == 2
     with pytest.raises(SceneError, match=r"solver\.seeds: 0 is out of range"):
         run_options(load_scene("strip", ["solver.seeds=0"]))
+
+
+def test_a_required_option_has_no_default_is_listed_as_required_and_named_when_missing():
+    from rftstatic.remesh.options import RemeshOptions
+
+    assert {n for n, _, d in declared(RemeshOptions) if d is REQUIRED} == {"const", "h_lower", "h_upper"}
+    rows = {r["key"]: r for r in option_rows("remesh")}
+    assert rows["remesh.const"]["default"] == "required" and rows["remesh.tol"]["default"] == 0.05
+    assert SCHEMA["remesh"][0]["h_upper"][1].endswith("(required)")
+    with pytest.raises(ParameterError, match=r"^remesh\.h_upper: is required: largest element size \[length\]"):
+        from_table((RemeshOptions,), {"const": 1.0, "h_lower": 1.0}, "remesh")
+    with pytest.raises(TypeError):
+        RemeshOptions(const=1.0, h_lower=1.0)  # no default in Python either
+    with pytest.raises(TypeError, match="needs its kind"):
+        option(REQUIRED, "a required option without its type")
+
+
+def test_a_remesh_table_is_converted_to_si_and_its_messages_quote_the_scene_units():
+    from rftstatic.scenes.options import remesh_options
+
+    base = ["remesh.const=0.5", "remesh.h_lower=0.25", "remesh.h_upper=2.0"]
+    opts = remesh_options(load_scene("strip", [*base, "remesh.kappa_h2_max=0.1", 'remesh.kappa_h_max="auto"']))
+    assert (opts.const, opts.h_lower, opts.h_upper) == pytest.approx((0.005, 0.0025, 0.02))  # cm -> m
+    assert opts.kappa_h2_max == pytest.approx(0.001) and opts.kappa_h_max is None and opts.tol == 0.05
+    with pytest.raises(SceneError, match=r"strip\.toml: remesh\.h_lower: -0\.25 is out of range: must be > 0"):
+        remesh_options(load_scene("strip", [*base, "remesh.h_lower=-0.25"]))
+    with pytest.raises(SceneError, match=r"remesh\.const: is required"):
+        remesh_options(load_scene("strip", ["remesh.h_lower=0.25", "remesh.h_upper=2.0"]))
 
 
 def test_an_option_default_outside_its_own_range_is_a_programming_error():
