@@ -21,6 +21,7 @@ from rftstatic.errors import SceneError
 from rftstatic.fabrics.lab import LAB_KEYS
 from rftstatic.optionspec import schema_entries
 from rftstatic.remesh.options import RemeshOptions
+from rftstatic.scenes.dynamics_options import FRAMES_HELP, DynamicsOptions
 from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
@@ -163,16 +164,8 @@ SCHEMA = {
     }, "penalty contact and self-contact"),
     "solver": (schema_entries(*SOLVER_GROUPS), "static solver options (rftstatic.solvers.options) and the app's "
                "(rftstatic.scenes.run_options): python -m rftstatic options solver"),
-    "dynamics": ({
-        "t_end": (NUM, "end time [time]"), "dt": (NUM, "time step (default: automatic)"),
-        "alpha": (NUM, "mass damping [1/time]"), "mass_scale": (NUM, "mass scaling factor"),
-        "frames": (ListOf(NUM), "times of the saved frames"), "checkpoint_every": (NUM, "[time]"),
-        "rest_tolerance": (NUM, "kinetic-energy ratio at which the sheet is at rest"),
-        "samples": (int, "regular states saved for the VTU series and the GIF"),
-        "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
-        "compare_static": (bool, "relax: report the difference from the static Newton solution"),
-        "max_steps": (int, "step limit: a dynamic run needing more is refused, a relaxation stops there (default 10^4 sqrt(nodes), 5e4..1e7)"),
-    }, "explicit dynamics options"),
+    "dynamics": ({**schema_entries(DynamicsOptions), "frames": (ListOf(NUM), FRAMES_HELP)},
+                 "explicit dynamics and dynamic relaxation: python -m rftstatic options dynamics"),
     "remesh": (schema_entries(RemeshOptions), "global adaptive remeshing (§5): python -m rftstatic options remesh"),
     "cantilever": (schema_entries(CantileverOptions), "cantilever bending tester (analysis = \"cantilever\"): the "
                    "strip's mesh.size[0] is the first overhang; python -m rftstatic options cantilever"),

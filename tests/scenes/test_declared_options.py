@@ -11,7 +11,7 @@ from rftstatic.optionspec import REQUIRED, declared, describe, from_table, optio
 from rftstatic.scenes.options import run_options, static_options
 from rftstatic.scenes.run_options import SOLVER_GROUPS, RunOptions
 from rftstatic.scenes.schema import SCHEMA, load_scene
-from rftstatic.scenes.sections import SECTIONS, option_rows
+from rftstatic.scenes.sections import SECTIONS, UNDECLARED, option_rows
 from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
 
 
@@ -29,7 +29,8 @@ def _required(cls) -> dict:
 def test_each_key_is_declared_once_and_the_schema_and_listing_are_generated_from_it(section):
     names = [name for *_, name, spec, _ in _declared_keys(section) if spec.scene]
     assert len(names) == len(set(names)), f"a [{section}] key declared in two groups"
-    assert set(SCHEMA[section][0]) == set(names)
+    assert set(SCHEMA[section][0]) == set(names) | set(UNDECLARED.get(section, ()))
+    assert not set(names) & set(UNDECLARED.get(section, ()))
     assert [r["key"] for r in option_rows(section)] == [f"{section}.{n}" for n in names]
     for *_, name, spec, default in _declared_keys(section):
         assert spec.help and SCHEMA[section][0][name][1].startswith(spec.help)
@@ -150,3 +151,43 @@ def test_the_options_command_lists_every_key_and_refuses_an_unknown_section(caps
     assert main(["options", "solverr"]) == 2
     err = capsys.readouterr().err
     assert 'no section "solverr"' in err and "known: solver" in err
+
+
+def test_a_rate_is_converted_by_the_inverse_of_the_scenes_time_unit():
+    from types import SimpleNamespace
+
+    from rftstatic.optionspec import scene_factor, scene_values
+    from rftstatic.scenes.dynamics_options import DynamicsOptions
+
+    minutes = SimpleNamespace(time=60.0, length=1.0)
+    assert scene_factor("rate", minutes) == pytest.approx(1 / 60) and scene_factor("time", minutes) == 60.0
+    table = from_table((DynamicsOptions,), {"t_end": 2.0, "alpha": 6.0}, "dynamics", minutes)[DynamicsOptions]
+    assert table == pytest.approx({"t_end": 120.0, "alpha": 0.1})  # 6 per minute = 0.1 /s
+    assert scene_values(DynamicsOptions(**table), minutes)["alpha"] == pytest.approx(6.0)
+    with pytest.raises(ParameterError, match=r"dynamics\.alpha: 100000000\.0 is out of range: must be in \[0, 6e\+07\]"):
+        from_table((DynamicsOptions,), {"t_end": 2.0, "alpha": 1e8}, "dynamics", minutes)  # 1e6 /s, per minute
+
+
+def test_the_dynamics_defaults_depend_on_the_analysis_and_frames_are_checked_against_t_end():
+    from rftstatic.scenes.dynamics_options import DYNAMICS_DEFAULTS, DynamicsOptions
+    from rftstatic.scenes.options import dynamics_options
+    from rftstatic.solvers.rest import RELAX_MASS_SCALE, RELAX_REST
+
+    tiny = ["mesh.nodes=[5,5]", "dynamics.frames=[0.5, 0.0, 0.5]", "dynamics.t_end=1.0"]
+    dyn = dynamics_options(load_scene("hang-20", [*tiny, "dynamics.alpha=0.0"]))
+    assert (dyn.t_end, dyn.alpha, dyn.mass_scale, dyn.samples) == (1.0, 0.0, 1.0, 30)
+    assert dyn.rest_tolerance == {n: d for n, _, d in declared(DynamicsOptions)}["rest_tolerance"] == 1e-3
+    assert list(dyn.frames) == [0.0, 0.005 * 100] and dyn.checkpoint_every == 0.2 and dyn.max_steps is None
+    relax = dynamics_options(load_scene("pedestal-square-20", ["analysis=relax", "dynamics.t_end=1.0"]))
+    assert (relax.alpha, relax.mass_scale, relax.rest_tolerance) == (5.0, RELAX_MASS_SCALE, RELAX_REST.tol_kinetic)
+    given = dynamics_options(load_scene("pedestal-square-20", ["analysis=relax", "dynamics.t_end=1.0",
+                                                               "dynamics.alpha=3.0", "dynamics.mass_scale=10.0"]))
+    assert (given.alpha, given.mass_scale) == (3.0, 10.0)
+    assert set(DYNAMICS_DEFAULTS["relax"]) <= {n for n, _, _ in declared(DynamicsOptions)}
+    with pytest.raises(SceneError, match=r"dynamics\.frames: expected times in \[0, t_end = 1\.0\], got \[2\.0\]"):
+        dynamics_options(load_scene("hang-20", [*tiny, "dynamics.frames=[2.0]"]))
+    with pytest.raises(SceneError, match=r"hang-20\.toml: dynamics\.max_steps: 0 is out of range: must be >= 1"):
+        dynamics_options(load_scene("hang-20", [*tiny, "dynamics.max_steps=0"]))
+    with pytest.raises(SceneError, match=r'dynamics\.t_end: an analysis = "relax" scene needs its end time'):
+        dynamics_options(load_scene("pedestal-square-20", ["analysis=relax"]))
+    assert dynamics_options(load_scene("hang-20", [*tiny, 'dynamics.max_steps="auto"'])).step_limit(49) == 70_000
