@@ -42,22 +42,25 @@ REQUIRED = _Required()
 """Give as the default of :func:`option` for an option without a default: a scene table must give the key
 (:func:`from_table` names it when missing) and the listings show "required"."""
 
-UNIT_LABELS = {"": "-", "length": "length", "time": "time", "rate": "1/time", "angle": "deg"}
-"""How a unit kind is shown in the listings (lengths and times in the scene's ``units``, a rate in 1/its
-time, angles in degrees)."""
+UNIT_LABELS = {"": "-", "length": "length", "time": "time", "rate": "1/time", "angle": "deg",
+               "stiffness_volumetric": "force/length^3", "element_sizes": "mean element sizes"}
+"""The units an option may declare, and how each is shown in the listings (lengths, times and the derived
+quantities of :class:`~rftstatic.units.UnitSystem` in the scene's ``units``, a rate in 1/its time, angles in
+degrees; ``"element_sizes"`` is a pure number counted in the mesh's mean element size)."""
 
 
 def scene_factor(unit: str, units=None) -> float:
     """SI value of one scene unit of the quantity ``unit`` [SI / scene unit]: a length or time by the scene's
     :class:`~rftstatic.units.UnitSystem` ``units`` (None: SI), a rate (1/time) by the inverse of the scene's
-    time, an angle from degrees to radians, else 1."""
+    time, an angle from degrees to radians, a derived quantity (``"stiffness_volumetric"``) by the unit system's
+    factor of that name, else 1."""
     if unit == "angle":
         return math.pi / 180.0
+    if not unit or units is None or unit == "element_sizes":
+        return 1.0
     if unit == "rate":
-        return 1.0 / float(units.time) if units is not None else 1.0
-    if unit in ("length", "time") and units is not None:
-        return float(getattr(units, unit))
-    return 1.0
+        return 1.0 / float(units.time)
+    return float(getattr(units, unit))
 
 
 @dataclass(frozen=True)
@@ -127,7 +130,8 @@ class OptionSpec:
             below = self.low is not None and (value <= self.low if self.open_low else value < self.low)
             above = self.high is not None and (value >= self.high if self.open_high else value > self.high)
             if below or above:
-                return f"{shown!r} is out of range: must be {self.range_text(factor)}"
+                label = f" ({UNIT_LABELS[self.unit]})" if self.unit else ""
+                return f"{shown!r} is out of range: must be {self.range_text(factor)}{label}"
         return None
 
 
@@ -137,6 +141,8 @@ def option(default, help: str, *, kind: str | None = None, unit: str = "", low=N
     (give it when the default is None, which makes the option nullable, or :data:`REQUIRED`, which makes the
     field one without a default: put it in a ``kw_only`` class or before the fields with defaults)."""
     required = default is REQUIRED
+    if unit not in UNIT_LABELS:
+        raise TypeError(f'option unit "{unit}" is not one of {", ".join(UNIT_LABELS)}')
     if kind is None:
         if required:
             raise TypeError("a required option needs its kind")

@@ -16,6 +16,7 @@ import numpy as np
 from rftstatic.errors import ParameterError, SceneError
 from rftstatic.optionspec import from_table
 from rftstatic.remesh.options import RemeshOptions
+from rftstatic.scenes.contact_options import ContactOptions
 from rftstatic.scenes.dynamics_options import DYNAMICS_DEFAULTS, DynamicsOptions
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions, RunOptions
 from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
@@ -98,6 +99,17 @@ def remesh_options(scene) -> RemeshOptions:
         raise scene.error(exc.key, exc.detail) from None
 
 
+def contact_options(scene) -> ContactOptions:
+    """The scene's ``[contact]`` table checked against its declarations
+    (:class:`~rftstatic.scenes.contact_options.ContactOptions`) and converted to SI
+    (:func:`rftstatic.optionspec.from_table`)."""
+    try:
+        table = from_table((ContactOptions,), dict(scene.get("contact", {})), "contact", scene.units)
+        return ContactOptions(**table[ContactOptions])
+    except ParameterError as exc:
+        raise scene.error(exc.key, exc.detail) from None
+
+
 def seed_count(scene) -> int:
     """``solver.seeds``: how many seeded starts a static drape runs (a lab's specimens), checked; 1 by default.
     More than one needs a seeded start (``solver.perturbation`` > 0)."""
@@ -121,4 +133,4 @@ def cantilever_options(scene) -> CantileverOptions:
 
 
 __all__ = ["run_options", "declared_run_options", "seed_count", "cantilever_options", "CantileverOptions",
-           "static_options", "dynamics_options", "remesh_options", "DynamicsOptions", "DYNAMICS_DEFAULTS", "SceneError"]
+           "static_options", "dynamics_options", "contact_options", "remesh_options", "DynamicsOptions", "DYNAMICS_DEFAULTS", "SceneError"]

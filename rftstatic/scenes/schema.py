@@ -21,6 +21,7 @@ from rftstatic.errors import SceneError
 from rftstatic.fabrics.lab import LAB_KEYS
 from rftstatic.optionspec import schema_entries
 from rftstatic.remesh.options import RemeshOptions
+from rftstatic.scenes.contact_options import ContactOptions
 from rftstatic.scenes.dynamics_options import FRAMES_HELP, DynamicsOptions
 from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
@@ -152,16 +153,8 @@ SCHEMA = {
                    "force_per_length": (XYZ, "[fx, fy, fz] per unit length")}], "boundary line loads"),
     }, "external loads at load factor 1"),
     "obstacles": ([_ObstacleKeys()], "rigid obstacles (the keys every registered obstacle type declares)"),
-    "contact": ({
-        "penalty": ((str, *NUM), '"auto" or a penalty stiffness [force/length^3]'),
-        "factor": (NUM, "multiplier of the automatic penalty"),
-        "hold_inplane": (bool, "hold the in-plane rigid modes of a sheet on a frictionless support"),
-        "smoothing": (NUM, "width of the C2 penalty onset, in mean element sizes (default 0.05)"),
-        "self": (bool, "self-contact of the sheet: its layers never pass through each other (default false)"),
-        "self_thickness": (NUM, "self-contact thickness [length] (default: material.thickness, else 0.05 cm); "
-                                "below half the smallest edge"),
-        "self_factor": (NUM, "multiplier of the automatic self-contact stiffness (default 1)"),
-    }, "penalty contact and self-contact"),
+    "contact": (schema_entries(ContactOptions), "penalty contact and self-contact: python -m rftstatic options "
+                "contact"),
     "solver": (schema_entries(*SOLVER_GROUPS), "static solver options (rftstatic.solvers.options) and the app's "
                "(rftstatic.scenes.run_options): python -m rftstatic options solver"),
     "dynamics": ({**schema_entries(DynamicsOptions), "frames": (ListOf(NUM), FRAMES_HELP)},

@@ -191,3 +191,27 @@ def test_the_dynamics_defaults_depend_on_the_analysis_and_frames_are_checked_aga
     with pytest.raises(SceneError, match=r'dynamics\.t_end: an analysis = "relax" scene needs its end time'):
         dynamics_options(load_scene("pedestal-square-20", ["analysis=relax"]))
     assert dynamics_options(load_scene("hang-20", [*tiny, 'dynamics.max_steps="auto"'])).step_limit(49) == 70_000
+
+
+def test_a_contact_penalty_is_auto_or_a_stiffness_in_the_scenes_units():
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.options import contact_options
+
+    assert contact_options(load_scene("pedestal-square-20")).penalty is None  # "auto" by default
+    given = load_scene("pedestal-square-20", ["mesh.nodes=[5,5]", "contact.penalty=2.0"])
+    units = given.units
+    assert contact_options(given).penalty == pytest.approx(2.0 * units.force / units.length ** 3)
+    model, _ = build_model(given)
+    assert model.contact.stiffness == pytest.approx(contact_options(given).penalty)
+    assert model.contact.smoothing == pytest.approx(0.05 * model.mesh.element_size.mean())
+    for bad, why in (('"stiff"', r'must be a number or "auto", got \'stiff\''), ("0.0", "0.0 is out of range: must be > 0")):
+        with pytest.raises(SceneError, match=rf"contact\.penalty: {why}"):
+            contact_options(load_scene("pedestal-square-20", [f"contact.penalty={bad}"]))
+    rows = {r["key"]: r for r in option_rows("contact")}
+    assert rows["contact.penalty"]["unit"] == "force/length^3" and rows["contact.penalty"]["default"] == "auto"
+    assert rows["contact.smoothing"]["unit"] == "mean element sizes"
+
+
+def test_an_undeclared_unit_is_a_programming_error():
+    with pytest.raises(TypeError, match='option unit "furlong"'):
+        option(1.0, "a distance", unit="furlong")
