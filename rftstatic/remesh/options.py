@@ -1,9 +1,10 @@
 """The options of the remeshing drivers (:func:`~rftstatic.remesh.static_driver.remesh_static`,
 :func:`~rftstatic.remesh.relax_driver.remesh_relax`), declared once.
 
-:class:`RemeshOptions` is the mesh sizing and the remeshing schedule (a scene's ``[remesh]`` table, in SI);
-:class:`RemeshRelaxOptions` the motion of the remeshed relaxation. A bad value raises
-:class:`~rftstatic.errors.ParameterError` naming the field.
+:class:`RemeshOptions` is the mesh sizing and the remeshing schedule (a scene's ``[remesh]`` table, in SI,
+declared as data: :mod:`rftstatic.optionspec`; a bad value raises :class:`~rftstatic.errors.ParameterError`
+naming ``remesh.<field>``); :class:`RemeshRelaxOptions` the motion of the remeshed relaxation (set by the app,
+not a scene table; a bad value names the field).
 """
 
 from __future__ import annotations

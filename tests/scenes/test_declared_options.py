@@ -139,14 +139,15 @@ def test_an_option_default_outside_its_own_range_is_a_programming_error():
         option(2.0, "a share", low=0.0, high=1.0)
 
 
-def test_the_options_command_lists_every_key_and_refuses_an_unknown_section(capsys):
-    assert main(["options", "solver"]) == 0
+@pytest.mark.parametrize("section", list(SECTIONS))
+def test_the_options_command_lists_every_key_and_refuses_an_unknown_section(capsys, section):
+    assert main(["options", section]) == 0
     out = capsys.readouterr().out
-    for row in describe(SECTIONS["solver"], "solver"):
+    for row in describe(SECTIONS[section], section):
         assert row["key"] in out
-    assert main(["options", "solver", "--format", "markdown"]) == 0
+    assert main(["options", section, "--format", "markdown"]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert table[0].startswith("| key |") and len(table) == 2 + len(option_rows("solver"))
+    assert table[0].startswith("| key |") and len(table) == 2 + len(option_rows(section))
     assert all(line.count("|") == 7 for line in table)  # no cell breaks the table
     assert main(["options", "solverr"]) == 2
     err = capsys.readouterr().err
