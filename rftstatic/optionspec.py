@@ -22,25 +22,45 @@ from dataclasses import MISSING, dataclass, field, fields
 
 from rftstatic.errors import ParameterError
 
-__all__ = ["OptionSpec", "option", "check", "declared", "schema_entries", "from_table", "describe"]
+__all__ = ["OptionSpec", "option", "check", "declared", "schema_entries", "from_table", "describe", "REQUIRED", "scene_values"]
 
 _KINDS = {"bool": (bool,), "int": (int,), "float": (int, float), "str": (str,)}
 
 AUTO = "auto"
 """How a scene says None ("automatic") for a nullable option."""
 
-UNIT_LABELS = {"": "-", "length": "length", "time": "time", "angle": "deg"}
-"""How a unit kind is shown in the listings (lengths and times in the scene's ``units``, angles in degrees)."""
+
+
+class _Required:
+    """The default of a required option (:data:`REQUIRED`): the scene must give the key."""
+
+    def __repr__(self):
+        return "required"
+
+
+REQUIRED = _Required()
+"""Give as the default of :func:`option` for an option without a default: a scene table must give the key
+(:func:`from_table` names it when missing) and the listings show "required"."""
+
+UNIT_LABELS = {"": "-", "length": "length", "time": "time", "rate": "1/time", "angle": "deg",
+               "stiffness_volumetric": "force/length^3", "element_sizes": "mean element sizes"}
+"""The units an option may declare, and how each is shown in the listings (lengths, times and the derived
+quantities of :class:`~rftstatic.units.UnitSystem` in the scene's ``units``, a rate in 1/its time, angles in
+degrees; ``"element_sizes"`` is a pure number counted in the mesh's mean element size)."""
 
 
 def scene_factor(unit: str, units=None) -> float:
     """SI value of one scene unit of the quantity ``unit`` [SI / scene unit]: a length or time by the scene's
-    :class:`~rftstatic.units.UnitSystem` ``units`` (None: SI), an angle from degrees to radians, else 1."""
+    :class:`~rftstatic.units.UnitSystem` ``units`` (None: SI), a rate (1/time) by the inverse of the scene's
+    time, an angle from degrees to radians, a derived quantity (``"stiffness_volumetric"``) by the unit system's
+    factor of that name, else 1."""
     if unit == "angle":
         return math.pi / 180.0
-    if unit in ("length", "time") and units is not None:
-        return float(getattr(units, unit))
-    return 1.0
+    if not unit or units is None or unit == "element_sizes":
+        return 1.0
+    if unit == "rate":
+        return 1.0 / float(units.time)
+    return float(getattr(units, unit))
 
 
 @dataclass(frozen=True)
@@ -51,11 +71,13 @@ class OptionSpec:
     ----------
     help : one line saying what it does
     kind : ``"bool"``, ``"int"``, ``"float"`` or ``"str"``
-    unit : the quantity's kind in a scene (``"length"``, ``"time"``) or ``""`` for a pure number
+    unit : the quantity's kind in a scene (``"length"``, ``"time"``, ``"rate"`` [1/time], ``"angle"``) or ``""``
+        for a pure number
     low, high : the closed range of a number (None: unbounded); ``open_low``/``open_high`` exclude the bound
     choices : the allowed strings of a ``str`` option
     nullable : None is allowed (it means "automatic"; ``help`` says what)
     scene : the option is a key of the scene's table (False: set by the program, e.g. a progress bar)
+    required : the option has no default (:data:`REQUIRED`): a scene table must give it
     """
 
     help: str
@@ -68,6 +90,7 @@ class OptionSpec:
     choices: tuple = ()
     nullable: bool = False
     scene: bool = True
+    required: bool = False
 
     def range_text(self, factor: float = 1.0) -> str:
         """The range in words: ``"in (0, 1]"``, ``">= 1"``, ``"one of a, b"``, or ``""``; ``factor``: SI value of
@@ -107,30 +130,40 @@ class OptionSpec:
             below = self.low is not None and (value <= self.low if self.open_low else value < self.low)
             above = self.high is not None and (value >= self.high if self.open_high else value > self.high)
             if below or above:
-                return f"{shown!r} is out of range: must be {self.range_text(factor)}"
+                label = f" ({UNIT_LABELS[self.unit]})" if self.unit else ""
+                return f"{shown!r} is out of range: must be {self.range_text(factor)}{label}"
         return None
 
 
 def option(default, help: str, *, kind: str | None = None, unit: str = "", low=None, high=None, open_low=False,
            open_high=False, choices=(), scene=True):
     """A dataclass field declared as an option (:class:`OptionSpec`); ``kind`` defaults to the default's type
-    (give it when the default is None, which makes the option nullable)."""
+    (give it when the default is None, which makes the option nullable, or :data:`REQUIRED`, which makes the
+    field one without a default: put it in a ``kw_only`` class or before the fields with defaults)."""
+    required = default is REQUIRED
+    if unit not in UNIT_LABELS:
+        raise TypeError(f'option unit "{unit}" is not one of {", ".join(UNIT_LABELS)}')
     if kind is None:
+        if required:
+            raise TypeError("a required option needs its kind")
         kind = {bool: "bool", int: "int", float: "float", str: "str"}[type(default)]
     spec = OptionSpec(help=help, kind=kind, unit=unit, low=low, high=high, open_low=open_low, open_high=open_high,
-                      choices=tuple(choices), nullable=default is None, scene=scene)
+                      choices=tuple(choices), nullable=default is None, scene=scene, required=required)
+    if required:
+        return field(metadata={"option": spec})
     if default is not None and spec.problem(default) is not None:
         raise TypeError(f"option default {default!r}: {spec.problem(default)}")
     return field(default=default, metadata={"option": spec})
 
 
 def declared(cls) -> list[tuple[str, OptionSpec, object]]:
-    """``(name, spec, default)`` of every option field of the options class ``cls``, in declaration order."""
+    """``(name, spec, default)`` of every option field of the options class ``cls``, in declaration order
+    (``default`` :data:`REQUIRED` for a required option)."""
     out = []
     for f in fields(cls):
         spec = f.metadata.get("option")
         if spec is not None:
-            out.append((f.name, spec, None if f.default is MISSING else f.default))
+            out.append((f.name, spec, REQUIRED if f.default is MISSING else f.default))
     return out
 
 
@@ -162,8 +195,8 @@ def from_table(classes, table: dict, section: str, units=None) -> dict:
     """Split a flat scene table ``table`` (scene units) over the options ``classes``: ``{cls: {name: value}}``
     with the values of the keys declared ``unit = "length"`` / ``"time"`` converted to SI by ``units``
     (a :class:`~rftstatic.units.UnitSystem`; None: as given) and ``"auto"`` of a nullable option made None.
-    Each value is checked against its declaration as given; an undeclared key or a bad value is a
-    ParameterError naming ``section.key``."""
+    Each value is checked against its declaration as given; an undeclared key, a bad value or a missing
+    required key is a ParameterError naming ``section.key``."""
     owner = {name: (cls, spec) for cls in classes for name, spec, _ in declared(cls) if spec.scene}
     out = {cls: {} for cls in classes}
     for key, value in table.items():
@@ -182,6 +215,22 @@ def from_table(classes, table: dict, section: str, units=None) -> dict:
         if bad is not None:
             raise ParameterError(f"{section}.{key}", bad)
         out[cls][key] = value
+    for key, (cls, spec) in owner.items():
+        if spec.required and key not in table:
+            raise ParameterError(f"{section}.{key}", f"is required: {spec.help}" +
+                                 (f" [{UNIT_LABELS[spec.unit]}]" if spec.unit else ""))
+    return out
+
+
+def scene_values(obj, units=None) -> dict:
+    """The declared scene options of the options object ``obj`` (SI) in the scene's units ``units`` (the inverse
+    of :func:`from_table`; None stays None), e.g. for a run's summary."""
+    out = {}
+    for name, spec, _ in declared(type(obj)):
+        if spec.scene:
+            value, factor = getattr(obj, name), scene_factor(spec.unit, units)
+            numeric = isinstance(value, (int, float)) and not isinstance(value, bool)
+            out[name] = value / factor if numeric and factor != 1.0 else value
     return out
 
 
@@ -191,6 +240,8 @@ def _help_line(spec: OptionSpec, default) -> str:
         parts.append(f"[{UNIT_LABELS.get(spec.unit, spec.unit)}]")
     if spec.range_text() and not spec.choices:
         parts.append(spec.range_text(scene_factor(spec.unit)))
+    if spec.required:
+        parts.append("(required)")
     return " ".join(parts)
 
 
@@ -204,7 +255,8 @@ def describe(classes, section: str) -> list[dict]:
                 continue
             factor = scene_factor(spec.unit)
             shown = default / factor if factor != 1.0 and isinstance(default, float) else default
+            shown = "required" if spec.required else AUTO if default is None else shown
             rows.append({"key": f"{section}.{name}", "type": spec.kind, "unit": UNIT_LABELS.get(spec.unit, spec.unit),
-                         "range": spec.range_text(factor), "default": AUTO if default is None else shown,
+                         "range": spec.range_text(factor), "default": shown,
                          "help": spec.help, "group": cls.__name__})
     return rows

@@ -31,7 +31,6 @@ Outputs in the run folder, every number in the scene's units:
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import math
 import time
@@ -46,13 +45,14 @@ from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_summary, self_intersection_summary,
                                    summary_header)
+from rftstatic.optionspec import scene_values
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.remesh.checkpoint import FIX, RemeshCheckpointer, load_remesh_checkpoint
 from rftstatic.remesh.options import RemeshRelaxOptions
 from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
 from rftstatic.remesh.static_driver import remesh_static
 from rftstatic.scenes.build import MAX_MESH_NODES, build_model
-from rftstatic.scenes.options import REMESH_LENGTH_KEYS, dynamics_options, remesh_options, static_options
+from rftstatic.scenes.options import dynamics_options, remesh_options, static_options
 from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.static_checkpoint import CHECKPOINT_SECONDS, remove_stale
 from rftstatic.solvers.step_plan import plan_steps
@@ -302,8 +302,7 @@ def summarize(scene, opts, solved) -> dict:
         d["max_kappa_h2"] = d["max_kappa_h2"] / u.length
         d["refinable_kappa_h2"] = d["refinable_kappa_h2"] / u.length
         records.append(d)
-    settings = {k: (v / u.length if k in REMESH_LENGTH_KEYS and v is not None else v)
-                for k, v in dataclasses.asdict(opts).items()}
+    settings = scene_values(opts, u)
     summary = summary_header(scene, model, scene.analysis)
     summary.update({
         "route": solved["route"], "initial_nodes": records[0]["nodes"],

@@ -41,10 +41,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.element.curvature import curvature_norm
-from rftstatic.errors import ParameterError
 from rftstatic.mesh import GRADATION
 from rftstatic.remesh.sizefield import check_size_bounds, size_field
-from rftstatic.remesh.transfer import METHODS, transfer_fields
+from rftstatic.remesh.transfer import transfer_fields
 
 DAMPING = ("fixed", "critical")
 """Damping of the remeshed relaxation: the scene's alpha, or critical for the sheet's slowest swing."""
@@ -52,7 +51,7 @@ DAMPING = ("fixed", "critical")
 log = logging.getLogger(__name__)
 
 __all__ = ["reference_domain", "adapt_mesh", "transfer_state", "RemeshRecord", "refinable_maxima",
-           "check_remesh_parameters", "DAMPING"]
+           "DAMPING"]
 
 
 # --------------------------------------------------------------------------------------------- one remesh
@@ -228,43 +227,6 @@ def refinable_maxima(mesh, kappa, *, const, h_lower):
     at_floor = (wanted < h_lower) & (h <= BAND * h_lower)
     keep = ~at_floor
     return float((mag * h)[keep].max(initial=0.0)), float((mag * h * h)[keep].max(initial=0.0))
-
-
-def check_remesh_parameters(*, const, h_lower, h_upper, gradation, max_cycles, tol, kappa_h_max, transfer, every,
-                            kappa_h2_max, damping) -> None:
-    """Check the fields of :class:`~rftstatic.remesh.options.RemeshOptions` (any consistent units; the
-    defaults are that class's).
-
-    Raises :class:`~rftstatic.errors.ParameterError` whose ``key`` names the parameter: const, h_lower,
-    h_upper, gradation, tol must be positive finite numbers (kappa_h_max too unless None), h_lower <=
-    h_upper, gradation >= 1, transfer in :data:`~rftstatic.remesh.transfer.METHODS`, damping in
-    :data:`DAMPING`, every a positive and max_cycles a non-negative integer (every may be None),
-    kappa_h2_max a positive length or None.
-    """
-    values = {"const": const, "h_lower": h_lower, "h_upper": h_upper, "gradation": gradation, "tol": tol,
-              "kappa_h_max": kappa_h_max}
-    for key, v in values.items():
-        if key == "kappa_h_max" and v is None:
-            continue
-        if not (isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(v, bool)
-                and np.isfinite(v) and v > 0):
-            raise ParameterError(key, f"must be a positive number, got {v!r}")
-    if gradation < 1:
-        raise ParameterError("gradation", f"must be >= 1 (a size ratio), got {gradation!r}")
-    if h_lower > h_upper:
-        raise ParameterError("h_lower", f"h_lower = {h_lower} exceeds h_upper = {h_upper}; Eq. 29 clips h_target "
-                             "to [h_lower, h_upper]: swap them")
-    if transfer not in METHODS:
-        raise ParameterError("transfer", f'"{transfer}" is unknown; use one of {", ".join(METHODS)}')
-    if damping not in DAMPING:
-        raise ParameterError("damping", f'"{damping}" is unknown; use one of {", ".join(DAMPING)}')
-    for key, v, low in (("every", every, 1), ("max_cycles", max_cycles, 0)):
-        if v is None and key == "every":
-            continue
-        if not (isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= low):
-            raise ParameterError(key, f"must be a {'positive' if low else 'non-negative'} integer, got {v!r}")
-    if kappa_h2_max is not None and not (isinstance(kappa_h2_max, (int, float)) and kappa_h2_max > 0):
-        raise ParameterError("kappa_h2_max", f"must be a positive length or None (Eq. 28), got {kappa_h2_max!r}")
 
 
 def _check_extent(mesh, const, h_lower, h_upper):

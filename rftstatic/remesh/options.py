@@ -1,59 +1,67 @@
 """The options of the remeshing drivers (:func:`~rftstatic.remesh.static_driver.remesh_static`,
 :func:`~rftstatic.remesh.relax_driver.remesh_relax`), declared once.
 
-:class:`RemeshOptions` is the mesh sizing and the remeshing schedule (a scene's ``[remesh]`` table, in SI);
-:class:`RemeshRelaxOptions` the motion of the remeshed relaxation. A bad value raises
-:class:`~rftstatic.errors.ParameterError` naming the field.
+:class:`RemeshOptions` is the mesh sizing and the remeshing schedule (a scene's ``[remesh]`` table, in SI,
+declared as data: :mod:`rftstatic.optionspec`; a bad value raises :class:`~rftstatic.errors.ParameterError`
+naming ``remesh.<field>``); :class:`RemeshRelaxOptions` the motion of the remeshed relaxation (set by the app,
+not a scene table; a bad value names the field).
 """
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from rftstatic.errors import ParameterError
 from rftstatic.mesh import GRADATION
-from rftstatic.remesh.adapt import DAMPING, check_remesh_parameters
+from rftstatic.optionspec import REQUIRED, check, option
+from rftstatic.remesh.adapt import DAMPING
 from rftstatic.remesh.transfer import METHODS
-from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RELAX_REST
-from rftstatic.solvers.rest import RestCriterion
+from rftstatic.solvers.rest import RELAX_MASS_SCALE, RELAX_REST, RestCriterion
 
 __all__ = ["RemeshOptions", "RemeshRelaxOptions"]
 
 
 @dataclass(frozen=True, kw_only=True)
 class RemeshOptions:
-    """Sizing (Eq. 29: h_new = sqrt(const / |kappa|) in [h_lower, h_upper]) and schedule of the remeshing.
+    """Sizing (Eq. 29: h_new = sqrt(const / |kappa|) in [h_lower, h_upper]) and schedule of the remeshing: a
+    scene's ``[remesh]`` table, in SI. Each field is declared once (:func:`rftstatic.optionspec.option`, ranges
+    in SI); a bad value raises :class:`~rftstatic.errors.ParameterError` naming ``remesh.<field>``. Beyond the
+    ranges: h_lower <= h_upper.
 
     Attributes
     ----------
-    const : Eq. 29 constant [m], > 0; h_lower, h_upper : element size bounds [m], 0 < h_lower <= h_upper
-    gradation : largest size ratio between neighbours one element apart [-], >= 1
-    max_cycles : static route: most remeshing cycles [-], >= 0
-    tol : stop when the node count changes by less than this fraction [-], > 0
-    kappa_h_max : static route: largest |kappa| h accepted without remeshing [-] (None: node count alone)
-    transfer : "mesh", "patch" or "grid" (:mod:`rftstatic.remesh.transfer`)
-    every : relax route: remesh every this many steps [-] (None: on the curvature trigger and at rest)
-    kappa_h2_max : relax route: remesh when max |kappa| h^2 exceeds this [m] (None: never on curvature)
-    damping : relax route: "fixed" (the stepper's alpha) or "critical" (:func:`critical_damping`)
+    const, h_lower, h_upper : Eq. 29 constant and element size bounds [m], required
+    gradation, max_cycles, tol, kappa_h_max, transfer, every, kappa_h2_max, damping : as their help says
+        (:func:`~rftstatic.remesh.transfer.transfer_fields` for ``transfer``, :func:`critical_damping` for
+        ``damping = "critical"``)
     """
 
-    const: float
-    h_lower: float
-    h_upper: float
-    gradation: float = GRADATION
-    max_cycles: int = 5
-    tol: float = 0.05
-    kappa_h_max: float | None = None
-    transfer: str = METHODS[0]
-    every: int | None = None
-    kappa_h2_max: float | None = None
-    damping: str = DAMPING[0]
+    const: float = option(REQUIRED, "const of Eq. 29, |kappa| h^2 = const", kind="float", unit="length", low=0.0,
+                          open_low=True)
+    h_lower: float = option(REQUIRED, "smallest element size", kind="float", unit="length", low=0.0, open_low=True)
+    h_upper: float = option(REQUIRED, "largest element size", kind="float", unit="length", low=0.0, open_low=True)
+    gradation: float = option(GRADATION, "largest size ratio between neighbours one element apart", low=1.0)
+    max_cycles: int = option(5, "static route: most remeshing cycles", low=0)
+    tol: float = option(0.05, "stop when the node count changes by less than this fraction", low=0.0,
+                        open_low=True)
+    kappa_h_max: float | None = option(None, 'static route: largest |kappa| h accepted without remeshing ("auto": '
+                                       "the node count alone decides)", kind="float", low=0.0, open_low=True)
+    transfer: str = option(METHODS[0], "mesh (interpolation on the old mesh), patch (its RF patch quadratics) or "
+                           "grid (background grid, as the paper)", choices=METHODS)
+    every: int | None = option(None, 'relax route: remesh every this many steps ("auto": on the curvature '
+                               "trigger and at rest only)", kind="int", low=1)
+    kappa_h2_max: float | None = option(None, 'relax route: remesh when max |kappa| h^2 exceeds this ("auto": '
+                                        "never on curvature)", kind="float", unit="length", low=0.0, open_low=True)
+    damping: str = option(DAMPING[0], "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's "
+                          "slowest swing, at most dynamics.alpha)", choices=DAMPING)
 
     def __post_init__(self):
-        check_remesh_parameters(**dataclasses.asdict(self))
+        check(self, "remesh")
+        if self.h_lower > self.h_upper:
+            raise ParameterError("remesh.h_lower", f"h_lower = {self.h_lower} exceeds h_upper = {self.h_upper}; "
+                                 "Eq. 29 clips h_target to [h_lower, h_upper]: swap them")
 
 
 @dataclass(frozen=True, kw_only=True)

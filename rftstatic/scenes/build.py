@@ -15,12 +15,11 @@ from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
 from rftstatic.scenes.material import build_material
-from rftstatic.scenes.options import declared_run_options, static_options
+from rftstatic.scenes.options import contact_options, declared_run_options, static_options
 from rftstatic.scenes.ranges import (
     check_mesh_table,
     check_obstacle_sizes,
     check_position,
-    check_smoothing,
     check_thickness,
     check_weight,
     sheet_size,
@@ -304,30 +303,22 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     obstacles = build_obstacles(scene)
     if not obstacles:
         return None, []
-    hold = scene.get("contact.hold_inplane", True)
+    c = contact_options(scene)
+    hold = c.hold_inplane
     if law == "kinematic":
         if hold and scene.analysis == "relax":
             hold_inplane_rigid_modes(mesh, supports)
         return None, obstacles
     from rftstatic.contact.penalty import PenaltyContact, auto_penalty
 
-    c = scene.get("contact", {})
     h = float(mesh.element_size.mean())
-    penalty = c.get("penalty", "auto")
-    if penalty == "auto":
-        try:
-            k = auto_penalty(membrane_rigidity=material.membrane_scale, bending_rigidity=material.bending_scale,
-                             weight=max(material.weight, 1e-300), h=h, factor=c.get("factor", 1.0))
-        except ValueError as exc:
-            raise scene.error("contact.factor", f"{exc}; use a positive multiplier of the automatic penalty") from None
-    elif isinstance(penalty, (int, float)) and penalty > 0:
-        k = scene.units.to_si(float(penalty), "stiffness_volumetric")
-    else:
-        raise scene.error("contact.penalty", f'expected "auto" or a positive number, got {penalty!r}')
+    k = c.penalty
+    if k is None:
+        k = auto_penalty(membrane_rigidity=material.membrane_scale, bending_rigidity=material.bending_scale,
+                         weight=max(material.weight, 1e-300), h=h, factor=c.factor)
     if hold:
         hold_inplane_rigid_modes(mesh, supports)
-    smoothing = check_smoothing(scene, c.get("smoothing", 0.05)) * h
-    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=smoothing), obstacles
+    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h), obstacles
 
 
 OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z"}
@@ -404,7 +395,7 @@ def run_kernels(scene: Scene, mesh) -> str:
     long_run = scene.analysis in ("dynamic", "relax") or (
         scene.analysis == "static" and static_options(scene, progress=False).increments.continuation == "arc-length")
     try:
-        return choose_kernels(mesh.n_elements, self_contact=bool(scene.get("contact.self", False)), long_run=long_run,
+        return choose_kernels(mesh.n_elements, self_contact=contact_options(scene).self, long_run=long_run,
                               requested=None if requested == "auto" else requested)
     except ValueError as exc:
         raise scene.error("kernels", f'"{requested}": {exc}') from None

@@ -18,21 +18,18 @@ element size, in the scene's own length units, so that the ranges read the same 
   [:data:`MIN_OBSTACLE_SIZE` element sizes, :data:`MAX_OBSTACLE_SIZE` sheet sizes];
 * a shell's thickness (``material.thickness``): [:data:`MIN_THICKNESS` element sizes, the sheet's smaller
   side];
-* ``contact.smoothing``: [0, :data:`MAX_SMOOTHING`] element sizes;
 * ``material.weight``: at most :data:`MAX_WEIGHT`.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from rftstatic.scenes.schema import Scene
 
-__all__ = ["MAX_OBSTACLE_SIZE", "MAX_OFFSET", "MAX_SMOOTHING", "MIN_INNER_RADIUS", "MIN_NODES",
+__all__ = ["MAX_OBSTACLE_SIZE", "MAX_OFFSET", "MIN_INNER_RADIUS", "MIN_NODES",
            "MIN_OBSTACLE_SIZE", "MIN_THICKNESS", "SHEET_RANGE_M", "check_mesh_table", "check_obstacle_sizes",
-           "check_smoothing", "check_thickness", "check_position", "check_weight", "MAX_WEIGHT", "sheet_size"]
+           "check_thickness", "check_position", "check_weight", "MAX_WEIGHT", "sheet_size"]
 
 SHEET_RANGE_M = (1e-6, 1e6)
 """Smallest and largest side (or diameter) of a sheet [m]: 1 um to 1000 km, far beyond any specimen (a few
@@ -63,11 +60,6 @@ position): a larger one is a plane to the sheet (use a floor), and at 1e300 its 
 MIN_THICKNESS = 1e-6
 """Thinnest shell or fabric, in mean element sizes: a shell's bending over membrane stiffness is
 t^2 / (12 h^2), below 1e-13 at this bound, under the round-off of the membrane terms."""
-
-MAX_SMOOTHING = 1.0
-"""Widest C2 onset of the penalty contact, in mean element sizes (default 0.05): the sheet rests about this
-far above the obstacle, and a wider onset is no longer a contact (at 1e300 its energy overflows)."""
-
 
 MAX_WEIGHT = 1e6
 """Heaviest sheet [N/m^2]: 100 t/m^2, a 13 m thick steel plate (fabrics weigh 0.5-10 N/m^2); at 1e300 the
@@ -195,12 +187,3 @@ def check_thickness(scene: Scene, mesh, thickness_m: float | None) -> None:
                           f"[{MIN_THICKNESS * h / u:.3g}, {width / u:.3g}] scene length units: from {MIN_THICKNESS:g} "
                           "mean element sizes (thinner, bending is below the round-off of the membrane) to the "
                           "sheet's smaller side (thicker is a block, not a shell)")
-
-
-def check_smoothing(scene: Scene, value) -> float:
-    """``contact.smoothing`` (mean element sizes) checked to lie in [0, :data:`MAX_SMOOTHING`]."""
-    if not (_number(value) and 0 <= value <= MAX_SMOOTHING and math.isfinite(value)):
-        raise scene.error("contact.smoothing", f"{value!r} must lie in [0, {MAX_SMOOTHING:g}] mean element sizes "
-                          "(the width of the penalty's C2 onset, default 0.05; 0: the plain quadratic penalty): the "
-                          "sheet rests about that far above the obstacle")
-    return float(value)

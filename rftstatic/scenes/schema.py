@@ -21,6 +21,9 @@ from rftstatic.contact.obstacles import scene_schema as obstacle_schema
 from rftstatic.errors import SceneError
 from rftstatic.fabrics.lab import LAB_KEYS
 from rftstatic.optionspec import schema_entries
+from rftstatic.remesh.options import RemeshOptions
+from rftstatic.scenes.contact_options import ContactOptions
+from rftstatic.scenes.dynamics_options import FRAMES_HELP, DynamicsOptions
 from rftstatic.scenes.analyses import SCENE_ANALYSES
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
@@ -153,42 +156,13 @@ SCHEMA = {
                    "force_per_length": (XYZ, "[fx, fy, fz] per unit length")}], "boundary line loads"),
     }, "external loads at load factor 1"),
     "obstacles": ([_ObstacleKeys()], "rigid obstacles (the keys every registered obstacle type declares)"),
-    "contact": ({
-        "penalty": ((str, *NUM), '"auto" or a penalty stiffness [force/length^3]'),
-        "factor": (NUM, "multiplier of the automatic penalty"),
-        "hold_inplane": (bool, "hold the in-plane rigid modes of a sheet on a frictionless support"),
-        "smoothing": (NUM, "width of the C2 penalty onset, in mean element sizes (default 0.05)"),
-        "self": (bool, "self-contact of the sheet: its layers never pass through each other (default false)"),
-        "self_thickness": (NUM, "self-contact thickness [length] (default: material.thickness, else 0.05 cm); "
-                                "below half the smallest edge"),
-        "self_factor": (NUM, "multiplier of the automatic self-contact stiffness (default 1)"),
-    }, "penalty contact and self-contact"),
+    "contact": (schema_entries(ContactOptions), "penalty contact and self-contact: python -m rftstatic options "
+                "contact"),
     "solver": (schema_entries(*SOLVER_GROUPS), "static solver options (rftstatic.solvers.options) and the app's "
                "(rftstatic.scenes.run_options): python -m rftstatic options solver"),
-    "dynamics": ({
-        "t_end": (NUM, "end time [time]"), "dt": (NUM, "time step (default: automatic)"),
-        "alpha": (NUM, "mass damping [1/time]"), "mass_scale": (NUM, "mass scaling factor"),
-        "frames": (ListOf(NUM), "times of the saved frames"), "checkpoint_every": (NUM, "[time]"),
-        "rest_tolerance": (NUM, "kinetic-energy ratio at which the sheet is at rest"),
-        "samples": (int, "regular states saved for the VTU series and the GIF"),
-        "force_tolerance": (NUM, "relax: out-of-balance force / load at which the sheet is at rest"),
-        "compare_static": (bool, "relax: report the difference from the static Newton solution"),
-        "max_steps": (int, "step limit: a dynamic run needing more is refused, a relaxation stops there (default 10^4 sqrt(nodes), 5e4..1e7)"),
-    }, "explicit dynamics options"),
-    "remesh": ({
-        "const": (NUM, "const of Eq. 29, |kappa| h^2 = const [length]"),
-        "h_lower": (NUM, "smallest element size [length]"), "h_upper": (NUM, "largest element size [length]"),
-        "gradation": (NUM, "largest size ratio between neighbours one element apart"),
-        "max_cycles": (int, "static route: most remeshing cycles"),
-        "tol": (NUM, "stop when the node count changes by less than this fraction"),
-        "kappa_h_max": (NUM, "static route: largest |kappa| h accepted without remeshing"),
-        "kappa_h2_max": (NUM, "relax route: remesh when max |kappa| h^2 exceeds this [length]"),
-        "every": (int, "relax route: remesh every this many steps"),
-        "transfer": (str, "mesh (interpolation on the old mesh), patch (its RF patch quadratics) or grid "
-                          "(background grid, as the paper)"),
-        "damping": (str, "relax route: fixed (dynamics.alpha) or critical (for the hanging sheet's slowest "
-                         "swing, at most dynamics.alpha)"),
-    }, "global adaptive remeshing (§5)"),
+    "dynamics": ({**schema_entries(DynamicsOptions), "frames": (ListOf(NUM), FRAMES_HELP)},
+                 "explicit dynamics and dynamic relaxation: python -m rftstatic options dynamics"),
+    "remesh": (schema_entries(RemeshOptions), "global adaptive remeshing (§5): python -m rftstatic options remesh"),
     "cantilever": (schema_entries(CantileverOptions), "cantilever bending tester (analysis = \"cantilever\"): the "
                    "strip's mesh.size[0] is the first overhang; python -m rftstatic options cantilever"),
     "probes": ([{"name": (str, "probe name"), "at": (XY, "[x, y] reference point")}], "tracked points"),

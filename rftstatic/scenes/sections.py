@@ -9,12 +9,22 @@ from __future__ import annotations
 
 from rftstatic.errors import SceneError
 from rftstatic.optionspec import describe
+from rftstatic.remesh.options import RemeshOptions
+from rftstatic.scenes.contact_options import ContactOptions
+from rftstatic.scenes.dynamics_options import DynamicsOptions
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 
-__all__ = ["SECTIONS", "option_rows", "format_rows"]
+__all__ = ["SECTIONS", "UNDECLARED", "option_rows", "format_rows"]
 
-SECTIONS = {"solver": SOLVER_GROUPS, "cantilever": (CantileverOptions,)}
-"""Scene table -> its declared option groups."""
+SECTIONS = {"solver": SOLVER_GROUPS, "dynamics": (DynamicsOptions,), "remesh": (RemeshOptions,),
+            "contact": (ContactOptions,), "cantilever": (CantileverOptions,)}
+"""Scene table -> its declared option groups (``dynamics.frames``, a list of times bounded by ``t_end``, is the one
+scene key of these tables that is not a declared option: :mod:`rftstatic.scenes.dynamics_options`)."""
+
+
+UNDECLARED = {"dynamics": ("frames",)}
+"""The scene keys of these tables that are not declared options, each with its schema entry written by hand and
+its own check (:mod:`rftstatic.scenes.dynamics_options`: a list of times bounded by ``t_end``)."""
 
 
 def option_rows(section: str | None = None) -> list[dict]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rftstatic.scenes.options import contact_options
 from rftstatic.scenes.schema import Scene
 
 __all__ = ["SELF_THICKNESS_M", "REMESH_THICKNESS_SHARE", "build_self_contact"]
@@ -26,21 +27,22 @@ def build_self_contact(scene: Scene, mesh, material, kernels: str | None = None)
     """The sheet's self-contact (:class:`~rftstatic.contact.self_contact.law.SelfContact`) when
     ``contact.self = true``, else None. Thickness ``contact.self_thickness`` [scene length] (default
     the material's thickness, else :data:`SELF_THICKNESS_M`); stiffness
-    :func:`~rftstatic.contact.self_contact.law.auto_stiffness` times ``contact.self_factor``; ``kernels``: the
-    run's kernel back end (:func:`rftstatic.scenes.build.run_kernels`)."""
-    if not scene.get("contact.self", False):
+    :func:`~rftstatic.contact.self_contact.law.auto_stiffness` times ``contact.self_factor``; their ranges are
+    declared (:class:`~rftstatic.scenes.contact_options.ContactOptions`), the checks against the mesh are here.
+    ``kernels``: the run's kernel back end (:func:`rftstatic.scenes.build.run_kernels`)."""
+    contact = contact_options(scene)
+    if not contact.self:
         return None
     from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
 
     u = scene.units.length
-    given = scene.get("contact.self_thickness")
-    if given is None:
+    if contact.self_thickness is None:
         d = float(material.info.get("thickness", SELF_THICKNESS_M))
         key, shown = "material.thickness" if "thickness" in material.info else "contact.self_thickness", d / u
+        if not d > 0:
+            raise scene.error(key, f"{shown!r} is not a positive thickness; give a thickness > 0")
     else:
-        d, key, shown = float(given) * u, "contact.self_thickness", given
-    if not d > 0:
-        raise scene.error(key, f"{shown!r} is not a positive thickness; give a thickness > 0")
+        d, key, shown = contact.self_thickness, "contact.self_thickness", scene.get("contact.self_thickness")
     edges = mesh.topology.edges
     smallest = float(np.linalg.norm(mesh.X[edges[:, 1]] - mesh.X[edges[:, 0]], axis=1).min())
     h_lower = scene.get("remesh.h_lower") if scene.get("remesh") is not None else None
@@ -52,14 +54,11 @@ def build_self_contact(scene: Scene, mesh, material, kernels: str | None = None)
         raise scene.error(key, f"{shown!r} is above half the smallest edge of the mesh ({smallest / u:.4g} / 2 = "
                           f"{0.5 * smallest / u:.4g}, scene length units): the self-contact would push apart "
                           "neighbours that are not in contact; give a thinner thickness or a coarser mesh")
-    factor = scene.get("contact.self_factor", 1.0)
-    if not factor > 0:
-        raise scene.error("contact.self_factor", f"{factor!r} is not a positive multiplier; give a number > 0")
     if not material.weight > 0:
         raise scene.error("contact.self", "true needs material.weight > 0 (the self-contact stiffness is sized "
                           "by the sheet's weight)")
     k = auto_stiffness(weight=material.weight, node_area=float(mesh.node_area.mean()), thickness=d,
-                       factor=float(factor))
+                       factor=contact.self_factor)
     try:
         return SelfContact(mesh, d, k, kernels=kernels)
     except ValueError as exc:

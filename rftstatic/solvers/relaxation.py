@@ -15,14 +15,10 @@ from rftstatic.element.explicit_force import BACKENDS
 from rftstatic.errors import ParameterError
 from rftstatic.solvers.explicit import ExplicitResult, run_explicit
 from rftstatic.solvers.explicit_options import ExplicitOptions
-from rftstatic.solvers.rest import AtRest, RestCriterion
+from rftstatic.solvers.rest import RELAX_MASS_SCALE, RELAX_REST, AtRest, RestCriterion
 from rftstatic.solvers.step_plan import MAX_STEPS_KEY
 
 log = logging.getLogger(__name__)
-
-RELAX_MASS_SCALE = 100.0
-"""Mass-scaling factor s of dynamic relaxation (§6 uses 100): the stable step grows by sqrt(s)."""
-
 
 @dataclass
 class RelaxResult:
@@ -39,9 +35,6 @@ class RelaxResult:
     peak_kinetic: float = 0.0
 
 
-RELAX_REST = RestCriterion(tol_kinetic=1e-8, tol_force=1e-4)
-"""The at-rest test of dynamic relaxation by default: kinetic energy 1e-8 of its peak, out-of-balance force 1e-4
-of the load."""
 
 
 @dataclass(frozen=True, kw_only=True)

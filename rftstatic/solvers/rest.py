@@ -27,7 +27,7 @@ import numpy as np
 
 from rftstatic.errors import ParameterError
 
-__all__ = ["RestCriterion", "AtRest"]
+__all__ = ["RestCriterion", "AtRest", "RELAX_MASS_SCALE", "RELAX_REST"]
 
 
 @dataclass(frozen=True)
@@ -118,3 +118,13 @@ class AtRest:
         residual = np.asarray(history["residual"], dtype=float)
         self.peak_kinetic = max(self.peak_kinetic, float(kinetic.max())) if kinetic.size else self.peak_kinetic
         self.peak_residual = max(self.peak_residual, float(residual.max())) if residual.size else self.peak_residual
+
+
+RELAX_MASS_SCALE = 100.0
+"""Mass-scaling factor s of dynamic relaxation (§6 uses 100): the stable step grows by sqrt(s)
+(:mod:`rftstatic.solvers.relaxation`; here, with its at-rest test, so that the options can name it without
+importing the explicit solver)."""
+
+RELAX_REST = RestCriterion(tol_kinetic=1e-8, tol_force=1e-4)
+"""The at-rest test of dynamic relaxation by default: kinetic energy 1e-8 of its peak, out-of-balance force 1e-4
+of the load."""

@@ -29,7 +29,7 @@ def test_defaults():
 def test_remesh_options_name_a_bad_value(kw, key):
     with pytest.raises(ParameterError) as err:
         RemeshOptions(**{**SIZING, **kw})
-    assert err.value.key == key
+    assert err.value.key == f"remesh.{key}"
 
 
 @pytest.mark.parametrize("kw, key", [({"alpha": -1.0}, "alpha"), ({"mass_scale": 0.0}, "mass_scale"),
