@@ -10,7 +10,7 @@ of the same sheet (:func:`rftstatic.scenes.levels.level_scenes`, each about twic
    arc-length or relaxation), where it is cheap;
 2. its equilibrium carried to the next mesh (:func:`transfer_start`: linear in the coarse triangles,
    the new nodes lifted out of the obstacles), the prescribed displacements set to zero;
-3. Newton at full load from there (:meth:`~rftstatic.solvers.newton.StaticOptions.from_state`: one load
+3. Newton at full load from there (:meth:`~rftstatic.solvers.options.StaticOptions.from_state`: one load
    step, the displacement iteration with its energy line search and trust region, the supernodal
    Cholesky factorisation wherever the tangent is positive definite), then the self-contact and stability
    checks of :func:`~rftstatic.solvers.static.solve_static`; repeated up to the scene's mesh.

@@ -69,7 +69,7 @@ def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None, 
         :func:`refinable_maxima`; None: the node count alone). An element at its Eq. 29 size has |kappa| h =
         sqrt(const |kappa|), up to const / h_lower where the size reaches the floor, so a cap below that is never
         met (the §6 scenes: const / h_lower = 1, measured max |kappa| h 0.86-1.5 on settled meshes)
-    solver : :class:`rftstatic.solvers.newton.StaticOptions` of the first solve (default: the
+    solver : :class:`rftstatic.solvers.options.StaticOptions` of the first solve (default: the
         defaults, without a progress bar); later solves start from the transferred state at
         full load (one load step) and fall back to the full load ramp from flat if that fails
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)

@@ -11,7 +11,7 @@ import numpy as np
 
 def start_perturbation(mesh, opts) -> np.ndarray:
     """The out-of-plane start ``(N,)`` [m] that the solver options ``opts`` ask for (``perturbation``,
-    ``perturbation_folds``, ``seed`` of :class:`~rftstatic.solvers.newton.StaticOptions`): random modes
+    ``perturbation_folds``, ``seed`` of :class:`~rftstatic.solvers.options.RouteOptions`): random modes
     or an n-fold lift."""
     if opts.perturbation_folds:
         return fold_perturbation(mesh, opts.perturbation_folds, opts.seed, opts.perturbation)
