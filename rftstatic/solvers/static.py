@@ -307,7 +307,8 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
         if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, ws.solver):
             route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
-        handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest}
+        handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest,
+                    "rest_test": info.get("rest_test")}
         info["handovers"].append(handover)
         try:
             # the first handover inside a basin gets the long budget; if that fails, the landscape is
@@ -364,9 +365,9 @@ def _relax_segment(model, opts, plan, route, fail, checkpoint, restart, t0) -> N
     route then stands at its end (``"handover"``), which is saved."""
     saver = None if checkpoint is None else checkpoint.segment(route)
     span = max(min(route.span, plan.max_time - route.t_used), plan.min_span)
+    rest = RestCriterion(tol_kinetic=1e-4, tol_force=route.tol_force)
     try:
-        rel = relax(model, RelaxOptions(mass_scale=plan.mass_scale, alpha=plan.alpha,
-                                        rest=RestCriterion(tol_kinetic=1e-4, tol_force=route.tol_force),
+        rel = relax(model, RelaxOptions(mass_scale=plan.mass_scale, alpha=plan.alpha, rest=rest,
                                         max_time=span if restart is None else float(restart["options"]["t_end"]),
                                         progress=opts.progress, max_steps=RELAX_SEGMENT_STEPS,
                                         max_steps_name="the relaxation route's segment limit"),
@@ -378,7 +379,7 @@ def _relax_segment(model, opts, plan, route, fail, checkpoint, restart, t0) -> N
     route.U, route.V, route.peak, route.at_rest = rel.U, rel.V, rel.peak_kinetic, rel.converged
     route.t_used += rel.t
     route.info.update(time_s=route.t_used, steps=route.info["steps"] + rel.steps, at_rest=rel.converged,
-                      wall_time_s=time.perf_counter() - t0)
+                      rest_test=rest.record(), wall_time_s=time.perf_counter() - t0)
     route.phase = "handover"
     if checkpoint is not None:
         checkpoint.route(route)

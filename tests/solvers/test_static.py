@@ -127,6 +127,10 @@ def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
     b = static.solve_static(mod, options=static.StaticOptions.from_keys(progress=False, start="relax"))
     assert a.route == "load-steps" and b.route == "relax+newton" and b.relax["at_rest"]
     assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
+    # the record says by which test the relaxation stopped: the first segment at |r| < |P|, later ones tighter
+    first = b.relax["handovers"][0]["rest_test"]
+    assert first == {"criterion": "kinetic+force", "tol_kinetic": 1e-4, "tol_force": 1.0}
+    assert b.relax["rest_test"]["tol_force"] <= first["tol_force"]
 
 
 def test_fold_perturbation_has_n_fold_symmetry():
