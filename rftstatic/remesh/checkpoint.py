@@ -32,7 +32,7 @@ import numpy as np
 
 from rftstatic.errors import CheckpointError
 from rftstatic.remesh.adapt import RemeshRecord
-from rftstatic.solvers.checkpoint import ThrottledWriter
+from rftstatic.solvers.checkpoint import ThrottledWriter, json_array, plain
 from rftstatic.solvers.newton import StaticResult
 from rftstatic.solvers.static_checkpoint import CHECKPOINT_SECONDS, result_arrays, result_from
 
@@ -116,24 +116,12 @@ class RemeshRestart:
     where: dict = field(default_factory=dict)
 
 
-def _plain(v):
-    if isinstance(v, np.generic):
-        return v.item()
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    raise TypeError(f"{type(v).__name__} is not JSON serialisable")
-
-
-def _json(value) -> np.ndarray:
-    return np.array(json.dumps(value, default=_plain))
-
-
 def _mesh_arrays(meshes) -> dict:
     """The meshes as flat arrays: nodes (sum N_k, 2) [m], triangles (sum E_k, 3), their counts and labels."""
     return {"mesh_X": np.concatenate([m.X for m in meshes]), "mesh_tri": np.concatenate([m.tri for m in meshes]),
             "mesh_nodes": np.array([m.n_nodes for m in meshes]),
             "mesh_elements": np.array([m.n_elements for m in meshes]),
-            "mesh_meta": _json([{"z0": m.z0, "name": m.name, "info": m.info} for m in meshes])}
+            "mesh_meta": json_array([{"z0": m.z0, "name": m.name, "info": m.info} for m in meshes])}
 
 
 def _meshes_from(z) -> list:
@@ -146,7 +134,7 @@ def _meshes_from(z) -> list:
 
 
 def _records_json(records) -> np.ndarray:
-    return _json([r.as_dict() for r in records])
+    return json_array([r.as_dict() for r in records])
 
 
 class RemeshCheckpointer(ThrottledWriter):
@@ -168,7 +156,7 @@ class RemeshCheckpointer(ThrottledWriter):
 
     def __init__(self, path, header: dict, *, every_seconds: float = CHECKPOINT_SECONDS, app=None):
         super().__init__(path, every_seconds)
-        self.header = json.loads(json.dumps(header, default=_plain))
+        self.header = json.loads(json.dumps(header, default=plain))
         self.app = app
         self._meshes = (0, {})  # the mesh arrays of the first k meshes (a run's meshes only grow)
 
@@ -179,8 +167,8 @@ class RemeshCheckpointer(ThrottledWriter):
 
     def _snapshot(self, phase, arrays, what):
         fields, extra = self.app() if self.app is not None else ({}, {})
-        arrays = {"remesh_format": np.array(FORMAT), "header": _json(self.header), "phase": np.array(phase),
-                  "app": _json(fields), **{"app_" + k: np.asarray(v) for k, v in extra.items()}, **arrays}
+        arrays = {"remesh_format": np.array(FORMAT), "header": json_array(self.header), "phase": np.array(phase),
+                  "app": json_array(fields), **{"app_" + k: np.asarray(v) for k, v in extra.items()}, **arrays}
         return arrays, what
 
     def cycle(self, state: StaticCycleState) -> None:
@@ -194,7 +182,7 @@ class RemeshCheckpointer(ThrottledWriter):
         when ``every_seconds`` have passed (else kept back for :meth:`flush`)."""
         arrays = {**self._mesh_arrays(state.meshes), "U": np.array(state.U, dtype=float),
                   "V": np.array(state.V, dtype=float), "records": _records_json(state.records),
-                  "relax": _json({k: getattr(state, k) for k in _RELAX_SCALARS})}
+                  "relax": json_array({k: getattr(state, k) for k in _RELAX_SCALARS})}
         what = (f"t = {state.t:.4g} s, step {state.steps}, mesh {len(state.meshes) - 1} "
                 f"({state.meshes[-1].n_nodes} nodes)")
         self._pending = self._snapshot(phase, arrays, what)
@@ -222,7 +210,7 @@ def load_remesh_checkpoint(path, header: dict) -> RemeshRestart:
             if int(z["remesh_format"]) != FORMAT:
                 raise CheckpointError(f"checkpoint {path}: remesh format {int(z['remesh_format'])}, this version "
                                       f"reads {FORMAT}; {FIX}")
-            _check_header(path, json.loads(str(z["header"])), json.loads(json.dumps(header, default=_plain)))
+            _check_header(path, json.loads(str(z["header"])), json.loads(json.dumps(header, default=plain)))
             phase = str(z["phase"])
             meshes = _meshes_from(z)
             records = [RemeshRecord(**r) for r in json.loads(str(z["records"]))]

@@ -47,6 +47,20 @@ def _obstacles_spec(obstacles) -> str:
     return json.dumps([ob.as_dict() for ob in obstacles], sort_keys=True, default=float)
 
 
+def plain(v):
+    """A JSON-able form of numpy scalars and arrays (json's ``default`` for the checkpoints' records)."""
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    raise TypeError(f"{type(v).__name__} is not JSON serialisable")
+
+
+def json_array(value) -> np.ndarray:
+    """``value`` as a JSON string in a 0-d array, the form a checkpoint's ``.npz`` keeps a record in."""
+    return np.array(json.dumps(value, default=plain))
+
+
 def save_atomic(path, arrays: dict) -> None:
     """Write ``arrays`` with ``np.savez`` to ``path`` atomically (temporary file + ``os.replace``)."""
     path = Path(path)

@@ -38,7 +38,14 @@ from pathlib import Path
 import numpy as np
 
 from rftstatic.errors import CheckpointError, ConvergenceError
-from rftstatic.solvers.checkpoint import ThrottledWriter, load_checkpoint, model_fingerprint, state_arrays
+from rftstatic.solvers.checkpoint import (
+    ThrottledWriter,
+    json_array,
+    load_checkpoint,
+    model_fingerprint,
+    plain,
+    state_arrays,
+)
 from rftstatic.solvers.load_steps import LoadPath
 from rftstatic.solvers.newton import StaticResult
 from rftstatic.solvers.static import RelaxRoute
@@ -63,7 +70,7 @@ def static_fingerprint(model) -> str:
     contact = None if c is None else {"obstacles": [ob.as_dict() for ob in c.obstacles], "stiffness": c.stiffness,
                                       "smoothing": c.smoothing}
     h.update(json.dumps([contact, [type(t).__name__ for t in model.load_terms]], sort_keys=True,
-                        default=_plain).encode())
+                        default=plain).encode())
     return h.hexdigest()
 
 
@@ -79,19 +86,6 @@ def remove_stale(path) -> None:
         stale.unlink(missing_ok=True)
 
 
-def _plain(v):
-    """A JSON-able form of numpy scalars and arrays (json's ``default``)."""
-    if isinstance(v, np.generic):
-        return v.item()
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    raise TypeError(f"{type(v).__name__} is not JSON serialisable")
-
-
-def _json(value) -> np.ndarray:
-    return np.array(json.dumps(value, default=_plain))
-
-
 def _field(U) -> np.ndarray:
     """(N, 3) displacements or velocities, or an empty (0, 3) array for None."""
     return np.zeros((0, 3)) if U is None else np.array(U, dtype=float)
@@ -104,7 +98,7 @@ def _unfield(a) -> np.ndarray | None:
 def result_arrays(prefix, result: StaticResult) -> dict:
     """The arrays of a :class:`StaticResult` under keys starting with ``prefix`` (U (N, 3) [m], the rest as JSON)."""
     return {prefix + "U": _field(result.U),
-            prefix + "result": _json({k: getattr(result, k) for k in _RESULT_FIELDS})}
+            prefix + "result": json_array({k: getattr(result, k) for k in _RESULT_FIELDS})}
 
 
 def result_from(prefix, z) -> StaticResult:
@@ -142,8 +136,8 @@ class StaticCheckpointer(ThrottledWriter):
     def _common(self, phase) -> dict:
         ws = self.workspace
         branches = list(ws.state.load_branches or ()) if ws is not None else []  # committed angle branches
-        return {"static_format": np.array(FORMAT), "static_header": _json(self.header), "phase": np.array(phase),
-                "workspace": _json({"factorisations": 0 if ws is None else ws.factorisations,
+        return {"static_format": np.array(FORMAT), "static_header": json_array(self.header), "phase": np.array(phase),
+                "workspace": json_array({"factorisations": 0 if ws is None else ws.factorisations,
                                     "lm_scale": None if ws is None else ws.lm_scale, "load_terms": branches})}
 
     def load_step(self, path: LoadPath) -> None:
@@ -152,7 +146,7 @@ class StaticCheckpointer(ThrottledWriter):
         counts = {k: getattr(r, k) for k in ("iterations", "cutbacks", "retries", "residual", "seed")}
         counts["tangent_modes"] = dict(self.workspace.modes) if self.workspace is not None else {}
         arrays = {**self._common("load-steps"), "U": _field(path.U), "U_prev": _field(path.U_prev),
-                  "path": _json({"lam": path.lam, "dlam": path.dlam, "target": path.target,
+                  "path": json_array({"lam": path.lam, "dlam": path.dlam, "target": path.target,
                                  "lam_prev": path.lam_prev, "load_steps": list(r.load_steps), **counts})}
         self._pending = (arrays, f"load factor {path.lam:.6g}, {len(r.load_steps)} increments")
         if path.lam >= 1.0 or self.due():
@@ -161,9 +155,9 @@ class StaticCheckpointer(ThrottledWriter):
     def _route_arrays(self, route: RelaxRoute) -> dict:
         first = route.first
         arrays = {**self._common(route.phase), "route_U": _field(route.U), "route_V": _field(route.V),
-                  "route": _json({k: getattr(route, k) for k in ("phase", "t_used", "peak", "tol_force", "span",
+                  "route": json_array({k: getattr(route, k) for k in ("phase", "t_used", "peak", "tol_force", "span",
                                                                   "at_rest", "seed", "info")}),
-                  "first": _json(None if first is None else str(first))}
+                  "first": json_array(None if first is None else str(first))}
         if first is not None and first.result is not None:
             arrays.update(result_arrays("first_", first.result))
         return arrays
@@ -294,7 +288,7 @@ def _check_header(path, head, model, options, scene) -> None:
         raise CheckpointError(f"checkpoint {path} was written for another model of the same size (element "
                               f"{head['element']} there, {model.element} here; or the mesh coordinates, supports, "
                               "loads, material or contact differ); run without --resume")
-    saved, now = head["options"], json.loads(json.dumps(options_spec(options), default=_plain))
+    saved, now = head["options"], json.loads(json.dumps(options_spec(options), default=plain))
     diff = [f"{k} {saved.get(k)!r} there, {now.get(k)!r} here" for k in sorted(set(saved) | set(now))
             if saved.get(k) != now.get(k)]
     if diff:
