@@ -21,8 +21,8 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
         from rftstatic.io.views import plot_views
 
         views = tuple(scene.get("output.views", ["side", "top", "iso"]))
-        status = "" if summary.get("converged", True) else " (NOT CONVERGED)"
-        title = f"{scene.get('title', scene.name)} - {model.element}, {model.mesh.n_nodes} nodes{status}"
+        status = "" if summary.get("converged", True) else "NOT CONVERGED; "
+        title = f"{scene.get('title', scene.name)}\n{status}{run_label(model)}"
         plot_views(str(out / "view"), model.positions(U) / u, model.mesh.tri, views=views, title=title,
                    color_by=cell["relative_curvature"], color_label="|kappa| h",
                    obstacles_draw=obstacle_drawers(extras.get("obstacles", ()), u))
@@ -30,6 +30,13 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
         if extras.get("disc") is not None and drape.get("drape_coefficient") is not None:
             _shadow(scene, model, extras["disc"], U, out, drape)
     write_json(out / "summary.json", summary)
+
+
+def run_label(model) -> str:
+    """What was run, for a figure's title: the fabric that was used (the material's name, "(modified)" when a
+    scene changed a preset's values), the element and the mesh size. A scene's title names the fabric it was
+    written for; after ``--set material...`` this line says which one the figure shows."""
+    return f"fabric {model.material.name}, {model.element}, {model.mesh.n_nodes} nodes"
 
 
 def _shadow(scene, model, disc, U, out: Path, drape: dict) -> None:
@@ -40,7 +47,7 @@ def _shadow(scene, model, disc, U, out: Path, drape: dict) -> None:
 
     u = scene.units.length
     r = np.hypot(*(model.mesh.X - disc.centre).T)
-    title = (f"{scene.get('title', scene.name)}: drape coefficient {drape['drape_coefficient_percent']:.1f}%, "
+    title = (f"{scene.get('title', scene.name)}\n{model.material.name}: DC {drape['drape_coefficient_percent']:.1f}%, "
              f"{drape['fold_count']} folds ({model.element}, {model.mesh.n_nodes} nodes)")
     plot_shadow(out / "shadow_top.png", model.positions(U) / u, model.mesh.tri, fill=disc.fill / u,
                 centre=disc.centre / u, specimen_radius=float(r.max()) / u,
