@@ -30,7 +30,6 @@ AUTO = "auto"
 """How a scene says None ("automatic") for a nullable option."""
 
 
-
 class _Required:
     """The default of a required option (:data:`REQUIRED`): the scene must give the key."""
 

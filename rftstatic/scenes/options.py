@@ -3,12 +3,13 @@
 Every key, default and range is declared once (:mod:`rftstatic.optionspec`): the static solver's in
 :mod:`rftstatic.solvers.options` (the app's ``[solver]`` keys in :mod:`rftstatic.scenes.run_options`), the
 explicit and relaxation runs' in :mod:`rftstatic.scenes.dynamics_options` (with the few defaults that depend on the
-analysis type), the remeshing drivers' in :class:`~rftstatic.remesh.options.RemeshOptions`. A bad value raises :class:`~rftstatic.errors.SceneError`
-naming the file, the key and the value.
+analysis type), the remeshing drivers' in :class:`~rftstatic.remesh.options.RemeshOptions`. A bad value
+raises :class:`~rftstatic.errors.SceneError` naming the file, the key and the value (:func:`scene_keys`).
 """
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import replace
 
 import numpy as np
@@ -22,33 +23,44 @@ from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions, RunOp
 from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
 
 
+@contextmanager
+def scene_keys(scene):
+    """A :class:`~rftstatic.errors.ParameterError` raised inside (a declaration's check names ``section.key``) as
+    the :class:`~rftstatic.errors.SceneError` of ``scene``: file, key, value."""
+    try:
+        yield
+    except ParameterError as exc:
+        raise scene.error(exc.key, exc.detail) from None
+
+
+def _declared(scene, section: str, cls):
+    """The scene's table ``section`` as its one declared options class ``cls``, in SI."""
+    with scene_keys(scene):
+        return cls(**from_table((cls,), dict(scene.get(section, {})), section, scene.units)[cls])
+
+
 def _solver_table(scene) -> dict:
     """The scene's ``[solver]`` table split over its declared groups, in SI
     (:func:`rftstatic.optionspec.from_table`)."""
-    try:
+    with scene_keys(scene):
         return from_table(SOLVER_GROUPS, dict(scene.get("solver", {})), "solver", scene.units)
-    except ParameterError as exc:
-        raise scene.error(exc.key, exc.detail) from None
 
 
 def static_options(scene, *, progress=True) -> StaticOptions:
     """The scene's ``[solver]`` table as :class:`StaticOptions` (lengths in SI [m]); the app's keys (mesh
     sequence, seeds, membrane switch) are :func:`run_options`'."""
     table = _solver_table(scene)
-    try:
+    with scene_keys(scene):
         return StaticOptions(newton=NewtonOptions(**table[NewtonOptions]),
                              increments=IncrementOptions(**table[IncrementOptions]),
                              route=RouteOptions(**table[RouteOptions]), progress=progress)
-    except ParameterError as exc:
-        raise scene.error(exc.key, exc.detail) from None
 
 
 def declared_run_options(scene) -> RunOptions:
     """The app's ``[solver]`` keys as the scene gives them (``levels`` None when ``"auto"``)."""
-    try:
-        return RunOptions(**_solver_table(scene)[RunOptions])
-    except ParameterError as exc:
-        raise scene.error(exc.key, exc.detail) from None
+    table = _solver_table(scene)
+    with scene_keys(scene):
+        return RunOptions(**table[RunOptions])
 
 
 def run_options(scene) -> RunOptions:
@@ -83,31 +95,21 @@ def dynamics_options(scene) -> DynamicsOptions:
     if not all(isinstance(f, (int, float)) and not isinstance(f, bool) and 0 <= f <= t_end for f in frames):
         raise scene.error("dynamics.frames", f"expected times in [0, t_end = {t_end}], got {frames!r}")
     t = scene.units.time
-    try:
+    with scene_keys(scene):
         return DynamicsOptions(**table, frames=np.array(sorted(set(float(f) * t for f in frames))))
-    except ParameterError as exc:
-        raise scene.error(exc.key, exc.detail) from None
 
 
 def remesh_options(scene) -> RemeshOptions:
     """The scene's ``[remesh]`` table checked against its declarations (:class:`~rftstatic.remesh.options.RemeshOptions`)
     and converted to SI (:func:`rftstatic.optionspec.from_table`)."""
-    try:
-        table = from_table((RemeshOptions,), dict(scene.get("remesh", {})), "remesh", scene.units)
-        return RemeshOptions(**table[RemeshOptions])
-    except ParameterError as exc:
-        raise scene.error(exc.key, exc.detail) from None
+    return _declared(scene, "remesh", RemeshOptions)
 
 
 def contact_options(scene) -> ContactOptions:
     """The scene's ``[contact]`` table checked against its declarations
     (:class:`~rftstatic.scenes.contact_options.ContactOptions`) and converted to SI
     (:func:`rftstatic.optionspec.from_table`)."""
-    try:
-        table = from_table((ContactOptions,), dict(scene.get("contact", {})), "contact", scene.units)
-        return ContactOptions(**table[ContactOptions])
-    except ParameterError as exc:
-        raise scene.error(exc.key, exc.detail) from None
+    return _declared(scene, "contact", ContactOptions)
 
 
 def seed_count(scene) -> int:
@@ -125,12 +127,9 @@ def seed_count(scene) -> int:
 def cantilever_options(scene) -> CantileverOptions:
     """The scene's ``[cantilever]`` table checked (:class:`~rftstatic.scenes.run_options.CantileverOptions`), the
     angle in radians."""
-    try:
-        table = from_table((CantileverOptions,), dict(scene.get("cantilever", {})), "cantilever", scene.units)
-        return CantileverOptions(**table[CantileverOptions])
-    except ParameterError as exc:
-        raise scene.error(exc.key, exc.detail) from None
+    return _declared(scene, "cantilever", CantileverOptions)
 
 
 __all__ = ["run_options", "declared_run_options", "seed_count", "cantilever_options", "CantileverOptions",
-           "static_options", "dynamics_options", "contact_options", "remesh_options", "DynamicsOptions", "DYNAMICS_DEFAULTS", "SceneError"]
+           "static_options", "dynamics_options", "contact_options", "remesh_options", "scene_keys", "DynamicsOptions",
+           "DYNAMICS_DEFAULTS", "SceneError"]
