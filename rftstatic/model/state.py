@@ -34,6 +34,17 @@ class State:
         the first (the principal branches)
     contact_history : per-contact history carried from step to step (e.g. friction anchors), keyed
         by the contact law's name; empty for frictionless contact
+    solver : the solve's one linear solver (:func:`~rftstatic.solvers.linear.make_solver`), a cache: its
+        symbolic analysis serves every Newton phase of the solve while the tangent's pattern holds; None
+        outside a Newton solve (:func:`~rftstatic.solvers.newton.start_state` makes it)
+    modes : counts of the Newton tangents used in the solve: exact, psd, shift, modified, reused, krylov
+        (steps by preconditioned CG, and their "CG iterations"), "self-contact limited", "mixed failed"
+    factorisations : numeric factorisations of a tangent in the solve (failed Cholesky attempts included;
+        the stability check not)
+    lm_scale : mean tangent diagonal [N/m], the scale of the Levenberg-Marquardt damping, computed once per
+        solve at the state where damping is first needed (None before)
+    modified_shift : the last diagonal shift [N/m] that made an indefinite exact tangent positive definite
+        (:func:`~rftstatic.solvers.iteration.direction`, mode ``"modified"``): the next try starts below it
     """
 
     U: np.ndarray
@@ -45,6 +56,11 @@ class State:
     self_pairs: object | None = None
     contact_history: dict = field(default_factory=dict)
     load_branches: tuple | None = None
+    solver: object | None = None
+    modes: dict = field(default_factory=lambda: {"exact": 0, "psd": 0, "shift": 0})
+    factorisations: int = 0
+    lm_scale: float | None = None
+    modified_shift: float = 0.0
 
     @classmethod
     def initial(cls, model, U=None, V=None, *, t: float = 0.0, step: int = 0, lam: float = 1.0) -> State:

@@ -43,7 +43,7 @@ MODES = 4
 """Most eigenpairs computed at a switch (the lowest one is followed; the others are recorded)."""
 
 
-def switch_branch(model, U, lam, K, fac, opts, ws, inertia, max_step, *, seed=0, away_from=None):
+def switch_branch(model, U, lam, K, fac, opts, state, inertia, max_step, *, seed=0, away_from=None):
     """Leave the unstable equilibrium ``(U (N, 3) [m], lam)`` along the lowest mode of ``K`` (free dofs,
     factorised as ``fac``, an :class:`~rftstatic.solvers.inertia.InertiaFactor`).
 
@@ -71,17 +71,17 @@ def switch_branch(model, U, lam, K, fac, opts, ws, inertia, max_step, *, seed=0,
     descent = replace(opts, max_iterations=max(opts.max_iterations, SWITCH_ITERATIONS), iteration="displacement")
     found = []
     for sign in (1.0, -1.0):
-        nt = newton(model, U + sign * eta * phi, lam, descent, ws, max_step, scheme="displacement")
+        nt = newton(model, U + sign * eta * phi, lam, descent, state, max_step, scheme="displacement")
         branch = {"sign": sign, "converged": bool(nt.converged), "iterations": int(nt.iterations)}
         if nt.converged:
-            _, K2 = model.tangent(nt.U, lam=lam, candidates=ws.candidates, pairs=ws.pairs)
+            _, K2 = model.tangent(nt.U, lam=lam, candidates=state.candidates, pairs=state.self_pairs)
             try:
                 fac2 = inertia.factor(K2)
             except LinearSolveError as exc:
                 branch["error"] = str(exc)
                 record["branches"].append(branch)
                 continue
-            energy = model.potential(nt.U, lam, candidates=ws.candidates, pairs=ws.pairs)
+            energy = model.potential(nt.U, lam, candidates=state.candidates, pairs=state.self_pairs)
             branch.update(negative=fac2.negative, energy=float(energy))
             found.append({"U": nt.U, "negative": fac2.negative, "energy": energy, "factor": fac2, "K": K2,
                           "sign": sign})

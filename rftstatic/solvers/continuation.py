@@ -49,7 +49,8 @@ from rftstatic.solvers.inertia import InertiaSolver
 from rftstatic.solvers.iteration import capped_step, roundoff_floor, self_contact_limited
 from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.loop import Direction, Iterate, StepFailure, newton_loop
-from rftstatic.solvers.newton import NewtonWorkspace, StaticResult, newton, route_outcome
+from rftstatic.model.state import State
+from rftstatic.solvers.newton import StaticResult, newton, route_outcome, start_state
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
 
@@ -131,10 +132,10 @@ class _Point:
 
 
 class _Path:
-    """What one arc-length solve shares: model, options, workspace, the inertia solver, the scale c."""
+    """What one arc-length solve shares: model, options, State, the inertia solver, the scale c."""
 
-    def __init__(self, model, opts, ws):
-        self.model, self.opts, self.ws = model, opts, ws
+    def __init__(self, model, opts, state):
+        self.model, self.opts, self.state = model, opts, state
         self.free = model.free.ravel()
         self.P = model.load.ravel()[self.free]
         self.Pnorm = float(np.linalg.norm(self.P))
@@ -145,7 +146,7 @@ class _Path:
         self.eps = float(getattr(model.contact, "smoothing", 0.0) or 0.0) if model.contact is not None else 0.0
 
     def point(self, U, lam) -> _Point:
-        _, K = self.model.tangent(U, lam=lam, candidates=self.ws.candidates, pairs=self.ws.pairs)
+        _, K = self.model.tangent(U, lam=lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
         return _Point(U, lam, K, self.inertia.factor(K))
 
     def tangent(self, pt: _Point, prev: _Point | None) -> None:
@@ -208,7 +209,7 @@ class _Path:
     def _converged(self, x: Iterate) -> bool:
         """The corrector's test: the residual at ``x`` within :meth:`tolerance`; evaluates and factorises the
         tangent there (the converged point keeps both: its inertia and the next predictor)."""
-        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.ws.candidates, pairs=self.ws.pairs)
+        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
         x.r = (f - x.lam * self.model.load).ravel()[self.free]
         x.rnorm = float(np.linalg.norm(x.r))
         if not np.isfinite(x.rnorm):
@@ -233,14 +234,14 @@ class _Path:
         """The corrector's step: capped (``max_step``), bounded by the self-contact collision test and the
         contact layer (:meth:`layer_limit`), the load factor scaled alike."""
         step, cap = capped_step(self.model, dn.d, self.max_step)
-        step, frac = self_contact_limited(self.model, x.U, step, self.ws)
+        step, frac = self_contact_limited(self.model, x.U, step, self.state)
         layer = self.layer_limit(x.U, step)
         step, frac = step * layer, frac * layer
         return Iterate(x.U + step, x.lam + cap * frac * dn.dlam), {"cap": cap * frac, "dlam": cap * frac * dn.dlam}
 
 
 def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, callback=None,
-                     workspace: NewtonWorkspace | None = None) -> StaticResult:
+                     state: State | None = None) -> StaticResult:
     """The load-scaled route by arc-length path following (module docstring).
 
     Raises :class:`~rftstatic.errors.ConvergenceError` naming the step, load factor and residual when a
@@ -258,9 +259,9 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
     if opts.route.perturbation and U0 is None:
         seed = opts.route.seed
         U[:, 2] += start_perturbation(model.mesh, opts.route) * model.free[:, 2]
-    ws = workspace if workspace is not None else NewtonWorkspace.for_model(model, opts.newton.linear_solver)
-    ws.modes = {"exact": 0, "psd": 0, "shift": 0}
-    path = _Path(model, opts, ws)
+    state = state if state is not None else start_state(model, opts.newton.linear_solver)
+    state.modes = {"exact": 0, "psd": 0, "shift": 0}
+    path = _Path(model, opts, state)
     result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=path.inertia.name, seed=seed,
                           route="arc-length")
     record = {"steps": [], "critical_points": [], "switches": [], "arc_length": 0.0}
@@ -270,7 +271,7 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
         res.factorisations += path.inertia.factorisations
         res.tangent_modes["ldl"] = path.inertia.ldl
 
-    with route_outcome(model, result, ws, t0, bar, extra=inertia_counters):
+    with route_outcome(model, result, state, t0, bar, extra=inertia_counters):
         pt = _start(path, U, result)
         record["start_negative"] = pt.fac.negative
         _accept(path, result, record, pt, result.iterations, 0.0, pt.lam, "start")
@@ -299,7 +300,7 @@ def _start(path, U, result) -> _Point:
     start, its = path.corrector(pt, 0.0, target=LAM_START, iterations=START_ITERATIONS)
     result.iterations += its
     if start is None:
-        r = model.residual(U, LAM_START, candidates=path.ws.candidates, pairs=path.ws.pairs).ravel()[path.free]
+        r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs).ravel()[path.free]
         raise ConvergenceError(f"arc-length start, load factor {LAM_START:g}: Newton did not converge in "
                                f"{START_ITERATIONS} iterations; |r| = {np.linalg.norm(r):.3e} N at the lifted start",
                                None)
@@ -364,7 +365,7 @@ def _follow(path, pt, result, record, bar, callback):
                     lam_max = max(lam_max, pt.lam)
                     continue
             if ds < MIN_ARC:
-                r = path.model.residual(pt.U, pt.lam, candidates=path.ws.candidates, pairs=path.ws.pairs)
+                r = path.model.residual(pt.U, pt.lam, candidates=path.state.candidates, pairs=path.state.self_pairs)
                 raise ConvergenceError(
                     f"arc-length step {len(record['steps']) + 1}, load factor {pt.lam:.6g}: the corrector did not "
                     f"converge even with arc length {ds:.3g}; |r| = {np.linalg.norm(r.ravel()[path.free]):.3e} N at "
@@ -426,7 +427,7 @@ def _switch(path, result, record, pt, lam, prev):
     from (``pt`` itself when no push converged), its tangent oriented with dlam > 0."""
     looser = replace(path.opts.newton, intermediate_rtol=PATH_RTOL)
     choice, rec = switch_branch(path.model, pt.U, lam, pt.K, pt.fac, looser,
-                                path.ws, path.inertia,
+                                path.state, path.inertia,
                                 path.max_step, seed=len(record["switches"]),
                                 away_from=None if prev is None else prev.U)
     rec["step"] = len(record["steps"])
@@ -450,12 +451,12 @@ def _descend(path, result, record, pt, dlam):
     lam = min(1.0, pt.lam + dlam)
     base = path.opts.newton
     opts = replace(base, max_iterations=max(base.max_iterations, 80), intermediate_rtol=PATH_RTOL)
-    nt = newton(path.model, pt.U, lam, opts, path.ws, path.max_step, scheme="displacement")
+    nt = newton(path.model, pt.U, lam, opts, path.state, path.max_step, scheme="displacement")
     result.iterations += nt.iterations
     for _ in range(DESCENT_CONTINUATIONS):  # a fold forming: still sliding downhill
         if nt.converged or not nt.descending:
             break
-        nt = newton(path.model, nt.U, lam, opts, path.ws, path.max_step, scheme="displacement")
+        nt = newton(path.model, nt.U, lam, opts, path.state, path.max_step, scheme="displacement")
         result.iterations += nt.iterations
     record["descents"] = record.get("descents", 0) + 1
     if not nt.converged:
@@ -472,12 +473,12 @@ def _descend(path, result, record, pt, dlam):
 def _finish(path, result, record, pt):
     """Newton at lam = 1 to the solver's tolerance from the path's last point; switch branches while the
     equilibrium is unstable (:data:`FINAL_SWITCHES`)."""
-    model, opts, ws = path.model, path.opts, path.ws
+    model, opts, state = path.model, path.opts, path.state
     U = pt.U
     for attempt in range(FINAL_SWITCHES + 1):
-        nt = newton(model, U, 1.0, opts.newton, ws, path.max_step)
+        nt = newton(model, U, 1.0, opts.newton, state, path.max_step)
         if not nt.converged:
-            nt = newton(model, U, 1.0, opts.newton, ws, path.max_step, scheme="displacement")
+            nt = newton(model, U, 1.0, opts.newton, state, path.max_step, scheme="displacement")
         result.iterations += nt.iterations
         if not nt.converged:
             raise ConvergenceError(f"arc-length final point, load factor 1, iteration {nt.iterations}: {nt.reason}, "

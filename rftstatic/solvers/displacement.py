@@ -32,9 +32,9 @@ class DisplacementDirection:
     """The displacement iteration's direction at an iterate (module docstring); ``stable`` tells whether
     the last fresh direct step's exact tangent was positive definite (None when the solver cannot tell)."""
 
-    def __init__(self, model, opts, ws, damping: Damping, first: Iterate):
-        self.model, self.opts, self.ws, self.damping = model, opts, ws, damping
-        self.krylov = uses_krylov(opts, len(first.r), ws.solver)
+    def __init__(self, model, opts, state, damping: Damping, first: Iterate):
+        self.model, self.opts, self.state, self.damping = model, opts, state, damping
+        self.krylov = uses_krylov(opts, len(first.r), state.solver)
         self.refresh = True  # krylov steps: the next step factorises the tangent anew
         self.first_rnorm = first.rnorm
         self.age = 0  # steps that reused the last factorisation
@@ -42,21 +42,21 @@ class DisplacementDirection:
         self.curvature = 0.0  # d.K.d of the last fresh step [J]
 
     def __call__(self, x: Iterate) -> Direction:
-        model, ws, solver, mu = self.model, self.ws, self.ws.solver, self.damping.mu
+        model, state, solver, mu = self.model, self.state, self.state.solver, self.damping.mu
         r = x.r
         if self.krylov and not self.refresh:
-            d, dKd, self.refresh = krylov_direction(model, x.U, x.lam, r, ws, mu, forcing(x.rnorm, self.first_rnorm))
+            d, dKd, self.refresh = krylov_direction(model, x.U, x.lam, r, state, mu, forcing(x.rnorm, self.first_rnorm))
             if d is not None:
                 self.curvature = dKd
                 return Direction(d, "krylov", fresh=True, curvature=dKd)
         elif x.reusable and self.age < self.opts.reuse_factorisation and not self.krylov:
             d = self._reused(r)
             if d is not None:
-                ws.modes["reused"] = ws.modes.get("reused", 0) + 1
+                state.modes["reused"] = state.modes.get("reused", 0) + 1
                 self.age += 1
                 return Direction(d, "reused", fresh=False, curvature=self.curvature)
         try:
-            d, mode, shift = direction(model, x.U, x.lam, r, self.opts, ws, damping=mu)
+            d, mode, shift = direction(model, x.U, x.lam, r, self.opts, state, damping=mu)
         except LinearSolveError as exc:
             raise StepFailure(f"linear solve failed ({exc})") from None
         self.stable = (mode == "exact" and mu == 0.0) if solver.detects_indefinite else None
@@ -69,7 +69,7 @@ class DisplacementDirection:
     def _reused(self, r):
         """The step with the last factorisation, if it is a finite descent direction (else None)."""
         try:
-            d = self.ws.solver.resolve(-r)
+            d = self.state.solver.resolve(-r)
         except LinearSolveError:
             return None
         return d if (np.all(np.isfinite(d)) and float(r @ d) < 0.0) else None
@@ -80,20 +80,20 @@ class LineSearch:
     Armijo backtracking on Pi, trust-region update of the damping. ``energies`` holds Pi after every step
     (:meth:`progress`); the first step sets the energy scale of the convergence test."""
 
-    def __init__(self, model, opts, ws, damping: Damping, test: Criteria, max_step: float, start: Iterate):
-        self.model, self.opts, self.ws, self.damping, self.test = model, opts, ws, damping, test
+    def __init__(self, model, opts, state, damping: Damping, test: Criteria, max_step: float, start: Iterate):
+        self.model, self.opts, self.state, self.damping, self.test = model, opts, state, damping, test
         self.max_step = max_step
         self.free = model.free.ravel()
         self.energies = [start.energy]
         self.work0 = None
 
     def __call__(self, x: Iterate, dn: Direction):
-        model, ws, free, mu = self.model, self.ws, self.free, self.damping.mu
+        model, state, free, mu = self.model, self.state, self.free, self.damping.mu
         step, cap = capped_step(model, dn.d, self.max_step)
-        step, frac = self_contact_limited(model, x.U, step, ws)
+        step, frac = self_contact_limited(model, x.U, step, state)
         cap *= frac
         slope = float(x.r @ step.ravel()[free])
-        alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, ws, x.energy_scale)
+        alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, state, x.energy_scale)
         if alpha is None:
             raise StepFailure("line search found no decrease of the energy")
         U = x.U + alpha * step
@@ -102,7 +102,7 @@ class LineSearch:
         record = {"alpha": alpha, "cap": cap, "mu": mu, "fresh": dn.fresh, "mode": dn.mode}
         if dn.fresh:
             self._trust_region(x.energy, Pi, alpha, slope, cap, dn.curvature)
-        r = model.residual(U, x.lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[free]
+        r = model.residual(U, x.lam, candidates=state.candidates, pairs=state.self_pairs).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r))
         if self.work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
@@ -146,22 +146,22 @@ class LineSearch:
         return drop / max(self.work0 or 0.0, abs(x.lam * float(np.einsum("ni,ni->", self.test.P, x.U))), 1e-300)
 
 
-def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
+def displacement_iterations(model, U, lam, opts, state, max_step) -> Iteration:
     """Newton on the displacements alone from ``U`` at load factor ``lam`` (module docstring), with the
-    :class:`~rftstatic.solvers.options.NewtonOptions` ``opts`` and the solve's workspace ``ws``."""
+    :class:`~rftstatic.solvers.options.NewtonOptions` ``opts`` and the solve's State ``state``."""
     test = Criteria(model, lam, opts, U)
     # the final increment converges to the tight tolerance and may need longer
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
     U = U.copy()
-    parts = model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs, branches=ws.state.load_branches)
-    r = model.residual(U, lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[model.free.ravel()]
+    parts = model.energies(U, lam, candidates=state.candidates, pairs=state.self_pairs, branches=state.load_branches)
+    r = model.residual(U, lam, candidates=state.candidates, pairs=state.self_pairs).ravel()[model.free.ravel()]
     x = Iterate(U, lam, r, float(np.linalg.norm(r)), energy=parts["total"], energy_scale=energy_scale(parts))
     if not np.isfinite(x.rnorm):
         return Iteration(False, U, 0, x.rnorm, "non-finite residual")
     damping = Damping()
-    find = DisplacementDirection(model, opts, ws, damping, x)
-    search = LineSearch(model, opts, ws, damping, test, max_step, x)
-    out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, ws.solver), direction=find,
+    find = DisplacementDirection(model, opts, state, damping, x)
+    search = LineSearch(model, opts, state, damping, test, max_step, x)
+    out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, state.solver), direction=find,
                       globalise=search, max_iterations=max_iterations)
     x = out.x
     if out.converged:
@@ -171,20 +171,20 @@ def displacement_iterations(model, U, lam, opts, ws, max_step) -> Iteration:
                      else 0.0, history=out.history)
 
 
-def line_search(model, U, step, lam, Pi0, slope, opts, ws, scale=None, max_trials=12):
+def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_trials=12):
     """Armijo backtracking on Pi along ``step (N, 3)`` [m] from ``U`` with energy ``Pi0`` [J] and slope
     ``r . step`` [J]: ``(alpha, parts)``, ``parts`` the energies (:meth:`~rftstatic.model.model.Model.energies`)
     at ``U + alpha step``; ``(None, None)`` when no trial lowers the energy. ``scale`` [J]: :func:`energy_scale`
     of the energies at ``U`` (computed when None)."""
     def parts_at(alpha):
-        return model.energies(U + alpha * step, lam, candidates=ws.candidates, pairs=ws.pairs,
-                              branches=ws.state.load_branches)
+        return model.energies(U + alpha * step, lam, candidates=state.candidates, pairs=state.self_pairs,
+                              branches=state.load_branches)
 
     if not opts.line_search:
         return 1.0, parts_at(1.0)
     if scale is None:
-        scale = energy_scale(model.energies(U, lam, candidates=ws.candidates, pairs=ws.pairs,
-                                            branches=ws.state.load_branches))
+        scale = energy_scale(model.energies(U, lam, candidates=state.candidates, pairs=state.self_pairs,
+                                            branches=state.load_branches))
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence

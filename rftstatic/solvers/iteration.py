@@ -121,7 +121,7 @@ MODIFIED_TRIES = 4
 """Most factorisations of the modified exact tangent per iteration before the projected one is used."""
 
 
-def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
+def direction(model, U, lam, r, opts, state, damping=0.0, stress=None):
     """Newton direction on the free dofs, with the indefinite-tangent safeguard: ``(d, mode, shift)``.
 
     ``damping`` adds ``damping * mean(diag K)`` to the diagonal (Levenberg-Marquardt); ``shift`` [N/m]
@@ -134,34 +134,34 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
     again); the projected tangent (compressive membrane stress dropped); and that one shifted. Each
     tangent is assembled once per call, its shifts added to the diagonal.
     """
-    solver, modes = ws.solver, ws.modes
+    solver, modes = state.solver, state.modes
     sequence = {"auto": ["exact", "modified", "psd", "shift"], "exact": ["exact", "shift"],
                 "psd": ["psd", "shift"]}[opts.tangent]
     matrices = {}
 
     def tangent(psd, shift):
         if psd not in matrices:
-            matrices[psd] = model.tangent(U, psd=psd, lam=lam, candidates=ws.candidates, stress=stress,
-                                          pairs=ws.pairs)[1]
+            matrices[psd] = model.tangent(U, psd=psd, lam=lam, candidates=state.candidates, stress=stress,
+                                          pairs=state.self_pairs)[1]
         K = matrices[psd]
         if shift:
             K = K.copy()
             K.setdiag(K.diagonal() + shift)
         return K
 
-    base = damping * diagonal_scale(model, U, ws) if damping else 0.0
+    base = damping * diagonal_scale(model, U, state) if damping else 0.0
     if "modified" in sequence:
-        least = MODIFIED_SHIFTS[0] * diagonal_scale(model, U, ws)
-        if ws.modified_shift / MODIFIED_GROWTH < least:
-            ws.modified_shift = 0.0
+        least = MODIFIED_SHIFTS[0] * diagonal_scale(model, U, state)
+        if state.modified_shift / MODIFIED_GROWTH < least:
+            state.modified_shift = 0.0
         elif base == 0.0:
             sequence = sequence[1:]  # the exact tangent was indefinite at the last iterate
     last_error = "no tangent tried"  # a message, not the exception: its traceback holds this frame, and
     for mode in sequence:              # the cycle would keep the tangents until the cyclic collector ran
         shifts = [base]
         if mode == "modified":
-            scale = diagonal_scale(model, U, ws)
-            first = max(ws.modified_shift / MODIFIED_GROWTH, MODIFIED_SHIFTS[0] * scale, base)
+            scale = diagonal_scale(model, U, state)
+            first = max(state.modified_shift / MODIFIED_GROWTH, MODIFIED_SHIFTS[0] * scale, base)
             shifts = [t for t in (first * MODIFIED_GROWTH ** k for k in range(MODIFIED_TRIES))
                       if t <= MODIFIED_SHIFTS[1] * scale]
         if mode == "shift":
@@ -169,7 +169,7 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
             shifts = [scale * s for s in (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)]
         for shift in shifts:
             K = tangent(mode not in ("exact", "modified"), shift)
-            ws.factorisations += 1
+            state.factorisations += 1
             try:
                 d = solver.solve(K, -r)
             except NotPositiveDefinite as exc:
@@ -180,7 +180,7 @@ def direction(model, U, lam, r, opts, ws, damping=0.0, stress=None):
                 continue
             if float(r @ d) < 0.0 or not np.any(r):
                 modes[mode] = modes.get(mode, 0) + 1
-                ws.modified_shift = shift if mode == "modified" else 0.0
+                state.modified_shift = shift if mode == "modified" else 0.0
                 return d, mode, shift
             last_error = "the step is not a descent direction of the energy"
     raise LinearSolveError(last_error)
@@ -202,14 +202,14 @@ def roundoff_floor(model, U) -> float:
     strain = scatter_forces(mem.nodes, np.repeat(size[:, :, None], 3, axis=2), n).ravel()[free]
     return eps * max(100.0 * float(np.linalg.norm(cancelling)), float(np.linalg.norm(strain)))
 
-def diagonal_scale(model, U, ws) -> float:
+def diagonal_scale(model, U, state) -> float:
     """Mean diagonal of the tangent [N/m], computed once per solve (the scale of the LM damping)."""
-    if ws.lm_scale is None:
-        _, K0 = model.tangent(U, psd=True, candidates=ws.candidates, pairs=ws.pairs)
-        ws.lm_scale = float(np.abs(K0.diagonal()).mean())
-    return ws.lm_scale
+    if state.lm_scale is None:
+        _, K0 = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs)
+        state.lm_scale = float(np.abs(K0.diagonal()).mean())
+    return state.lm_scale
 
-def self_contact_limited(model, U, step, ws):
+def self_contact_limited(model, U, step, state):
     """``step (N, 3)`` [m] scaled by the self-contact step bound (no pair of the sheet comes closer than
     a fraction of its distance on the way, so none passes through another,
     :meth:`~rftstatic.contact.self_contact.law.SelfContact.max_step_fraction`), and that factor (1
@@ -217,9 +217,9 @@ def self_contact_limited(model, U, step, ws):
     sc = getattr(model, "self_contact", None)
     if sc is None:
         return step, 1.0
-    alpha = sc.max_step_fraction(model.positions(U), step, cache=ws.pairs)
+    alpha = sc.max_step_fraction(model.positions(U), step, cache=state.self_pairs)
     if alpha < 1.0:
-        ws.modes["self-contact limited"] = ws.modes.get("self-contact limited", 0) + 1
+        state.modes["self-contact limited"] = state.modes.get("self-contact limited", 0) + 1
         step = alpha * step
     return step, alpha
 

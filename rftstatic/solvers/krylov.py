@@ -123,21 +123,21 @@ def uses_krylov(opts, unknowns: int, solver) -> bool:
     return opts.step_solver == "krylov" or unknowns >= KRYLOV_FROM
 
 
-def krylov_direction(model, U, lam, r, ws, mu, rtol):
+def krylov_direction(model, U, lam, r, state, mu, rtol):
     """A Newton step by CG on the exact tangent, preconditioned with the solver's last factorisation
     (:func:`truncated_cg`): ``(d, d.K.d, refresh)``, ``d`` None when no descent
-    step came out (then the caller factorises); ``refresh``: factorise at the next step. ``ws``: the
-    :class:`~rftstatic.solvers.newton.NewtonWorkspace` (its solver holds the factorisation; the steps and CG
+    step came out (then the caller factorises); ``refresh``: factorise at the next step. ``state``: the
+    :class:`~rftstatic.model.state.State` (its solver holds the factorisation; the steps and CG
     iterations are counted in its modes); ``mu``: the Levenberg-Marquardt damping relative to the mean
     tangent diagonal; ``rtol``: the forcing term (:func:`forcing`)."""
     try:
-        K = model.tangent(U, lam=lam, candidates=ws.candidates, pairs=ws.pairs)[1]
-        shift = mu * diagonal_scale(model, U, ws) if mu else 0.0
-        step = truncated_cg(K, r, ws.solver.resolve, shift=shift, rtol=rtol)
+        K = model.tangent(U, lam=lam, candidates=state.candidates, pairs=state.self_pairs)[1]
+        shift = mu * diagonal_scale(model, U, state) if mu else 0.0
+        step = truncated_cg(K, r, state.solver.resolve, shift=shift, rtol=rtol)
     except LinearSolveError:
         return None, 0.0, True
-    ws.modes["CG iterations"] = ws.modes.get("CG iterations", 0) + step.iterations
+    state.modes["CG iterations"] = state.modes.get("CG iterations", 0) + step.iterations
     if not (np.all(np.isfinite(step.d)) and float(r @ step.d) < 0.0):
         return None, 0.0, True
-    ws.modes["krylov"] = ws.modes.get("krylov", 0) + 1
+    state.modes["krylov"] = state.modes.get("krylov", 0) + 1
     return step.d, step.curvature, step.stale

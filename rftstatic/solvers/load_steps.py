@@ -24,7 +24,8 @@ import numpy as np
 from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
-from rftstatic.solvers.newton import NewtonWorkspace, StaticResult, newton, route_outcome
+from rftstatic.model.state import State
+from rftstatic.solvers.newton import StaticResult, newton, route_outcome, start_state
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
 
@@ -57,11 +58,11 @@ class LoadPath:
 
 
 def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None,
-                     workspace: NewtonWorkspace | None = None, checkpoint=None,
+                     state: State | None = None, checkpoint=None,
                      resume: LoadPath | None = None, iteration_fallback: bool = True) -> StaticResult:
     """The load-scaled Newton iteration of :func:`solve_static` (module docstring).
 
-    ``workspace``: shared with the other phases of one solve (:class:`NewtonWorkspace`; default a new one).
+    ``state``: the solve's :class:`~rftstatic.model.state.State`, shared with its other phases (default :func:`~rftstatic.solvers.newton.start_state`).
     ``checkpoint``: called as ``checkpoint(path)`` with the :class:`LoadPath` after every converged increment
     (after ``callback``). ``resume``: such a path, from which the solve continues as the uninterrupted one
     did (``U0`` is then unused). ``iteration_fallback``: an increment the mixed iteration cannot converge
@@ -83,9 +84,9 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         what = "the load (nodal forces)" if not np.isfinite(model.load).all() else "the start displacements"
         raise ConvergenceError(f"load factor 0: {what} are not finite (NaN or inf); check the scene's loads, "
                                "weight and mesh coordinates", None)
-    ws = workspace if workspace is not None else NewtonWorkspace.for_model(model, opts.newton.linear_solver)
-    ws.modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
-    solver = ws.solver
+    state = state if state is not None else start_state(model, opts.newton.linear_solver)
+    state.modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
+    solver = state.solver
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
     max_step = opts.newton.max_step if opts.newton.max_step is not None else 0.1 * diagonal
     inc = opts.increments
@@ -94,16 +95,16 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
     lam = 0.0
     mixed = opts.newton.iteration == "mixed" and model.with_membrane
     if resume is None:
-        dlam = _first_increment(model, U, opts, ws, target)
+        dlam = _first_increment(model, U, opts, state, target)
         U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
     else:
         lam, dlam, target, U_prev, lam_prev = resume.lam, resume.dlam, resume.target, resume.U_prev, resume.lam_prev
-        _continue_result(model, result, resume, ws)
+        _continue_result(model, result, resume, state)
     continuing = None  # Newton state of an increment that is still snapping through
     continuations = 0
     failures = 0  # mixed iterations failed in a row at this load level
     bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
-    with route_outcome(model, result, ws, t0, bar):
+    with route_outcome(model, result, state, t0, bar):
         while lam < 1.0:
             if len(result.load_steps) >= opts.increments.max_load_steps:
                 raise ConvergenceError(
@@ -121,7 +122,7 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
             # the mixed iteration starts from the last equilibrium itself: its first step there is the
             # tangent predictor (a secant start stretches a stiff membrane: the 21 x 5 RFT6 strip at
             # C/B = 1e9 /cm^2 took 177 iterations from it, 38 from the equilibrium)
-            nt = newton(model, start, lam_next, opts.newton, ws, max_step, scheme="displacement" if fallback else None)
+            nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement" if fallback else None)
             continuing = None
             result.iterations += nt.iterations
             # the whole load from a given state (a relaxed or transferred drape) retries with the
@@ -132,13 +133,13 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                 result.retries += 1
                 log.info("load factor %.6g: %s (|r| = %.3e); retrying with displacement iterations",
                          lam_next, nt.reason, nt.residual)
-                nt = newton(model, start, lam_next, opts.newton, ws, max_step, scheme="displacement")
+                nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement")
                 result.iterations += nt.iterations
             if nt.converged:
                 continuations = 0
                 U_prev, lam_prev = U, lam
                 lam, U = lam_next, nt.U
-                ws.state.load_branches = model.load_branches(U, ws.state.load_branches)  # angle-type potentials
+                state.load_branches = model.load_branches(U, state.load_branches)  # angle-type potentials
                 result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
                                           "increment": dlam, "scheme": nt.scheme})
                 result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
@@ -194,14 +195,14 @@ of an unconverged Newton call at full load from a given state at which the call 
 well above the energy's round-off (1e-16 of its terms, each about the load's work)."""
 
 
-def _continue_result(model, result, path: LoadPath, ws) -> None:
+def _continue_result(model, result, path: LoadPath, state) -> None:
     """``result`` carries on from ``path.result`` (records, counts) at the equilibrium ``path.U``; the branches
-    of the potential loads in ``ws.state`` (as restored from the checkpoint) are committed there."""
+    of the potential loads in ``state.state`` (as restored from the checkpoint) are committed there."""
     old = path.result
     result.load_steps = list(old.load_steps)
     result.iterations, result.cutbacks, result.retries = old.iterations, old.cutbacks, old.retries
     result.U, result.lam, result.residual = path.U, path.lam, old.residual
-    ws.state.load_branches = model.load_branches(path.U, ws.state.load_branches)
+    state.load_branches = model.load_branches(path.U, state.load_branches)
 
 
 TARGET_SHARE = 0.1
@@ -229,17 +230,17 @@ def _target_factor(iterations: int) -> float:
     return 0.5 if iterations >= 8 else 1.0
 
 
-def _first_increment(model, U, opts, ws, target) -> float:
+def _first_increment(model, U, opts, state, target) -> float:
     """First load increment: the tangent displacement rate d|U|/d lam at the start, scaled to ``target``."""
     free = model.free.ravel()
     P = model.load.ravel()[free]
     if not np.any(P) or model.load_terms:
         return opts.increments.initial_increment
     try:
-        _, K = model.tangent(U, psd=True, candidates=ws.candidates, pairs=ws.pairs)
+        _, K = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs)
         du = np.zeros(3 * model.mesh.n_nodes)
-        ws.factorisations += 1
-        du[free] = ws.solver.solve(K, P)
+        state.factorisations += 1
+        du[free] = state.solver.solve(K, P)
     except (NotPositiveDefinite, LinearSolveError):
         return opts.increments.initial_increment
     rate = float(np.linalg.norm(du.reshape(-1, 3), axis=1).max())

@@ -15,7 +15,7 @@ not converged by 12 wanders (RFT6 at C/B = 1e8 from a secant start went on for 3
 a smaller increment is the better remedy."""
 
 
-def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
+def mixed_iterations(model, U, lam, opts, state, max_step, stress) -> Iteration:
     """MIP Newton (Magisano, Leonetti & Garcea, CMAME 313, 2017): Newton on the Hellinger-Reissner form
     of Eq. 15 with the membrane stress of every element an unknown of its own, condensed element by
     element. The step solves ``K(U, S) d = -r(U)`` with the ordinary residual r and the ordinary tangent
@@ -38,19 +38,19 @@ def mixed_iterations(model, U, lam, opts, ws, max_step, stress) -> Iteration:
     max_iterations = 2 * budget if lam >= 1.0 else budget
     U = U.copy()
     S = model.membrane_stress(U) if stress is None else np.array(stress, float)
-    r = model.residual(U, lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[model.free.ravel()]
+    r = model.residual(U, lam, candidates=state.candidates, pairs=state.self_pairs).ravel()[model.free.ravel()]
     x = Iterate(U, lam, r, float(np.linalg.norm(r)), stress=S)
     if not np.isfinite(x.rnorm):
         return Iteration(False, U, 0, x.rnorm, "non-finite residual", scheme="mixed")
-    find = MixedDirection(model, opts, ws)
-    out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, ws.solver), direction=find,
-                      globalise=CappedStep(model, ws, test, max_step), max_iterations=max_iterations)
+    find = MixedDirection(model, opts, state)
+    out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, state.solver), direction=find,
+                      globalise=CappedStep(model, state, test, max_step), max_iterations=max_iterations)
     x = out.x
     if out.converged:
         return Iteration(True, x.U, out.iterations, x.rnorm, stable=find.stable, history=out.history, stress=x.stress,
                          scheme="mixed")
     if out.reason is None:
-        ws.modes["mixed failed"] = ws.modes.get("mixed failed", 0) + 1
+        state.modes["mixed failed"] = state.modes.get("mixed failed", 0) + 1
     reason = out.reason or f"no convergence in {max_iterations} mixed iterations"
     return Iteration(False, x.U, out.iterations, x.rnorm, reason, history=out.history, stress=x.stress, scheme="mixed")
 
@@ -60,16 +60,16 @@ class MixedDirection:
     (:func:`~rftstatic.solvers.iteration.direction` with ``stress``); ``stable``: the last tangent was the
     exact one and positive definite (None when the solver cannot tell)."""
 
-    def __init__(self, model, opts, ws):
-        self.model, self.opts, self.ws = model, opts, ws
+    def __init__(self, model, opts, state):
+        self.model, self.opts, self.state = model, opts, state
         self.stable = None
 
     def __call__(self, x: Iterate) -> Direction:
         try:
-            d, mode, _ = direction(self.model, x.U, x.lam, x.r, self.opts, self.ws, stress=x.stress)
+            d, mode, _ = direction(self.model, x.U, x.lam, x.r, self.opts, self.state, stress=x.stress)
         except LinearSolveError as exc:
             raise StepFailure(f"linear solve failed ({exc})") from None
-        self.stable = mode == "exact" if self.ws.solver.detects_indefinite else None
+        self.stable = mode == "exact" if self.state.solver.detects_indefinite else None
         return Direction(d, mode)
 
 
@@ -78,22 +78,22 @@ class CappedStep:
     collision test; the carried stress updated to that of the linearised strain; the first step sets the
     energy scale of the convergence test (the work of the load on it)."""
 
-    def __init__(self, model, ws, test: Criteria, max_step: float):
-        self.model, self.ws, self.test, self.max_step = model, ws, test, max_step
+    def __init__(self, model, state, test: Criteria, max_step: float):
+        self.model, self.state, self.test, self.max_step = model, state, test, max_step
         self.free = model.free.ravel()
         self.first = True
 
     def __call__(self, x: Iterate, dn: Direction):
-        model, ws = self.model, self.ws
+        model, state = self.model, self.state
         step, cap = capped_step(model, dn.d, self.max_step)
-        step, frac = self_contact_limited(model, x.U, step, ws)
+        step, frac = self_contact_limited(model, x.U, step, state)
         cap *= frac
         if self.first:
             self.test.load_work(x.U, step)
             self.first = False
         S = model.mixed_stress(x.U, step)
         U = x.U + step
-        r = model.residual(U, x.lam, candidates=ws.candidates, pairs=ws.pairs).ravel()[self.free]
+        r = model.residual(U, x.lam, candidates=state.candidates, pairs=state.self_pairs).ravel()[self.free]
         new = Iterate(U, x.lam, r, float(np.linalg.norm(r)), work=abs(float(step.ravel()[self.free] @ r)), stress=S)
         if not np.isfinite(new.rnorm):
             raise StepFailure("non-finite residual", new)

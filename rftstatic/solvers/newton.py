@@ -100,50 +100,16 @@ class StaticResult:
     self_contact_stiffenings: int = 0
     self_contact_scale: float = 1.0
 
-@dataclass
-class NewtonWorkspace:
-    """What the Newton phases of one static solve share and update (never the Model).
-
-    Attributes
-    ----------
-    state : the solve's :class:`~rftstatic.model.state.State` (its contact candidate list is used by
-        every energy, residual and tangent evaluation)
-    solver : the solve's one linear solver (:func:`~rftstatic.solvers.linear.make_solver`, made with the
-        workspace): its symbolic analysis serves every phase while the tangent's pattern holds
-    modes : counts of the tangents used: exact, psd, shift, reused, krylov (steps by preconditioned CG, and
-        their "CG iterations")
-    factorisations : numeric factorisations of a tangent (failed Cholesky attempts included)
-    lm_scale : mean tangent diagonal [N/m], the scale of the Levenberg-Marquardt damping, computed once
-        per solve at the state where damping is first needed
-    modified_shift : the last diagonal shift [N/m] that made the indefinite exact tangent positive definite
-        (:func:`~rftstatic.solvers.iteration.direction`, mode ``"modified"``): the next try starts below it
-    """
-
-    state: State
-    solver: object = None
-    modes: dict = field(default_factory=lambda: {"exact": 0, "psd": 0, "shift": 0})
-    lm_scale: float | None = None
-    factorisations: int = 0
-    modified_shift: float = 0.0
-
-    @classmethod
-    def for_model(cls, model, linear_solver: str = "auto") -> NewtonWorkspace:
-        """A fresh workspace: the flat state at load factor 0 and the solve's linear solver (``linear_solver``,
-        :class:`~rftstatic.solvers.options.NewtonOptions`)."""
-        solver = make_solver(linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
-        return cls(State.initial(model, lam=0.0), solver=solver)
-
-    @property
-    def candidates(self):
-        return self.state.candidates
-
-    @property
-    def pairs(self):
-        """The solve's self-contact pair cache (None without self-contact)."""
-        return self.state.self_pairs
+def start_state(model, linear_solver: str = "auto") -> State:
+    """The State a static solve starts from: the flat sheet at load factor 0, fresh contact caches and the
+    solve's one linear solver (``linear_solver``, :class:`~rftstatic.solvers.options.NewtonOptions`), which
+    every phase of the solve shares (its symbolic analysis too, while the tangent's pattern holds)."""
+    state = State.initial(model, lam=0.0)
+    state.solver = make_solver(linear_solver, coordinates=model.X3, free_dofs=model.plan.free_dofs)
+    return state
 
 
-def newton(model, U, lam, opts, ws, max_step, *, stress=None, scheme=None) -> Iteration:
+def newton(model, U, lam, opts, state, max_step, *, stress=None, scheme=None) -> Iteration:
     """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified), with the options ``opts``
     (:class:`~rftstatic.solvers.options.NewtonOptions`).
 
@@ -153,15 +119,15 @@ def newton(model, U, lam, opts, ws, max_step, *, stress=None, scheme=None) -> It
     """
     scheme = scheme or opts.iteration
     if scheme == "mixed" and model.with_membrane:
-        return mixed_iterations(model, U, lam, opts, ws, max_step, stress)
-    return displacement_iterations(model, U, lam, opts, ws, max_step)
+        return mixed_iterations(model, U, lam, opts, state, max_step, stress)
+    return displacement_iterations(model, U, lam, opts, state, max_step)
 
 @contextmanager
-def route_outcome(model, result: StaticResult, ws: NewtonWorkspace, t0: float, bar, *, extra=None):
+def route_outcome(model, result: StaticResult, state: State, t0: float, bar, *, extra=None):
     """The ending every static route shares, around its body: ``converged`` and ``message`` on success; a
     :class:`~rftstatic.errors.ConvergenceError` labelled with its message and carrying the last
     equilibrium (``exc.result``); in any case the bar closed, tangent modes, factorisations, wall time
-    [s] (from ``t0``), energies and the workspace's State of the final ``result``. ``extra(result)``
+    [s] (from ``t0``), energies and the State of the final ``result``. ``extra(result)``
     adds a route's own counters before the energies."""
     try:
         yield
@@ -173,12 +139,12 @@ def route_outcome(model, result: StaticResult, ws: NewtonWorkspace, t0: float, b
         raise
     finally:
         bar.close()
-        result.tangent_modes = dict(ws.modes)
-        result.factorisations = ws.factorisations
+        result.tangent_modes = dict(state.modes)
+        result.factorisations = state.factorisations
         if extra is not None:
             extra(result)
         result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam, candidates=ws.candidates, pairs=ws.pairs,
-                                         branches=ws.state.load_branches)
-        ws.state.U, ws.state.lam = result.U, result.lam
-        result.state = ws.state
+        result.energies = model.energies(result.U, result.lam, candidates=state.candidates, pairs=state.self_pairs,
+                                         branches=state.load_branches)
+        state.U, state.lam = result.U, result.lam
+        result.state = state

@@ -19,7 +19,7 @@ from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
 from rftstatic.solvers.continuation import solve_arc_length
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 from rftstatic.solvers.load_steps import solve_load_steps
-from rftstatic.solvers.newton import NewtonWorkspace, StaticResult
+from rftstatic.solvers.newton import StaticResult, start_state
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RelaxOptions, relax
@@ -60,32 +60,32 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         fails too); ``.result`` holds the last equilibrium (``converged=False``).
     """
     opts = options or StaticOptions()
-    ws = NewtonWorkspace.for_model(model, opts.newton.linear_solver)  # shared by the phases of this solve
+    state = start_state(model, opts.newton.linear_solver)  # shared by the phases of this solve
     if checkpoint is not None:
-        checkpoint.workspace = ws
+        checkpoint.state = state
     if restart is not None:
-        restart.restore(model, ws)
+        restart.restore(model, state)
         if restart.phase == "done":
-            return _check_stability(model, restart.result, ws)
+            return _check_stability(model, restart.result, state)
         if restart.route is not None:
-            return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint,
-                                                     route=restart.route, segment=restart.segment), opts, ws)
+            return _finish(model, _relax_then_newton(model, opts, callback, state, checkpoint=checkpoint,
+                                                     route=restart.route, segment=restart.segment), opts, state)
     elif opts.route.start == "relax":
-        return _finish(model, _relax_then_newton(model, opts, callback, ws, checkpoint=checkpoint), opts, ws)
+        return _finish(model, _relax_then_newton(model, opts, callback, state, checkpoint=checkpoint), opts, state)
     try:
         if opts.increments.continuation == "arc-length" and restart is None:
-            return _finish(model, solve_arc_length(model, U0=U0, options=opts, callback=callback, workspace=ws),
-                           opts, ws)
+            return _finish(model, solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state),
+                           opts, state)
         return _finish(model, solve_load_steps(
-            model, U0=U0, options=opts, callback=callback, workspace=ws,
+            model, U0=U0, options=opts, callback=callback, state=state,
             checkpoint=None if checkpoint is None else checkpoint.load_step,
-            resume=None if restart is None else restart.load_path), opts, ws)
+            resume=None if restart is None else restart.load_path), opts, state)
     except ConvergenceError as exc:
         if not opts.route.relax_fallback or model.load_terms or not np.any(model.load):
             raise
         log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
-        return _finish(model, _relax_then_newton(model, opts, callback, ws, first=exc, checkpoint=checkpoint),
-                       opts, ws)
+        return _finish(model, _relax_then_newton(model, opts, callback, state, first=exc, checkpoint=checkpoint),
+                       opts, state)
 
 
 SELF_CONTACT_STIFFENINGS = 3
@@ -101,12 +101,12 @@ SELF_CONTACT_STIFFENING = 8.0
 so a gap of 0.05 d under the automatic stiffness opens to about d/2 after two raises."""
 
 
-def _stiffen_self_contact(model, result, opts, ws):
+def _stiffen_self_contact(model, result, opts, state):
     """Continuation on the self-contact stiffness (as IPC adapts its barrier stiffness): while the
     converged state has a pair closer than :data:`SELF_CONTACT_MIN_GAP` times the thickness d (folds pinched harder than the automatic
     stiffness's design load, ten times the sheet's weight), raise the stiffness and converge again from
     that state (its steps bounded by the collision test, so no pair crosses on the way). The raised
-    stiffness is the solve's State's (``ws.state.self_contact_scale``; the model's law stays as built):
+    stiffness is the solve's State's (``state.self_contact_scale``; the model's law stays as built):
     ``result.self_contact_stiffenings`` counts the raises, ``result.self_contact_scale`` is the factor
     the equilibrium holds with (its summary reports the stiffness)."""
     sc = model.self_contact
@@ -117,18 +117,18 @@ def _stiffen_self_contact(model, result, opts, ws):
         gap = sc.min_distance(model.positions(result.U))
         if not gap < SELF_CONTACT_MIN_GAP * sc.thickness:
             break
-        ws.state.self_contact_scale *= SELF_CONTACT_STIFFENING
+        state.self_contact_scale *= SELF_CONTACT_STIFFENING
         log.info("self-contact: a pair %.3g d apart; stiffness x %g, Newton again", gap / sc.thickness,
                  SELF_CONTACT_STIFFENING)
         try:
-            res = solve_load_steps(model, U0=result.U, options=polish, workspace=ws)
+            res = solve_load_steps(model, U0=result.U, options=polish, state=state)
         except ConvergenceError as exc:
-            ws.state.self_contact_scale /= SELF_CONTACT_STIFFENING
+            state.self_contact_scale /= SELF_CONTACT_STIFFENING
             log.warning("self-contact: Newton with the raised stiffness did not converge (%s); the equilibrium "
                         "of the last stiffness stands", exc)
             break
         result.self_contact_stiffenings += 1
-        result.self_contact_scale = ws.state.self_contact_scale
+        result.self_contact_scale = state.self_contact_scale
         result.U, result.residual, result.energies = res.U, res.residual, res.energies
         result.iterations += res.iterations
         result.factorisations += res.factorisations
@@ -136,17 +136,17 @@ def _stiffen_self_contact(model, result, opts, ws):
     return result
 
 
-def _finish(model, result, opts, ws):
+def _finish(model, result, opts, state):
     """The self-contact continuation (:func:`_stiffen_self_contact`), then the stability check."""
-    return _check_stability(model, _stiffen_self_contact(model, result, opts, ws), ws)
+    return _check_stability(model, _stiffen_self_contact(model, result, opts, state), state)
 
 
-def _check_stability(model, result, ws):
+def _check_stability(model, result, state):
     """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact
     tangent positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver
     cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
-    solver = ws.solver
-    result.stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=ws.pairs)
+    solver = state.solver
+    result.stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs)
                      if solver.detects_indefinite else None)
     return result
 
@@ -253,7 +253,7 @@ def _relax_plan(model, first) -> _RelaxPlan:
                       chunk=4.0 / alpha, min_span=10 * est.dt)
 
 
-def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None, route=None, segment=None):
+def _relax_then_newton(model, opts, callback, state, *, first=None, checkpoint=None, route=None, segment=None):
     """Dynamic relaxation at full load to near rest, then Newton to the full tolerance.
 
     The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while
@@ -304,7 +304,7 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
             _relax_segment(model, opts, plan, route, fail, checkpoint, segment, t0)
             segment = None
         final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
-        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, ws.solver):
+        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, state.solver):
             route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
         handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest,
@@ -317,7 +317,7 @@ def _relax_then_newton(model, opts, callback, ws, *, first=None, checkpoint=None
             long_try = route.tol_force < 1.0 and not any(h.get("basin") for h in info["handovers"][:-1])
             handover["basin"] = route.tol_force < 1.0
             res = solve_load_steps(model, U0=route.U, options=polish if final else basin if long_try else short,
-                                   callback=callback, workspace=ws, iteration_fallback=final or long_try)
+                                   callback=callback, state=state, iteration_fallback=final or long_try)
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
             if final:

@@ -120,8 +120,8 @@ class StaticCheckpointer(ThrottledWriter):
     ----------
     writes : files written; write_time : wall time spent writing them [s]
     saved : what the last write holds (e.g. ``"load factor 0.42"``), for messages
-    workspace : the solve's :class:`~rftstatic.solvers.newton.NewtonWorkspace` (set by :func:`solve_static`;
-        its factorisation count and damping scale are saved)
+    state : the solve's :class:`~rftstatic.model.state.State` (set by :func:`solve_static`; its factorisation
+        count, damping scale and load branches are saved)
     """
 
     run = "the static solve"
@@ -131,20 +131,20 @@ class StaticCheckpointer(ThrottledWriter):
         self.header = {"scene": scene, "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements,
                        "element": model.element, "model": static_fingerprint(model), "options": options_spec(options)}
         self.model = model
-        self.workspace = None
+        self.state = None
 
     def _common(self, phase) -> dict:
-        ws = self.workspace
-        branches = list(ws.state.load_branches or ()) if ws is not None else []  # committed angle branches
+        state = self.state
+        branches = list(state.load_branches or ()) if state is not None else []  # committed angle branches
         return {"static_format": np.array(FORMAT), "static_header": json_array(self.header), "phase": np.array(phase),
-                "workspace": json_array({"factorisations": 0 if ws is None else ws.factorisations,
-                                    "lm_scale": None if ws is None else ws.lm_scale, "load_terms": branches})}
+                "workspace": json_array({"factorisations": 0 if state is None else state.factorisations,
+                                    "lm_scale": None if state is None else state.lm_scale, "load_terms": branches})}
 
     def load_step(self, path: LoadPath) -> None:
         """After a converged increment: keep the load path, write it when due and at full load."""
         r = path.result
         counts = {k: getattr(r, k) for k in ("iterations", "cutbacks", "retries", "residual", "seed")}
-        counts["tangent_modes"] = dict(self.workspace.modes) if self.workspace is not None else {}
+        counts["tangent_modes"] = dict(self.state.modes) if self.state is not None else {}
         arrays = {**self._common("load-steps"), "U": _field(path.U), "U_prev": _field(path.U_prev),
                   "path": json_array({"lam": path.lam, "dlam": path.dlam, "target": path.target,
                                  "lam_prev": path.lam_prev, "load_steps": list(r.load_steps), **counts})}
@@ -202,7 +202,7 @@ class StaticRestart:
     route : the relaxation route's state (the relaxation phases)
     segment : the explicit state inside a relaxation segment (:func:`load_checkpoint`), or None
     result : the finished solve's result (phase ``"done"``)
-    factorisations, lm_scale : the Newton workspace's counts (:class:`NewtonWorkspace`)
+    factorisations, lm_scale : the solve State's counts (:class:`~rftstatic.model.state.State`)
     load_terms : the committed branch of each of the model's potential loads (``State.load_branches``)
     where : where the saved solve stood (for ``summary.json``): phase, load factor and load steps, or
         relaxation time [s]
@@ -219,12 +219,12 @@ class StaticRestart:
     load_terms: list | None = None
     where: dict | None = None
 
-    def restore(self, model, ws) -> None:
-        """Give the Newton workspace ``ws`` its saved counts and its State the saved branches of ``model``'s
+    def restore(self, model, state) -> None:
+        """Give the solve's State ``state`` its saved counts and the saved branches of ``model``'s
         potential loads, before the solve continues."""
-        ws.factorisations, ws.lm_scale = self.factorisations, self.lm_scale
+        state.factorisations, state.lm_scale = self.factorisations, self.lm_scale
         if self.load_terms and len(self.load_terms) == len(model.load_terms):
-            ws.state.load_branches = tuple(None if b is None else np.asarray(b, dtype=float) for b in self.load_terms)
+            state.load_branches = tuple(None if b is None else np.asarray(b, dtype=float) for b in self.load_terms)
 
     def _where(self) -> dict:
         out = {"phase": self.phase}
@@ -298,9 +298,9 @@ def _check_header(path, head, model, options, scene) -> None:
 
 def _restart_from(path, z) -> StaticRestart:
     phase = str(z["phase"])
-    ws = json.loads(str(z["workspace"]))
-    out = StaticRestart(path=path, phase=phase, factorisations=int(ws["factorisations"]), lm_scale=ws["lm_scale"],
-                        load_terms=ws["load_terms"])
+    saved = json.loads(str(z["workspace"]))
+    out = StaticRestart(path=path, phase=phase, factorisations=int(saved["factorisations"]), lm_scale=saved["lm_scale"],
+                        load_terms=saved["load_terms"])
     if phase == "done":
         out.result = result_from("", z)
     elif phase == "load-steps":

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from rftstatic.model.state import State
 from rftstatic.solvers import linear
 from rftstatic.solvers.iteration import direction
 from rftstatic.solvers.options import NewtonOptions
@@ -32,11 +33,11 @@ class _Model:
         return None, _laplacian(self.n, 0.5 if psd else self.exact_shift)
 
 
-class _Workspace:
-    def __init__(self):
-        self.solver = linear.CholmodSolver()
-        self.modes, self.factorisations, self.krylov_iterations = {}, 0, 0
-        self.modified_shift, self.lm_scale, self.candidates, self.pairs = 0.0, None, None, None
+def _state(n):
+    """A solve's State (no contact) with a CHOLMOD solver."""
+    state = State(U=np.zeros((n // 3, 3)), V=np.zeros((n // 3, 3)))
+    state.solver = linear.CholmodSolver()
+    return state
 
 
 def test_failed_factorisations_leave_no_reference_cycle():
@@ -44,7 +45,7 @@ def test_failed_factorisations_leave_no_reference_cycle():
     local of that frame, it made a cycle with the frame's tangents (85 MB each at 201 x 201 nodes) that
     only the cyclic collector frees, rarely in a numpy loop: 22 GB resident after 30 minutes."""
     n = 600
-    model, ws, r = _Model(n), _Workspace(), -np.ones(n)
+    model, ws, r = _Model(n), _state(n), -np.ones(n)
     gc.collect()
     gc.disable()
     try:

@@ -7,9 +7,8 @@ import pytest
 
 from rftstatic.bench.problems import strip_model
 from rftstatic.solvers import static
-from rftstatic.solvers.newton import NewtonWorkspace, newton
+from rftstatic.solvers.newton import newton, start_state
 from rftstatic.solvers.options import NewtonOptions
-from rftstatic.solvers.linear import make_solver
 from rftstatic.validate.stability.cell_functions import strip_cell
 
 
@@ -58,11 +57,10 @@ def test_newton_converges_quadratically_near_the_solution(scheme):
     model = strip_model(21, 5)
     res = static.solve_static(model, options=static.StaticOptions(progress=False))
     opts = NewtonOptions(iteration=scheme, line_search=False, reuse_factorisation=0)
-    ws = NewtonWorkspace.for_model(model)
-    ws.solver = make_solver("auto")
+    state = start_state(model)
     start = res.U.copy()
     start[:, 2] *= 0.999  # a nearby state
-    nt = newton(model, start, 1.0, opts, ws, max_step=1.0)
+    nt = newton(model, start, 1.0, opts, state, max_step=1.0)
     assert nt.converged and nt.scheme == scheme
     e = np.array([h["residual"] for h in nt.history] + [nt.residual]) / nt.history[0]["residual"]
     assert len(e) >= 3
