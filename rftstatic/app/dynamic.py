@@ -44,9 +44,10 @@ from rftstatic.io.summary import self_contact_summary, self_intersection_summary
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import dynamics_options, static_options
-from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint
-from rftstatic.solvers.checkpoint import resume as resume_run
-from rftstatic.solvers.explicit import run_explicit
+from rftstatic.model.state import State
+from rftstatic.solvers.checkpoint import CheckpointSaver, explicit_header, load_explicit_state
+from rftstatic.solvers.drive import drive
+from rftstatic.solvers.explicit import EXPLICIT, explicit_steps
 from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.rest import AtRest, RestCriterion
 from rftstatic.solvers.static import compare_with_static, solve_static
@@ -136,7 +137,12 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     wall0 = time.perf_counter()
     resumed_from = None
     if resume and ckpt_path.exists():
-        data = load_checkpoint(ckpt_path)
+        try:
+            state, options, frame_times, probe_nodes = load_explicit_state(ckpt_path, model, obstacles,
+                                                                           progress=progress)
+        except CheckpointError as exc:
+            raise scene.error("--resume", f"{exc}") from None
+        data = state.route[EXPLICIT]
         saved = data["options"]
         horizon = _plan(scene, model, o, float(data["dt"]), check_dt=False).t_end
         for key, want in (("t_end", horizon), ("alpha", o.alpha), ("mass_scale", o.mass_scale)):
@@ -147,13 +153,10 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
             raise scene.error("dynamics.frames", f"the checkpoint {ckpt_path} saved other frame times; run "
                               "without --resume")
         rest.resume_from(data["history"])
-        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, data["dt"]))
-        resumed_from, reason = data["t"], "the step of the checkpoint's run"
-        try:
-            run = resume_run(ckpt_path, model, obstacles=obstacles, callback=watch, checkpoint=ckpt,
-                             progress=progress)
-        except CheckpointError as exc:
-            raise scene.error("--resume", f"{exc}") from None
+        every = checkpoint_steps(o.checkpoint_every, data["dt"])
+        resumed_from, reason = state.t, "the step of the checkpoint's run"
+        route = explicit_steps(model, state, options, obstacles=obstacles, frame_times=frame_times, probes=probe_nodes,
+                               callback=watch)
     else:
         if resume:
             log.warning("no checkpoint %s: starting the run from t = 0", ckpt_path)
@@ -163,13 +166,17 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
             raise scene.error("dynamics.dt", f"{o.dt / scene.units.time:.4g} is below {MIN_DT_SHARE:g} of the stable "
                               f"step estimate {plan.estimate.dt / scene.units.time:.4g} (scene time units): the steps "
                               "would not move the sheet; give a dt near the estimate or leave dynamics.dt out")
-        ckpt = Checkpointer(ckpt_path, every_steps=checkpoint_steps(o.checkpoint_every, plan.dt))
+        every = checkpoint_steps(o.checkpoint_every, plan.dt)
         options = ExplicitOptions(t_end=plan.t_end, dt=plan.dt, alpha=o.alpha, mass_scale=o.mass_scale,
                                   rest_tol=o.rest_tolerance, backend=backend, max_steps=limit,
                                   max_steps_name=_limit_name(o, model.mesh.n_nodes), progress=progress)
-        run = run_explicit(model, options, obstacles=obstacles, frame_times=save_times, probes=pnodes.ravel(),
-                           callback=watch, checkpoint=ckpt, plan=plan)
+        state = State.initial(model)
+        route = explicit_steps(model, state, options, obstacles=obstacles, frame_times=save_times,
+                               probes=pnodes.ravel(), callback=watch, plan=plan)
         reason = plan.reason
+    saver = CheckpointSaver(ckpt_path, explicit_header(model, obstacles), every_steps=every, run=f"the {analysis} run")
+    with saver.stopping():
+        run = drive(route, saver.on(state))
     wall = time.perf_counter() - wall0
 
     summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)

@@ -44,7 +44,9 @@ from rftstatic.scenes.build import build_mesh, build_model
 from rftstatic.scenes.levels import level_scenes
 from rftstatic.scenes.options import run_options
 from rftstatic.solvers.checkpoint import save_atomic
-from rftstatic.solvers.static import solve_static
+from rftstatic.solvers.drive import drive
+from rftstatic.solvers.newton import start_state
+from rftstatic.solvers.static import solve_static, static_route
 from rftstatic.solvers.static_checkpoint import static_fingerprint
 
 log = logging.getLogger(__name__)
@@ -71,7 +73,7 @@ def transfer_start(coarse_model, U, fine_model) -> np.ndarray:
     return U0
 
 
-def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None, checkpoint=None):
+def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None, saver=None):
     """Solve ``model`` (the model of ``scene``) by mesh sequencing over the scene's ``solver.levels`` meshes
     (:func:`~rftstatic.scenes.options.run_options`).
 
@@ -82,7 +84,8 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     opts : :class:`~rftstatic.solvers.options.StaticOptions` of every level's solve
     folder : run folder where each converged level is saved (``level-K.npz``); None: nothing saved
     resume : take up the levels saved in ``folder`` (those of the same model only)
-    callback, checkpoint : as for :func:`~rftstatic.solvers.static.solve_static`, on the finest level
+    callback : ``callback(lam, U)`` after every converged increment of the finest level
+    saver : a :class:`~rftstatic.solvers.checkpoint.CheckpointSaver` given the finest level's pauses (None: none)
 
     Returns the finest level's :class:`~rftstatic.solvers.newton.StaticResult`, its ``route``
     ``"<coarsest route>+levels"``, ``levels`` one record per mesh, the counters summed over them, and
@@ -127,8 +130,9 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             what = f"Newton at full load from level {k - 1}" + (f", membrane x {scale:.4g}" if scale != 1.0 else "")
         log.info("mesh sequencing: level %d of %d, %s nodes, by %s", k, len(scenes), m.mesh.n_nodes, what)
         try:
-            res = solve_static(m, **start, callback=callback if last else None,
-                               checkpoint=checkpoint if last else None)
+            state = start_state(m, start["options"].newton.linear_solver)
+            route = static_route(m, state, start["options"], U0=start.get("U0"), callback=callback if last else None)
+            res = drive(route, saver.on(state) if last and saver is not None else None)
         except ConvergenceError as exc:
             failed = exc.result if last else None
             if failed is not None:  # the summary of the failed run lists the levels solved and this one

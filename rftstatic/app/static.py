@@ -5,9 +5,9 @@ Every number written is in the scene's units. A solve that fails still writes it
 labelled ``"converged": false``, before the :class:`~rftstatic.errors.ConvergenceError` is raised again
 (the command line exits with status 3).
 
-The solve saves ``checkpoint.npz`` in the run folder after converged increments and relaxation segments
-(:mod:`rftstatic.solvers.static_checkpoint`: at most one write per
-:data:`~rftstatic.solvers.static_checkpoint.CHECKPOINT_SECONDS` of wall time, the end of every phase
+The solve's State is saved in ``checkpoint.npz`` in the run folder at the pauses of its route (after converged
+increments, relaxation segments and explicit steps; :mod:`rftstatic.solvers.static_checkpoint`: at most one
+write per :data:`~rftstatic.solvers.static_checkpoint.CHECKPOINT_SECONDS` of wall time, the end of every phase
 always, the last converged increment on a Ctrl-C); ``--resume`` (:func:`resume_scene`) continues from it
 to the same equilibrium as the uninterrupted run.
 """
@@ -27,13 +27,10 @@ from rftstatic.io.summary import drape_summary, probe_summary, self_contact_summ
 from rftstatic.scenes.build import build_model
 from rftstatic.app.specimens import seeded_specimens
 from rftstatic.scenes.options import run_options, seed_count, static_options
-from rftstatic.solvers.static import solve_static
-from rftstatic.solvers.static_checkpoint import (
-    CHECKPOINT_SECONDS,
-    StaticCheckpointer,
-    load_static_checkpoint,
-    remove_stale,
-)
+from rftstatic.solvers.drive import drive
+from rftstatic.solvers.newton import start_state
+from rftstatic.solvers.static import static_route
+from rftstatic.solvers.static_checkpoint import CHECKPOINT_SECONDS, load_static_state, remove_stale, static_saver, where
 
 log = logging.getLogger(__name__)
 
@@ -59,22 +56,24 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     seeds = seed_count(scene)
     path = out / CHECKPOINT
     remove_stale(path)
-    restart = None
+    resumed = None
     single = run_options(scene).levels == 1  # mesh sequencing resumes from its own saved levels (level-K.npz)
+    state = start_state(model, opts.newton.linear_solver)
     if resume and single and path.exists():
-        restart = load_static_checkpoint(path, model, opts, scene=scene.name)
-        log.info("resuming the static solve from %s (%s)", path, restart.where)
+        state = load_static_state(path, model, opts, scene=scene.name)
+        resumed = where(state)
+        log.info("resuming the static solve from %s (%s)", path, resumed)
     elif resume and single:
         log.warning("no checkpoint %s: solving from the start", path)
-    saver = StaticCheckpointer(path, model, opts, scene=scene.name, every_seconds=checkpoint_seconds)
+    saver = static_saver(path, model, opts, scene=scene.name, every_seconds=checkpoint_seconds)
     error = None
     try:
-        with saver.on_interrupt():
+        with saver.stopping():
             if not single:
                 result = solve_levels(scene, model, opts, folder=out, resume=resume, callback=callback,
-                                      checkpoint=saver)
+                                      saver=saver)
             else:
-                result = solve_static(model, options=opts, callback=callback, checkpoint=saver, restart=restart)
+                result = drive(static_route(model, state, opts, callback=callback), saver.on(state))
     except ConvergenceError as exc:
         error, result = exc, exc.result
         if result is None:
@@ -82,9 +81,8 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     summary = static_summary(scene, model, extras, result, build_time)
     if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
         summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds)
-    summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or restart else None, "writes": saver.writes,
-                             "write_time_s": saver.write_time,
-                             "resumed_from": None if restart is None else restart.where}
+    summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or resumed else None, "writes": saver.writes,
+                             "write_time_s": saver.write_time, "resumed_from": resumed}
     write_outputs(scene, model, extras, result.U, out, summary, figures=figures)
     if error is not None:
         raise error

@@ -45,6 +45,9 @@ class State:
         solve at the state where damping is first needed (None before)
     modified_shift : the last diagonal shift [N/m] that made an indefinite exact tangent positive definite
         (:func:`~rftstatic.solvers.iteration.direction`, mode ``"modified"``): the next try starts below it
+    route : the position of every route under way, keyed by route (:mod:`rftstatic.solvers.drive`): what a
+        checkpoint of this State lets the route go on from (e.g. the load steps' next increment, the
+        relaxation route's phase, an explicit run's records)
     """
 
     U: np.ndarray
@@ -61,6 +64,7 @@ class State:
     factorisations: int = 0
     lm_scale: float | None = None
     modified_shift: float = 0.0
+    route: dict = field(default_factory=dict)
 
     @classmethod
     def initial(cls, model, U=None, V=None, *, t: float = 0.0, step: int = 0, lam: float = 1.0) -> State:

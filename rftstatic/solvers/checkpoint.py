@@ -11,7 +11,9 @@ the saved numbers, reproduces the uninterrupted run bitwise.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
+import importlib
 import json
 import logging
 import os
@@ -23,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic.errors import CheckpointError
+from rftstatic.errors import CheckpointError, ConvergenceError
 
 log = logging.getLogger(__name__)
 
@@ -129,128 +131,266 @@ class ThrottledWriter:
             raise
 
 
-class Checkpointer:
-    """Saves the explicit state every ``every_steps`` steps and/or every ``every_seconds`` of wall time.
+CHECKPOINT_FORMAT = 2
+"""Version of the one checkpoint layout (key ``checkpoint_format``): a State and a header."""
 
-    Parameters
-    ----------
-    path : checkpoint file (``.npz``)
-    every_steps : save interval in steps
-    every_seconds : save interval in wall-clock seconds [s]
+SAVED = ("U", "V", "t", "step", "lam", "load_branches", "contact_history", "modes", "factorisations", "lm_scale",
+         "modified_shift", "route")
+"""The :class:`~rftstatic.model.state.State` fields a checkpoint keeps (with ``self_contact_scale``); the
+contact candidate list, the self-contact pair cache and the linear solver are caches, made again."""
+
+
+def encode(value, arrays: dict):
+    """``value`` as a JSON-able tree, its arrays stored in ``arrays`` (key ``"a<k>"``) and referenced by key.
+
+    Takes None, bool, int, float (NaN and inf too), str, numpy scalars and arrays, lists (a list of arrays of one
+    shape and type stored as one stacked array, a list of floats as one float array), tuples, dicts with
+    str keys, the dataclasses of this package (by qualified name) and a
+    :class:`~rftstatic.errors.ConvergenceError` (message and its ``result``). Arrays are copied: a snapshot
+    kept in memory does not change with the State.
     """
-
-    def __init__(self, path, *, every_steps: int | None = None, every_seconds: float | None = None):
-        if every_steps is None and every_seconds is None:
-            raise ValueError("a Checkpointer needs every_steps or every_seconds")
-        if every_steps is not None and every_steps < 1:
-            raise ValueError(f"every_steps must be >= 1, got {every_steps}")
-        self.path = Path(path)
-        self.every_steps = every_steps
-        self.every_seconds = every_seconds
-        self._last_wall = time.monotonic()
-        self.saved = 0
-
-    def due(self, step: int) -> bool:
-        if self.every_steps is not None and step % self.every_steps == 0:
-            return True
-        return self.every_seconds is not None and time.monotonic() - self._last_wall >= self.every_seconds
-
-    def save(self, model, obstacles, state, *, dt, n_steps, estimate, acc, history, probes, frames, options):
-        """Write the state after ``state.step`` steps (called by :func:`rftstatic.explicit.run_explicit`)."""
-        save_atomic(self.path, state_arrays(model, obstacles, state, dt=dt, n_steps=n_steps, estimate=estimate,
-                                            acc=acc, history=history, probes=probes, frames=frames, options=options))
-        self._last_wall = time.monotonic()
-        self.saved += 1
-        log.info("checkpoint at t = %.6g s (step %d) -> %s", state.t, state.step, self.path)
-
-
-def state_arrays(model, obstacles, state, *, dt, n_steps, estimate, acc, history, probes, frames, options) -> dict:
-    """The arrays of a checkpoint of an explicit run after ``state.step`` steps (what :func:`load_checkpoint`
-    reads): the state ``U``, ``V_half`` (N, 3) [m, m/s], step, step size [s], accumulators, history,
-    probe records (S, P, 3) [m], frames and the run's options."""
-    N = model.mesh.n_nodes
-    P = len(options["probe_nodes"])
-    arrays = {
-        "format": np.array(FORMAT), "fingerprint": np.array(model_fingerprint(model)),
-        "obstacles": np.array(_obstacles_spec(obstacles)),
-        "t": np.array(state.t), "step": np.array(state.step), "n_steps": np.array(n_steps),
-        "dt": np.array(dt), "U": state.U, "V_half": state.V_half,
-        "acc": np.array(json.dumps(acc)),
-        "estimate": np.array(json.dumps(None if estimate is None else estimate.__dict__)),
-        "probes": np.asarray(probes, dtype=float).reshape(len(probes), P, 3),
-        "frame_t": np.array([t for t, _ in frames], dtype=float),
-        "frame_U": np.asarray([u for _, u in frames], dtype=float).reshape(len(frames), N, 3),
-    }
-    for k, v in history.items():
-        arrays["history_" + k] = np.asarray(v, dtype=float)
-    for k, v in options.items():
-        arrays["option_" + k] = np.asarray(v)
-    return arrays
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        key = f"a{len(arrays)}"
+        arrays[key] = np.array(value)
+        return {"@array": key}
+    if isinstance(value, list):
+        if len(value) > 1 and all(isinstance(v, np.ndarray) for v in value) and len({(v.shape, v.dtype) for v in value}) == 1:
+            key = f"a{len(arrays)}"  # a list of like arrays (an explicit run's probe records): one stacked array
+            arrays[key] = np.stack(value)
+            return {"@stack": key}
+        if len(value) > 1 and all(type(v) in (float, np.float64) for v in value):  # a history: one float array
+            key = f"a{len(arrays)}"
+            arrays[key] = np.array(value, dtype=float)
+            return {"@floats": key}
+        return [encode(v, arrays) for v in value]
+    if isinstance(value, tuple):
+        return {"@tuple": [encode(v, arrays) for v in value]}
+    if isinstance(value, dict):
+        if not all(isinstance(k, str) for k in value):
+            raise TypeError(f"a checkpoint keeps dicts with str keys only, got keys {list(value)[:3]!r}")
+        return {"@dict": {k: encode(v, arrays) for k, v in value.items()}}
+    if isinstance(value, ConvergenceError):
+        return {"@error": str(value), "result": encode(value.result, arrays)}
+    cls = type(value)
+    if cls.__module__ == "rftstatic.model.state" and cls.__name__ == "State":  # a route's own State: its saved fields
+        return {"@state": encode(saved_fields(value), arrays)}
+    if dataclasses.is_dataclass(value) and cls.__module__.startswith("rftstatic."):
+        return {"@dataclass": f"{cls.__module__}:{cls.__qualname__}",
+                "fields": {f.name: encode(getattr(value, f.name), arrays) for f in dataclasses.fields(value)
+                           if f.init}}
+    raise TypeError(f"{cls.__name__} cannot be saved in a checkpoint")
 
 
-def load_checkpoint(path) -> dict:
-    """Read a checkpoint into a dict (state, accumulators, history, options)."""
-    from rftstatic.solvers.explicit import HISTORY_KEYS
-    from rftstatic.solvers.timestep import StepEstimate
+def decode(tree, arrays):
+    """The value :func:`encode` wrote (``arrays``: the open ``.npz`` or a dict)."""
+    if isinstance(tree, list):
+        return [decode(v, arrays) for v in tree]
+    if not isinstance(tree, dict):
+        return tree
+    if "@array" in tree:
+        return np.array(arrays[tree["@array"]])
+    if "@floats" in tree:
+        return arrays[tree["@floats"]].tolist()
+    if "@stack" in tree:
+        return list(np.array(arrays[tree["@stack"]]))
+    if "@tuple" in tree:
+        return tuple(decode(v, arrays) for v in tree["@tuple"])
+    if "@dict" in tree:
+        return {k: decode(v, arrays) for k, v in tree["@dict"].items()}
+    if "@error" in tree:
+        return ConvergenceError(tree["@error"], decode(tree["result"], arrays))
+    if "@state" in tree:
+        return SavedState(decode(tree["@state"], arrays))
+    if "@dataclass" in tree:
+        module, name = tree["@dataclass"].split(":")
+        if not module.startswith("rftstatic."):
+            raise ValueError(f"a checkpoint names class {tree['@dataclass']!r}, not one of rftstatic's")
+        cls = importlib.import_module(module)
+        for part in name.split("."):
+            cls = getattr(cls, part)
+        return cls(**{k: decode(v, arrays) for k, v in tree["fields"].items()})
+    raise ValueError(f"unknown record in a checkpoint: keys {sorted(tree)!r}")
 
+
+class SavedState(dict):
+    """The saved fields of a State (:data:`SAVED`) read back from a checkpoint; :func:`as_state` makes the State."""
+
+
+def saved_fields(state) -> dict:
+    """The fields of ``state`` a checkpoint keeps (:data:`SAVED`, and the self-contact stiffness scale)."""
+    saved = {name: getattr(state, name) for name in SAVED}
+    saved["self_contact_scale"] = state.self_contact_scale
+    return saved
+
+
+def as_state(model, value):
+    """``value`` itself, or the State of ``model`` it was saved as (a :class:`SavedState`, its caches new)."""
+    return restore_state(model, value) if isinstance(value, SavedState) else value
+
+
+def state_arrays(state, header: dict) -> dict:
+    """The arrays of a checkpoint of ``state`` (its :data:`SAVED` fields and self-contact scale) under
+    ``header`` (JSON-able: what the run was, checked on resume)."""
+    arrays = {}
+    tree = encode(saved_fields(state), arrays)
+    return {"checkpoint_format": np.array(CHECKPOINT_FORMAT), "header": json_array(header),
+            "state": json_array(tree), **arrays}
+
+
+def read_checkpoint(path) -> tuple[dict, dict]:
+    """``(header, saved)``: the header and the saved State fields of the checkpoint ``path``.
+
+    Raises
+    ------
+    CheckpointError
+        if the file is missing, corrupt, or not written in this format (the message names the file and the fix).
+    """
     path = Path(path)
     if not path.exists():
         raise CheckpointError(f"checkpoint {path} does not exist")
     try:
         with np.load(path, allow_pickle=False) as z:
-            if int(z["format"]) != FORMAT:
-                raise CheckpointError(f"checkpoint {path}: format {int(z['format'])}, this version reads {FORMAT}")
-            est = json.loads(str(z["estimate"]))
-            out = {
-                "fingerprint": str(z["fingerprint"]), "obstacles": str(z["obstacles"]),
-                "t": float(z["t"]), "step": int(z["step"]), "n_steps": int(z["n_steps"]), "dt": float(z["dt"]),
-                "U": z["U"].copy(), "V_half": z["V_half"].copy(), "acc": json.loads(str(z["acc"])),
-                "estimate": None if est is None else StepEstimate(**est),
-                "history": {k: z["history_" + k].tolist() for k in HISTORY_KEYS},
-                "probes": list(z["probes"]),
-                "frames": list(zip(z["frame_t"].tolist(), list(z["frame_U"]))),
-                "options": {k[len("option_"):]: z[k] for k in z.files if k.startswith("option_")},
-            }
-    except (OSError, ValueError, KeyError, TypeError, zipfile.BadZipFile, json.JSONDecodeError) as exc:
+            if "checkpoint_format" not in z.files:
+                raise CheckpointError(f"checkpoint {path} was written by an older version of rftstatic; run "
+                                      "without --resume")
+            if int(z["checkpoint_format"]) != CHECKPOINT_FORMAT:
+                raise CheckpointError(f"checkpoint {path}: format {int(z['checkpoint_format'])}, this version reads "
+                                      f"{CHECKPOINT_FORMAT}; run without --resume")
+            header = json.loads(str(z["header"]))
+            saved = decode(json.loads(str(z["state"])), z)
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, ImportError, zipfile.BadZipFile,
+            json.JSONDecodeError) as exc:
         if isinstance(exc, CheckpointError):
             raise
         raise CheckpointError(f"checkpoint {path} is corrupt or incomplete ({type(exc).__name__}: {exc}); "
                               "run without --resume to start again") from None
-    return out
+    return header, saved
 
 
-def resume(path, model, *, obstacles=(), callback=None, checkpoint=None, progress=True):
-    """Continue the run saved in ``path`` to its ``t_end``; the result equals the uninterrupted run.
+def restore_state(model, saved: dict, state=None):
+    """``state`` (default a fresh :meth:`~rftstatic.model.state.State.initial` of ``model``, its caches new)
+    with the saved fields of :func:`read_checkpoint` set."""
+    from rftstatic.model.state import State
+
+    state = State.initial(model) if state is None else state
+    for name in SAVED:
+        if name in saved:
+            setattr(state, name, saved[name])
+    if state.self_pairs is not None:
+        state.self_contact_scale = saved.get("self_contact_scale", 1.0)
+    return state
+
+
+class CheckpointSaver(ThrottledWriter):
+    """Saves a State at its routes' pauses (:class:`~rftstatic.solvers.drive.Pause`) to one file, in the one
+    format (:func:`state_arrays`): a final pause at once, the others when due (every ``every_seconds`` of wall
+    time, or every ``every_steps`` explicit steps), the last snapshot held back written on an interrupt.
+
+    Interrupts (:meth:`stopping`): the first Ctrl-C asks the run to stop at its next pause, which is saved
+    (``KeyboardInterrupt("... checkpoint saved")``); a second stops at once, and the snapshot held back, if any,
+    is written.
 
     Parameters
     ----------
-    path : checkpoint written by a :class:`Checkpointer`
-    model : the same model as the interrupted run (checked by fingerprint)
-    obstacles : the same obstacles (checked against the saved descriptions)
-    callback : as in :func:`rftstatic.explicit.run_explicit`
-    checkpoint : a :class:`Checkpointer` for the continued run (default: none)
+    path : the checkpoint file (``.npz``)
+    header : what the run is (JSON-able), saved to refuse another run's checkpoint
+    every_seconds : least wall time between two writes [s] (0: every pause; None: not by wall time)
+    every_steps : save after every so many explicit steps (None: not by steps)
+    run : names the run in messages (e.g. ``"the static solve"``)
+    """
+
+    def __init__(self, path, header: dict, *, every_seconds: float | None = None, every_steps: int | None = None,
+                 run: str = "the run"):
+        if every_steps is not None and not every_steps >= 1:
+            raise ValueError(f"every_steps must be >= 1, got {every_steps}")
+        super().__init__(path, float("inf") if every_seconds is None else every_seconds)
+        self.header, self.run, self.every_steps = header, run, every_steps
+        self.interrupted = False
+
+    def pause(self, state, pause) -> None:
+        """``state`` at a route's ``pause``: written when final or due (kept back, if ``pause.keep``, when not);
+        after a first Ctrl-C, written and the run stopped."""
+        what = pause.what or f"t = {state.t:.6g} s, step {state.step}"
+        if self.interrupted:
+            self._write(state_arrays(state, self.header), what)
+            raise KeyboardInterrupt(f"interrupted at {what}; checkpoint saved")
+        by_step = self.every_steps is not None and pause.step is not None and pause.step % self.every_steps == 0
+        if pause.final or by_step or self.due():
+            self._write(state_arrays(state, self.header), what)
+        elif pause.keep:
+            self._pending = (state_arrays(state, self.header), what)
+
+    def on(self, state):
+        """The ``on_pause`` of :func:`~rftstatic.solvers.drive.drive` for a route stepping ``state``."""
+        return lambda pause: self.pause(state, pause)
+
+    @contextmanager
+    def stopping(self):
+        """Inside: Ctrl-C stops the run at its next pause (saved); a second Ctrl-C at once (the held-back
+        snapshot saved). The SIGINT handler is installed only in the main thread, and restored after."""
+        import signal
+        import threading
+
+        if threading.current_thread() is not threading.main_thread():
+            with self.on_interrupt():
+                yield self
+            return
+        previous = signal.getsignal(signal.SIGINT)
+
+        def ask(signum, frame):
+            if self.interrupted:
+                raise KeyboardInterrupt
+            self.interrupted = True
+            log.warning("interrupt: stopping %s at its next pause (Ctrl-C again to stop at once)", self.run)
+
+        signal.signal(signal.SIGINT, ask)
+        try:
+            with self.on_interrupt():
+                yield self
+        finally:
+            signal.signal(signal.SIGINT, previous)
+
+
+def explicit_header(model, obstacles) -> dict:
+    """What an explicit run's checkpoint is for: the model's fingerprint and its obstacles."""
+    obstacles = tuple(obstacles) if not hasattr(obstacles, "signed_distance") else (obstacles,)
+    return {"kind": "explicit", "model": model_fingerprint(model), "obstacles": _obstacles_spec(obstacles)}
+
+
+def load_explicit_state(path, model, obstacles=(), *, progress: bool = True):
+    """``(state, options, frame_times, probes)``: the State of the explicit run of ``model`` saved in ``path``
+    (its ``route`` holds the run's position) and the arguments of
+    :func:`~rftstatic.solvers.explicit.explicit_steps` that continue it as the uninterrupted run.
 
     Raises
     ------
     CheckpointError
-        if the model or the obstacles differ from those of the saved run.
+        if the file is missing, corrupt, not an explicit run's, or written for another model or obstacles.
     """
-    from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit import EXPLICIT
     from rftstatic.solvers.explicit_options import ExplicitOptions
 
-    data = load_checkpoint(path)
-    if data["fingerprint"] != model_fingerprint(model):
+    header, saved = read_checkpoint(path)
+    if header.get("kind") != "explicit":
+        raise CheckpointError(f"checkpoint {path} was not written by a dynamic or relax run (a {header.get('kind')} "
+                              "run's); run without --resume")
+    mine = explicit_header(model, obstacles)
+    if header["model"] != mine["model"]:
         raise CheckpointError(
             f"checkpoint {path} was written for another model (mesh, supports, load, material or element "
             "differ); rebuild the model of the interrupted run")
-    obstacles = tuple(obstacles) if not hasattr(obstacles, "signed_distance") else (obstacles,)
-    if data["obstacles"] != _obstacles_spec(obstacles):
-        raise CheckpointError(f"checkpoint {path}: obstacles differ from the saved run ({data['obstacles']})")
-    o = data["options"]
-    options = ExplicitOptions(t_end=float(o["t_end"]), dt=float(data["dt"]), alpha=float(o["alpha"]),
+    if header["obstacles"] != mine["obstacles"]:
+        raise CheckpointError(f"checkpoint {path}: obstacles differ from the saved run ({header['obstacles']})")
+    state = restore_state(model, saved)
+    position = state.route[EXPLICIT]
+    o = position["options"]
+    options = ExplicitOptions(t_end=float(o["t_end"]), dt=float(position["dt"]), alpha=float(o["alpha"]),
                               mass_scale=float(o["mass_scale"]), sample_every=int(o["sample_every"]),
                               energy_check=bool(o["energy_check"]), energy_tol=float(o["energy_tol"]),
                               rest_tol=float(o["rest_tol"]), safety=float(o["safety"]), backend=str(o["backend"]),
                               progress=progress)
-    return run_explicit(model, options, obstacles=obstacles, frame_times=o["frame_times"], probes=o["probe_nodes"],
-                        callback=callback, checkpoint=checkpoint, _restart=data)
+    return state, options, o["frame_times"], o["probe_nodes"]

@@ -45,6 +45,7 @@ from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.model.state import State
 from rftstatic.progress import Progress
+from rftstatic.solvers.drive import Pause, finish
 from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.step_plan import StepPlan, plan_steps
@@ -94,30 +95,40 @@ class ExplicitResult:
     state: State | None = None
 
 
+EXPLICIT = "explicit"
+"""The explicit run's key in ``State.route``: its step [s], step count, stable-step estimate, energy
+accumulators, history, probe records, frames and options (what a resumed run continues from)."""
+
+
 def run_explicit(model, options: ExplicitOptions, *, U0=None, V0=None, obstacles=(), load=None, frame_times=(),
-                 probes=None, callback=None, checkpoint=None, plan: StepPlan | None = None,
-                 _restart: dict | None = None) -> ExplicitResult:
-    """Integrate the motion of ``model`` from t = 0 to ``options.t_end`` (module docstring).
+                 probes=None, callback=None, plan: StepPlan | None = None) -> ExplicitResult:
+    """Integrate the motion of ``model`` from t = 0 to ``options.t_end`` (module docstring): :func:`explicit_steps`
+    from ``U0``, ``V0`` (N, 3) [m, m/s] (default zero), run to its end without checkpoints."""
+    return finish(explicit_steps(model, State.initial(model, U0, V0), options, obstacles=obstacles, load=load,
+                                 frame_times=frame_times, probes=probes, callback=callback, plan=plan))
+
+
+def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(), load=None, frame_times=(),
+                   probes=None, callback=None, plan: StepPlan | None = None):
+    """The explicit run as a route (:mod:`rftstatic.solvers.drive`): steps ``state`` to ``options.t_end``, pausing
+    after every whole step; returns the :class:`ExplicitResult`.
 
     Parameters
     ----------
     model : :class:`rftstatic.model.Model` (supports, gravity in ``model.load``)
+    state : the :class:`~rftstatic.model.state.State` to step: U, V (N, 3) [m, m/s] at t = 0 (V is zeroed on
+        the supported dofs), or a saved State whose ``route`` holds the run's position (:data:`EXPLICIT`), which
+        then goes on step for step as the uninterrupted run
     options : :class:`~rftstatic.solvers.explicit_options.ExplicitOptions` (end time, step, damping, mass
         scaling, start, sampling, checks, step limit)
-    U0, V0 : (N, 3) initial displacements [m] and velocities [m/s] (default zero)
     obstacles : obstacles acting kinematically after every step (any type, §6.3)
     load : (N, 3) external nodal load [N] to use instead of ``model.load`` (e.g. a guided stage)
     frame_times : times [s] at which to store the displacement field (first step at or after each)
     probes : node indices (P,) whose displacements are recorded at every sample
     callback : called as ``callback(state, sample)`` at every sample (``sample``: dict of the history
         values); returning True stops the run
-    checkpoint : :class:`rftstatic.checkpoint.Checkpointer` saving the state at intervals
     plan : the :class:`~rftstatic.solvers.step_plan.StepPlan` of this run, made by the caller with
         :func:`~rftstatic.solvers.step_plan.plan_steps` from the same options (default: planned here)
-
-    Returns
-    -------
-    ExplicitResult
     """
     o = options
     wall0 = time.perf_counter()
@@ -128,8 +139,8 @@ def run_explicit(model, options: ExplicitOptions, *, U0=None, V0=None, obstacles
         raise ValueError(f"probe nodes must lie in 0..{N - 1}, got min {probes.min()}, max {probes.max()}")
     loop = _Loop(model, obstacles, mass_scale=o.mass_scale, alpha=o.alpha, load=load, backend=o.backend,
                  probes=probes, frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()))
-    if _restart is None:
-        state = State.initial(model, U0, V0)
+    saved = state.route.get(EXPLICIT)
+    if saved is None:
         state.V *= model.free
         if plan is not None and plan.t_end != o.t_end:
             raise ParameterError("plan", f"planned to t_end = {plan.t_end!r} s, the options ask {o.t_end!r} s")
@@ -140,26 +151,23 @@ def run_explicit(model, options: ExplicitOptions, *, U0=None, V0=None, obstacles
         dt, n_steps, estimate = plan.dt, plan.steps, plan.estimate
         loop.begin(dt, start_consistent=o.start == "consistent", state=state)
     else:
-        r = _restart
-        state = State.initial(model, r["U"], r["V_half"], t=r["step"] * r["dt"], step=r["step"])
-        dt, n_steps, estimate = r["dt"], r["n_steps"], r["estimate"]
-        loop.resume(dt, r)
+        dt, n_steps, estimate = saved["dt"], saved["n_steps"], saved["estimate"]
+        loop.resume(dt, saved)
     sample_every = max(1, n_steps // 2000) if o.sample_every is None else o.sample_every
-    saved = {"t_end": o.t_end, "alpha": o.alpha, "mass_scale": o.mass_scale, "sample_every": int(sample_every),
-             "energy_check": o.energy_check, "energy_tol": o.energy_tol, "rest_tol": o.rest_tol, "safety": o.safety,
-             "frame_times": loop.frame_times, "probe_nodes": probes, "backend": loop.kernel.backend}
+    state.route[EXPLICIT] = loop.position(n_steps, estimate, {
+        "t_end": o.t_end, "alpha": o.alpha, "mass_scale": o.mass_scale, "sample_every": int(sample_every),
+        "energy_check": o.energy_check, "energy_tol": o.energy_tol, "rest_tol": o.rest_tol, "safety": o.safety,
+        "frame_times": loop.frame_times, "probe_nodes": probes, "backend": loop.kernel.backend})
     check = _EnergyCheck(model, estimate, mass_scale=o.mass_scale, alpha=o.alpha, safety=o.safety, tol=o.energy_tol,
                          enabled=o.energy_check)
     bar = Progress(o.t_end, "explicit", unit=" s", enabled=o.progress)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            info = {"estimate": estimate, "options": saved}
-            with _StopOnInterrupt(loop, enabled=checkpoint is not None):
-                stopped = loop.advance(state, n_steps, int(sample_every), check, bar, callback=callback,
-                                       checkpoint=checkpoint, checkpoint_info=info)
+            stopped = yield from loop.advance(state, n_steps, int(sample_every), check, bar, callback=callback)
             loop.final_sample(state, check)
     finally:
         bar.close()
+    del state.route[EXPLICIT]
     history = {k: np.asarray(v, dtype=float) for k, v in loop.hist.items()}
     wall = time.perf_counter() - wall0
     return ExplicitResult(
@@ -168,35 +176,6 @@ def run_explicit(model, options: ExplicitOptions, *, U0=None, V0=None, obstacles
         frames=loop.frames, time_at_rest=RestCriterion(o.rest_tol).time_at_rest(history), stopped=stopped,
         contact_nodes=loop.n_contact, wall_time=wall,
         element_steps_per_second=model.mesh.n_elements * state.step / max(wall, 1e-12), state=state)
-
-
-class _StopOnInterrupt:
-    """While a checkpointed run steps, Ctrl-C (SIGINT) only asks the loop to stop at the end of the step
-    (so that the checkpoint it saves is a whole step); a second Ctrl-C stops at once. Only in the main
-    thread, and only when ``enabled``."""
-
-    def __init__(self, loop, *, enabled):
-        self.loop, self.enabled, self.previous = loop, enabled, None
-
-    def __enter__(self):
-        import signal
-        import threading
-
-        if self.enabled and threading.current_thread() is threading.main_thread():
-            def ask(signum, frame):
-                if self.loop.interrupted:
-                    raise KeyboardInterrupt
-                self.loop.interrupted = True
-
-            self.previous = signal.signal(signal.SIGINT, ask)
-        return self
-
-    def __exit__(self, *exc):
-        if self.previous is not None:
-            import signal
-
-            signal.signal(signal.SIGINT, self.previous)
-        return False
 
 
 class _Loop:
@@ -219,7 +198,6 @@ class _Loop:
         else:
             self.self_filter = None
         self.n_contact = 0
-        self.interrupted = False  # set by Ctrl-C (:class:`_StopOnInterrupt`); checked after every step
 
     def begin(self, dt, *, start_consistent, state):
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
@@ -234,12 +212,17 @@ class _Loop:
             state.V = state.V - 0.5 * dt * a0 * self.free
 
     def resume(self, dt, r):
-        """Continue the records of a checkpoint ``r`` (:func:`rftstatic.solvers.checkpoint.load_checkpoint`)."""
+        """Continue the records of a saved position ``r`` (:meth:`position`)."""
         self.dt = dt
         self.acc = r["acc"]
         self.hist = {k: list(r["history"][k]) for k in HISTORY_KEYS}
         self.probe_hist = list(r["probes"])
         self.frames = list(r["frames"])
+
+    def position(self, n_steps, estimate, options) -> dict:
+        """The run's position (:data:`EXPLICIT`): the loop's records themselves, so it stays current as it steps."""
+        return {"dt": self.dt, "n_steps": n_steps, "estimate": estimate, "acc": self.acc, "history": self.hist,
+                "probes": self.probe_hist, "frames": self.frames, "options": options}
 
     def _frames_due(self, t, U):
         acc, times = self.acc, self.frame_times
@@ -247,8 +230,9 @@ class _Loop:
             self.frames.append((t, U.copy()))
             acc["frame_index"] += 1
 
-    def advance(self, state, n_steps, sample_every, check, bar, *, callback, checkpoint, checkpoint_info) -> bool:
-        """Step ``state`` to ``n_steps`` (Eq. 20-22); True if the callback stopped the run."""
+    def advance(self, state, n_steps, sample_every, check, bar, *, callback):
+        """Step ``state`` to ``n_steps`` (Eq. 20-22), pausing after every whole step before the last; returns True
+        if the callback stopped the run."""
         dt, P, minv, free, mass, acc = self.dt, self.P, self.minv, self.free, self.mass, self.acc
         U, V = state.U, state.V
         check_every = min(sample_every, 50)
@@ -297,19 +281,9 @@ class _Loop:
             state.U, state.V, state.t, state.step = U, V, step * dt, step
             if stopped:
                 break
-            if self.interrupted:  # Ctrl-C, at a whole step: save, then stop (--resume continues)
-                if checkpoint is not None and step < n_steps:
-                    self.save_checkpoint(checkpoint, state, n_steps, checkpoint_info)
-                raise KeyboardInterrupt(f"interrupted at t = {state.t:.6g} s (step {step}); checkpoint saved")
-            if checkpoint is not None and checkpoint.due(step) and step < n_steps:
-                self.save_checkpoint(checkpoint, state, n_steps, checkpoint_info)
+            if step < n_steps:
+                yield Pause("", keep=False, step=step)
         return stopped
-
-    def save_checkpoint(self, checkpoint, state, n_steps, info):
-        """Save ``state`` (after a whole step) with the records so far."""
-        checkpoint.save(self.model, self.obstacles, state, dt=self.dt, n_steps=n_steps, estimate=info["estimate"],
-                        acc=self.acc, history=self.hist, probes=self.probe_hist, frames=self.frames,
-                        options=info["options"])
 
     def _record(self, rec, U):
         for k in HISTORY_KEYS:

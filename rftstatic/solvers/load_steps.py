@@ -26,6 +26,7 @@ from rftstatic.progress import Progress
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 from rftstatic.model.state import State
 from rftstatic.solvers.newton import StaticResult, newton, route_outcome, start_state
+from rftstatic.solvers.drive import Pause, finish
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
 
@@ -34,8 +35,8 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class LoadPath:
-    """Where the load steps stand after a converged increment: what :func:`solve_load_steps` hands its
-    ``checkpoint`` hook and continues from as ``resume``.
+    """Where the load steps stand after a converged increment (``State.route["load-steps"]``): what a resumed
+    :func:`load_steps` continues from.
 
     Attributes
     ----------
@@ -57,21 +58,40 @@ class LoadPath:
     result: StaticResult
 
 
-def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None,
-                     state: State | None = None, checkpoint=None,
-                     resume: LoadPath | None = None, iteration_fallback: bool = True) -> StaticResult:
-    """The load-scaled Newton iteration of :func:`solve_static` (module docstring).
+LOAD_STEPS = "load-steps"
+"""The load steps' key in ``State.route``: their :class:`LoadPath` after the last converged increment."""
 
-    ``state``: the solve's :class:`~rftstatic.model.state.State`, shared with its other phases (default :func:`~rftstatic.solvers.newton.start_state`).
-    ``checkpoint``: called as ``checkpoint(path)`` with the :class:`LoadPath` after every converged increment
-    (after ``callback``). ``resume``: such a path, from which the solve continues as the uninterrupted one
-    did (``U0`` is then unused). ``iteration_fallback``: an increment the mixed iteration cannot converge
-    and that cannot be cut back (or has failed twice) is tried with the displacement iteration; off for the
-    relaxation route's intermediate handovers, where the relaxation goes on instead.
-    """
+
+def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None,
+                     state: State | None = None, iteration_fallback: bool = True) -> StaticResult:
+    """The load-scaled Newton iteration of :func:`solve_static` (module docstring): :func:`load_steps` run to its
+    end. ``state``: the solve's :class:`~rftstatic.model.state.State`, shared with its other phases (default
+    :func:`~rftstatic.solvers.newton.start_state`)."""
     opts = options or StaticOptions()
+    state = state if state is not None else start_state(model, opts.newton.linear_solver)
+    return finish(load_steps(model, state, opts, U0=U0, callback=callback, iteration_fallback=iteration_fallback))
+
+
+def load_steps(model, state: State, opts: StaticOptions, *, U0=None, callback=None, iteration_fallback: bool = True):
+    """The load steps as a route (:mod:`rftstatic.solvers.drive`): from ``U0`` (default the flat sheet, perturbed
+    if asked) or from the :class:`LoadPath` saved in ``state.route`` (then as the uninterrupted solve went on),
+    pausing after every converged increment (the last one final); returns the :class:`StaticResult`.
+
+    ``callback``: ``callback(lam, U)`` after every converged increment. ``iteration_fallback``: an increment the
+    mixed iteration cannot converge and that cannot be cut back (or has failed twice) is tried with the
+    displacement iteration; off for the relaxation route's intermediate handovers, where the relaxation goes on
+    instead.
+    """
+    try:
+        return (yield from _load_steps(model, state, opts, U0, callback, iteration_fallback))
+    finally:
+        state.route.pop(LOAD_STEPS, None)
+
+
+def _load_steps(model, state, opts, U0, callback, iteration_fallback):
     t0 = time.perf_counter()
     n = model.mesh.n_nodes
+    resume = state.route.get(LOAD_STEPS)
     if resume is not None:
         U0 = resume.U
     from_state = U0 is not None and resume is None and opts.increments.initial_increment >= 1.0
@@ -84,8 +104,8 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
         what = "the load (nodal forces)" if not np.isfinite(model.load).all() else "the start displacements"
         raise ConvergenceError(f"load factor 0: {what} are not finite (NaN or inf); check the scene's loads, "
                                "weight and mesh coordinates", None)
-    state = state if state is not None else start_state(model, opts.newton.linear_solver)
-    state.modes = {"exact": 0, "psd": 0, "shift": 0} if resume is None else dict(resume.result.tangent_modes)
+    if resume is None:
+        state.modes = {"exact": 0, "psd": 0, "shift": 0}
     solver = state.solver
     diagonal = float(np.linalg.norm(np.ptp(model.mesh.X, axis=0)))
     max_step = opts.newton.max_step if opts.newton.max_step is not None else 0.1 * diagonal
@@ -151,8 +171,9 @@ def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, ca
                 rate = np.linalg.norm(U - U_prev, axis=1).max() / (lam - lam_prev)
                 grow = GROWTH * (lam - lam_prev)
                 dlam = float(np.clip(target / max(rate, 1e-300), inc.min_increment, min(inc.max_increment, grow)))
-                if checkpoint is not None:
-                    checkpoint(LoadPath(lam, U, dlam, target, lam_prev, U_prev, result))
+                state.route[LOAD_STEPS] = LoadPath(lam, U, dlam, target, lam_prev, U_prev, result)
+                state.U, state.lam = U, lam
+                yield Pause(f"load factor {lam:.6g}, {len(result.load_steps)} increments", final=lam >= 1.0)
                 continue
             # from a given state at full load the energy's slow creep along a flat valley counts too: the
             # 31 x 240 round pedestal's finest level needed 468 iterations, 20 of them at |r| ~ 1e-3 |P|
@@ -197,7 +218,7 @@ well above the energy's round-off (1e-16 of its terms, each about the load's wor
 
 def _continue_result(model, result, path: LoadPath, state) -> None:
     """``result`` carries on from ``path.result`` (records, counts) at the equilibrium ``path.U``; the branches
-    of the potential loads in ``state.state`` (as restored from the checkpoint) are committed there."""
+    of the potential loads in ``state`` (as restored from a checkpoint) are committed there."""
     old = path.result
     result.load_steps = list(old.load_steps)
     result.iterations, result.cutbacks, result.retries = old.iterations, old.cutbacks, old.retries

@@ -66,7 +66,6 @@ class StaticResult:
     retries : increments whose mixed iteration failed and that the displacement iteration retried
     factorisations : numeric factorisations of the tangent (Newton steps, failed Cholesky attempts, the
         first increment's rate; not the stability check)
-    state : the solve's final :class:`~rftstatic.model.state.State` (U, load factor, contact candidates)
     path : the arc-length route's record (:func:`~rftstatic.solvers.continuation.solve_arc_length`: each
         step's load factor, arc length and negative pivots, the critical points and the branches taken);
         empty for the other routes
@@ -94,7 +93,6 @@ class StaticResult:
     seed: int | None = None
     route: str = "load-steps"
     relax: dict = field(default_factory=dict)
-    state: State | None = None
     path: dict = field(default_factory=dict)
     levels: list = field(default_factory=list)
     self_contact_stiffenings: int = 0
@@ -127,7 +125,7 @@ def route_outcome(model, result: StaticResult, state: State, t0: float, bar, *, 
     """The ending every static route shares, around its body: ``converged`` and ``message`` on success; a
     :class:`~rftstatic.errors.ConvergenceError` labelled with its message and carrying the last
     equilibrium (``exc.result``); in any case the bar closed, tangent modes, factorisations, wall time
-    [s] (from ``t0``), energies and the State of the final ``result``. ``extra(result)``
+    [s] (from ``t0``), energies of the final ``result``, and its U and load factor in ``state``. ``extra(result)``
     adds a route's own counters before the energies."""
     try:
         yield
@@ -147,4 +145,3 @@ def route_outcome(model, result: StaticResult, state: State, t0: float, bar, *, 
         result.energies = model.energies(result.U, result.lam, candidates=state.candidates, pairs=state.self_pairs,
                                          branches=state.load_branches)
         state.U, state.lam = result.U, result.lam
-        result.state = state

@@ -13,7 +13,9 @@ import numpy as np
 
 from rftstatic.element.explicit_force import BACKENDS
 from rftstatic.errors import ParameterError
-from rftstatic.solvers.explicit import ExplicitResult, run_explicit
+from rftstatic.model.state import State
+from rftstatic.solvers.drive import finish
+from rftstatic.solvers.explicit import EXPLICIT, ExplicitResult, explicit_steps
 from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.rest import RELAX_MASS_SCALE, RELAX_REST, AtRest, RestCriterion
 from rftstatic.solvers.step_plan import MAX_STEPS_KEY
@@ -84,9 +86,19 @@ class RelaxOptions:
                                max_steps_name=self.max_steps_name)
 
 
-def relax(model, options: RelaxOptions, *, U0=None, V0=None, obstacles=(), load=None, peak_kinetic: float = 0.0,
-          checkpoint=None, restart: dict | None = None) -> RelaxResult:
-    """Dynamic relaxation (§6): damped explicit motion until the sheet is at rest.
+def relax(model, options: RelaxOptions, *, U0=None, V0=None, obstacles=(), load=None,
+          peak_kinetic: float = 0.0) -> RelaxResult:
+    """Dynamic relaxation (§6) from ``U0`` [m] and the half-step velocity ``V0`` [m/s] (default zero; given, it
+    is v_(-1/2), e.g. to resume from a :class:`RelaxResult`'s ``U``, ``V``): :func:`relax_steps` run to its end."""
+    state = State.initial(model, U0, V0)
+    return finish(relax_steps(model, state, options, given_velocity=V0 is not None, obstacles=obstacles, load=load,
+                              peak_kinetic=peak_kinetic))
+
+
+def relax_steps(model, state: State, options: RelaxOptions, *, given_velocity: bool = False, obstacles=(), load=None,
+                peak_kinetic: float = 0.0):
+    """Dynamic relaxation (§6) as a route (:mod:`rftstatic.solvers.drive`): damped explicit motion of ``state``
+    until the sheet is at rest, pausing after every step; returns the :class:`RelaxResult`.
 
     At rest: ``options.rest`` (:class:`~rftstatic.solvers.rest.RestCriterion`) at a sample, kinetic energy
     against its peak and the out-of-balance force on the free dofs ``|P - F(U)|`` against ``|P|``. Mass scaling
@@ -95,27 +107,24 @@ def relax(model, options: RelaxOptions, *, U0=None, V0=None, obstacles=(), load=
 
     Parameters
     ----------
+    state : U, V (N, 3) [m, m/s] to start from, or a saved State inside the relaxation (its ``route`` holds the
+        explicit run's position), which goes on step for step as the uninterrupted run
     options : :class:`RelaxOptions`
-    U0, V0 : start [m] and half-step velocity v_(-1/2) [m/s] (default zero), e.g. to resume a
-        relaxation from its :class:`RelaxResult` (``U``, ``V``)
+    given_velocity : ``state.V`` is the half-step velocity v_(-1/2) (else the start is consistent from it)
     obstacles : obstacles acting kinematically (§6.3)
     load : (N, 3) external nodal load [N] instead of ``model.load`` (the resting state then balances it)
-    peak_kinetic : peak kinetic energy [J] of the motion so far, when resuming (``RelaxResult.peak_kinetic``)
-    checkpoint : saves the explicit state during the run, as in :func:`~rftstatic.solvers.explicit.run_explicit`
-        (and a Ctrl-C then stops at a whole step, saved)
-    restart : the explicit state saved during an earlier call with the same arguments
-        (:func:`~rftstatic.solvers.checkpoint.load_checkpoint`): the run continues from it, step for step as
-        the uninterrupted one (``peak_kinetic`` is the peak before that call; ``U0``, ``V0``, ``dt`` are unused)
+    peak_kinetic : peak kinetic energy [J] of the motion before this relaxation (``RelaxResult.peak_kinetic``)
     """
     P = model.load if load is None else load
     P_norm = float(np.linalg.norm(np.where(model.free, P, 0.0)))
     at_rest = AtRest(options.rest, load_norm=P_norm, peak_kinetic=peak_kinetic)
-    if restart is not None:  # the peaks of the samples before the interruption, as the rest test saw them
-        at_rest.resume_from(restart["history"])
-    run = run_explicit(model, options.explicit(given_velocity=V0 is not None), U0=U0, V0=V0, obstacles=obstacles,
-                       load=load, callback=at_rest, checkpoint=checkpoint, _restart=restart)
-    if not run.stopped:
-        log.warning("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
-                    run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])
+    saved = state.route.get(EXPLICIT)
+    if saved is not None:  # the peaks of the samples before the interruption, as the rest test saw them
+        at_rest.resume_from(saved["history"])
+    run = yield from explicit_steps(model, state, options.explicit(given_velocity=given_velocity), obstacles=obstacles,
+                                    load=load, callback=at_rest)
+    if not run.stopped:  # the caller decides what follows (the static route relaxes on or hands over)
+        log.info("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
+                 run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])
     return RelaxResult(U=run.U, converged=run.stopped, t=run.t, steps=run.steps, run=run, V=run.V,
                        peak_kinetic=at_rest.peak_kinetic)

@@ -16,13 +16,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
+from rftstatic.model.state import State
+from rftstatic.solvers.checkpoint import as_state
 from rftstatic.solvers.continuation import solve_arc_length
+from rftstatic.solvers.drive import Pause, finish
+from rftstatic.solvers.explicit import EXPLICIT
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
-from rftstatic.solvers.load_steps import solve_load_steps
+from rftstatic.solvers.load_steps import load_steps, solve_load_steps
 from rftstatic.solvers.newton import StaticResult, start_state
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
-from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RelaxOptions, relax
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RelaxOptions, relax_steps
 from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.units import STANDARD_GRAVITY
@@ -32,15 +36,20 @@ __all__ = ["ConvergenceError", "RelaxRoute", "StaticOptions", "StaticResult", "c
 log = logging.getLogger(__name__)
 
 
-def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None, checkpoint=None,
-                 restart=None) -> StaticResult:
-    """Solve the static equilibrium of ``model`` under its full load (see module docstring).
+STATIC = "static"
+"""The static route's key in ``State.route``: ``{"result": StaticResult}`` once the solve is done (a checkpoint
+written then lets an interrupted output step lose nothing)."""
 
-    The load-scaled Newton iteration is the main route. When it cannot get through (a drape whose
-    many folds snap through one after another) and ``relax_fallback`` is on, or when
-    ``start = "relax"``, dynamic relaxation (§6: damped, mass-scaled explicit motion at full load)
-    brings the sheet near rest and Newton polishes the equilibrium to the same tolerance; the
-    result's ``route`` and ``relax`` record what was done.
+RELAX_ROUTE = "relax-route"
+"""The relaxation route's key in ``State.route``: its :class:`RelaxRoute`."""
+
+SEGMENT = "relax-segment"
+"""The key in ``State.route`` of the explicit State of a relaxation segment under way (its own contact caches)."""
+
+
+def solve_static(model, *, U0=None, options: StaticOptions | None = None, callback=None) -> StaticResult:
+    """Solve the static equilibrium of ``model`` under its full load: :func:`static_route` from a fresh
+    :func:`~rftstatic.solvers.newton.start_state`, run to its end without checkpoints.
 
     Parameters
     ----------
@@ -48,10 +57,6 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
     U0 : (N, 3) start [m] (default: the flat reference, optionally perturbed)
     options : :class:`StaticOptions`
     callback : called as ``callback(lam, U)`` after every converged increment (frames, probes)
-    checkpoint : a :class:`~rftstatic.solvers.static_checkpoint.StaticCheckpointer` that saves the solve
-        after converged increments and relaxation segments (default: none)
-    restart : a :class:`~rftstatic.solvers.static_checkpoint.StaticRestart` (a loaded checkpoint of this
-        model and these options): the solve continues from it as the uninterrupted one did
 
     Raises
     ------
@@ -60,32 +65,45 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
         fails too); ``.result`` holds the last equilibrium (``converged=False``).
     """
     opts = options or StaticOptions()
-    state = start_state(model, opts.newton.linear_solver)  # shared by the phases of this solve
-    if checkpoint is not None:
-        checkpoint.state = state
-    if restart is not None:
-        restart.restore(model, state)
-        if restart.phase == "done":
-            return _check_stability(model, restart.result, state)
-        if restart.route is not None:
-            return _finish(model, _relax_then_newton(model, opts, callback, state, checkpoint=checkpoint,
-                                                     route=restart.route, segment=restart.segment), opts, state)
-    elif opts.route.start == "relax":
-        return _finish(model, _relax_then_newton(model, opts, callback, state, checkpoint=checkpoint), opts, state)
-    try:
-        if opts.increments.continuation == "arc-length" and restart is None:
-            return _finish(model, solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state),
-                           opts, state)
-        return _finish(model, solve_load_steps(
-            model, U0=U0, options=opts, callback=callback, state=state,
-            checkpoint=None if checkpoint is None else checkpoint.load_step,
-            resume=None if restart is None else restart.load_path), opts, state)
-    except ConvergenceError as exc:
-        if not opts.route.relax_fallback or model.load_terms or not np.any(model.load):
-            raise
-        log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
-        return _finish(model, _relax_then_newton(model, opts, callback, state, first=exc, checkpoint=checkpoint),
-                       opts, state)
+    state = start_state(model, opts.newton.linear_solver)
+    return finish(static_route(model, state, opts, U0=U0, callback=callback))
+
+
+def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
+    """The static solve as a route (:mod:`rftstatic.solvers.drive`): returns its :class:`StaticResult`.
+
+    The load-scaled Newton iteration is the main route. When it cannot get through (a drape whose
+    many folds snap through one after another) and ``relax_fallback`` is on, or when
+    ``start = "relax"``, dynamic relaxation (§6: damped, mass-scaled explicit motion at full load)
+    brings the sheet near rest and Newton polishes the equilibrium to the same tolerance; the
+    result's ``route`` and ``relax`` record what was done. Then the self-contact continuation and the
+    stability check; the result is kept in ``state.route`` at a final pause.
+
+    It pauses after converged increments (the load steps), at the ends of relaxation segments, after failed
+    handovers and after every explicit step of a segment; ``state`` (from
+    :func:`~rftstatic.solvers.newton.start_state`) with a saved ``route`` goes on from where that was saved.
+    """
+    done = state.route.get(STATIC)
+    if done is not None:
+        return done["result"]
+    if RELAX_ROUTE in state.route or opts.route.start == "relax":
+        result = yield from _relax_then_newton(model, opts, callback, state)
+    else:
+        try:
+            if opts.increments.continuation == "arc-length":
+                result = solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state)
+            else:
+                result = yield from load_steps(model, state, opts, U0=U0, callback=callback)
+        except ConvergenceError as exc:
+            if not opts.route.relax_fallback or model.load_terms or not np.any(model.load):
+                raise
+            log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
+            result = yield from _relax_then_newton(model, opts, callback, state, first=exc)
+    result = _check_stability(model, _stiffen_self_contact(model, result, opts, state), state)
+    state.route[STATIC] = {"result": result}
+    yield Pause("the result", final=True)
+    del state.route[STATIC]
+    return result
 
 
 SELF_CONTACT_STIFFENINGS = 3
@@ -134,11 +152,6 @@ def _stiffen_self_contact(model, result, opts, state):
         result.factorisations += res.factorisations
         result.load_steps = list(result.load_steps) + list(res.load_steps)
     return result
-
-
-def _finish(model, result, opts, state):
-    """The self-contact continuation (:func:`_stiffen_self_contact`), then the stability check."""
-    return _check_stability(model, _stiffen_self_contact(model, result, opts, state), state)
 
 
 def _check_stability(model, result, state):
@@ -253,7 +266,7 @@ def _relax_plan(model, first) -> _RelaxPlan:
                       chunk=4.0 / alpha, min_span=10 * est.dt)
 
 
-def _relax_then_newton(model, opts, callback, state, *, first=None, checkpoint=None, route=None, segment=None):
+def _relax_then_newton(model, opts, callback, state, *, first=None):
     """Dynamic relaxation at full load to near rest, then Newton to the full tolerance.
 
     The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while
@@ -267,17 +280,27 @@ def _relax_then_newton(model, opts, callback, state, *, first=None, checkpoint=N
     the 80 cm sheet did). The relaxation ends at rest at half the solver's ``rtol`` or at its time
     limit; Newton then finishes with the solver's own budget.
 
-    ``checkpoint`` saves the :class:`RelaxRoute` at the end of every segment and after every failed
-    handover, and the explicit state during a segment; ``route`` (and ``segment``, the explicit state
-    saved during its segment) continue a saved solve.
+    A route (:mod:`rftstatic.solvers.drive`): its :class:`RelaxRoute` is ``state.route[RELAX_ROUTE]``, the
+    explicit State of a segment under way ``state.route[SEGMENT]``. It pauses (final) after the failed load
+    steps, at the end of every segment and after every failed handover, and after every explicit step of a
+    segment; given a State with a saved route, it goes on from there.
     """
+    try:
+        return (yield from _relax_route(model, opts, callback, state, first))
+    finally:
+        state.route.pop(RELAX_ROUTE, None)
+        state.route.pop(SEGMENT, None)
+
+
+def _relax_route(model, opts, callback, state, first):
     t0 = time.perf_counter()
+    route = state.route.get(RELAX_ROUTE)
     first = route.first if route is not None else first
     plan = _relax_plan(model, first)
     if route is None:
-        route = _start_route(model, opts, plan, first)
-        if checkpoint is not None and first is not None:  # the end of the failed load steps' phase
-            checkpoint.route(route)
+        route = state.route[RELAX_ROUTE] = _start_route(model, opts, plan, first)
+        if first is not None:  # the end of the failed load steps' phase
+            yield _route_pause(route)
     polish = opts.from_state(relax_fallback=False)
     # a handover that fails gives way to more relaxation, not to the slower displacement iteration
     # (solved without the fallback to the displacement iteration)
@@ -296,13 +319,11 @@ def _relax_then_newton(model, opts, callback, state, *, first=None, checkpoint=N
 
     if route.phase in ("start", "guide"):
         if opts.route.guide_folds and opts.route.guide_weight:
-            _guided_relaxation(model, opts, plan, route, fail, checkpoint, segment)
-            segment = None
+            yield from _guided_relaxation(model, opts, plan, route, fail, state)
         route.phase = "relax"
     while True:
         if route.phase == "relax":
-            _relax_segment(model, opts, plan, route, fail, checkpoint, segment, t0)
-            segment = None
+            yield from _relax_segment(model, opts, plan, route, fail, state, t0)
         final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
         if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, state.solver):
             route.phase = "relax"
@@ -330,8 +351,7 @@ def _relax_then_newton(model, opts, callback, state, *, first=None, checkpoint=N
             log.info("Newton did not converge from the relaxed state at t = %.3g s (%s); relaxing further",
                      route.t_used, exc)
             route.tol_force, route.span, route.phase = 0.5 * opts.newton.rtol, plan.chunk, "relax"
-            if checkpoint is not None:
-                checkpoint.route(route)
+            yield _route_pause(route)
             continue
         handover["newton"] = f"converged in {res.iterations} iterations"
         break
@@ -340,9 +360,22 @@ def _relax_then_newton(model, opts, callback, state, *, first=None, checkpoint=N
     if first is not None and first.result is not None:
         res.cutbacks += first.result.cutbacks
         res.iterations += first.result.iterations
-    if checkpoint is not None:
-        checkpoint.done(res)
     return res
+
+
+def _route_pause(route) -> Pause:
+    """The final pause of the relaxation route where it stands (the end of a phase)."""
+    return Pause(f"relaxation to t = {route.t_used:.4g} s, {route.phase}", final=True)
+
+
+def _segment_state(model, state, route) -> State:
+    """The explicit State of the segment that starts from ``route`` (its own contact caches), or the one saved
+    in ``state.route``; kept there while the segment runs."""
+    seg = as_state(model, state.route.get(SEGMENT))
+    if seg is None:
+        seg = State.initial(model, route.U, route.V)
+    state.route[SEGMENT] = seg
+    return seg
 
 
 def _start_route(model, opts, plan, first) -> RelaxRoute:
@@ -360,63 +393,62 @@ def _start_route(model, opts, plan, first) -> RelaxRoute:
                       at_rest=False, seed=seed, info=info, first=first)
 
 
-def _relax_segment(model, opts, plan, route, fail, checkpoint, restart, t0) -> None:
-    """One relaxation segment from ``route`` (or from ``restart``, the explicit state saved during it): the
-    route then stands at its end (``"handover"``), which is saved."""
-    saver = None if checkpoint is None else checkpoint.segment(route)
+def _relax_segment(model, opts, plan, route, fail, state, t0):
+    """One relaxation segment from ``route`` (or going on with the segment saved in ``state``): the route then
+    stands at its end (``"handover"``), a final pause."""
+    seg = _segment_state(model, state, route)
+    saved = seg.route.get(EXPLICIT)
     span = max(min(route.span, plan.max_time - route.t_used), plan.min_span)
     rest = RestCriterion(tol_kinetic=1e-4, tol_force=route.tol_force)
     try:
-        rel = relax(model, RelaxOptions(mass_scale=plan.mass_scale, alpha=plan.alpha, rest=rest,
-                                        max_time=span if restart is None else float(restart["options"]["t_end"]),
-                                        progress=opts.progress, max_steps=RELAX_SEGMENT_STEPS,
-                                        max_steps_name="the relaxation route's segment limit"),
-                    U0=route.U, V0=route.V, peak_kinetic=route.peak, checkpoint=saver, restart=restart)
+        rel = yield from relax_steps(model, seg, RelaxOptions(
+            mass_scale=plan.mass_scale, alpha=plan.alpha, rest=rest,
+            max_time=span if saved is None else float(saved["options"]["t_end"]), progress=opts.progress,
+            max_steps=RELAX_SEGMENT_STEPS, max_steps_name="the relaxation route's segment limit"),
+            given_velocity=route.V is not None, peak_kinetic=route.peak)
     except InstabilityError as exc:
         raise fail(f"dynamic relaxation became unstable ({exc})") from None
     except StepLimitError as exc:  # the stable step at this state collapsed (a stretched start)
         raise fail(f"dynamic relaxation cannot go on from t = {route.t_used:.3g} s: {exc}") from None
+    del state.route[SEGMENT]
     route.U, route.V, route.peak, route.at_rest = rel.U, rel.V, rel.peak_kinetic, rel.converged
     route.t_used += rel.t
     route.info.update(time_s=route.t_used, steps=route.info["steps"] + rel.steps, at_rest=rel.converged,
                       rest_test=rest.record(), wall_time_s=time.perf_counter() - t0)
     route.phase = "handover"
-    if checkpoint is not None:
-        checkpoint.route(route)
+    yield _route_pause(route)
 
 
 GUIDE_DAMPING_TIMES = 30.0  # length of the guided stage of the relaxation [damping times 1/alpha]
 
 
-def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, checkpoint, restart) -> None:
+def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     """The guided first stage of :func:`_relax_then_newton`: relax under an n-fold modulated weight.
 
     The weight of every node is scaled by ``1 + guide_weight * fold_pattern(...)`` (so the total
     stays about the same and the load stays downward) for :data:`GUIDE_DAMPING_TIMES` damping
-    times; the model itself keeps its true load. ``restart``: the explicit state saved during this stage.
+    times; the model itself keeps its true load. A route: it goes on with the stage saved in ``state``.
     """
     guide = opts.route
     guided = model.load * (1.0 + guide.guide_weight * fold_pattern(model.mesh, guide.guide_folds, guide.seed))[:, None]
     route.phase = "guide"
-    saver = None if checkpoint is None else checkpoint.segment(route)
+    seg = _segment_state(model, state, route)
     try:
-        rel = relax(model, RelaxOptions(mass_scale=plan.mass_scale, alpha=plan.alpha,
-                                        rest=RestCriterion(tol_kinetic=1e-4, tol_force=1.0),
-                                        max_time=GUIDE_DAMPING_TIMES / plan.alpha, progress=opts.progress,
-                                        max_steps=RELAX_SEGMENT_STEPS,
-                                        max_steps_name="the relaxation route's segment limit"),
-                    U0=route.U, load=guided, checkpoint=saver, restart=restart)
+        rel = yield from relax_steps(model, seg, RelaxOptions(
+            mass_scale=plan.mass_scale, alpha=plan.alpha, rest=RestCriterion(tol_kinetic=1e-4, tol_force=1.0),
+            max_time=GUIDE_DAMPING_TIMES / plan.alpha, progress=opts.progress, max_steps=RELAX_SEGMENT_STEPS,
+            max_steps_name="the relaxation route's segment limit"), given_velocity=route.V is not None, load=guided)
     except InstabilityError as exc:
         raise fail(f"the guided dynamic relaxation became unstable ({exc})") from None
     except StepLimitError as exc:
         raise fail(f"the guided dynamic relaxation cannot run: {exc}") from None
+    del state.route[SEGMENT]
     route.U, route.V, route.peak, route.t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
     route.seed = guide.seed
     route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": guide.guide_folds, "weight": guide.guide_weight,
                                                             "time_s": rel.t, "steps": rel.steps})
     route.phase = "relax"
-    if checkpoint is not None:
-        checkpoint.route(route)
+    yield _route_pause(route)
 
 
 def _positive_definite(model, U, solver, lam=1.0, pairs=None) -> bool:

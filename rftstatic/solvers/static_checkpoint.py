@@ -1,66 +1,60 @@
 """Checkpoints of static solves: a long static run never loses finished work.
 
-During :func:`rftstatic.solvers.static.solve_static` a :class:`StaticCheckpointer` keeps one ``.npz``
-file, written atomically (:func:`rftstatic.solvers.checkpoint.save_atomic`: temporary file, fsync,
-``os.replace``), holding
+The app layer drives :func:`~rftstatic.solvers.static.static_route` and saves the solve's State at its pauses
+(:class:`~rftstatic.solvers.checkpoint.CheckpointSaver`, the one checkpoint format: the State with the position
+of every route under way, one ``.npz`` written atomically):
 
-* on the load-steps route, after a converged increment (:class:`~rftstatic.solvers.load_steps.LoadPath`):
-  the equilibrium U (N, 3) [m], its load factor, the next increment, the target displacement [m], the
-  previous equilibrium (secant predictor), the load-step records and counts;
-* on the relaxation route (:class:`~rftstatic.solvers.static.RelaxRoute`): U and the half-step velocities
-  V (N, 3) [m, m/s], the relaxation time used [s], the peak kinetic energy [J] and the handover records,
-  at the end of every relaxation segment and after every failed handover; during a segment also the
-  explicit state (:func:`~rftstatic.solvers.checkpoint.state_arrays`), from which the segment goes on
-  step for step as the uninterrupted one;
-* at the end, the result (``"done"``), so that an interruption while the outputs are written loses nothing.
+* on the load-steps route, after a converged increment (``State.route["load-steps"]``, a
+  :class:`~rftstatic.solvers.load_steps.LoadPath`: the equilibrium U (N, 3) [m], its load factor, the next
+  increment, the target displacement [m], the previous equilibrium and the load-step records);
+* on the relaxation route (``State.route["relax-route"]``, a :class:`~rftstatic.solvers.static.RelaxRoute`):
+  U and the half-step velocities V (N, 3) [m, m/s], the relaxation time used [s], the peak kinetic energy [J]
+  and the handover records, at the end of every relaxation segment and after every failed handover; during a
+  segment also the segment's explicit State (``State.route["relax-segment"]``), from which it goes on step
+  for step as the uninterrupted one;
+* at the end, the result (``State.route["static"]``), so that an interruption while the outputs are written
+  loses nothing.
 
-Writes are throttled to one per ``every_seconds`` of wall time (:data:`CHECKPOINT_SECONDS`), except at
-the end of a phase (the last increment, the end of a relaxation segment, a failed handover, the failed
-load steps before the relaxation fallback), which is always written. A converged increment not yet
-written is kept in memory and written when the solve is interrupted (:meth:`StaticCheckpointer.on_interrupt`);
-a Ctrl-C during a relaxation segment stops it at a whole step, which is saved. A kill loses at most
-``every_seconds`` of work.
+Writes are throttled to one per ``every_seconds`` of wall time (:data:`CHECKPOINT_SECONDS`), except at the end
+of a phase (the last increment, the end of a relaxation segment, a failed handover, the failed load steps
+before the relaxation fallback, the result), which is always written. A converged increment not yet written is
+kept in memory and written when the solve is interrupted; a Ctrl-C stops the solve at its next pause, saved. A
+kill loses at most ``every_seconds`` of work.
 
-Every file names the scene, the mesh size, a fingerprint of the model (mesh, supports, load, material,
-element, contact) and the solver options; :func:`load_static_checkpoint` refuses a file written for
-another scene, mesh, model or options, or a corrupt one, with a :class:`~rftstatic.errors.CheckpointError`
-naming the file and what differs.
+Every file's header names the scene, the mesh size, a fingerprint of the model (mesh, supports, load, material,
+element, contact) and the solver options; :func:`load_static_state` refuses a file written for another scene,
+mesh, model or options, or a corrupt one, with a :class:`~rftstatic.errors.CheckpointError` naming the file and
+what differs.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import zipfile
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, fields
 from pathlib import Path
 
 import numpy as np
 
-from rftstatic.errors import CheckpointError, ConvergenceError
+from rftstatic.errors import CheckpointError
 from rftstatic.solvers.checkpoint import (
-    ThrottledWriter,
+    CheckpointSaver,
     json_array,
-    load_checkpoint,
     model_fingerprint,
     plain,
-    state_arrays,
+    read_checkpoint,
+    restore_state,
 )
-from rftstatic.solvers.load_steps import LoadPath
-from rftstatic.solvers.newton import StaticResult
-from rftstatic.solvers.static import RelaxRoute
-
-
-FORMAT = 1
-"""Version of the static checkpoint layout (key ``static_format``)."""
+from rftstatic.solvers.load_steps import LOAD_STEPS
+from rftstatic.solvers.newton import StaticResult, start_state
+from rftstatic.solvers.static import RELAX_ROUTE, SEGMENT, STATIC
 
 CHECKPOINT_SECONDS = 10.0
 """Least wall time [s] between two checkpoint writes of a static solve (the ends of phases excepted). A
 write of the 51 x 11 strip or the 33 x 33 drape (about 35 kB) took 7-17 ms on the 2-core test machine,
-nearly all of it the fsync: written after each of the strip's 7 increments, 4-6 % of its 1.3 s solve."""
+nearly all of it the fsync."""
 
-_RESULT_FIELDS = [f.name for f in fields(StaticResult) if f.name not in ("U", "state")]
-
+_RESULT_FIELDS = [f.name for f in fields(StaticResult) if f.name != "U"]
 
 def static_fingerprint(model) -> str:
     """SHA-1 of what a static solve of ``model`` depends on: :func:`model_fingerprint` (mesh, supports,
@@ -77,6 +71,56 @@ def static_fingerprint(model) -> str:
 def options_spec(options) -> dict:
     """The solver options that decide the result (all of :class:`StaticOptions` but ``progress``)."""
     return {k: v for k, v in asdict(options).items() if k != "progress"}
+
+
+def static_header(model, options, scene: str = "") -> dict:
+    """What a static solve's checkpoint is for: the scene's name, the mesh size, the element, the model's
+    fingerprint and the solver options."""
+    return {"kind": "static", "scene": scene, "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements,
+            "element": model.element, "model": static_fingerprint(model), "options": options_spec(options)}
+
+
+def static_saver(path, model, options, *, scene: str = "", every_seconds: float = CHECKPOINT_SECONDS) -> CheckpointSaver:
+    """The saver of a static solve of ``model`` with ``options`` to ``path`` (module docstring)."""
+    return CheckpointSaver(path, static_header(model, options, scene), every_seconds=every_seconds,
+                           run="the static solve")
+
+
+def load_static_state(path, model, options, *, scene: str = ""):
+    """The State of a static solve of ``model`` with ``options`` (of scene ``scene``) saved in ``path``, with a
+    new linear solver and contact caches: :func:`~rftstatic.solvers.static.static_route` goes on from it.
+
+    Raises
+    ------
+    CheckpointError
+        if the file is missing, corrupt, not a static run's, or written for another scene, mesh, model or
+        solver options (the message names the file and the difference).
+    """
+    path = Path(path)
+    header, saved = read_checkpoint(path)
+    if header.get("kind") != "static":
+        raise CheckpointError(f"checkpoint {path} was not written by a static solve (a {header.get('kind')} "
+                              "run's?); run without --resume")
+    _check_header(path, header, model, options, scene)
+    return restore_state(model, saved, start_state(model, options.newton.linear_solver))
+
+
+def where(state) -> dict:
+    """Where the saved static solve ``state`` stood (for ``summary.json``): phase, and load factor and load
+    steps, or relaxation time [s] and handovers."""
+    r = state.route
+    if STATIC in r:
+        res = r[STATIC]["result"]
+        return {"phase": "done", "load_factor": res.lam, "load_steps": len(res.load_steps)}
+    if RELAX_ROUTE in r:
+        route = r[RELAX_ROUTE]
+        seg = r.get(SEGMENT)
+        t = route.t_used + (0.0 if seg is None else seg["t"] if isinstance(seg, dict) else seg.t)
+        return {"phase": route.phase, "relaxation_time_s": t, "handovers": len(route.info.get("handovers", []))}
+    if LOAD_STEPS in r:
+        path = r[LOAD_STEPS]
+        return {"phase": "load-steps", "load_factor": path.lam, "load_steps": len(path.result.load_steps)}
+    return {"phase": "start"}
 
 
 def remove_stale(path) -> None:
@@ -106,174 +150,6 @@ def result_from(prefix, z) -> StaticResult:
     return StaticResult(U=z[prefix + "U"].copy(), **json.loads(str(z[prefix + "result"])))
 
 
-class StaticCheckpointer(ThrottledWriter):
-    """Saves a static solve to ``path`` (module docstring); given to :func:`solve_static` as ``checkpoint``.
-
-    Parameters
-    ----------
-    path : the checkpoint file (``.npz``)
-    model, options : the model and :class:`StaticOptions` of the solve (their fingerprints are saved)
-    scene : the scene's name, saved to refuse another scene's checkpoint
-    every_seconds : least wall time between two writes [s] (0: write every increment)
-
-    Attributes
-    ----------
-    writes : files written; write_time : wall time spent writing them [s]
-    saved : what the last write holds (e.g. ``"load factor 0.42"``), for messages
-    state : the solve's :class:`~rftstatic.model.state.State` (set by :func:`solve_static`; its factorisation
-        count, damping scale and load branches are saved)
-    """
-
-    run = "the static solve"
-
-    def __init__(self, path, model, options, *, scene: str = "", every_seconds: float = CHECKPOINT_SECONDS):
-        super().__init__(path, every_seconds)
-        self.header = {"scene": scene, "nodes": model.mesh.n_nodes, "elements": model.mesh.n_elements,
-                       "element": model.element, "model": static_fingerprint(model), "options": options_spec(options)}
-        self.model = model
-        self.state = None
-
-    def _common(self, phase) -> dict:
-        state = self.state
-        branches = list(state.load_branches or ()) if state is not None else []  # committed angle branches
-        return {"static_format": np.array(FORMAT), "static_header": json_array(self.header), "phase": np.array(phase),
-                "workspace": json_array({"factorisations": 0 if state is None else state.factorisations,
-                                    "lm_scale": None if state is None else state.lm_scale, "load_terms": branches})}
-
-    def load_step(self, path: LoadPath) -> None:
-        """After a converged increment: keep the load path, write it when due and at full load."""
-        r = path.result
-        counts = {k: getattr(r, k) for k in ("iterations", "cutbacks", "retries", "residual", "seed")}
-        counts["tangent_modes"] = dict(self.state.modes) if self.state is not None else {}
-        arrays = {**self._common("load-steps"), "U": _field(path.U), "U_prev": _field(path.U_prev),
-                  "path": json_array({"lam": path.lam, "dlam": path.dlam, "target": path.target,
-                                 "lam_prev": path.lam_prev, "load_steps": list(r.load_steps), **counts})}
-        self._pending = (arrays, f"load factor {path.lam:.6g}, {len(r.load_steps)} increments")
-        if path.lam >= 1.0 or self.due():
-            self.flush()
-
-    def _route_arrays(self, route: RelaxRoute) -> dict:
-        first = route.first
-        arrays = {**self._common(route.phase), "route_U": _field(route.U), "route_V": _field(route.V),
-                  "route": json_array({k: getattr(route, k) for k in ("phase", "t_used", "peak", "tol_force", "span",
-                                                                  "at_rest", "seed", "info")}),
-                  "first": json_array(None if first is None else str(first))}
-        if first is not None and first.result is not None:
-            arrays.update(result_arrays("first_", first.result))
-        return arrays
-
-    def route(self, route: RelaxRoute) -> None:
-        """Write the relaxation route where it stands (the end of a phase: not throttled)."""
-        self._write(self._route_arrays(route), f"relaxation to t = {route.t_used:.4g} s, {route.phase}")
-
-    def segment(self, route: RelaxRoute) -> _SegmentSaver:
-        """The explicit run's checkpoint object for the relaxation segment that starts from ``route``."""
-        return _SegmentSaver(self, route)
-
-    def done(self, result: StaticResult) -> None:
-        """Write the solve's result (not throttled)."""
-        self._write({**self._common("done"), **result_arrays("", result)}, "the result")
-
-
-class _SegmentSaver:
-    """The checkpoint object of :func:`~rftstatic.solvers.explicit.run_explicit` during one relaxation segment
-    (``due(step)``, ``save(...)``): the explicit state with the route where the segment started."""
-
-    def __init__(self, owner: StaticCheckpointer, route: RelaxRoute):
-        self.owner, self.route = owner, route
-
-    def due(self, step: int) -> bool:
-        return self.owner.due()
-
-    def save(self, model, obstacles, state, **explicit) -> None:
-        arrays = {**state_arrays(model, obstacles, state, **explicit), **self.owner._route_arrays(self.route)}
-        t = self.route.t_used + state.t
-        self.owner._write(arrays, f"relaxation to t = {t:.4g} s, step {state.step} of a segment")
-
-
-@dataclass
-class StaticRestart:
-    """A loaded static checkpoint (:func:`load_static_checkpoint`), for :func:`solve_static`'s ``restart``.
-
-    Attributes
-    ----------
-    path : the file; phase : ``"load-steps"``, ``"start"``, ``"guide"``, ``"relax"``, ``"handover"`` or ``"done"``
-    load_path : the load steps' state (phase ``"load-steps"``)
-    route : the relaxation route's state (the relaxation phases)
-    segment : the explicit state inside a relaxation segment (:func:`load_checkpoint`), or None
-    result : the finished solve's result (phase ``"done"``)
-    factorisations, lm_scale : the solve State's counts (:class:`~rftstatic.model.state.State`)
-    load_terms : the committed branch of each of the model's potential loads (``State.load_branches``)
-    where : where the saved solve stood (for ``summary.json``): phase, load factor and load steps, or
-        relaxation time [s]
-    """
-
-    path: Path
-    phase: str
-    load_path: LoadPath | None = None
-    route: RelaxRoute | None = None
-    segment: dict | None = None
-    result: StaticResult | None = None
-    factorisations: int = 0
-    lm_scale: float | None = None
-    load_terms: list | None = None
-    where: dict | None = None
-
-    def restore(self, model, state) -> None:
-        """Give the solve's State ``state`` its saved counts and the saved branches of ``model``'s
-        potential loads, before the solve continues."""
-        state.factorisations, state.lm_scale = self.factorisations, self.lm_scale
-        if self.load_terms and len(self.load_terms) == len(model.load_terms):
-            state.load_branches = tuple(None if b is None else np.asarray(b, dtype=float) for b in self.load_terms)
-
-    def _where(self) -> dict:
-        out = {"phase": self.phase}
-        if self.load_path is not None:
-            out.update(load_factor=self.load_path.lam, load_steps=len(self.load_path.result.load_steps))
-        if self.route is not None:
-            t = self.route.t_used + (self.segment["t"] if self.segment is not None else 0.0)
-            out.update(relaxation_time_s=t, handovers=len(self.route.info.get("handovers", [])))
-        if self.result is not None:
-            out.update(load_factor=self.result.lam, load_steps=len(self.result.load_steps))
-        return out
-
-
-def load_static_checkpoint(path, model, options, *, scene: str = "") -> StaticRestart:
-    """Read the static checkpoint ``path`` of a solve of ``model`` with ``options`` (of scene ``scene``).
-
-    Raises
-    ------
-    CheckpointError
-        if the file is missing, corrupt, not a static run's, or written for another scene, mesh, model or
-        solver options (the message names the file and the difference).
-    """
-    path = Path(path)
-    if not path.exists():
-        raise CheckpointError(f"checkpoint {path} does not exist")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            if "static_format" not in z.files:
-                raise CheckpointError(f"checkpoint {path} was not written by a static solve (a dynamic or relax "
-                                      "run's?); run without --resume")
-            if int(z["static_format"]) != FORMAT:
-                raise CheckpointError(f"checkpoint {path}: static format {int(z['static_format'])}, this version "
-                                      f"reads {FORMAT}; run without --resume")
-            _check_header(path, json.loads(str(z["static_header"])), model, options, scene)
-            restart = _restart_from(path, z)
-            in_segment = restart.phase in ("guide", "relax") and "format" in z.files  # the explicit state too
-    except (OSError, ValueError, KeyError, TypeError, zipfile.BadZipFile, json.JSONDecodeError) as exc:
-        if isinstance(exc, CheckpointError):
-            raise
-        raise CheckpointError(f"checkpoint {path} is corrupt or incomplete ({type(exc).__name__}: {exc}); "
-                              "run without --resume to start again") from None
-    if in_segment:
-        restart.segment = load_checkpoint(path)
-        if restart.segment["fingerprint"] != model_fingerprint(model):
-            raise CheckpointError(f"checkpoint {path}: its relaxation state was written for another model")
-    restart.where = restart._where()
-    return restart
-
-
 def _check_header(path, head, model, options, scene) -> None:
     """CheckpointError naming the first difference between the saved run and this one."""
     if scene and head["scene"] and head["scene"] != scene:
@@ -296,27 +172,3 @@ def _check_header(path, head, model, options, scene) -> None:
                               "run without --resume or with the options of the interrupted run")
 
 
-def _restart_from(path, z) -> StaticRestart:
-    phase = str(z["phase"])
-    saved = json.loads(str(z["workspace"]))
-    out = StaticRestart(path=path, phase=phase, factorisations=int(saved["factorisations"]), lm_scale=saved["lm_scale"],
-                        load_terms=saved["load_terms"])
-    if phase == "done":
-        out.result = result_from("", z)
-    elif phase == "load-steps":
-        p = json.loads(str(z["path"]))
-        result = StaticResult(U=z["U"].copy(), lam=p["lam"], converged=False, load_steps=p["load_steps"],
-                              iterations=p["iterations"], cutbacks=p["cutbacks"], retries=p["retries"],
-                              residual=p["residual"], seed=p["seed"], tangent_modes=p["tangent_modes"])
-        out.load_path = LoadPath(lam=p["lam"], U=z["U"].copy(), dlam=p["dlam"], target=p["target"],
-                                 lam_prev=p["lam_prev"], U_prev=_unfield(z["U_prev"]), result=result)
-    elif phase in ("start", "guide", "relax", "handover"):
-        r = json.loads(str(z["route"]))
-        message = json.loads(str(z["first"]))
-        first = None
-        if message is not None:
-            first = ConvergenceError(message, result_from("first_", z) if "first_U" in z.files else None)
-        out.route = RelaxRoute(U=_unfield(z["route_U"]), V=_unfield(z["route_V"]), first=first, **r)
-    else:
-        raise CheckpointError(f"checkpoint {path}: unknown phase {phase!r}; run without --resume")
-    return out

@@ -173,14 +173,14 @@ def test_a_failed_finest_level_is_reported_with_the_levels_solved_below_it(tmp_p
     """When the finest Newton fails, summary.json still lists every level (the coarse ones converged, the
     finest not), the route and the counters over all of them; the state written is the finest level's
     last iterate at full load (a cut back would have unloaded the carried drape)."""
-    solve = levels_mod.solve_static
+    route = levels_mod.static_route
 
-    def starved_finest(model, *, U0=None, options=None, **kw):  # the fine level gets a single iteration
+    def starved_finest(model, state, options, *, U0=None, **kw):  # the fine level gets a single iteration
         if U0 is not None:
             options = options.replace(max_iterations=1, max_continuations=0)
-        return solve(model, U0=U0, options=options, **kw)
+        return route(model, state, options, U0=U0, **kw)
 
-    monkeypatch.setattr(levels_mod, "solve_static", starved_finest)
+    monkeypatch.setattr(levels_mod, "static_route", starved_finest)
     out = tmp_path / "run"
     with pytest.raises(ConvergenceError, match=r"level 2 of 2 .* from the given state") as info:
         app.run(load_scene("pedestal-square-20", DRAPE), out, progress=False, figures=False)

@@ -4,6 +4,7 @@ is refused with a CheckpointError."""
 
 import json
 import signal
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -16,7 +17,9 @@ from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import static_options
 from rftstatic.scenes.schema import load_scene
 from rftstatic.solvers import load_steps, rest
-from rftstatic.solvers.static_checkpoint import load_static_checkpoint
+from rftstatic.model.state import State
+from rftstatic.solvers.checkpoint import explicit_header, save_atomic, state_arrays
+from rftstatic.solvers.static_checkpoint import load_static_state, where
 
 STRIP = ["mesh.nodes=[21,5]"]  # 7 load increments in about 0.2 s
 DRAPE = ["mesh.nodes=[7,7]"]  # start = "relax": two handovers (the first Newton fails), about 3 s
@@ -27,8 +30,13 @@ def _solve(scene, out, **kw):
 
 
 def _load(scene, path):
+    """The saved State of the static solve in ``path``, and its routes' positions by name."""
     model, _ = build_model(scene)
-    return load_static_checkpoint(path, model, static_options(scene, progress=False), scene=scene.name)
+    state = load_static_state(path, model, static_options(scene, progress=False), scene=scene.name)
+    r = state.route
+    return SimpleNamespace(state=state, phase=where(state)["phase"], load_path=r.get("load-steps"),
+                           route=r.get("relax-route"), segment=r.get("relax-segment"),
+                           result=r.get("static", {}).get("result"))
 
 
 def _same(a, b, rtol=1e-9):
@@ -63,7 +71,7 @@ def _interrupt_at(k):
 def test_an_interrupted_load_step_solve_resumes_to_the_same_equilibrium(tmp_path, strip_full):
     scene, full = strip_full
     steps = full.summary["solver_path"]
-    assert len(steps) >= 5 and full.summary["checkpoint"]["writes"] == 1  # throttled: the last increment only
+    assert len(steps) >= 5 and full.summary["checkpoint"]["writes"] == 2  # throttled: the last increment, the result
     out = tmp_path / "cut"
     with pytest.raises(KeyboardInterrupt):  # at the 4th increment; the 3rd is the last one kept
         _solve(scene, out, callback=_interrupt_at(4), checkpoint_seconds=1e9)
@@ -83,9 +91,9 @@ def test_every_increment_is_saved_without_the_throttle(tmp_path, strip_full):
     scene, full = strip_full
     out = tmp_path / "each"
     s = _solve(scene, out, checkpoint_seconds=0.0).summary
-    assert s["checkpoint"]["writes"] == len(full.summary["solver_path"])
-    done = _load(scene, out / "checkpoint.npz")  # the last: full load, which a resume only writes out
-    assert done.load_path.lam == 1.0
+    assert s["checkpoint"]["writes"] == len(full.summary["solver_path"]) + 1  # and the result
+    done = _load(scene, out / "checkpoint.npz")  # the last: the result, which a resume only writes out
+    assert done.phase == "done" and done.result.lam == 1.0
     again = _solve(scene, out, resume=True)
     assert np.array_equal(again.U, full.U) and again.summary["newton_iterations"] == full.summary["newton_iterations"]
 
@@ -166,7 +174,8 @@ def test_a_corrupt_checkpoint_is_a_checkpoint_error_and_exit_status_2(tmp_path, 
 
 def test_a_dynamic_runs_checkpoint_is_not_taken_for_a_static_one(tmp_path, strip_full):
     scene, _ = strip_full
-    np.savez(tmp_path / "checkpoint.npz", format=np.array(1), t=np.array(0.1))
+    model, _ = build_model(scene)
+    save_atomic(tmp_path / "checkpoint.npz", state_arrays(State.initial(model), explicit_header(model, ())))
     with pytest.raises(CheckpointError, match="not written by a static solve"):
         _solve(scene, tmp_path, resume=True)
 

@@ -11,7 +11,10 @@ from rftstatic.errors import CheckpointError, InstabilityError
 from rftstatic.material import fabric, preset
 from rftstatic.mesh.trimesh import rectangle
 from rftstatic.model.model import Model, Supports, gravity_load
-from rftstatic.solvers.checkpoint import Checkpointer, load_checkpoint, resume
+from rftstatic.model.state import State
+from rftstatic.solvers.checkpoint import CheckpointSaver, explicit_header, load_explicit_state, read_checkpoint
+from rftstatic.solvers.drive import drive
+from rftstatic.solvers.explicit import explicit_steps
 from rftstatic.solvers.explicit import run_explicit
 from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.relaxation import RelaxOptions, relax
@@ -198,10 +201,10 @@ def test_resume_reproduces_the_uninterrupted_run(tmp_path):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        run_explicit(model, options, callback=interrupt, checkpoint=Checkpointer(path, every_steps=100), **kw)
-    assert load_checkpoint(path)["step"] == 200
+        _checkpointed(model, options, path, callback=interrupt, **kw)
+    assert read_checkpoint(path)[1]["step"] == 200
     assert [p.name for p in tmp_path.iterdir()] == ["run.npz"]  # no temporary file left
-    res = resume(path, model)
+    res = _resume(path, model)
     assert np.array_equal(res.U, full.U) and np.array_equal(res.V, full.V)
     for k in full.history:
         assert np.array_equal(res.history[k], full.history[k]), k
@@ -209,7 +212,21 @@ def test_resume_reproduces_the_uninterrupted_run(tmp_path):
     assert [t for t, _ in res.frames] == [t for t, _ in full.frames]
     assert all(np.array_equal(a, b) for (_, a), (_, b) in zip(res.frames, full.frames))
     with pytest.raises(CheckpointError, match="another model"):
-        resume(path, strip(WOOL))
+        _resume(path, strip(WOOL))
+
+
+def _checkpointed(model, options, path, **kw):
+    """The explicit run of ``model`` driven with a checkpoint saver (every 100 steps, Ctrl-C at a whole step)."""
+    state = State.initial(model)
+    saver = CheckpointSaver(path, explicit_header(model, ()), every_steps=100)
+    with saver.stopping():
+        return drive(explicit_steps(model, state, options, **kw), saver.on(state))
+
+
+def _resume(path, model):
+    """The explicit run saved in ``path`` continued to its end."""
+    state, options, frame_times, probes = load_explicit_state(path, model, progress=False)
+    return drive(explicit_steps(model, state, options, frame_times=frame_times, probes=probes))
 
 
 def test_ctrl_c_saves_a_whole_step_and_resume_reproduces_the_run(tmp_path):
@@ -227,12 +244,11 @@ def test_ctrl_c_saves_a_whole_step_and_resume_reproduces_the_run(tmp_path):
             signal.raise_signal(signal.SIGINT)
 
     with pytest.raises(KeyboardInterrupt, match="checkpoint saved"):
-        run_explicit(model, options, probes=[tip(model)], callback=press_ctrl_c,
-                     checkpoint=Checkpointer(path, every_steps=100))
-    saved = load_checkpoint(path)["step"]
+        _checkpointed(model, options, path, probes=[tip(model)], callback=press_ctrl_c)
+    saved = read_checkpoint(path)[1]["step"]
     assert 250 < saved < 260  # the step after the signal, not the last periodic checkpoint (200)
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the handler is restored
-    res = resume(path, model)
+    res = _resume(path, model)
     assert np.array_equal(res.U, full.U) and np.array_equal(res.V, full.V)
     for k in full.history:
         assert np.array_equal(res.history[k], full.history[k]), k
@@ -242,7 +258,7 @@ def test_a_corrupt_checkpoint_is_reported_as_such(tmp_path):
     path = tmp_path / "run.npz"
     path.write_bytes(b"PK\x03\x04 not really a zip")
     with pytest.raises(CheckpointError, match="corrupt or incomplete"):
-        load_checkpoint(path)
+        read_checkpoint(path)
 
 
 def test_numpy_and_numba_runs_agree():

@@ -10,8 +10,10 @@ from rftstatic.model import model as model_mod
 from rftstatic.model.loads import LeverMoment
 from rftstatic.references import END_MOMENT
 from rftstatic.solvers.options import StaticOptions
-from rftstatic.solvers.static import solve_static
-from rftstatic.solvers.static_checkpoint import StaticCheckpointer, load_static_checkpoint
+from rftstatic.solvers.drive import drive
+from rftstatic.solvers.newton import start_state
+from rftstatic.solvers.static import solve_static, static_route
+from rftstatic.solvers.static_checkpoint import load_static_state, static_saver
 
 
 def _rolled_strip(nx=9):
@@ -37,13 +39,14 @@ def test_a_resumed_roll_up_keeps_the_branch_of_its_lever_angles(tmp_path):
         if lam > 0.75:  # the end has turned past pi: angles only a committed branch tells apart
             raise KeyboardInterrupt
 
-    saver = StaticCheckpointer(path, model, opts, every_seconds=0.0)
+    saver = static_saver(path, model, opts, every_seconds=0.0)
+    state = start_state(model)
     with pytest.raises(KeyboardInterrupt), saver.on_interrupt():
-        solve_static(model, options=opts, callback=stop, checkpoint=saver)
+        drive(static_route(model, state, opts, callback=stop), saver.on(state))
     again = _rolled_strip()
-    restart = load_static_checkpoint(path, again, opts)
-    assert 0.5 < restart.load_path.lam <= 0.75 and restart.load_terms[0][0] > np.pi
-    res = solve_static(again, options=opts, restart=restart)
+    saved = load_static_state(path, again, opts)
+    assert 0.5 < saved.route["load-steps"].lam <= 0.75 and saved.load_branches[0][0] > np.pi
+    res = drive(static_route(again, saved, opts))
     assert res.converged and [s["lam"] for s in res.load_steps] == [s["lam"] for s in full.load_steps]
     assert np.abs(res.U - full.U).max() <= 1e-9 * np.abs(full.U).max()
     # the moment's potential -M phi counts the turns: on another branch it would be off by 2 pi M
