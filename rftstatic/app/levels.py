@@ -38,12 +38,13 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError
+from rftstatic.errors import CheckpointError, ConvergenceError
 from rftstatic.remesh.transfer import transfer_fields
 from rftstatic.scenes.build import build_mesh, build_model
 from rftstatic.scenes.levels import level_scenes
 from rftstatic.scenes.options import run_options
-from rftstatic.solvers.checkpoint import save_atomic
+from rftstatic.model.state import State
+from rftstatic.solvers.checkpoint import read_checkpoint, save_atomic, state_arrays
 from rftstatic.solvers.drive import drive
 from rftstatic.solvers.newton import start_state
 from rftstatic.solvers.static import solve_static, static_route
@@ -246,26 +247,25 @@ def _level_path(folder, k) -> Path:
 
 
 def _save_level(folder, k, model, U, record) -> None:
-    import json
-
-    save_atomic(_level_path(folder, k), {"U": U, "fingerprint": np.array(static_fingerprint(model)),
-                                         "record": np.array(json.dumps(record, default=float))})
+    """Level ``k``'s equilibrium ``U`` (N, 3) [m] of ``model`` and its record, in the one checkpoint format (a State
+    whose ``route["level"]`` is the record), keyed to the model's fingerprint."""
+    state = State(U=np.array(U, dtype=float), V=np.zeros_like(U), route={"level": record})
+    save_atomic(_level_path(folder, k), state_arrays(state, {"kind": "level", "level": k,
+                                                             "model": static_fingerprint(model)}))
 
 
 def _load_level(folder, k, model):
     """A saved level of this model (same fingerprint), or None (logged) when there is none or it differs."""
-    import json
-    import zipfile
-
     if folder is None or not _level_path(folder, k).exists():
         return None
     path = _level_path(folder, k)
     try:
-        with np.load(path, allow_pickle=False) as z:
-            if str(z["fingerprint"]) != static_fingerprint(model) or z["U"].shape != (model.mesh.n_nodes, 3):
-                log.warning("%s was saved for another model: level %d is solved again", path, k)
-                return None
-            return {"U": z["U"].copy(), "record": json.loads(str(z["record"]))}
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile, json.JSONDecodeError) as exc:
-        log.warning("%s cannot be read (%s): level %d is solved again", path, exc, k)
+        header, saved = read_checkpoint(path)
+    except CheckpointError as exc:
+        log.warning("%s (level %d is solved again)", exc, k)
         return None
+    if header.get("kind") != "level" or header.get("model") != static_fingerprint(model) or \
+            saved["U"].shape != (model.mesh.n_nodes, 3):
+        log.warning("%s was saved for another model: level %d is solved again", path, k)
+        return None
+    return {"U": saved["U"], "record": saved["route"]["level"]}

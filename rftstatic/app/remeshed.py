@@ -47,10 +47,12 @@ from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_sum
                                    summary_header)
 from rftstatic.optionspec import scene_values
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
-from rftstatic.remesh.checkpoint import FIX, RemeshCheckpointer, load_remesh_checkpoint
+from rftstatic.model.state import State
+from rftstatic.remesh.checkpoint import FIX, REMESH_RELAX, REMESH_STATIC, load_remesh_state, remesh_saver, where
 from rftstatic.remesh.options import RemeshRelaxOptions
-from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax
-from rftstatic.remesh.static_driver import remesh_static
+from rftstatic.remesh.relax_driver import explicit_advance, remesh_relax_route
+from rftstatic.remesh.static_driver import remesh_static_route
+from rftstatic.solvers.drive import drive
 from rftstatic.scenes.build import MAX_MESH_NODES, build_model
 from rftstatic.scenes.options import dynamics_options, remesh_options, static_options
 from rftstatic.solvers.rest import RestCriterion
@@ -62,6 +64,9 @@ log = logging.getLogger(__name__)
 __all__ = ["run", "resume_scene", "run_remesh_scene", "solve_remesh_scene", "summarize", "checkpoint_header"]
 
 CHECKPOINT = "checkpoint.npz"
+
+TRACK = "remesh-track"
+"""The key in ``State.route`` of the remeshed relaxation's tracker (:meth:`_Tracker.position`)."""
 
 SAFETY = 0.5
 """Safety factor on the critical explicit step of the remeshed relaxation (a new mesh starts moving)."""
@@ -80,18 +85,18 @@ class _Tracker:
         self.t, self.steps, self.meshes, self.last = 0.0, 0, [], None
         self._rebind = False
 
-    def state(self) -> tuple[dict, dict]:
-        """The checkpoint fields (time, steps, snapshot times and steps) and arrays (the snapshots' U)."""
-        fields = {"t": self.t, "steps": self.steps, "snap_t": [m["t"] for m in self.meshes],
-                  "snap_step": [m["step"] for m in self.meshes], **self.advance.state()}
-        return fields, {"snap_U": np.concatenate([m["U"] for m in self.meshes]) if self.meshes else np.zeros((0, 3))}
+    def position(self) -> dict:
+        """What a checkpoint keeps (``State.route[TRACK]``): time, steps, the snapshots' times, steps and U, and the
+        stepper's damping history and step."""
+        return {"t": self.t, "steps": self.steps, "snap_t": [m["t"] for m in self.meshes],
+                "snap_step": [m["step"] for m in self.meshes], "snap_U": [m["U"] for m in self.meshes],
+                **self.advance.state()}
 
-    def restore(self, fields: dict, arrays: dict, meshes: list) -> None:
-        """Continue from :meth:`state` of a run whose driver had made ``meshes``."""
+    def restore(self, fields: dict, meshes: list) -> None:
+        """Continue from :meth:`position` of a run whose driver had made ``meshes``."""
         self.t, self.steps = float(fields["t"]), int(fields["steps"])
-        offsets = np.cumsum([0] + [m.n_nodes for m in meshes])
-        self.meshes = [{"mesh": meshes[k], "model": None, "U": arrays["snap_U"][offsets[k]:offsets[k + 1]].copy(),
-                        "t": t, "step": step} for k, (t, step) in enumerate(zip(fields["snap_t"], fields["snap_step"]))]
+        self.meshes = [{"mesh": meshes[k], "model": None, "U": np.array(U), "t": t, "step": step}
+                       for k, (t, step, U) in enumerate(zip(fields["snap_t"], fields["snap_step"], fields["snap_U"]))]
         self._rebind = len(self.meshes) == len(meshes)  # the next call is on the last snapshot's mesh
         self.advance.restore(fields, same_mesh=self._rebind)
 
@@ -126,19 +131,19 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False,
     opts = remesh_options(scene)
     path = out / CHECKPOINT
     remove_stale(path)  # the temporary file of a write that a kill cut short
-    restart = None
+    state, resumed = None, None
     if resume and path.exists():
-        restart = load_remesh_checkpoint(path, checkpoint_header(scene))
-        log.info("resuming the remeshed run from %s (%s)", path, restart.where)
+        state = load_remesh_state(path, checkpoint_header(scene))
+        resumed = where(state)
+        log.info("resuming the remeshed run from %s (%s)", path, resumed)
     elif resume:
         log.warning("no checkpoint %s: running from the start", path)
-    saver = RemeshCheckpointer(path, checkpoint_header(scene), every_seconds=checkpoint_seconds)
-    with saver.on_interrupt():
-        solved = solve_remesh_scene(scene, opts, checkpoint=saver, restart=restart)
+    saver = remesh_saver(path, checkpoint_header(scene), every_seconds=checkpoint_seconds)
+    with saver.stopping():
+        solved = solve_remesh_scene(scene, opts, state=state, saver=saver)
     summary = summarize(scene, opts, solved)
-    summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or restart else None, "writes": saver.writes,
-                             "write_time_s": saver.write_time,
-                             "resumed_from": None if restart is None else restart.where}
+    summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or resumed else None, "writes": saver.writes,
+                             "write_time_s": saver.write_time, "resumed_from": resumed}
     _write(scene, solved, out, summary, figures=figures)
     return RunResult(to_jsonable(summary), solved["model"], solved["U"], solved["extras"], out)
 
@@ -162,37 +167,38 @@ def run_remesh_scene(scene, out, *, progress=True, figures=True) -> dict:
     return run(scene, out, progress=progress, figures=figures).summary
 
 
-def solve_remesh_scene(scene, opts=None, *, checkpoint=None, restart=None) -> dict:
+def solve_remesh_scene(scene, opts=None, *, state=None, saver=None) -> dict:
     """Run the remeshing route of ``scene``; return the final ``model``, ``U`` [m], ``extras``,
     ``records``, ``converged``, ``meshes`` (the snapshots drawn as frames) and ``wall_time_s``.
 
-    ``checkpoint``: a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`; ``restart``: a
-    :class:`~rftstatic.remesh.checkpoint.RemeshRestart` to continue from."""
+    ``state``: the run's State (a saved one, :func:`~rftstatic.remesh.checkpoint.load_remesh_state`, to continue
+    from; default a new one); ``saver``: a :class:`~rftstatic.solvers.checkpoint.CheckpointSaver` given the
+    route's pauses (None: none)."""
+    state = State(U=np.zeros((0, 3)), V=np.zeros((0, 3))) if state is None else state
     opts = remesh_options(scene) if opts is None else opts
     analysis = scene.analysis
     t0 = time.perf_counter()
     if analysis not in ("static", "relax"):
         raise scene.error("analysis", f'"{analysis}" cannot be remeshed; use "static" or "relax" with [remesh]')
     try:
-        solved = (_static if analysis == "static" else _relax)(scene, opts, checkpoint, restart)
+        solved = (_static if analysis == "static" else _relax)(scene, opts, state, saver)
     except ParameterError as exc:  # checked against the mesh: sizes larger than the sheet
         raise scene.error(f"remesh.{exc.key}", exc.detail) from None
     solved["wall_time_s"] = time.perf_counter() - t0
     return solved
 
 
-def _static(scene, opts, checkpoint=None, restart=None) -> dict:
+def _static(scene, opts, state, saver) -> dict:
     def factory(mesh=None):
         model, extras = build_model(scene, mesh=mesh, quiet=mesh is not None)
         if mesh is None:
             _check_node_budget(scene, opts, model.mesh)
         return model, extras
 
-    if restart is not None and restart.phase != "cycle":
-        raise CheckpointError(f"checkpoint {restart.path} is a remeshed relaxation's, this scene's route is static; "
-                              f"{FIX}")
-    res = remesh_static(factory, opts, solver=static_options(scene, progress=False), checkpoint=checkpoint,
-                        restart=None if restart is None else restart.state)
+    if REMESH_RELAX in state.route:
+        raise CheckpointError(f"the checkpoint is a remeshed relaxation's, this scene's route is static; {FIX}")
+    route = remesh_static_route(factory, opts, state, solver=static_options(scene, progress=False))
+    res = drive(route, None if saver is None else saver.on(state))
     meshes = [{"mesh": m, "U": None, "t": 0.0, "step": 0} for m in res.meshes]
     meshes[-1]["U"] = res.result.U
     return {"route": "remesh_static", "model": res.model, "extras": res.extras, "U": res.result.U,
@@ -201,7 +207,7 @@ def _static(scene, opts, checkpoint=None, restart=None) -> dict:
             "meshes": meshes, "t": None, "steps": None, "skipped": 0}
 
 
-def _relax(scene, opts, checkpoint=None, restart=None) -> dict:
+def _relax(scene, opts, state, saver) -> dict:
     d = dynamics_options(scene)
 
     def factory(mesh=None):
@@ -216,13 +222,15 @@ def _relax(scene, opts, checkpoint=None, restart=None) -> dict:
     stepper = explicit_advance(alpha=d.alpha, mass_scale=d.mass_scale, dt=d.dt, safety=SAFETY,
                                obstacles=obstacles, damping=opts.damping)
     track = _Tracker(stepper, d.t_end)
-    if restart is not None:
-        if restart.phase == "cycle":
-            raise CheckpointError(f"checkpoint {restart.path} is a static remesh run's, this scene's route is the "
-                                  f"remeshed relaxation; {FIX}")
-        track.restore(restart.app, restart.app_arrays, restart.state.meshes)
-    if checkpoint is not None:
-        checkpoint.app = track.state
+    if REMESH_STATIC in state.route:
+        raise CheckpointError(f"the checkpoint is a static remesh run's, this scene's route is the remeshed "
+                              f"relaxation; {FIX}")
+    if REMESH_RELAX in state.route:
+        track.restore(state.route[TRACK], state.route[REMESH_RELAX].meshes)
+
+    def on_pause(pause):  # the tracker's position rides along with the driver's
+        state.route[TRACK] = track.position()
+        saver.pause(state, pause)
     first = [(model0, extras0)]
 
     def make(mesh=None):  # hand the already built initial model to the driver
@@ -234,8 +242,8 @@ def _relax(scene, opts, checkpoint=None, restart=None) -> dict:
     try:
         motion = RemeshRelaxOptions(mass_scale=d.mass_scale, max_steps=max_steps,
                                     rest=RestCriterion(d.rest_tolerance, d.force_tolerance))
-        res = remesh_relax(make, opts, motion, advance=track, residual=residual, checkpoint=checkpoint,
-                           restart=None if restart is None else restart.state)
+        route = remesh_relax_route(make, opts, state, motion, advance=track, residual=residual)
+        res = drive(route, None if saver is None else on_pause)
         model, U, records, converged, skipped = res.model, res.U, res.records, res.converged, res.skipped
         t, steps = res.t, res.steps
         stopped_by = "rest" if converged else "max_steps" if steps >= max_steps else "max_remesh"

@@ -25,8 +25,10 @@ from rftstatic.remesh.adapt import (
     refinable_maxima,
     transfer_state,
 )
-from rftstatic.remesh.checkpoint import RelaxState
+from rftstatic.model.state import State
+from rftstatic.remesh.checkpoint import REMESH_RELAX, RelaxState
 from rftstatic.remesh.options import RemeshOptions, RemeshRelaxOptions
+from rftstatic.solvers.drive import Pause, finish
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 from rftstatic.solvers.timestep import SAFETY
 
@@ -226,8 +228,18 @@ def _initial_state(model, U0, V0) -> RelaxState:
 
 
 def remesh_relax(problem, options: RemeshOptions, motion: RemeshRelaxOptions = RemeshRelaxOptions(), *, advance=None,
-                 domain=None, U0=None, V0=None, residual=None, checkpoint=None, restart=None) -> RemeshRelaxResult:
-    """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6).
+                 domain=None, U0=None, V0=None, residual=None) -> RemeshRelaxResult:
+    """Dynamic relaxation with global adaptive remeshing: :func:`remesh_relax_route` from ``U0``, ``V0`` (N, 3)
+    [m, m/s] on the initial mesh (default zero), run to its end without checkpoints."""
+    state = State(U=np.zeros((0, 3)) if U0 is None else np.array(U0, dtype=float),
+                  V=np.zeros((0, 3)) if V0 is None else np.array(V0, dtype=float))
+    return finish(remesh_relax_route(problem, options, state, motion, advance=advance, domain=domain,
+                                     start=(U0, V0), residual=residual))
+
+
+def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: RemeshRelaxOptions = RemeshRelaxOptions(),
+                       *, advance=None, domain=None, start=(None, None), residual=None):
+    """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6), as a route (:mod:`rftstatic.solvers.drive`).
 
     The motion is advanced ``motion.chunk`` steps at a time. After each chunk (step d) the mesh is
     remeshed when ``options.every`` steps have passed since the last remesh, or when the largest
@@ -250,16 +262,15 @@ def remesh_relax(problem, options: RemeshOptions, motion: RemeshRelaxOptions = R
     advance : ``advance(model, U, V, n_steps) -> (U, V, t_advanced)``; default
         :func:`explicit_advance` with ``motion.alpha``, ``motion.mass_scale`` and the scene's obstacles
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
-    U0, V0 : (N, 3) start on the initial mesh (default zero)
+    state : the run's :class:`~rftstatic.model.state.State`; its position ``state.route[REMESH_RELAX]`` (a
+        :class:`~rftstatic.remesh.checkpoint.RelaxState`) before every chunk (a pause, held back by the saver's
+        throttle; final after a remesh) and at the end (final). Given a State with a saved position, the run goes on
+        from there (``start`` unused). With an ``advance`` that keeps state of its own (the damping history, the
+        stable step of the mesh), the caller restores that too.
+    start : ``(U0, V0)``, (N, 3) start on the initial mesh [m, m/s] (default zero)
     residual : ``residual(model, U) -> (N, 3)`` [N], the out-of-balance force of the rest test (default
         ``model.residual(U)``; with kinematic obstacles,
         :func:`rftstatic.contact.kinematic.contact_reaction_residual` takes their reaction off)
-    checkpoint : a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`, given the
-        :class:`~rftstatic.remesh.checkpoint.RelaxState` before every chunk (``"chunk"``, throttled; ``"remesh"``
-        after a remesh) and at the end (``"done"``)
-    restart : a :class:`~rftstatic.remesh.checkpoint.RelaxState` to continue from (a saved one; ``U0``, ``V0``
-        are then ignored). With an ``advance`` that keeps state of its own (the damping history, the stable step
-        of the mesh), the caller restores that too.
 
     Returns
     -------
@@ -285,20 +296,24 @@ def remesh_relax(problem, options: RemeshOptions, motion: RemeshRelaxOptions = R
     if domain is None:
         domain = reference_domain(model.mesh)
     wall = time.perf_counter()
-    r = _initial_state(model, U0, V0) if restart is None else restart
+    restart = state.route.get(REMESH_RELAX)
+    r = _initial_state(model, *start) if restart is None else restart
     U, V, t, steps, since, n_remesh, skipped = r.U.copy(), r.V.copy(), r.t, r.steps, r.since, r.n_remesh, r.skipped
     peak, records, meshes, done, converged = r.peak, list(r.records), list(r.meshes), r.done, r.converged
     if len(meshes) > 1:  # a restart on a later mesh (the initial model serves mesh 0)
         model, extras = make(meshes[-1])
     phase = None  # what the next snapshot is: None (the state just loaded or started), "chunk", "remesh"
 
-    def save(phase):
-        checkpoint.relax(RelaxState(meshes, U, V, t, steps, since, n_remesh, skipped, peak, records, done=done,
-                                    converged=converged), phase=phase)
+    def pause(phase):
+        state.route[REMESH_RELAX] = RelaxState(meshes, U, V, t, steps, since, n_remesh, skipped, peak, records,
+                                               done=done, converged=converged, phase=phase)
+        state.U, state.V, state.t, state.step = U, V, t, steps
+        return Pause(f"t = {t:.4g} s, step {steps}, mesh {len(meshes) - 1} ({meshes[-1].n_nodes} nodes)",
+                     final=phase != "chunk")
 
     while steps < max_steps and not done:
-        if checkpoint is not None and phase is not None:
-            save(phase)  # every path through the loop ends here: the state the next chunk starts from
+        if phase is not None:
+            yield pause(phase)  # every path through the loop ends here: the state the next chunk starts from
         phase = "chunk"
         n = int(min(m.chunk, max_steps - steps))
         U, V, dt_adv = advance(model, U, V, n)
@@ -352,9 +367,10 @@ def remesh_relax(problem, options: RemeshOptions, motion: RemeshRelaxOptions = R
         phase = "remesh"
         log.info("remesh_relax: t = %.4g s, step %d (%s): %d -> %d nodes, max |kappa| h %.3g",
                  t, steps, reason, rec.nodes, new_mesh.n_nodes, kh)
-    if checkpoint is not None and phase is not None:
+    if phase is not None:
         done = True
-        save("done")
+        yield pause("done")
+    state.route.pop(REMESH_RELAX, None)
     rec = records[-1]
     if not np.isfinite(rec.max_kappa_h):
         kappa, rec.max_kappa_h, rec.max_kappa_h2 = _curvature_figures(model, U)

@@ -9,6 +9,8 @@ import logging
 import time
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from rftstatic.remesh.adapt import (
     RemeshRecord,
     _check_extent,
@@ -19,8 +21,10 @@ from rftstatic.remesh.adapt import (
     refinable_maxima,
     transfer_state,
 )
-from rftstatic.remesh.checkpoint import StaticCycleState
+from rftstatic.model.state import State
+from rftstatic.remesh.checkpoint import REMESH_STATIC, StaticCycleState
 from rftstatic.remesh.options import RemeshOptions
+from rftstatic.solvers.drive import Pause, finish
 
 log = logging.getLogger(__name__)
 
@@ -53,9 +57,18 @@ def _continuation(options):
     return options.from_state()
 
 
-def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None, checkpoint=None,
-                  restart=None) -> RemeshStaticResult:
-    """Static solution with global adaptive remeshing (module docstring).
+def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None) -> RemeshStaticResult:
+    """Static solution with global adaptive remeshing (module docstring): :func:`remesh_static_route` run to its
+    end without checkpoints."""
+    return finish(remesh_static_route(problem, options, State(U=np.zeros((0, 3)), V=np.zeros((0, 3))), solver=solver,
+                                      domain=domain))
+
+
+def remesh_static_route(problem, options: RemeshOptions, state: State, *, solver=None, domain=None):
+    """Static solution with global adaptive remeshing (module docstring) as a route
+    (:mod:`rftstatic.solvers.drive`): its position is ``state.route[REMESH_STATIC]`` (a
+    :class:`~rftstatic.remesh.checkpoint.StaticCycleState`), with a final pause after every solved cycle; given a
+    State with a saved position, it goes on from the cycle after it as the uninterrupted run.
 
     Parameters
     ----------
@@ -73,10 +86,7 @@ def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None, 
         defaults, without a progress bar); later solves start from the transferred state at
         full load (one load step) and fall back to the full load ramp from flat if that fails
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
-    checkpoint : a :class:`~rftstatic.remesh.checkpoint.RemeshCheckpointer`, given the
-        :class:`~rftstatic.remesh.checkpoint.StaticCycleState` after every solved cycle (None: no checkpoint)
-    restart : a :class:`~rftstatic.remesh.checkpoint.StaticCycleState` to continue from (a saved one);
-        the run then goes on as the uninterrupted one from the cycle after it
+    state : the run's :class:`~rftstatic.model.state.State` (U is the last equilibrium at each pause)
 
     Returns
     -------
@@ -99,13 +109,13 @@ def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None, 
     _check_extent(model.mesh, const, h_lower, h_upper)
     if domain is None:
         domain = reference_domain(model.mesh)
+    restart = state.route.get(REMESH_STATIC)
     if restart is None:
         result = solve_static(model, options=solver)
         records = [RemeshRecord(0, model.mesh.n_nodes, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})),
                                 solve=_static_figures(result, restarted=False))]
         meshes, first = [model.mesh], 1
-        if checkpoint is not None:
-            checkpoint.cycle(StaticCycleState(0, meshes, result, records))
+        yield _cycle_pause(state, StaticCycleState(0, meshes, result, records))
     else:
         result, records, meshes, first = restart.result, list(restart.records), list(restart.meshes), restart.cycle + 1
         if restart.cycle > 0:  # the initial model serves cycle 0
@@ -141,8 +151,8 @@ def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None, 
         records.append(RemeshRecord(cycle, new_mesh.n_nodes, new_mesh.n_elements, new_mesh.info["quality"],
                                     reason="cycle", solve=_static_figures(result, restarted=restarted)))
         meshes.append(new_mesh)
-        if checkpoint is not None:
-            checkpoint.cycle(StaticCycleState(cycle, meshes, result, records))
+        yield _cycle_pause(state, StaticCycleState(cycle, meshes, result, records))
+    state.route.pop(REMESH_STATIC, None)
     rec = records[-1]
     if not converged:
         kappa, rec.max_kappa_h, rec.max_kappa_h2 = _curvature_figures(model, result.U)
@@ -152,6 +162,13 @@ def remesh_static(problem, options: RemeshOptions, *, solver=None, domain=None, 
                     o.max_cycles, rec.max_kappa_h)
     return RemeshStaticResult(result=result, model=model, extras=extras, records=records, converged=converged,
                               meshes=meshes)
+
+
+def _cycle_pause(state, position: StaticCycleState) -> Pause:
+    """``position`` as the route's in ``state`` (U its equilibrium), and the final pause after its cycle."""
+    state.route[REMESH_STATIC] = position
+    state.U = position.result.U
+    return Pause(f"cycle {position.cycle}, {position.meshes[-1].n_nodes} nodes", final=True)
 
 
 def _static_figures(result, *, restarted):

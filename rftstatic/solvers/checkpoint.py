@@ -80,57 +80,6 @@ def save_atomic(path, arrays: dict) -> None:
         raise
 
 
-class ThrottledWriter:
-    """A checkpoint file written atomically (:func:`save_atomic`) at most every ``every_seconds`` of wall
-    time, the snapshot kept back by the throttle written by :meth:`flush` and on a Ctrl-C
-    (:meth:`on_interrupt`). The base of the static and the remeshed checkpointers; ``run`` names the run
-    in the interrupt message (e.g. ``"the static solve"``).
-
-    Attributes
-    ----------
-    writes : files written; write_time : wall time spent writing them [s]
-    saved : what the last write holds (e.g. ``"load factor 0.42"``), for messages
-    """
-
-    run = "the run"
-
-    def __init__(self, path, every_seconds: float):
-        self.path = Path(path)
-        self.every_seconds = float(every_seconds)
-        self.writes, self.write_time, self.saved = 0, 0.0, ""
-        self._pending = None
-        self._last = time.monotonic()
-
-    def due(self, step=None) -> bool:
-        """Whether ``every_seconds`` have passed since the last write (``step`` unused: the explicit loop's call)."""
-        return time.monotonic() - self._last >= self.every_seconds
-
-    def _write(self, arrays, what) -> None:
-        t = time.perf_counter()
-        save_atomic(self.path, arrays)
-        self.write_time += time.perf_counter() - t
-        self.writes += 1
-        self.saved, self._pending, self._last = what, None, time.monotonic()
-        log.info("checkpoint (%s) -> %s", what, self.path)
-
-    def flush(self) -> None:
-        """Write the snapshot kept back by the throttle, if any."""
-        if self._pending is not None:
-            self._write(*self._pending)
-
-    @contextmanager
-    def on_interrupt(self):
-        """A KeyboardInterrupt inside writes the last snapshot kept back before it goes on."""
-        try:
-            yield self
-        except KeyboardInterrupt:
-            self.flush()
-            if self.writes:
-                log.warning("interrupted: %s is saved in %s (%s); continue it with --resume", self.run, self.path,
-                            self.saved)
-            raise
-
-
 CHECKPOINT_FORMAT = 2
 """Version of the one checkpoint layout (key ``checkpoint_format``): a State and a header."""
 
@@ -267,16 +216,18 @@ def read_checkpoint(path) -> tuple[dict, dict]:
         if isinstance(exc, CheckpointError):
             raise
         raise CheckpointError(f"checkpoint {path} is corrupt or incomplete ({type(exc).__name__}: {exc}); "
-                              "run without --resume to start again") from None
+                              "delete it or run without --resume to start again") from None
     return header, saved
 
 
 def restore_state(model, saved: dict, state=None):
-    """``state`` (default a fresh :meth:`~rftstatic.model.state.State.initial` of ``model``, its caches new)
-    with the saved fields of :func:`read_checkpoint` set."""
+    """``state`` (default a fresh :meth:`~rftstatic.model.state.State.initial` of ``model``, its caches new; for
+    ``model`` None, a State without caches: a remeshed run's, whose models its route makes) with the saved
+    fields of :func:`read_checkpoint` set."""
     from rftstatic.model.state import State
 
-    state = State.initial(model) if state is None else state
+    if state is None:
+        state = State(U=saved["U"], V=saved["V"]) if model is None else State.initial(model)
     for name in SAVED:
         if name in saved:
             setattr(state, name, saved[name])
@@ -285,7 +236,7 @@ def restore_state(model, saved: dict, state=None):
     return state
 
 
-class CheckpointSaver(ThrottledWriter):
+class CheckpointSaver:
     """Saves a State at its routes' pauses (:class:`~rftstatic.solvers.drive.Pause`) to one file, in the one
     format (:func:`state_arrays`): a final pause at once, the others when due (every ``every_seconds`` of wall
     time, or every ``every_steps`` explicit steps), the last snapshot held back written on an interrupt.
@@ -293,6 +244,9 @@ class CheckpointSaver(ThrottledWriter):
     Interrupts (:meth:`stopping`): the first Ctrl-C asks the run to stop at its next pause, which is saved
     (``KeyboardInterrupt("... checkpoint saved")``); a second stops at once, and the snapshot held back, if any,
     is written.
+
+    Attributes: ``writes`` (files written), ``write_time`` (wall time spent writing them [s]), ``saved`` (what the
+    last write holds, for messages).
 
     Parameters
     ----------
@@ -307,9 +261,42 @@ class CheckpointSaver(ThrottledWriter):
                  run: str = "the run"):
         if every_steps is not None and not every_steps >= 1:
             raise ValueError(f"every_steps must be >= 1, got {every_steps}")
-        super().__init__(path, float("inf") if every_seconds is None else every_seconds)
+        self.path = Path(path)
+        self.every_seconds = float("inf") if every_seconds is None else float(every_seconds)
         self.header, self.run, self.every_steps = header, run, every_steps
         self.interrupted = False
+        self.writes, self.write_time, self.saved = 0, 0.0, ""
+        self._pending = None
+        self._last = time.monotonic()
+
+    def due(self) -> bool:
+        """Whether ``every_seconds`` have passed since the last write."""
+        return time.monotonic() - self._last >= self.every_seconds
+
+    def _write(self, arrays, what) -> None:
+        t = time.perf_counter()
+        save_atomic(self.path, arrays)
+        self.write_time += time.perf_counter() - t
+        self.writes += 1
+        self.saved, self._pending, self._last = what, None, time.monotonic()
+        log.info("checkpoint (%s) -> %s", what, self.path)
+
+    def flush(self) -> None:
+        """Write the snapshot held back by the throttle, if any."""
+        if self._pending is not None:
+            self._write(*self._pending)
+
+    @contextmanager
+    def on_interrupt(self):
+        """A KeyboardInterrupt inside writes the last snapshot held back before it goes on."""
+        try:
+            yield self
+        except KeyboardInterrupt:
+            self.flush()
+            if self.writes:
+                log.warning("interrupted: %s is saved in %s (%s); continue it with --resume", self.run, self.path,
+                            self.saved)
+            raise
 
     def pause(self, state, pause) -> None:
         """``state`` at a route's ``pause``: written when final or due (kept back, if ``pause.keep``, when not);

@@ -31,30 +31,25 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import asdict, fields
+from dataclasses import asdict
 from pathlib import Path
-
-import numpy as np
 
 from rftstatic.errors import CheckpointError
 from rftstatic.solvers.checkpoint import (
     CheckpointSaver,
-    json_array,
     model_fingerprint,
     plain,
     read_checkpoint,
     restore_state,
 )
 from rftstatic.solvers.load_steps import LOAD_STEPS
-from rftstatic.solvers.newton import StaticResult, start_state
+from rftstatic.solvers.newton import start_state
 from rftstatic.solvers.static import RELAX_ROUTE, SEGMENT, STATIC
 
 CHECKPOINT_SECONDS = 10.0
 """Least wall time [s] between two checkpoint writes of a static solve (the ends of phases excepted). A
 write of the 51 x 11 strip or the 33 x 33 drape (about 35 kB) took 7-17 ms on the 2-core test machine,
 nearly all of it the fsync."""
-
-_RESULT_FIELDS = [f.name for f in fields(StaticResult) if f.name != "U"]
 
 def static_fingerprint(model) -> str:
     """SHA-1 of what a static solve of ``model`` depends on: :func:`model_fingerprint` (mesh, supports,
@@ -128,26 +123,6 @@ def remove_stale(path) -> None:
     path = Path(path)
     for stale in path.parent.glob(path.name + ".*.tmp"):
         stale.unlink(missing_ok=True)
-
-
-def _field(U) -> np.ndarray:
-    """(N, 3) displacements or velocities, or an empty (0, 3) array for None."""
-    return np.zeros((0, 3)) if U is None else np.array(U, dtype=float)
-
-
-def _unfield(a) -> np.ndarray | None:
-    return None if a.shape[0] == 0 else a.copy()
-
-
-def result_arrays(prefix, result: StaticResult) -> dict:
-    """The arrays of a :class:`StaticResult` under keys starting with ``prefix`` (U (N, 3) [m], the rest as JSON)."""
-    return {prefix + "U": _field(result.U),
-            prefix + "result": json_array({k: getattr(result, k) for k in _RESULT_FIELDS})}
-
-
-def result_from(prefix, z) -> StaticResult:
-    """The :class:`StaticResult` saved by :func:`result_arrays` in the open ``.npz`` ``z``."""
-    return StaticResult(U=z[prefix + "U"].copy(), **json.loads(str(z[prefix + "result"])))
 
 
 def _check_header(path, head, model, options, scene) -> None:

@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -18,7 +19,7 @@ from rftstatic.app import remeshed
 from rftstatic.cli import main
 from rftstatic.errors import CheckpointError
 from rftstatic.remesh import relax_driver
-from rftstatic.remesh.checkpoint import load_remesh_checkpoint
+from rftstatic.remesh import checkpoint as remesh_checkpoint
 from rftstatic.scenes.schema import load_scene
 from rftstatic.solvers import static as static_solver
 
@@ -39,6 +40,13 @@ def _run(scene, out, **kw):
 
 def _header(scene):
     return remeshed.checkpoint_header(scene)
+
+
+def load_remesh_checkpoint(path, header):
+    """The saved State of a remeshed run: its phase and its driver's position."""
+    state = remesh_checkpoint.load_remesh_state(path, header)
+    position = state.route.get(remesh_checkpoint.REMESH_STATIC) or state.route.get(remesh_checkpoint.REMESH_RELAX)
+    return SimpleNamespace(phase=remesh_checkpoint.where(state)["phase"], state=position)
 
 
 @pytest.fixture(scope="module")
