@@ -1,4 +1,4 @@
-"""From a validated scene (scene units) to a :class:`~rftstatic.model.Model` (SI units).
+"""From a validated scene (scene units) to a :class:`~rftstatic.model.model.Model` (SI units).
 
 Everything a scene names in reference coordinates -- supports, loads, probes, obstacles -- is
 located on the mesh here, so that it carries over to any other mesh of the same sheet.

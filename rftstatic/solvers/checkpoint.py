@@ -156,7 +156,7 @@ class Checkpointer:
         return self.every_seconds is not None and time.monotonic() - self._last_wall >= self.every_seconds
 
     def save(self, model, obstacles, state, *, dt, n_steps, estimate, acc, history, probes, frames, options):
-        """Write the state after ``state.step`` steps (called by :func:`rftstatic.explicit.run_explicit`)."""
+        """Write the state after ``state.step`` steps (called by :func:`rftstatic.solvers.explicit.run_explicit`)."""
         save_atomic(self.path, state_arrays(model, obstacles, state, dt=dt, n_steps=n_steps, estimate=estimate,
                                             acc=acc, history=history, probes=probes, frames=frames, options=options))
         self._last_wall = time.monotonic()
@@ -227,7 +227,7 @@ def resume(path, model, *, obstacles=(), callback=None, checkpoint=None, progres
     path : checkpoint written by a :class:`Checkpointer`
     model : the same model as the interrupted run (checked by fingerprint)
     obstacles : the same obstacles (checked against the saved descriptions)
-    callback : as in :func:`rftstatic.explicit.run_explicit`
+    callback : as in :func:`rftstatic.solvers.explicit.run_explicit`
     checkpoint : a :class:`Checkpointer` for the continued run (default: none)
 
     Raises

@@ -44,7 +44,7 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
 
     Parameters
     ----------
-    model : :class:`rftstatic.model.Model`
+    model : :class:`rftstatic.model.model.Model`
     U0 : (N, 3) start [m] (default: the flat reference, optionally perturbed)
     options : :class:`StaticOptions`
     callback : called as ``callback(lam, U)`` after every converged increment (frames, probes)
