@@ -89,6 +89,8 @@ def _obstacle_default(cls, sk) -> str:
         if param is None or param.default is inspect.Parameter.empty:
             return "-"
         value = param.default
+    if value is None:
+        return "-"
     if isinstance(value, float) and math.isinf(value):
         return "none (unbounded)"
     if isinstance(value, tuple):

@@ -1,7 +1,7 @@
 """Run a dynamic scene (``analysis = "dynamic"`` or ``"relax"``) and write what users look at.
 
 ``dynamic``: the explicit central-difference motion of Sze & Zhou (2016) §2.4 (Eq. 16-22) with the
-mass damping ``alpha M v`` of Eq. 27 (sign as in method.md), as in their §4.6 (Figs. 12-13: sheets
+mass damping ``alpha M v`` of Eq. 27 (opposing the motion), as in their §4.6 (Figs. 12-13: sheets
 hung at two adjacent corners, alpha = 5/s, falling from flat at t = 0). ``relax``: the same motion
 with mass scaling (§6, default s = 100), stopped when the sheet is at rest (kinetic energy below
 ``rest_tolerance`` of its peak and out-of-balance force below ``force_tolerance`` of the load); with

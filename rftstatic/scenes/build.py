@@ -349,7 +349,7 @@ def check_obstacle_positions(scene: Scene, mesh) -> None:
 
 
 def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
-    """Remove the in-plane rigid modes of a sheet on a frictionless support (method.md).
+    """Remove the in-plane rigid modes of a sheet on a frictionless support (docs/theory/contact.md).
 
     The node nearest the sheet's centre is held in x and y (translations) and the node nearest
     the point one quarter of the sheet's width along +x from it is held in y (spin about z).

@@ -1,7 +1,7 @@
 """Explicit dynamics and dynamic relaxation (Sze & Zhou 2016, §2.4 Eq. 16-22, §4.6, §6).
 
 Equation of motion (Eq. 16) with the mass damping of Eq. 27 written so that it opposes the motion
-(method.md: Eq. 27 prints the wrong sign):
+(Eq. 27 as printed has the opposite sign):
 
     M D'' + alpha M D' + F(D) = P.
 

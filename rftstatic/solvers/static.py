@@ -1,4 +1,4 @@
-"""The static route (method.md, §4 and §6): load-scaled Newton, dynamic relaxation, or both.
+"""The static route (§4 and §6): load-scaled Newton, dynamic relaxation, or both.
 
 :func:`solve_static` runs the load-scaled Newton iteration (:mod:`rftstatic.solvers.newton`) from the
 flat start; when it cannot get through (a drape whose many folds snap through one after another), or

@@ -1,4 +1,4 @@
-"""Lumped mass and the stable step of the central-difference scheme (Eq. 18-22, method.md).
+"""Lumped mass and the stable step of the central-difference scheme (§2.4, Eq. 18-22).
 
 Mass: each triangle's mass ``rho_A A`` is split equally among its three vertices (§2.4), times an
 optional mass-scaling factor ``s`` (§6; the weight in the load is *not* scaled).

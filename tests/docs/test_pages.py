@@ -41,3 +41,24 @@ def test_readme_links_resolve():
 
 def test_readme_is_short():
     assert len((ROOT / "README.md").read_text(encoding="utf-8").splitlines()) <= 200
+
+
+def _obstacle_fragments():
+    for page in sorted(DOCS.rglob("*.md")):
+        if "_build" in page.parts or "_generated" in page.parts:
+            continue
+        for i, block in enumerate(re.findall(r"```toml\n(.*?)```", page.read_text(encoding="utf-8"), re.S)):
+            if "[[obstacles]]" in block and not re.search(r"^title\s*=", block, re.M):
+                yield pytest.param(block, id=f"{page.relative_to(ROOT)}#{i}")
+
+
+@pytest.mark.parametrize("block", list(_obstacle_fragments()))
+def test_documented_obstacles_build(block):
+    """An ``[[obstacles]]`` fragment of a page, put in place of pedestal-square-20's obstacle, builds."""
+    from rftstatic import api
+
+    data = api.load_scene("pedestal-square-20").data
+    data.pop("obstacles")
+    data.update(tomllib.loads(block))
+    _model, extras = api.build_model(api.scene_from_dict(data, name="docs-obstacles"))
+    assert len(extras["obstacles"]) == len(tomllib.loads(block)["obstacles"])

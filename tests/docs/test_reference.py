@@ -39,8 +39,12 @@ def test_every_schema_key_is_in_the_reference(gen):
     for name in _keys(SCHEMA):
         top = name.split(".")[0].split("[")[0]
         if top == "obstacles" or (top in SECTIONS and "." in name):
-            continue  # the obstacle types and the declared tables are checked below
+            continue  # the obstacle types and the declared tables' options are checked below
+        if top in SECTIONS:
+            assert f"## `[{name}]`" in page, f"table [{name}] is missing from the generated reference"
+            continue
         assert f"`{name}`" in page, f"scene key {name} is missing from the generated reference"
+    assert "## `[[obstacles]]`" in page
     for row in option_rows():
         assert f"`{row['key']}`" in page and row["help"].replace("|", "&#124;") in page, row["key"]
 
@@ -54,7 +58,7 @@ def test_every_obstacle_key_is_in_the_reference(gen):
         for key, sk in obstacle_class(name).scene_keys.items():
             assert f"| `{key}` |" in section and sk.help in section, (name, key)
     square = page.split('### `type = "square-pedestal"`', 1)[1].split("\n### ", 1)[0]
-    assert "`height`" in square and "`size`" in square and "none (unbounded)" in square
+    assert "`height`" in square and "`size`" in square and "infinitely tall" in square
 
 
 def test_the_cli_page_lists_every_subcommand(gen):

@@ -16,6 +16,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 DOTTED = re.compile(r"(?<![\w/.\-])rftstatic(?:\.[A-Za-z_]\w*)+")
+CITED_FILE = re.compile(r"(?<![\w/.\-])((?:[\w\-]+/)*[\w\-]+\.md)\b")
+PLACEHOLDERS = ("NAME", "DIR")  # ``validate`` writes NAME.md into DIR
 
 
 def _prose(path: Path) -> str:
@@ -101,6 +103,26 @@ def test_every_dotted_reference_resolves():
     assert not stale, "stale dotted references:\n" + "\n".join(f"  {k}: {', '.join(v)}" for k, v in stale.items())
 
 
+def missing_citations() -> dict[str, list[str]]:
+    """``{file name: [files citing it]}`` for every ``*.md`` file that a page or the package's prose names and that
+    the repository does not have (looked up from the repository root, ``validation/``, ``docs/`` and the citing
+    file's folder)."""
+    missing: dict[str, list[str]] = {}
+    for path in _sources():
+        for name in sorted(set(CITED_FILE.findall(_prose(path)))):
+            if re.split(r"[/.]", name)[0] in PLACEHOLDERS or path.parent.name == "_ext":
+                continue  # a placeholder, or a page the docs extension writes at build time
+            places = (ROOT, ROOT / "validation", ROOT / "docs", path.parent, path.parent / "data")
+            if not any((base / name).exists() for base in places):
+                missing.setdefault(name, []).append(str(path.relative_to(ROOT)))
+    return missing
+
+
+def test_no_citation_of_a_file_the_repository_does_not_have():
+    missing = missing_citations()
+    assert not missing, "cited but missing:\n" + "\n".join(f"  {k}: {', '.join(v)}" for k, v in missing.items())
+
+
 if __name__ == "__main__":  # pragma: no cover
-    for k, v in stale_references().items():
+    for k, v in {**stale_references(), **missing_citations()}.items():
         print(k, v)
