@@ -62,3 +62,15 @@ def test_documented_obstacles_build(block):
     data.update(tomllib.loads(block))
     _model, extras = api.build_model(api.scene_from_dict(data, name="docs-obstacles"))
     assert len(extras["obstacles"]) == len(tomllib.loads(block)["obstacles"])
+
+
+def test_the_package_never_imports_the_docs_tools():
+    import subprocess
+    import sys
+
+    code = ("import sys, rftstatic, rftstatic.api, rftstatic.cli; "
+            "bad = sorted(m for m in sys.modules if m.split('.')[0] in ('sphinx', 'myst_parser', 'docutils')); "
+            "assert not bad, bad")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False,
+                          env={**__import__("os").environ, "PYTHONPATH": str(ROOT)})
+    assert proc.returncode == 0, proc.stderr
