@@ -26,3 +26,4 @@ suppress_warnings = ["myst.header"]  # the validation reports start at a level-2
 html_theme = "alabaster"
 html_title = "rftstatic"
 html_static_path = []
+html_theme_options = {"page_width": "1240px", "sidebar_width": "240px"}  # room for the reference tables and code
