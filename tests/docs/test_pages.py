@@ -74,3 +74,15 @@ def test_the_package_never_imports_the_docs_tools():
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False,
                           env={**__import__("os").environ, "PYTHONPATH": str(ROOT)})
     assert proc.returncode == 0, proc.stderr
+
+
+def test_files_named_by_the_pages_exist():
+    """A repository path a page or the README names (``tests/...py``, ``cases/...toml``, ``validation/...md``, ...)
+    exists."""
+    pattern = re.compile(r"(?<![\w/.\-])((?:tests|tools|cases|validation|docs|rftstatic)/[\w/.\-]*\.(?:py|toml|md|png))")
+    pages = [ROOT / "README.md", ROOT / "DEVELOPERS.md",
+             *(p for p in DOCS.rglob("*.md") if "_build" not in p.parts and "_generated" not in p.parts)]
+    missing = sorted({(name, str(page.relative_to(ROOT))) for page in pages
+                      for name in pattern.findall(page.read_text(encoding="utf-8"))
+                      if "NAME" not in name and not (ROOT / name).exists()})  # NAME: a placeholder
+    assert not missing, missing
