@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 EXIT = {"done": 0, "internal": 1, "input": 2, "goal": 3, "output": 4, "interrupted": 130}
-"""Exit status of each outcome (the README's table)."""
+"""Exit status of each outcome (docs/howto/scenes.md, "Exit statuses")."""
 
 
 def main(argv=None) -> int:

@@ -34,7 +34,7 @@ class ParameterError(ValueError):
 
 
 class PatchError(ValueError):
-    """A singular patch: its six points lie (nearly) on one conic (method.md)."""
+    """A singular patch: its six points lie (nearly) on one conic (C of Eq. 2 is singular)."""
 
 
 class CheckpointError(ValueError):

@@ -1,7 +1,7 @@
 """Fabric and shell rigidities: the membrane matrix D^m (Eq. 15) and bending matrix D^b (Eq. 4).
 
 Strain and curvature vectors are (e_xx, e_yy, 2 e_xy) and (k_xx, k_yy, 2 k_xy) with x along the
-warp (method.md). A fabric cut on the bias has its warp at an angle to the global X axis; the
+warp (Eq. 3, 14). A fabric cut on the bias has its warp at an angle to the global X axis; the
 matrices are then rotated into global axes once, here, so the element code never sees the angle.
 All rigidities are per unit width: tensile/shear [N/m], bending/twisting [N m].
 """

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Set up rftstatic on a fresh Debian machine: SuiteSparse headers and OpenBLAS (when root), then the
-# package with CHOLMOD and the test tools. Safe to run again: it skips what is already there.
+# package with CHOLMOD, numba, the test tools and the documentation tools (Sphinx). Safe to run again: it
+# skips what is already there.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
@@ -11,7 +12,7 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libsuitesparse-dev libopenblas0-pthread >/dev/null
   fi
 fi
-if ! "$PY" -m pip install -q -e ".[cholmod,fast,test]"; then
+if ! "$PY" -m pip install -q -e ".[cholmod,fast,test,docs]"; then
   echo "setup: scikit-sparse (CHOLMOD) did not build; installing without it (scipy's solver is used)" >&2
-  "$PY" -m pip install -q -e ".[fast,test]" || "$PY" -m pip install -q -e ".[test]"
+  "$PY" -m pip install -q -e ".[fast,test,docs]" || "$PY" -m pip install -q -e ".[test,docs]"
 fi

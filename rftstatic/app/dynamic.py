@@ -1,14 +1,14 @@
 """Run a dynamic scene (``analysis = "dynamic"`` or ``"relax"``) and write what users look at.
 
 ``dynamic``: the explicit central-difference motion of Sze & Zhou (2016) §2.4 (Eq. 16-22) with the
-mass damping ``alpha M v`` of Eq. 27 (sign as in method.md), as in their §4.6 (Figs. 12-13: sheets
+mass damping ``alpha M v`` of Eq. 27 (opposing the motion), as in their §4.6 (Figs. 12-13: sheets
 hung at two adjacent corners, alpha = 5/s, falling from flat at t = 0). ``relax``: the same motion
 with mass scaling (§6, default s = 100), stopped when the sheet is at rest (kinetic energy below
 ``rest_tolerance`` of its peak and out-of-balance force below ``force_tolerance`` of the load); with
 ``compare_static = true`` the resting state is compared with the static Newton solution.
 
 Obstacles act kinematically (§6.3): the penalty contact (and, for true dynamics, the in-plane holds) that
-:func:`rftstatic.build.build_model` adds for the static solver are dropped for these runs.
+:func:`rftstatic.scenes.build.build_model` adds for the static solver are dropped for these runs.
 
 Outputs in the run folder, every number in the scene's units:
 
@@ -24,9 +24,9 @@ Outputs in the run folder, every number in the scene's units:
   the self-intersection check of the final state and of every saved state
   (:func:`rftstatic.io.summary.self_intersection_summary`);
 * ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
-  continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.checkpoint`).
+  continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.solvers.checkpoint`).
 
-All files are written atomically (:mod:`rftstatic.output`), so an interrupted run leaves no partial file.
+All files are written atomically (:mod:`rftstatic.io.files`), so an interrupted run leaves no partial file.
 """
 
 from __future__ import annotations
@@ -99,12 +99,12 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
 
     Parameters
     ----------
-    scene : validated :class:`rftstatic.scene.Scene`
-    model, extras : from :func:`rftstatic.build.build_model` (extras: obstacles, probes [m])
+    scene : validated :class:`rftstatic.scenes.schema.Scene`
+    model, extras : from :func:`rftstatic.scenes.build.build_model` (extras: obstacles, probes [m])
     out : output folder
     resume : continue from ``out/checkpoint.npz`` (a fresh run, logged, when there is none)
     callback : extra ``callback(state, sample)`` at every history sample; returning True stops the run
-    backend : force back end of :func:`rftstatic.explicit.run_explicit`
+    backend : force back end of :func:`rftstatic.solvers.explicit.run_explicit`
 
     Returns
     -------

@@ -81,7 +81,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     Parameters
     ----------
     scene : the :class:`~rftstatic.scenes.schema.Scene` (its coarser levels are built from it)
-    model : the scene's :class:`~rftstatic.model.Model` (the finest level)
+    model : the scene's :class:`~rftstatic.model.model.Model` (the finest level)
     opts : :class:`~rftstatic.solvers.options.StaticOptions` of every level's solve
     folder : run folder where each converged level is saved (``level-K.npz``); None: nothing saved
     resume : take up the levels saved in ``folder`` (those of the same model only)

@@ -1,12 +1,12 @@
 """Run a scene with a ``[remesh]`` table: global adaptive remeshing (Sze & Zhou 2016, §5.2 and §6).
 
 ``analysis = "static"``
-    :func:`rftstatic.remesh.remesh_static`: Newton solve, size a new mesh from the converged
+    :func:`rftstatic.remesh.static_driver.remesh_static`: Newton solve, size a new mesh from the converged
     curvature by Eq. 28-29 (|kappa| h_new^2 = const, h clipped to [h_lower, h_upper]), transfer U,
     solve again, until the node count changes by less than ``tol`` (and max |kappa| h <= ``kappa_h_max``
     when the scene sets it).
 ``analysis = "relax"`` (§6, Figs. 14-16)
-    :func:`rftstatic.remesh.remesh_relax`: the damped explicit motion (Eq. 16-22, damping Eq. 27
+    :func:`rftstatic.remesh.relax_driver.remesh_relax`: the damped explicit motion (Eq. 16-22, damping Eq. 27
     with ``[dynamics] alpha``) with the mass scaled by ``[dynamics] mass_scale`` (§6: 100; the weight
     is not scaled), remeshed every ``every`` steps or when max |kappa| h^2 > ``kappa_h2_max``, U and V
     transferred, until the sheet rests on a mesh that no longer changes, or ``[dynamics] t_end``.
@@ -17,13 +17,13 @@ Outputs in the run folder, every number in the scene's units:
 * ``summary.json``: scene, element, route, final node and triangle counts, converged flag, wall
   time, the ``[remesh]`` settings, one record per mesh (cycle, time and step, reason, node and
   triangle counts, mesher quality, largest |kappa| h and |kappa| h^2, node-count change, wall time),
-  the drape measures of the final state (:func:`rftstatic.run.drape_summary`), its self-intersection
+  the drape measures of the final state (:func:`rftstatic.io.summary.drape_summary`), its self-intersection
   check (:func:`rftstatic.io.summary.self_intersection_summary`) and the probes;
 * ``mesh_<k>_{top,iso}.png``: the deformed sheet with its mesh edges at each successive mesh
   (relax: the transferred state just after remesh k; static: the equilibrium on mesh k is only
   known for the last mesh, so the earlier ones are drawn flat in the top view), ``remesh.gif``
   (the isometric frames), ``nodes.png`` (node count against time or cycle);
-* ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.run.write_outputs`);
+* ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.io.results.write_outputs`);
 * ``checkpoint.npz`` (:mod:`rftstatic.remesh.checkpoint`): after every solved cycle (static), after every
   remesh, at most every 10 s between remeshes and at the end (relax); ``--resume`` (:func:`resume_scene`)
   continues from it to the meshes and state of the uninterrupted run.

@@ -2,7 +2,7 @@
 
 A drape tester's result scatters from specimen to specimen (the fold count above all: a drape has several
 stable equilibria, §6.2), so labs average several specimens (how many the
-standards ask for is unverified here: README, Textile laboratory tests).
+standards ask for is unverified here: docs/howto/textile-tests.md).
 The same scatter appears in the simulation when the seeded lift that tips the flat start off its
 bifurcation changes: :func:`seeded_specimens` solves the scene's model from seeds ``seed + 1, ...`` (the
 first specimen is the run itself) and reports every drape coefficient and fold count with their mean

@@ -1,6 +1,6 @@
 """Benchmark of the explicit loop: element-steps per second on the §4.6 sheets (41 x 41, 51 x 51).
 
-``python -m rftstatic.bench_explicit [--steps N] [--backend numpy numba]`` runs the hanging-sheet
+``python -m rftstatic.bench.explicit [--steps N] [--backend numpy numba]`` runs the hanging-sheet
 set-up of §4.6 (two adjacent corners pinned, gravity, alpha = 5/s) for a fixed number of steps per
 back end and prints E * steps / wall time. The target is >= 5e6 element-steps/s on one core.
 """

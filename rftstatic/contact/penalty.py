@@ -12,7 +12,7 @@ to the total potential energy. Its gradient ``f_n = k A_n min(phi, 0) n`` (``n =
 
     K_n = d f_n / d x_n = k A_n (n n^T + phi H)     for phi < 0,  0 otherwise,
 
-with ``H`` the Hessian of ``phi`` (:meth:`rftstatic.obstacles.Obstacle.normal_gradient`); the global
+with ``H`` the Hessian of ``phi`` (:meth:`rftstatic.contact.obstacles.Obstacle.normal_gradient`); the global
 tangent only needs these ``(N, 3, 3)`` diagonal blocks. The ``phi H`` term is negative semi-definite on a
 convex obstacle (it softens the tangential directions on a sphere or a rounded edge) and is tiny next to
 ``n n^T`` because ``|phi| << 1 / |H|``.

@@ -1,7 +1,7 @@
 """The magnitude of an RF triangle's curvature, the one norm that sizes elements and flags sharp folds.
 
 Eq. 7 gives each triangle a constant curvature vector in Voigt form, with the engineering twist
-(as the strains, method.md):
+(as the strains of Eq. 14):
 
     kappa = (k_xx, k_yy, 2 k_xy)                                                   [1/m]
 

@@ -1,6 +1,6 @@
 """Fused internal force of the RF model for the explicit loop (the hot path of Eq. 20).
 
-The force is the same as :meth:`rftstatic.model.Model.internal_force` (tested against it) but laid
+The force is the same as :meth:`rftstatic.model.model.Model.internal_force` (tested against it) but laid
 out for speed: the constant bending stiffness (Eq. 13) as one scalar CSR product ``K_b @ U`` and the
 membrane forces of the kernels of :mod:`rftstatic.element.kernels` (the same code as the static
 force and tangent: strain-point gradients, averaged Green strain of Eq. 14, ``S = D^m eps`` of
@@ -37,7 +37,7 @@ class ForceKernel:
 
     Parameters
     ----------
-    model : :class:`rftstatic.model.Model`
+    model : :class:`rftstatic.model.model.Model`
     backend : ``"auto"``, ``"numpy"`` or ``"numba"``
     threads : numba back end: element blocks computed in parallel (``None``:
         :func:`rftstatic.compiled.force_threads`, all cores for large meshes); the result does not

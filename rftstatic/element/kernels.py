@@ -163,7 +163,7 @@ def element_tangent(g, H, sxx, syy, sxy, area, Dm, psd, B, DB, SG, ke):
     (the mean over the strain points, into the scratch ``B (3, A, 3)`` [1/m]; ``DB = A D^m Bbar``
     [N/m^2]; ``SG (Q, A, 2) = (A/Q) S g_qa`` [N/m^2], scratch).
     With ``psd`` the geometric part uses the :func:`positive_part` of S, so the tangent is positive
-    semi-definite under compression (method.md); the material part always is. The element area and
+    semi-definite under compression (docs/theory/membrane.md); the material part always is. The element area and
     the weight 1/Q are folded into DB and SG, so that the numpy twin (element axis last) does a third
     fewer whole-array operations."""
     Q, A = g.shape[0], g.shape[1]

@@ -153,7 +153,7 @@ class MembraneOperator:
         """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m].
 
         With ``psd=True`` the geometric (initial-stress) part uses the positive part of the stress,
-        so the tangent is positive semi-definite under compression (the safeguard of method.md);
+        so the tangent is positive semi-definite under compression (docs/theory/membrane.md);
         the material part ``Bbar^T D^m Bbar`` is always positive semi-definite.
         ``stress (E, 3)`` [N/m]: the stress of the geometric part in place of ``D^m eps(U)`` (the mixed
         stress of MIP Newton, :mod:`rftstatic.solvers.newton`); None: the exact Hessian.

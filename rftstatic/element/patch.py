@@ -5,7 +5,7 @@ in the neighbouring triangle across 5-6, node 2 the one across 6-4, node 3 the o
 the six patch nodes are ``[opp0, opp1, opp2, v0, v1, v2]`` (the paper's 1..6).
 
 The quadratic fit of Eq. 2, ``w = c1 + c2 x + c3 y + c4 x^2/2 + c5 y^2/2 + c6 xy/2``, is made in
-local coordinates centred on the element and scaled by its size (method.md) so that C stays well
+local coordinates centred on the element and scaled by its size so that C (Eq. 2) stays well
 conditioned; L, the lower half of C^-1, maps the six nodal values to (w_xx, w_yy, 2 w_xy) (Eq. 3).
 
 Where an edge a-b of element c-a-b has no neighbour, the missing patch node is an *image node* at

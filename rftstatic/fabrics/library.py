@@ -25,7 +25,7 @@ What the data set does not give is *derived* by a stated rule (``Fabric.derived`
 silently: the membrane rigidities C_warp, C_weft, C_shear are the library wool's (the library's only
 published ones), C12 = B12 = 0, and B_twist = sqrt(B_warp B_weft) / 2 (:func:`rftstatic.fabrics.lab.
 default_twist`, the rule for any fabric without a measured twist). Measured effect of the membrane rule
-(README, "The fabric library"): the cantilever does not feel it (bending length within 0.03 % for the
+(docs/howto/fabric-data.md): the cantilever does not feel it (bending length within 0.03 % for the
 membrane x 0.1 and x 10), the Cusick drape does (``ctd-213-medium``, default mesh: DC 55.4 % -> 42.3 % with
 the membrane x 0.1, 62.4 % with x 3): a ``ctd-*`` preset's bending length is the data set's, its DC rests
 on the borrowed membrane.
@@ -104,7 +104,7 @@ _CTD_USED = {"density[kg.m-2]": "ctd_density", "linear warp[SI*1e9]": "ctd_B_war
              "linear weft[SI*1e9]": "ctd_B_weft"}
 
 _MEMBRANE_RULE = ("membrane rigidities C_warp, C_weft, C_shear of the library's wool-kang-yu (not in the data set; "
-                  "the cantilever does not feel them, the Cusick DC does: README, The fabric library), "
+                  "the cantilever does not feel them, the Cusick DC does: docs/howto/fabric-data.md), "
                   "C12 = B12 = 0, B_twist = sqrt(B_warp B_weft) / 2 (not measured)")
 
 CTD_TARGETS = {"light-soft": (10, 10), "light-stiff": (10, 90), "medium": (50, 50), "heavy-soft": (90, 10),

@@ -2,7 +2,7 @@
 
 - :func:`summary_header`: what ran (scene, its resolved data, element, mesh, software with git commit and
   code fingerprint, warnings, peak memory);
-- :func:`drape_summary`: drape coefficient, fold count and the sharp-fold indicator (method.md);
+- :func:`drape_summary`: drape coefficient, fold count and the sharp-fold indicator (§3, Figs. 1 and 8);
 - :func:`probe_summary`: reference and deformed positions of the scene's probes;
 - :func:`self_intersection_summary`: the self-intersection check (crossing triangle pairs, smallest
   distance between non-adjacent triangles) of the final state, and of every saved state of a dynamic run.
@@ -52,7 +52,7 @@ def summary_header(scene, model, analysis: str) -> dict:
 
 
 def drape_summary(scene, model, extras, U) -> dict:
-    """Drape coefficient, fold count and sharp-fold indicator (method.md) at ``U (N, 3)`` [m], scene units."""
+    """Drape coefficient, fold count and sharp-fold indicator (§3, Figs. 1 and 8) at ``U (N, 3)`` [m], scene units."""
     u = scene.units.length
     x = model.positions(U)
     obstacles = extras["obstacles"]

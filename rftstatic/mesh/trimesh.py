@@ -395,7 +395,7 @@ def square_polar(half_side, n_radial, n_circ, *, centre=(0.0, 0.0), core_radius=
     of radius ``core_radius``, the last ring is the square's edge, ring t in between is
     ``rho(t) [(1 - t) c(theta) + t c(theta) / |c(theta)|_inf]`` with ``rho`` linear in t. A polar fan
     down to the centre would put slivers, and patches whose six points lie on a line pair (singular,
-    method.md), at the centre; the disc inside ring 0 is instead meshed by our advancing-front mesher
+    Eq. 2), at the centre; the disc inside ring 0 is instead meshed by our advancing-front mesher
     with ring 0's nodes as its boundary. The default ``core_radius`` makes the quadrilaterals next to
     the core square (circumferential spacing = radial spacing).
 

@@ -3,7 +3,7 @@
 ``Model`` owns the mesh, its patches and image-node rules, the material, the constant bending
 stiffness K_b (Eq. 13), the membrane operator of RFT3 or RFT6, supports, the external load and the
 contact term. Its methods evaluate, for a displacement field ``U (N, 3)`` [m] and a load factor
-``lam``, the total potential energy (method.md)
+``lam``, the total potential energy (docs/theory/path-following.md)
 
     Pi(U) = E_b + E_m + E_c + E_s - lam P . U,
 

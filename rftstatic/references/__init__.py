@@ -44,7 +44,7 @@ SZE2004_NAMES = ("end_shear", "end_moment", "slit_annular")
 
 
 class _IsotropicShellRigidities:
-    """C and D of an isotropic shell with fields E, nu, h (the formulas of the shared README)."""
+    """C and D of an isotropic shell with fields E, nu, h (C = E h / (1 - nu^2), D = E h^3 / (12 (1 - nu^2)))."""
 
     @property
     def C(self) -> float:

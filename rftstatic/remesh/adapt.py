@@ -4,16 +4,16 @@ dynamic relaxation.
 One remesh (:func:`adapt_mesh` + :func:`transfer_state`):
 
 e. h_target per triangle of the present mesh from its curvature, Eq. 29
-   (:func:`rftstatic.sizefield.target_sizes`);
+   (:func:`rftstatic.remesh.sizefield.target_sizes`);
 f. h_target to the square background grid with a gradation limit
-   (:func:`rftstatic.sizefield.size_field`); the kinematic variables are carried by the old mesh
-   itself (route ``"mesh"``, :mod:`rftstatic.transfer`) or by a background grid (``"grid"``);
-g. a new advancing-front mesh of the flat reference sheet (:func:`rftstatic.mesher.generate`);
+   (:func:`rftstatic.remesh.sizefield.size_field`); the kinematic variables are carried by the old mesh
+   itself (route ``"mesh"``, :mod:`rftstatic.remesh.transfer`) or by a background grid (``"grid"``);
+g. a new advancing-front mesh of the flat reference sheet (:func:`rftstatic.mesh.mesher.generate`);
    the sheet's outline is recovered from the old mesh (:func:`reference_domain`): straight sides
    as polygons, circles exactly, so repeated remeshing does not shrink a disc;
 h. U (and V) at the new nodes, then zero on the new mesh's supports;
 and the model is rebuilt on the new mesh by the caller's factory (for a scene,
-:func:`rftstatic.build.build_model` with ``mesh=``: supports, loads, probes and obstacles are
+:func:`rftstatic.scenes.build.build_model` with ``mesh=``: supports, loads, probes and obstacles are
 defined in reference coordinates, the bending stiffness and the lumped mass follow the mesh).
 
 Drivers:
@@ -56,7 +56,7 @@ __all__ = ["reference_domain", "adapt_mesh", "transfer_state", "RemeshRecord", "
 
 # --------------------------------------------------------------------------------------------- one remesh
 def reference_domain(mesh, *, circle_tol=1e-6):
-    """The outline of the flat sheet meshed by ``mesh``, as a mesher :class:`~rftstatic.mesher.Domain`.
+    """The outline of the flat sheet meshed by ``mesh``, as a mesher :class:`~rftstatic.mesh.mesher.Domain`.
 
     The boundary edges give closed loops (:meth:`Domain.from_segments`, which drops vertices on
     straight runs, so a rectangle comes back as its four corners). A loop of at least 8 vertices
@@ -66,7 +66,7 @@ def reference_domain(mesh, *, circle_tol=1e-6):
 
     Parameters
     ----------
-    mesh : :class:`rftstatic.mesh.TriMesh` (reference coordinates [m])
+    mesh : :class:`rftstatic.mesh.trimesh.TriMesh` (reference coordinates [m])
     circle_tol : relative radius spread below which a loop is taken as a circle [-]
     """
     from rftstatic.mesh.mesher import Domain, Loop
@@ -96,18 +96,18 @@ def adapt_mesh(mesh, kappa, *, const, h_lower, h_upper, gradation=GRADATION, dom
 
     Parameters
     ----------
-    mesh : present :class:`rftstatic.mesh.TriMesh` [m]
+    mesh : present :class:`rftstatic.mesh.trimesh.TriMesh` [m]
     kappa : (E, 3) its element curvature (k_xx, k_yy, 2 k_xy) [1/m] (``model.curvature(U)``)
-    const, h_lower, h_upper : Eq. 29 [m] (:mod:`rftstatic.sizefield`)
+    const, h_lower, h_upper : Eq. 29 [m] (:mod:`rftstatic.remesh.sizefield`)
     gradation : gradation limit of the size field (ratio >= 1)
     domain : mesher Domain of the sheet (default :func:`reference_domain` of ``mesh``)
-    spacing : background-grid spacing [m] (default in :func:`rftstatic.sizefield.size_field`)
-    smooth_iterations : passed to :func:`rftstatic.mesher.generate`
+    spacing : background-grid spacing [m] (default in :func:`rftstatic.remesh.sizefield.size_field`)
+    smooth_iterations : passed to :func:`rftstatic.mesh.mesher.generate`
 
     Returns
     -------
-    new_mesh : :class:`rftstatic.mesh.TriMesh` in the same plane z0, ``info["quality"]`` the mesher's figures
-    result : :class:`rftstatic.mesher.MeshResult`
+    new_mesh : :class:`rftstatic.mesh.trimesh.TriMesh` in the same plane z0, ``info["quality"]`` the mesher's figures
+    result : :class:`rftstatic.mesh.mesher.MeshResult`
     """
     from rftstatic.mesh.mesher import generate
     from rftstatic.mesh.trimesh import TriMesh
@@ -212,7 +212,7 @@ def refinable_maxima(mesh, kappa, *, const, h_lower):
 
     Parameters
     ----------
-    mesh : :class:`rftstatic.mesh.TriMesh` (``element_size`` [m])
+    mesh : :class:`rftstatic.mesh.trimesh.TriMesh` (``element_size`` [m])
     kappa : (E, 3) element curvature [1/m]
     const, h_lower : Eq. 29 [m]
 

@@ -59,7 +59,7 @@ def critical_damping(model, U, *, mass_scale, alpha_max):
 
     Parameters
     ----------
-    model : the model (``load`` [N], lumped mass from :func:`rftstatic.timestep.lumped_mass`)
+    model : the model (``load`` [N], lumped mass from :func:`rftstatic.solvers.timestep.lumped_mass`)
     U : (N, 3) displacements [m]
     mass_scale : s [-]
     alpha_max : upper bound [1/s] (the scene's alpha)
@@ -78,7 +78,7 @@ def critical_damping(model, U, *, mass_scale, alpha_max):
 class NearObstacle:
     """An obstacle whose signed distance is computed only for the points near it (a candidate list).
 
-    For the kinematic contact of the explicit steps (:func:`rftstatic.contact.kinematic_contact`
+    For the kinematic contact of the explicit steps (:func:`rftstatic.contact.kinematic.kinematic_contact`
     needs phi only to find phi < 0, and the normal there). The exact distance of every point is
     computed when the list is (re)made; the candidates are the points within ``margin`` of the
     obstacle. Until some point has moved more than ``margin / 2`` since then, only the candidates

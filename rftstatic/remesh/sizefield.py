@@ -5,19 +5,19 @@ For every RF triangle of the present mesh the new size follows from
     |kappa| h_new^2 = const,   h_target = clip(h_new, h_lower, h_upper)            (Eq. 29)
 
 with the curvature vector of Eq. 7, ``kappa = (k_xx, k_yy, 2 k_xy)`` as returned by
-:meth:`rftstatic.model.Model.curvature`. Its magnitude is the Frobenius norm of the curvature tensor,
+:meth:`rftstatic.model.model.Model.curvature`. Its magnitude is the Frobenius norm of the curvature tensor,
 
     |kappa| = sqrt(k_xx^2 + k_yy^2 + 2 k_xy^2),   k_xy = (2 k_xy) / 2,
 
-:func:`rftstatic.element.curvature.curvature_norm` (here also under the name
-:func:`rftstatic.element.curvature.curvature_norm`), the same measure as :meth:`~rftstatic.model.Model.relative_curvature`
-(``|kappa| h``), so it does not depend on the orientation of the in-plane axes. ``const`` is a
+:func:`rftstatic.element.curvature.curvature_norm`, the same measure as
+:meth:`~rftstatic.model.model.Model.relative_curvature` (``|kappa| h``), so it does not depend on the
+orientation of the in-plane axes. ``const`` is a
 length [m] (Eq. 28 compares ``|kappa| h^2`` with it): a triangle of the new mesh of size h_new has
 ``|kappa| h_new = const / h_new``.
 A flat triangle (|kappa| = 0) takes h_upper.
 
 Step f of §5.2: the per-triangle h_target is put on the square background grid of the mesher
-(:meth:`rftstatic.mesher.BackgroundGrid.from_samples`, sampled at the triangle centroids in
+(:meth:`rftstatic.mesh.mesher.BackgroundGrid.from_samples`, sampled at the triangle centroids in
 reference coordinates, each grid node keeping the smallest nearby sample) with a gradation limit,
 which the advancing front of step g reads.
 """
@@ -78,17 +78,17 @@ def size_field(mesh, kappa, *, const, h_lower, h_upper, gradation=GRADATION, spa
 
     Parameters
     ----------
-    mesh : :class:`rftstatic.mesh.TriMesh`, the present mesh (reference coordinates [m])
+    mesh : :class:`rftstatic.mesh.trimesh.TriMesh`, the present mesh (reference coordinates [m])
     kappa : (E, 3) its element curvature (k_xx, k_yy, 2 k_xy) [1/m]
     const, h_lower, h_upper : Eq. 29 [m]
     gradation : ratio >= 1; neighbouring grid sizes obey ``h_q <= h_p + (gradation - 1) |x_q - x_p|``
-        (:mod:`rftstatic.mesher.sizefield`); ``None`` stores the clipped samples as they are
+        (:mod:`rftstatic.mesh.mesher.sizefield`); ``None`` stores the clipped samples as they are
     spacing : grid spacing [m]; default ``max(h_lower / 2, longest side / 500)``
     region : Domain or (xmin, ymin, xmax, ymax) [m] to cover (default: the mesh's bounding box)
 
     Returns
     -------
-    :class:`rftstatic.mesher.BackgroundGrid`; its values lie in [h_lower, h_upper].
+    :class:`rftstatic.mesh.mesher.BackgroundGrid`; its values lie in [h_lower, h_upper].
     """
     from rftstatic.mesh.mesher import BackgroundGrid
 

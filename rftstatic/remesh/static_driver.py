@@ -36,7 +36,7 @@ class RemeshStaticResult:
 
     Attributes
     ----------
-    result : the :class:`rftstatic.static.StaticResult` on the final mesh (``result.U`` (N, 3) [m])
+    result : the :class:`rftstatic.solvers.newton.StaticResult` on the final mesh (``result.U`` (N, 3) [m])
     model, extras : the final model and its extras (probes, obstacles)
     records : one :class:`RemeshRecord` per mesh solved
     converged : the mesh stopped changing (and, if given, |kappa| h <= kappa_h_max) within ``max_cycles``
@@ -94,7 +94,7 @@ def remesh_static_route(problem, options: RemeshOptions, state: State, *, solver
 
     Raises
     ------
-    rftstatic.static.ConvergenceError
+    rftstatic.errors.ConvergenceError
         when a solve fails even from flat (its ``.result`` is the last equilibrium)
     """
     from rftstatic.errors import ConvergenceError

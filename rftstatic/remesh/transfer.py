@@ -10,7 +10,7 @@ coordinates ``X`` in the old mesh. Three routes:
 ``"patch"``
     The quadratic of the RF patch (Eq. 2) of the old triangle that contains the new node: the
     six patch nodes' values fitted by 1, x, y, x^2, y^2, xy in the element's scaled coordinates
-    (the fit whose second derivatives are the element's curvature, :mod:`rftstatic.patch`), the
+    (the fit whose second derivatives are the element's curvature, :mod:`rftstatic.element.patch`), the
     image node of a boundary edge taking the linear rule U_a + U_b - U_c. Exact for linear fields
     everywhere and for quadratic ones inside, third order for smooth fields. On a curved drape the
     new nodes then lie on the old patch surfaces rather than on the old flat triangles, so the
@@ -106,7 +106,7 @@ def locate(mesh, points, *, candidates=12, outside="extrapolate"):
 
     Parameters
     ----------
-    mesh : :class:`rftstatic.mesh.TriMesh` (reference coordinates [m])
+    mesh : :class:`rftstatic.mesh.trimesh.TriMesh` (reference coordinates [m])
     points : (P, 2) reference points [m]
     candidates : triangles (nearest centroids) examined for a point the point location misses
     outside : for points outside the mesh, ``"extrapolate"`` (barycentric coordinates of the point
@@ -164,10 +164,10 @@ def patch_weights(mesh, elem, points, *, patches=None):
 
     Parameters
     ----------
-    mesh : the old :class:`rftstatic.mesh.TriMesh`
+    mesh : the old :class:`rftstatic.mesh.trimesh.TriMesh`
     elem : (P,) old triangle of each point (:func:`locate`)
     points : (P, 2) reference points [m]
-    patches : :class:`rftstatic.patch.Patches` of ``mesh`` (default: built here)
+    patches : :class:`rftstatic.element.patch.Patches` of ``mesh`` (default: built here)
 
     Returns
     -------
@@ -287,7 +287,7 @@ def transfer_fields(old_mesh, new_points, fields, *, method="mesh", outside="ext
 
     Parameters
     ----------
-    old_mesh : :class:`rftstatic.mesh.TriMesh`
+    old_mesh : :class:`rftstatic.mesh.trimesh.TriMesh`
     new_points : (P, 2) reference coordinates of the new nodes [m]
     fields : sequence of (N, ...) nodal arrays of the old mesh (e.g. U (N, 3) [m], V (N, 3) [m/s])
     method : ``"mesh"`` (barycentric in the old mesh, default), ``"patch"`` (quadratic of the old RF
@@ -296,7 +296,7 @@ def transfer_fields(old_mesh, new_points, fields, *, method="mesh", outside="ext
         (:func:`locate`); route "patch" always extends the quadratic of the nearest old triangle
     spacing : grid spacing of route "grid" [m] (default: the old mean element size)
     smoothing : regularisation of route "grid" (:func:`fit_grid`)
-    patches : route "patch": the old mesh's :class:`rftstatic.patch.Patches` (default: built)
+    patches : route "patch": the old mesh's :class:`rftstatic.element.patch.Patches` (default: built)
 
     Returns
     -------

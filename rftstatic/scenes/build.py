@@ -1,4 +1,4 @@
-"""From a validated scene (scene units) to a :class:`~rftstatic.model.Model` (SI units).
+"""From a validated scene (scene units) to a :class:`~rftstatic.model.model.Model` (SI units).
 
 Everything a scene names in reference coordinates -- supports, loads, probes, obstacles -- is
 located on the mesh here, so that it carries over to any other mesh of the same sheet.
@@ -349,7 +349,7 @@ def check_obstacle_positions(scene: Scene, mesh) -> None:
 
 
 def hold_inplane_rigid_modes(mesh, supports: Supports) -> None:
-    """Remove the in-plane rigid modes of a sheet on a frictionless support (method.md).
+    """Remove the in-plane rigid modes of a sheet on a frictionless support (docs/theory/contact.md).
 
     The node nearest the sheet's centre is held in x and y (translations) and the node nearest
     the point one quarter of the sheet's width along +x from it is held in y (spin about z).

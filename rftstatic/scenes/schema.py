@@ -3,7 +3,7 @@
 A scene is parsed into plain dictionaries, validated against :data:`SCHEMA` (an unknown key or a
 value of the wrong type is a :class:`SceneError` naming the file, the key and the value), and
 ``--set key=value`` overrides are applied before validation. :func:`build_model` turns a scene
-into a :class:`rftstatic.model.Model` in SI units; the schema is documented in the README.
+into a :class:`rftstatic.model.model.Model` in SI units; the documentation's scene-key reference is generated from it.
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ def option_rows(section: str | None = None) -> list[dict]:
         return [row for name in SECTIONS for row in describe(SECTIONS[name], name)]
     if section not in SECTIONS:
         raise SceneError(f'options: no section "{section}" declares its keys as data; known: {", ".join(SECTIONS)} '
-                         "(the other tables are listed in the README's scene reference)")
+                         "(the other tables: the scene-key reference of the documentation, docs/howto/scenes.md)")
     return describe(SECTIONS[section], section)
 
 

@@ -1,12 +1,15 @@
-"""Checkpoints of long explicit runs: save the state at intervals, resume from the last one.
+"""Checkpoints: one format for every run, a long run never loses finished work.
 
-A checkpoint is one ``.npz`` file holding the state (t, step, D_n, v_(n-1/2)), the step size, the
-energy accumulators, the history, probe records and frames so far, the run's options and a
-fingerprint of the model (mesh, supports, load, material, element). It is written to a temporary
-file in the same directory, flushed to disk and moved over the old one with ``os.replace``, which is
-atomic: a Ctrl-C or kill at any moment leaves either the previous checkpoint or the new one, never
-a partial file. :func:`resume` continues from it and, because the loop is restarted from exactly
-the saved numbers, reproduces the uninterrupted run bitwise.
+A checkpoint is one ``.npz`` file holding a header (what the run is: its kind, the model's fingerprint, the
+scene, the options) and a :class:`~rftstatic.model.state.State`'s saved fields (:data:`SAVED`: U, V, t, step,
+load factor, load branches, self-contact scale, Newton counts and, in ``State.route``, the position of every
+route under way: an explicit run's records, the load steps' next increment, the relaxation route's phase, a
+remesh driver's meshes). Arrays are stored as arrays, the rest as JSON (:func:`encode`). It is written to a
+temporary file in the same directory, flushed to disk and moved over the old one with ``os.replace``, which is
+atomic: a Ctrl-C or kill at any moment leaves either the previous checkpoint or the new one, never a partial
+file. The routes (:mod:`rftstatic.solvers.drive`) go on from a restored State with exactly the saved numbers,
+so a resumed run reproduces the uninterrupted one bitwise. :class:`CheckpointSaver` writes at the routes'
+pauses; the app layer drives the routes with it.
 """
 
 from __future__ import annotations

@@ -5,9 +5,9 @@ Equation of motion (Eq. 16) with the mass damping of Eq. 27 written so that it o
 
     M D'' + alpha M D' + F(D) = P.
 
-``M`` is the lumped mass (:func:`rftstatic.timestep.lumped_mass`, times the mass-scaling factor s),
+``M`` is the lumped mass (:func:`rftstatic.solvers.timestep.lumped_mass`, times the mass-scaling factor s),
 ``F`` the internal force (bending + membrane + penalty contact, the same element code as the static
-solver, :mod:`rftstatic.explicit_force`) and ``P = model.load`` (gravity, never mass scaled). The
+solver, :mod:`rftstatic.element.explicit_force`) and ``P = model.load`` (gravity, never mass scaled). The
 damping force is lagged half a step (asynchronous damping, Eq. 19) and central differences give
 
     a_n = M^-1 (P - F(D_n)) - alpha v_(n-1/2)                            (Eq. 20)
@@ -15,7 +15,7 @@ damping force is lagged half a step (asynchronous damping, Eq. 19) and central d
     D_(n+1) = D_n + v_(n+1/2) dt                                         (Eq. 22)
 
 on the free dofs; supported dofs keep their displacement. After each position update the
-obstacles act kinematically (§6.3, :func:`rftstatic.contact.kinematic_contact`).
+obstacles act kinematically (§6.3, :func:`rftstatic.contact.kinematic.kinematic_contact`).
 
 Start: from ``U0`` and the velocity ``V0`` at t = 0, the default ``start="consistent"`` sets
 ``v_(-1/2) = V0 - a_0 dt / 2`` with ``a_0`` from Eq. 20 at ``V0``, so that the scheme is exact for a

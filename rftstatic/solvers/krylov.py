@@ -6,8 +6,8 @@ Optimization, 2nd ed., Algorithm 7.2 without the trust radius, which the step ca
 
 Why: on the finest mesh of a drape a Newton step costs one supernodal factorisation (2.1 s at 201 x 201
 nodes, 121,200 unknowns, 42e6 entries of L) against 0.12 s for a back-substitution with it, and the
-finest level creeps along a flat valley for ~350 steps (~200 from locking-matched coarse levels, README,
-"Mesh sequencing"), in which the tangent changes little from one step to the next. Solving ``K d = -r`` by preconditioned CG with the last
+finest level creeps along a flat valley for ~350 steps (~200 from locking-matched coarse levels,
+docs/howto/solver-routes.md), in which the tangent changes little from one step to the next. Solving ``K d = -r`` by preconditioned CG with the last
 factorisation takes 3-12 back-substitutions while that factorisation is fresh; the solver factorises
 anew when CG needs more than :data:`REFRESH_ITERATIONS` or meets negative curvature. Measured
 (``python -m rftstatic case pedestal-square-80 --set mesh.nodes=[201,201]``, default settings, the finest
@@ -28,7 +28,7 @@ from rftstatic.solvers.linear import LinearSolveError
 KRYLOV_FROM = 60_000
 """Free unknowns from which ``step_solver = "auto"`` takes the preconditioned CG step (the 201 x 201 sheet
 has 121,200; at 101 x 101, 30,600, a factorisation costs 0.4 s and the direct step is as fast or faster:
-README, "Mesh sequencing"). The same size at which the factorisation turns to nested dissection
+docs/howto/solver-routes.md). The same size at which the factorisation turns to nested dissection
 (:data:`rftstatic.solvers.linear.CholmodSolver.NESTED_DISSECTION_FROM`)."""
 
 REFRESH_ITERATIONS = 12

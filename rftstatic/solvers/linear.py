@@ -37,7 +37,7 @@ class LinearSolveError(ArithmeticError):
 def _single_threaded_blas() -> None:
     """CHOLMOD's BLAS (Debian's OpenBLAS) busy-waits with threads; on the small supernodes of a
     sheet's tangent one thread is faster (measured: 81 x 81 nodes, 400 ms against 670 ms on 2 cores
-    shared with another process; again 2026-12-01: 143 ms against 184 ms, best of 10, 81 x 81 supernodal
+    shared with another process; again: 143 ms against 184 ms, best of 10, 81 x 81 supernodal
     AMD with one OpenMP thread). Set before the library loads; an explicit user setting wins."""
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -79,7 +79,7 @@ def _openmp_runtimes() -> tuple:
 class SerialOpenMP:
     """Context manager: OpenMP parallel regions that this thread opens inside it get one thread.
 
-    Why (measured 2026-12-01 on the 2-core AMD EPYC KVM machine, Debian 12, SuiteSparse 5.12 /
+    Why (measured on the 2-core AMD EPYC KVM machine, Debian 12, SuiteSparse 5.12 /
     CHOLMOD 3.0.14, OpenBLAS 0.3.21 pthread, scikit-sparse 0.4.16; the other core busy with another
     job, so compare ratios): Debian's CHOLMOD is compiled with OpenMP, and its supernodal numeric
     factorisation opens ``#pragma omp parallel for num_threads(CHOLMOD_OMP_NUM_THREADS)`` regions
@@ -179,7 +179,7 @@ class CholmodSolver:
 
     NESTED_DISSECTION_FROM = 60_000
     """Unknowns from which the supernodal factorisation is ordered by CHOLMOD's nested dissection
-    (``nesdis``: METIS separators, CAMD on the parts). Measured 2026-12-02 (the 80 cm drape carried from
+    (``nesdis``: METIS separators, CAMD on the parts). Measured (the 80 cm drape carried from
     101 x 101 to 201 x 201 nodes, exact tangent + 1e-3 x its mean diagonal; best of 3 per ordering, three
     processes on the 2 cores, so compare within a row): 121,200 unknowns: AMD 47.4e6 entries of L, 4.0 and
     4.5 s per factorisation, analysis 0.6 s; METIS 41.6e6, 3.2 s, 1.6 s; nested dissection 41.1e6, 2.6 and
@@ -207,7 +207,7 @@ class CholmodSolver:
     def choose_mode(cls, n: int) -> tuple[str, str]:
         """(mode, ordering) of ``sksparse.cholmod.analyze`` for a tangent of ``n`` unknowns.
 
-        Measured 2026-12-01 (``python -m rftstatic.bench.factor``, one run; 2-core AMD EPYC KVM, load
+        Measured (``python -m rftstatic.bench.factor``, one run; 2-core AMD EPYC KVM, load
         average 1.3-1.9 from another job, so compare within a row): one ``cholesky_inplace`` of the
         flat-state RFT6 tangent, median of 10 [ms], CHOLMOD's OpenMP serial as :meth:`solve` runs it,
         and in the last column as built (4-thread regions, what the old rule was measured with):

@@ -1,4 +1,4 @@
-"""The load-scaled route of the static solver (method.md, §4): the load factor rises from 0 to 1 in
+"""The load-scaled route of the static solver (§4): the load factor rises from 0 to 1 in
 adaptive increments, each solved by Newton's method (:func:`rftstatic.solvers.newton.newton`).
 
 Increments are sized from the secant displacement rate d|U|/d lam (the first from the tangent rate)

@@ -1,4 +1,4 @@
-"""Load-scaled Newton iteration on the total potential energy (method.md, §4).
+"""Load-scaled Newton iteration on the total potential energy (§4).
 
 The gravity/load factor ``lam`` rises from 0 to 1 in adaptive increments. At each increment a
 Newton iteration minimises Pi(U) = E_b + E_m + E_c - lam P.U. Two iterations are offered:

@@ -1,4 +1,4 @@
-"""The static route (method.md, §4 and §6): load-scaled Newton, dynamic relaxation, or both.
+"""The static route (§4 and §6): load-scaled Newton, dynamic relaxation, or both.
 
 :func:`solve_static` runs the load-scaled Newton iteration (:mod:`rftstatic.solvers.newton`) from the
 flat start; when it cannot get through (a drape whose many folds snap through one after another), or
@@ -53,7 +53,7 @@ def solve_static(model, *, U0=None, options: StaticOptions | None = None, callba
 
     Parameters
     ----------
-    model : :class:`rftstatic.model.Model`
+    model : :class:`rftstatic.model.model.Model`
     U0 : (N, 3) start [m] (default: the flat reference, optionally perturbed)
     options : :class:`StaticOptions`
     callback : called as ``callback(lam, U)`` after every converged increment (frames, probes)

@@ -1,4 +1,4 @@
-"""Lumped mass and the stable step of the central-difference scheme (Eq. 18-22, method.md).
+"""Lumped mass and the stable step of the central-difference scheme (§2.4, Eq. 18-22).
 
 Mass: each triangle's mass ``rho_A A`` is split equally among its three vertices (§2.4), times an
 optional mass-scaling factor ``s`` (§6; the weight in the load is *not* scaled).
@@ -21,7 +21,7 @@ Eq. 19-20, a mode ``omega`` obeys ``x_{n+1} - 2 x_n + x_{n-1} = -omega^2 dt^2 x_
     iteration. Ritz values approach ``omega_max^2`` from below, to the stated tolerance.
 The recommended step is ``safety * dt_crit`` with ``safety = 0.9``: it covers the Lanczos tolerance
 and a moderate stiffening of the membrane (geometric stiffness) during the run; the run's energy
-check (``rftstatic.explicit``) catches anything beyond.
+check (``rftstatic.solvers.explicit``) catches anything beyond.
 """
 
 from __future__ import annotations
@@ -166,7 +166,7 @@ def stable_time_step(model, U=None, *, mass_scale: float = 1.0, alpha: float = 0
 
     Parameters
     ----------
-    model : :class:`rftstatic.model.Model`
+    model : :class:`rftstatic.model.model.Model`
     U : (N, 3) state at which the stiffness is taken [m] (default: reference)
     mass_scale : mass-scaling factor s [-]
     alpha : mass damping factor [1/s]

@@ -59,7 +59,7 @@ MALLOC_TRIM = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 dynamic mmap threshold, so every array above 128 kB is a fresh mmap whose pages fault in again: the
 strip at 51 x 11 solved 35 % slower with it (6 points, 4.0-4.1 s against 5.4-5.7 s, in-process). The
 LocalCluster's workers start without it (this key set to None); ``dask worker`` processes of an
-external cluster get it unless their configuration unsets it (README)."""
+external cluster get it unless their configuration unsets it (docs/howto/studies.md)."""
 
 
 @dataclass(frozen=True)

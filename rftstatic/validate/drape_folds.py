@@ -4,7 +4,7 @@ The paper finds 12 folds with RFT6 on both its 21 x 160 and 31 x 240 node meshes
 21 x 160 is fine enough. We run ``cases/pedestal-round-50.toml`` (square-polar mesh: rings of 160 or
 240 nodes, seeded out-of-plane perturbation, seed 1) on both, and report the number of folds
 (prominent maxima of the projected boundary's radius r(theta) about the pedestal axis,
-:func:`rftstatic.measures.fold_count`), their angles, the branch (perturbation seed), the drape
+:func:`rftstatic.post.measures.boundary.fold_count`), their angles, the branch (perturbation seed), the drape
 coefficient and the sharp-fold indicators. A coarser 11 x 80 mesh is reported when its run is in
 the cache. Drapes have several equilibria (§6.2: the paper's own adaptive relaxation of this drape
 ends with 8 folds, its static solution with 12), so the 21 x 160 drape is also solved from other

@@ -9,7 +9,7 @@ The paper's claims checked here:
 - (also reported) the 80 x 80 cm sheet on 41 x 41 nodes (h = 2 cm, coarser than the paper's) and the
   20 x 20 cm sheet of §4.2 on 17 x 17 and 33 x 33 nodes.
 
-Sharp-fold indicators of the final configuration (:mod:`rftstatic.measures`): the largest dihedral
+Sharp-fold indicators of the final configuration (:mod:`rftstatic.post.measures`): the largest dihedral
 angle between adjacent triangles, its 99th and 99.9th percentiles, the number of interior edges
 folded by more than 90 deg, and the largest relative curvature |kappa| h (h the element size).
 Pass criterion (fixed before the runs): RFT6 has no interior edge folded by more than 90 deg in any

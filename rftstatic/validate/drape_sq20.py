@@ -8,7 +8,7 @@ solution we do not have; ours is RFT6 on 121 x 121 nodes, the density of the pap
 Error measures against the reference, per mesh and element:
 
 - boundary: the largest distance between the projected outer boundary curve and the reference's
-  (symmetric Hausdorff distance of the closed polylines, :func:`rftstatic.drape_figures.boundary_distance`),
+  (symmetric Hausdorff distance of the closed polylines, :func:`rftstatic.io.drape_figures.boundary_distance`),
   divided by the half side L/2 = 10 cm;
 - drape coefficient: |DC - DC_ref| (DC itself is a fraction).
 

@@ -35,8 +35,8 @@ from rftstatic.validate.report import BenchmarkResult
 ROUTE = ["solver.start=load-steps", "solver.continuation=arc-length", "solver.relax_fallback=false",
          "solver.level_membrane=same"]
 # level_membrane: the report's sequences keep the fabric on every level, as they were measured (pedestal-square-80
-# sets "matched" for its fine meshes since 5bead2f; on this report's 81 x 81 sequence that lands on another
-# stable drape: 8 folds, DC 0.0749, -1029.34 gf cm, 351 s, against 5, 0.0865, -1028.05; see README)
+# sets "matched" for its fine meshes; on this report's 81 x 81 sequence "matched" lands on another stable drape,
+# docs/howto/solver-routes.md, "Fine meshes: levels")
 # (scene, nodes or None for an unstructured mesh, mesh override needed, levels): fast rows first
 FULL = [("pedestal-square-20", (33, 33), False, 1), ("sphere-30", (17, 17), True, 1),
         ("pedestal-square-40", (81, 81), False, 3), ("sphere-30", (61, 61), False, 3),

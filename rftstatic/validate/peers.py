@@ -13,7 +13,7 @@ Two comparisons (issue 7, item 4):
    are the same plate). Same meshes (our ``rectangle`` node layout, pattern ``right``, handed to
    scikit-fem), same reference values (:func:`rftstatic.references.plates.centre_deflection`:
    Navier series for simply supported edges, Timoshenko & Woinowsky-Krieger (1959) tables for
-   clamped ones), same linear solver (:func:`rftstatic.linsolve.make_solver`, CHOLMOD when
+   clamped ones), same linear solver (:func:`rftstatic.solvers.linear.make_solver`, CHOLMOD when
    installed), same clock: wall time of mesh + model/basis construction + assembly + solve, after
    one untimed warm-up solve per element, the least of up to three repeats when a solve takes
    under 1 s.
@@ -366,7 +366,7 @@ def _notes(result, version, quick) -> list[str]:
         "Neither Morley nor Argyris is a large-rotation shell (their dofs include slopes of a plane "
         f"deflection). In the sze2004 report (finest meshes) {_sze2004_measured()}; the S4R section compares "
         "at S4R's own mesh density. The price: moments and rotation supports are expressed through "
-        "translations (the lever of rftstatic.loads.LeverMoment, the image-node clamp).",
+        "translations (the lever of rftstatic.model.loads.LeverMoment, the image-node clamp).",
         "Fairness: the same meshes (our node layout handed to scikit-fem), the same reference values, "
         "the same linear solver (CHOLMOD when installed), the same clock (construction + solve), one "
         "untimed warm-up per element, the least of up to three repeats of solves under 1 s. The load is "

@@ -4,7 +4,7 @@
   over the free edge (edge load); tip -U and W against the S4R table at every tabulated load fraction.
 - End moment: L = 12, M_max = 2 pi EI / L rolls the strip into a full circle. With translational dofs
   only, the strip is extended by one element (a lever of length d) beyond the tip x = L and the
-  moment is the conservative potential -M phi of the lever angles (rftstatic.loads.LeverMoment): its
+  moment is the conservative potential -M phi of the lever angles (rftstatic.model.loads.LeverMoment): its
   gradient is a follower couple M_row/|r| perpendicular to each lever, exactly M_row about the width
   axis at any rotation, and its Hessian the load stiffness, so solve_static runs it like any load.
   The strip is held in its plane (u_y = 0): left free, RFT6 leaves the x-z plane at a bifurcation
@@ -94,10 +94,10 @@ def end_shear(nx, ny, element, table):
 
 
 def end_moment(nx, ny, element, table, *, plane=True, steps_per_table=4):
-    """Cantilever rolled up by a conservative end moment (:class:`rftstatic.loads.LeverMoment`).
+    """Cantilever rolled up by a conservative end moment (:class:`rftstatic.model.loads.LeverMoment`).
 
     The strip is extended by one lever element beyond x = L; the moment acts through the potential
-    -M phi of the lever angles, so it enters :func:`rftstatic.static.solve_static` with its load
+    -M phi of the lever angles, so it enters :func:`rftstatic.solvers.static.solve_static` with its load
     stiffness. ``plane=True`` holds u_y = 0 (the benchmark is a plane roll-up): free in y, RFT6 leaves
     the x-z plane at a bifurcation near closure (M/M_max ~ 0.95; reported in the notes).
     """
@@ -240,8 +240,8 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
         result.notes.append(f"End moment, finest mesh ({finest['element']} {finest['mesh']}): error against the "
                             f"exact circle {fmt_err(finest['error'])}, against the S4R table "
                             f"{fmt_err(finest['error_vs_s4r'])}. The moment acts through the potential -M phi "
-                            "of the lever angles beyond x = L (rftstatic.loads.LeverMoment), so it is exactly M on "
-                            "[0, L] and enters the Newton solver with its load stiffness; u_y is held (plane "
+                            "of the lever angles beyond x = L (rftstatic.model.loads.LeverMoment), so it is exactly "
+                            "M on [0, L] and enters the Newton solver with its load stiffness; u_y is held (plane "
                             "roll-up). Measured with u_y free: RFT6 leaves the plane at M/M_max ~ 0.95 (49 x 3 "
                             "and 97 x 5 nodes stop there, the out-of-plane bifurcation); RFT3 rolls up fully.")
     result.notes.append("The end shear and slit plate use solve_static as is (dead loads), with the load-deflection "

@@ -222,11 +222,11 @@ MEASURED_NOTE = (
     "dataset/dataset.csv: published density and bending rigidities, no tensile, shear or Cusick data; their "
     "membrane rigidities are the wool's by a stated rule. Their DC above (DC against disc radius / bending length) "
     "is a simulation only and rests on that rule: with the membrane rigidities x 0.1 the DC of ctd-213-medium "
-    "falls from 55.4 % to 42.3 % on the default mesh (README, The fabric library). A search of public copies "
+    "falls from 55.4 % to 42.3 % on the default mesh (docs/howto/fabric-data.md). A search of public copies "
     "(2026-12-02) found the studies that pair KES-F or FAST data with a Cusick DC by title and abstract only, "
     "their tables out of reach: Hu & Chan (1998), Text. Res. J. 68(1) 57-64; Kenkare et al. (2008), J. Text. "
     "Inst., doi:10.1080/00405000701489222; Jeong & Phillips (1998), J. Text. Inst. 89(1) 70-79; Kuijpers (2017), "
     "MPhil thesis, Manchester; Sanad et al. (2013), J. Fiber Bioeng. Inform. 6(1); Wang et al. (2011, ten "
     "fabrics in ARCSim's format) give no Cusick DC either. No value is entered from memory. A fabric enters the "
     "library with its source table (Fabric.measured_dc with the specimen and disc sizes), and this section then "
-    "compares (README, The fabric library).")
+    "compares (docs/howto/fabric-data.md).")

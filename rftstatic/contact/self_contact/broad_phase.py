@@ -17,18 +17,6 @@ boxes, swept ones for a swept test). Two paths, same pairs in the same order:
   candidate, kept as above and deduplicated by ``np.unique`` on the pair key (a loop over the three
   axes only).
 
-Measured 2026-12-02 (2 cores shared with other jobs, load average 2.6 - 3.1; 0.8 m sheet,
-``alternate`` pattern, crumpled by random waves of 2 cm, r = d + margin = 0.5 mm + 2.5 mm;
-``python -m rftstatic.bench.self_contact``, best of 3, ``--numpy`` for that path; "before" is the numpy
-code of commit c874a84, whose grid cell ignored the swept boxes):
-
-=========  =========  ==================================  ===================================
-mesh       triangles  build [s]: before, numpy, compiled  swept 7 cm step, r = 0.5 mm [s]
-=========  =========  ==================================  ===================================
-81 x 81    12,800     0.33, 0.17, 0.011                   23, 3.7, 0.09 (1.06 M pairs)
-161 x 161  51,200     1.90, 1.8, 0.055               -, 126, 1.2 (14.3 M pairs)
-=========  =========  ==================================  ===================================
-
 The candidates of a flat or gently crumpled sheet are its neighbours one ring of elements away
 (their boxes overlap, their distance is an element size); only pairs closer than the thickness enter
 the law. A swept test of a long step costs several builds (tall boxes overlap many boxes: the smooth

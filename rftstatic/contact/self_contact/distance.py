@@ -8,11 +8,7 @@ Shapes: pairs on the first axis, ``x4 (P, 4, 3)`` [m] -> ``s (P,)`` [m^2], gradi
 Two back ends run the one source of :mod:`.geometry`: numpy (all pairs at once, pair axis last:
 :func:`.geometry.derivatives_numpy`) and compiled (numba, one loop over the pairs,
 :mod:`._kernels_numba`), chosen by :func:`compiled_for`; they do the same arithmetic in the same order
-(equal to the last bit on the bench's pairs and the tests' random ones). Measured 2026-12-04 (2
-cores shared, load average 3.4 - 4.0, best of 3 x 7) on the 81 x 81 fold of
-:mod:`rftstatic.bench.self_contact`: squared distances of the 242,047 listed pairs 0.054 s numpy,
-0.006 s compiled; gradients and Hessians of the 28,360 pairs closer than d 0.014 s and 0.005 s. The
-numpy path pays ~0.5 ms a call of a few pairs (~900 whole-array operations, a Hessian entry each)."""
+(equal to the last bit on the bench's pairs and the tests' random ones)."""
 
 from __future__ import annotations
 

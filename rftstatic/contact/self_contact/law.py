@@ -45,14 +45,6 @@ primitive, ``j`` of the other; the closest points are convex combinations), so f
 bound and re-evaluating the distance converges to the first time the distance reaches
 ``g = min_fraction * delta(0)``, from below: the step fraction returned never lets any pair come
 closer than ``g`` anywhere on the path, i.e. no pair tunnels, however long the step.
-
-Costs, measured 2026-12-02 (numpy, 2 cores shared with other jobs): the 81 x 81 sheet of 1 cm
-elements (12,800 triangles) with its right half folded onto its left half 0.6 d above it (d = 0.5 mm,
-3,280 nodes over the other layer): 37,840 point-triangle and 112,169 edge-edge pairs listed (build
-0.75 s), 28,082 closer than d (the minimum 0.36 d); energy and force 0.22 s, with the PSD-projected
-tangent 0.90 s (mostly the 12 x 12 eigen-decompositions); the step bound of a random step of 0.1 mm
-per node 0.24 s (alpha = 0.53). A step that moves every node by ~1 cm at random needs the swept broad
-phase (tall boxes) and took 20 s: the Newton step cap keeps such steps rare near a fold.
 """
 
 from __future__ import annotations

@@ -2,15 +2,6 @@
 12 x 12 pair blocks and the additive continuous collision detection of the step bound (:mod:`.law`
 gives the equations). Drop-in twins of ``law._psd`` and ``law._additive_ccd`` (same arguments and
 results, to round-off); their numpy paths are kept here for machines without numba.
-
-Measured 2026-12-02 (2 cores shared with other jobs, load average 2.6 - 3.1), the 81 x 81 folded sheet
-of :mod:`rftstatic.bench.self_contact` (242,047 listed pairs, 28,360 closer than d; energy and force
-0.03 s compiled with cached pairs): :func:`psd_project` of the 28,360 blocks 0.09 - 0.11 s compiled,
-0.34 s numpy (``eigh``); :func:`additive_ccd` over the listed pairs, random 0.1 mm step 0.044 s
-(numpy 0.22 s), random 1 cm step 0.045 s (numpy 2.1 s); :func:`additive_ccd_nodes` over the 824,000
-swept pairs of the 1 cm step 0.06 s (``additive_ccd`` with the gather 0.23 s). With ``law._psd`` and
-``law._additive_ccd`` replaced by these (``python -m rftstatic.bench.self_contact --wired``) the step
-bound of the 1 cm step takes 0.9 s (before this module and the compiled broad phase: 20 - 35 s).
 """
 
 from __future__ import annotations

@@ -48,14 +48,6 @@ distances stay positive and no pair passes through another (straight-line steps;
 projection after the step is not part of the path). The kinetic energy the filter removes is returned
 (the explicit loop adds it to ``contact_loss``).
 
-Measured 2026-12-02 (2 shared cores, other jobs running, so upper figures), pedestal-square-80 with
-``contact.self = true`` (81 x 81, d = 0.05 cm, margin 0.28 cm): its relaxation (28,302 explicit steps)
-rebuilt the list 513 times, 0.35 s each (179 s: :func:`~.broad_phase.find_pairs` of ~54,000 box pairs
-plus the exact-distance cut to 571 near pairs); the force on the near pairs 23 s over 23,532 calls
-(~1 ms); the filter 269 s including the rebuilds it triggered, i.e. ~3 ms a step of per-pair tests
-(16,794 steps ran them, none needed an impulse; the early exit when nothing approaches too fast was
-added after that run). On a flat sheet (no near pairs) the force and filter add only O(N) tests.
-
 Shapes: ``x, v (N, 3)`` [m], [m/s]; ``minv (N, 3)`` [1/kg]; pairs ``(P, 4)`` node rows.
 """
 

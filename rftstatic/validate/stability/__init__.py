@@ -14,7 +14,7 @@ caught there and recorded by type and message. Outcomes:
   for a degenerate patch);
 - ``limitation``: stopped with a clear error (``ConvergenceError``) although a solution exists, or
   converged outside the tolerance on a model that warned at construction that this mesh is outside
-  its accuracy (RFT6 membrane locking, :func:`rftstatic.model.locking_number`);
+  its accuracy (RFT6 membrane locking, :func:`rftstatic.model.model.locking_number`);
 - ``FAIL``: a hang (budget exceeded), a crash (an unexpected exception type, or the process died), or a
   wrong answer reported as converged (error above tolerance). The benchmark passes without FAIL cells.
 
