@@ -138,7 +138,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             failed = exc.result if last else None
             if failed is not None:  # the summary of the failed run lists the levels solved and this one
                 _add_counts(totals, failed)
-                _sequence_outcome(failed, records + [_record(k, sc, m, failed, prev is None, build)], totals)
+                failed = _sequence_outcome(failed, records + [_record(k, sc, m, failed, prev is None, build)], totals)
             raise ConvergenceError(
                 f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}, {m.mesh.n_nodes} nodes) did not "
                 f"converge by {what}: {exc}", result=failed) from None
@@ -146,7 +146,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
         _add_counts(totals, res)
         if not res.converged:
             if last:
-                _sequence_outcome(res, records, totals)
+                res = _sequence_outcome(res, records, totals)
             raise ConvergenceError(f"mesh sequencing: level {k} of {len(scenes)} ({_nodes(sc)}) did not converge: "
                                    f"{res.message}", result=res if last else None)
         U = res.U
@@ -157,10 +157,9 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
         if prev is None:
             first_path, first_relax = res.path, res.relax
         prev = (carry, U)
-    _sequence_outcome(res, records, totals)
-    res.path, res.relax = res.path or first_path, res.relax or first_relax
-    res.wall_time = time.perf_counter() - t_all
-    return res
+    res = _sequence_outcome(res, records, totals)
+    return replace(res, path=res.path or first_path, relax=res.relax or first_relax,
+                   wall_time=time.perf_counter() - t_all)
 
 
 def membrane_match(mesh, finest) -> float:
@@ -217,12 +216,10 @@ def _record(k, scene, model, res, coarsest: bool, build: float) -> dict:
             "energy_J": res.energies.get("total"), "build_time_s": build, "wall_time_s": res.wall_time}
 
 
-def _sequence_outcome(res, records, totals) -> None:
+def _sequence_outcome(res, records, totals):
     """``res`` (the finest level's result) as the sequence's: its route, levels and counters over all levels."""
-    res.route = f"{records[0]['route']}+levels"
-    res.levels = records
-    res.iterations, res.factorisations = totals["iterations"], totals["factorisations"]
-    res.cutbacks, res.retries = totals["cutbacks"], totals["retries"]
+    return replace(res, route=f"{records[0]['route']}+levels", levels=records, iterations=totals["iterations"],
+                   factorisations=totals["factorisations"], cutbacks=totals["cutbacks"], retries=totals["retries"])
 
 
 def _add_counts(totals: dict, res) -> None:

@@ -50,7 +50,7 @@ from rftstatic.solvers.iteration import capped_step, roundoff_floor, self_contac
 from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.loop import Direction, Iterate, StepFailure, newton_loop
 from rftstatic.model.state import State
-from rftstatic.solvers.newton import StaticResult, newton, route_outcome, start_state
+from rftstatic.solvers.newton import StaticResult, close_record, newton, start_state
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
 
@@ -271,12 +271,17 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
         res.factorisations += path.inertia.factorisations
         res.tangent_modes["ldl"] = path.inertia.ldl
 
-    with route_outcome(model, result, state, t0, bar, extra=inertia_counters):
+    try:
         pt = _start(path, U, result)
         record["start_negative"] = pt.fac.negative
         _accept(path, result, record, pt, result.iterations, 0.0, pt.lam, "start")
         _follow(path, pt, result, record, bar, callback)
-    return result
+    except ConvergenceError as exc:
+        close_record(model, result, state, t0, exc, counts=inertia_counters)
+        raise
+    finally:
+        bar.close()
+    return close_record(model, result, state, t0, counts=inertia_counters)
 
 
 def _start(path, U, result) -> _Point:

@@ -1,7 +1,7 @@
 """Explicit dynamics and dynamic relaxation (Sze & Zhou 2016, §2.4 Eq. 16-22, §4.6, §6).
 
 Equation of motion (Eq. 16) with the mass damping of Eq. 27 written so that it opposes the motion
-(method.md: Eq. 27 prints the wrong sign):
+(Eq. 27 as printed has the opposite sign):
 
     M D'' + alpha M D' + F(D) = P.
 
@@ -115,7 +115,7 @@ def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(
 
     Parameters
     ----------
-    model : :class:`rftstatic.model.Model` (supports, gravity in ``model.load``)
+    model : :class:`rftstatic.model.model.Model` (supports, gravity in ``model.load``)
     state : the :class:`~rftstatic.model.state.State` to step: U, V (N, 3) [m, m/s] at t = 0 (V is zeroed on
         the supported dofs), or a saved State whose ``route`` holds the run's position (:data:`EXPLICIT`), which
         then goes on step for step as the uninterrupted run

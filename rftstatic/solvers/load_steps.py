@@ -25,7 +25,7 @@ from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 from rftstatic.model.state import State
-from rftstatic.solvers.newton import StaticResult, newton, route_outcome, start_state
+from rftstatic.solvers.newton import StaticResult, close_record, newton, start_state
 from rftstatic.solvers.drive import Pause, finish
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
@@ -124,7 +124,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
     continuations = 0
     failures = 0  # mixed iterations failed in a row at this load level
     bar = Progress(1.0, f"static {model.element}", enabled=opts.progress)
-    with route_outcome(model, result, state, t0, bar):
+    try:
         while lam < 1.0:
             if len(result.load_steps) >= opts.increments.max_load_steps:
                 raise ConvergenceError(
@@ -207,7 +207,12 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                     f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
                     f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
                     f"min_increment = {opts.increments.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
-    return result
+    except ConvergenceError as exc:
+        close_record(model, result, state, t0, exc)
+        raise
+    finally:
+        bar.close()
+    return close_record(model, result, state, t0)
 
 
 FROM_STATE_PROGRESS = 1e-9

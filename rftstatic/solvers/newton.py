@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import logging
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -120,28 +119,22 @@ def newton(model, U, lam, opts, state, max_step, *, stress=None, scheme=None) ->
         return mixed_iterations(model, U, lam, opts, state, max_step, stress)
     return displacement_iterations(model, U, lam, opts, state, max_step)
 
-@contextmanager
-def route_outcome(model, result: StaticResult, state: State, t0: float, bar, *, extra=None):
-    """The ending every static route shares, around its body: ``converged`` and ``message`` on success; a
-    :class:`~rftstatic.errors.ConvergenceError` labelled with its message and carrying the last
-    equilibrium (``exc.result``); in any case the bar closed, tangent modes, factorisations, wall time
-    [s] (from ``t0``), energies of the final ``result``, and its U and load factor in ``state``. ``extra(result)``
-    adds a route's own counters before the energies."""
-    try:
-        yield
-        result.converged = True
-        result.message = "converged"
-    except ConvergenceError as exc:
-        result.message = str(exc)
-        exc.result = result
-        raise
-    finally:
-        bar.close()
-        result.tangent_modes = dict(state.modes)
-        result.factorisations = state.factorisations
-        if extra is not None:
-            extra(result)
-        result.wall_time = time.perf_counter() - t0
-        result.energies = model.energies(result.U, result.lam, candidates=state.candidates, pairs=state.self_pairs,
-                                         branches=state.load_branches)
-        state.U, state.lam = result.U, result.lam
+def close_record(model, result: StaticResult, state: State, t0: float, error: ConvergenceError | None = None,
+                 counts=None) -> StaticResult:
+    """The end of a static route's record ``result``, by the route that built it: converged and ``"converged"``,
+    or not and the ``error``'s message (the error then carries ``result``, its last equilibrium); the solve's
+    tangent modes and factorisations (plus ``counts(result)``, a route's own), wall time [s] from ``t0`` and
+    energies [J]. The State takes the result's U and load factor."""
+    result.converged = error is None
+    result.message = "converged" if error is None else str(error)
+    result.tangent_modes = dict(state.modes)
+    result.factorisations = state.factorisations
+    if counts is not None:
+        counts(result)
+    result.wall_time = time.perf_counter() - t0
+    result.energies = model.energies(result.U, result.lam, candidates=state.candidates, pairs=state.self_pairs,
+                                     branches=state.load_branches)
+    state.U, state.lam = result.U, result.lam
+    if error is not None:
+        error.result = result
+    return result

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -145,12 +145,11 @@ def _stiffen_self_contact(model, result, opts, state):
             log.warning("self-contact: Newton with the raised stiffness did not converge (%s); the equilibrium "
                         "of the last stiffness stands", exc)
             break
-        result.self_contact_stiffenings += 1
-        result.self_contact_scale = state.self_contact_scale
-        result.U, result.residual, result.energies = res.U, res.residual, res.energies
-        result.iterations += res.iterations
-        result.factorisations += res.factorisations
-        result.load_steps = list(result.load_steps) + list(res.load_steps)
+        result = replace(result, self_contact_stiffenings=result.self_contact_stiffenings + 1,
+                         self_contact_scale=state.self_contact_scale, U=res.U, residual=res.residual,
+                         energies=res.energies, iterations=result.iterations + res.iterations,
+                         factorisations=result.factorisations + res.factorisations,
+                         load_steps=list(result.load_steps) + list(res.load_steps))
     return result
 
 
@@ -159,9 +158,9 @@ def _check_stability(model, result, state):
     tangent positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver
     cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
     solver = state.solver
-    result.stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs)
-                     if solver.detects_indefinite else None)
-    return result
+    stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs)
+              if solver.detects_indefinite else None)
+    return replace(result, stable=stable)
 
 
 MAX_RELAX_STEPS = 200_000
@@ -312,7 +311,7 @@ def _relax_route(model, opts, callback, state, first):
 
     def fail(text, result=None):
         if result is not None:
-            result.route, result.relax, result.seed = "relax+newton", info, route.seed
+            result = replace(result, route="relax+newton", relax=info, seed=route.seed)
         if first is not None:
             text = f"{first}; {text}"
         return ConvergenceError(text, result if result is not None else (first.result if first else None))
@@ -344,8 +343,8 @@ def _relax_route(model, opts, callback, state, first):
             if final:
                 result = exc.result
                 if result is not None:  # write the relaxed shape at full load, labelled not converged
-                    result.U, result.lam = route.U, 1.0
-                    result.residual = float(np.linalg.norm(model.residual(route.U, 1.0).ravel()[model.free.ravel()]))
+                    r = model.residual(route.U, 1.0).ravel()[model.free.ravel()]
+                    result = replace(result, U=route.U, lam=1.0, residual=float(np.linalg.norm(r)))
                 raise fail(f"{exc} (after dynamic relaxation to t = {route.t_used:.3g} s, {info['steps']} steps; "
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
             log.info("Newton did not converge from the relaxed state at t = %.3g s (%s); relaxing further",
@@ -355,12 +354,11 @@ def _relax_route(model, opts, callback, state, first):
             continue
         handover["newton"] = f"converged in {res.iterations} iterations"
         break
-    res.route, res.relax, res.seed = "relax+newton", info, route.seed
-    res.wall_time = time.perf_counter() - t0 + (0.0 if first is None or first.result is None else first.result.wall_time)
-    if first is not None and first.result is not None:
-        res.cutbacks += first.result.cutbacks
-        res.iterations += first.result.iterations
-    return res
+    before = first.result if first is not None else None  # the failed load steps' record, if any
+    return replace(res, route="relax+newton", relax=info, seed=route.seed,
+                   wall_time=time.perf_counter() - t0 + (0.0 if before is None else before.wall_time),
+                   cutbacks=res.cutbacks + (0 if before is None else before.cutbacks),
+                   iterations=res.iterations + (0 if before is None else before.iterations))
 
 
 def _route_pause(route) -> Pause:
