@@ -15,7 +15,7 @@ Outputs in the run folder, every number in the scene's units:
 * ``frame_t<time>_{iso,side}.png`` at the scene's ``frames`` times;
 * ``series/state_<k>.vtu`` (the frames and ``samples`` regular states) indexed by ``series.pvd``;
 * ``animation.gif`` (the sampled states, isometric view), ``energy.png`` (kinetic and potential
-  energy against time);
+  energy against time), ``view.html`` (:mod:`rftstatic.io.viewer`: the saved states in 3-D, with a slider);
 * ``summary.json`` (written once, at the end): counts, step, its estimate and why it was chosen (``dt_reason``,
   :func:`~rftstatic.solvers.step_plan.plan_steps`), steps, wall time, element-steps per second, probe
   trajectories (t, x, y, z), time at rest and the at-rest test's criterion and tolerances (``rest_test``:
@@ -40,6 +40,7 @@ import numpy as np
 from rftstatic.app.result import RunResult
 from rftstatic.errors import CheckpointError, StepLimitError
 from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
+from rftstatic.io.results import write_run_view
 from rftstatic.io.summary import self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model
@@ -298,6 +299,8 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
     try:
         if figures:
             _figures(scene, model, out, run, summary, o, save_times, idx)
+            if series:  # view.html: a slider over the saved states
+                write_run_view(out, summary)
     finally:  # written once, with the figures drawn so far (a plot that fails leaves the numbers written)
         write_json(out / "summary.json", summary)
 

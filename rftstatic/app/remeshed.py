@@ -24,6 +24,8 @@ Outputs in the run folder, every number in the scene's units:
   known for the last mesh, so the earlier ones are drawn flat in the top view), ``remesh.gif``
   (the isometric frames), ``nodes.png`` (node count against time or cycle);
 * ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.run.write_outputs`);
+* ``meshes/mesh_<k>.vtu`` indexed by ``meshes.pvd`` (each mesh's state, as the PNGs draw it) and ``view.html``
+  (:mod:`rftstatic.io.viewer`, a slider over the meshes);
 * ``checkpoint.npz`` (:mod:`rftstatic.remesh.checkpoint`): after every solved cycle (static), after every
   remesh, at most every 10 s between remeshes and at the end (relax); ``--resume`` (:func:`resume_scene`)
   continues from it to the meshes and state of the uninterrupted run.
@@ -42,7 +44,7 @@ from rftstatic.app.result import RunResult
 from rftstatic.contact.kinematic import contact_reaction_residual
 from rftstatic.errors import CheckpointError, InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable
-from rftstatic.io.results import write_outputs
+from rftstatic.io.results import write_mesh_series, write_outputs
 from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_summary, self_intersection_summary,
                                    summary_header)
 from rftstatic.optionspec import scene_values
@@ -337,6 +339,7 @@ def _write(scene, solved, out: Path, summary: dict, *, figures=True) -> None:
         summary["frames"] = _frames(scene, solved, out)
         _node_plot(scene, summary, out)
         summary["node_plot"] = "nodes.png"
+    write_mesh_series(scene, solved["meshes"], out)  # meshes.pvd: the viewer's slider over the meshes
     write_outputs(scene, solved["model"], solved["extras"], solved["U"], out, summary, figures=figures)
 
 

@@ -4,10 +4,13 @@ curvature |kappa| h, membrane strain), the PNG views and the interactive ``view.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 from rftstatic.io.figure import LENGTH_UNITS
 from rftstatic.io.files import write_json, write_vtu
+
+log = logging.getLogger(__name__)
 
 
 def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=True) -> None:
@@ -51,14 +54,19 @@ def write_run_view(out: Path, summary: dict) -> None:
     entered in ``summary["view"]``."""
     from rftstatic.io.viewer import VIEW_FILE, write_view
 
-    write_view(out, summary=summary)
+    try:
+        write_view(out, summary=summary)
+    except Exception as exc:  # noqa: BLE001 - a picture must not cost the run's results
+        log.warning("view.html was not written (%s: %s); the other outputs are complete: try "
+                    "'python -m rftstatic view RUN_DIR' on the run folder", type(exc).__name__, exc)
+        return
     summary["view"] = VIEW_FILE
 
 
 def write_mesh_series(scene, meshes, out: Path) -> None:
     """A remeshed run's meshes as ``meshes/mesh_<k>.vtu`` indexed by ``meshes.pvd`` (the time of a relaxation's
     remesh, else the cycle k), for the viewer's slider; ``meshes``: dicts with ``mesh``, ``U (N, 3)`` [m] (None:
-    drawn flat) and ``t`` [s]."""
+    drawn flat), ``t`` [s] and ``model`` (its curvature and strain fields; without one a flat mesh has none, zeros)."""
     import numpy as np
 
     from rftstatic.io.files import write_pvd, write_vtu
@@ -71,7 +79,16 @@ def write_mesh_series(scene, meshes, out: Path) -> None:
         mesh = m["mesh"]
         U = m["U"] if m["U"] is not None else np.zeros_like(mesh.X3)
         name = f"meshes/mesh_{k:02d}.vtu"
-        write_vtu(out / name, mesh.X3, U, mesh.tri, length_unit_scale=scene.units.length)
+        model, e = m.get("model"), mesh.n_elements
+        if model is not None:
+            cell = {"curvature": model.curvature(U) * scene.units.length,
+                    "relative_curvature": model.relative_curvature(U), "membrane_strain": model.membrane_strain(U)}
+        elif m["U"] is None:                                        # the flat reference: no curvature, no strain
+            cell = {"curvature": np.zeros((e, 3)), "relative_curvature": np.zeros(e),
+                    "membrane_strain": np.zeros((e, 3))}
+        else:
+            cell = {}
+        write_vtu(out / name, mesh.X3, U, mesh.tri, length_unit_scale=scene.units.length, cell_data=cell)
         t = m.get("t")
         entries.append((k if t is None else t / scene.units.time, name))
     if len({t for t, _ in entries}) < len(entries):               # a static route: no times, the cycles

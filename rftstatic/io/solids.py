@@ -103,10 +103,10 @@ def obstacle_surface(obstacle, lo, hi, *, n_lat: int = 48, n_lon: int = 96) -> t
 
 def drawing_box(x: np.ndarray, pad: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
     """The box the solids are drawn in: the sheet's positions ``x (N, 3)`` widened by ``pad`` of its largest
-    span on every side (below by 3 ``pad``, so that a pedestal shows a side under the sheet)."""
+    span on every side (a pedestal shows a side under the sheet, a floor is a slab that thick)."""
     lo, hi = x.min(axis=0), x.max(axis=0)
     span = float(np.max(hi - lo)) or 1.0
-    return lo - pad * span * np.array([1.0, 1.0, 3.0]), hi + pad * span
+    return lo - pad * span, hi + pad * span
 
 
 def support_disc(centre, radius: float, z: float) -> tuple[np.ndarray, np.ndarray]:

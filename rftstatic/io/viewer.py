@@ -101,20 +101,21 @@ def _pick(n: int, most: int) -> list[int]:
 def read_states(run_dir: Path, summary: dict, *, most: int = MAX_FRAMES) -> list[SavedState]:
     """The sheet's saved states in ``run_dir``: a series (dynamic ``series.pvd``, remeshed ``meshes.pvd``) or the
     final ``deformed.vtu``; :class:`ViewError` when there is none."""
-    time_unit = "s"
     for pvd, kind in (("series.pvd", "time"), ("meshes.pvd", "mesh")):
         if (run_dir / pvd).is_file():
             entries = _pvd_entries(run_dir / pvd)
             missing = [str(f) for _, f in entries if not f.is_file()]
             if missing:
                 raise ViewError(f"{run_dir / pvd} lists files that are not there: {missing[:3]}")
+            if kind == "mesh" and (run_dir / "deformed.vtu").is_file():
+                entries[-1] = (entries[-1][0], run_dir / "deformed.vtu")   # the final state, with all its fields
             states = []
             for k in _pick(len(entries), most):
                 t, f = entries[k]
-                label = f"t = {t:.4g} {time_unit}" if kind == "time" else f"mesh {k}"
+                label = f"{t:.4g}" if kind == "time" else f"{k}"
                 states.append(_read_vtu(f, label))
             if kind == "mesh":                                   # name each mesh by its node count
-                states = [SavedState(f"{s.label}: {len(s.x)} nodes", s.x, s.tri, s.point_data, s.cell_data)
+                states = [SavedState(f"{s.label} ({len(s.x)} nodes)", s.x, s.tri, s.point_data, s.cell_data)
                           for s in states]
             return states
     if (run_dir / "deformed.vtu").is_file():
@@ -165,7 +166,10 @@ def _title(summary: dict) -> str:
     what = ", ".join(p for p in (f"fabric {material}" if material else "", summary.get("element", ""),
                                  f"{summary.get('nodes')} nodes" if summary.get("nodes") else "") if p)
     status = "" if summary.get("converged", True) else "NOT CONVERGED; "
-    return f"{summary.get('title') or summary.get('scene', '')}<br><sub>{status}{what}</sub>"
+    import textwrap
+
+    title = "<br>".join(textwrap.wrap(summary.get("title") or summary.get("scene", ""), 90)[:2])
+    return f"{title}<br><sub>{status}{what}</sub>"
 
 
 def _mesh_trace(state: SavedState, values: np.ndarray, field: Field, unit: str, clim, *, topology=True) -> dict:
@@ -194,7 +198,8 @@ def build_figure(run_dir: Path, summary: dict, field: str = DEFAULT_FIELD, *, mo
 
     states = read_states(run_dir, summary, most=most)
     obstacles = _obstacles(summary)
-    fields = available_fields(states[-1], obstacles)
+    fields = [f for f in available_fields(states[-1], obstacles)
+              if all(f in available_fields(s, obstacles) for s in states[:-1])]
     if field not in fields:
         raise ViewError(f"field {field!r} is not in the run {run_dir}; its fields are {', '.join(fields)}")
     spec = FIELDS[field]
@@ -216,7 +221,7 @@ def build_figure(run_dir: Path, summary: dict, field: str = DEFAULT_FIELD, *, mo
     length = LENGTH_UNITS.get(summary.get("units", ""), "")
     axis = {f"{a}axis": {"title": {"text": f"{a} [{length}]" if length else a}} for a in "xyz"}
     layout = {"title": {"text": _title(summary), "x": 0.5}, "margin": {"l": 0, "r": 0, "t": 60, "b": 0},
-              "scene": {"aspectmode": "data", "camera": {"eye": {"x": 0.9, "y": -1.6, "z": 1.1}}, **axis},
+              "scene": {"aspectmode": "data", "camera": {"eye": {"x": 1.1, "y": -1.95, "z": 1.3}}, **axis},
               "paper_bgcolor": "white", "showlegend": False}
     fig = go.Figure(data=data, layout=layout)
     if len(states) > 1:
@@ -226,7 +231,9 @@ def build_figure(run_dir: Path, summary: dict, field: str = DEFAULT_FIELD, *, mo
         fig.frames = frames
         animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
         fig.update_layout(sliders=[{
-            "active": len(states) - 1, "currentvalue": {"prefix": "state: "}, "pad": {"t": 10},
+            "active": len(states) - 1, "pad": {"t": 10},
+            "currentvalue": {"prefix": "t = ", "suffix": " s"} if (run_dir / "series.pvd").is_file() else
+                            {"prefix": "mesh "},
             "steps": [{"label": s.label, "method": "animate", "args": [[str(k)], animate]}
                       for k, s in enumerate(states)]}])
     return fig
@@ -266,7 +273,8 @@ def write_view(run_dir: str | os.PathLike, *, field: str | None = None, summary:
     run_dir = Path(run_dir)
     fig = build_figure(run_dir, summary, field or DEFAULT_FIELD, most=most)
     out = Path(path) if path is not None else run_dir / VIEW_FILE
-    html = fig.to_html(include_plotlyjs=True, full_html=True, config={"displaylogo": False, "responsive": True})
+    html = fig.to_html(include_plotlyjs=True, full_html=True, auto_play=False, default_height="96vh",
+                       config={"displaylogo": False, "responsive": True})
     with atomic_write(out) as tmp:
         tmp.write_text(html, encoding="utf-8")
     return out
