@@ -313,15 +313,18 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     frames = run.frames
     from rftstatic.io.animation import animate
     from rftstatic.io.charts import plot_history
+    from rftstatic.io.solids import run_solids
     from rftstatic.io.views import plot_views
 
     lu = {"cm-gf-s": "cm", "mm-N-s": "mm", "SI": "m"}.get(u.name, "")
     short = f"{scene.name} ({model.element}, {model.mesh.n_nodes} nodes)"
     views = [v for v in scene.get("output.views", ["iso", "side"]) if v in ("iso", "side", "top")]
+    shown = [(X3 + frames[i][1]) / u.length for i in idx[: len(summary["frames"])]]
+    solids = run_solids(scene.data, X3 / u.length, np.concatenate(shown)) if shown else []
     for entry, i in zip(summary["frames"], idx):
         t, U = frames[i]
         files = plot_views(str(out / f"frame_t{_tag(entry['time'])}"), (X3 + U) / u.length, tri, views=views,
-                           title=f"{short}: t = {entry['time']:g} s", length_unit=lu)
+                           title=f"{short}: t = {entry['time']:g} s", length_unit=lu, solids=solids)
         entry["files"] = {v: p.name for v, p in files.items()}
     reg = np.linspace(0.0, o.t_end, o.samples + 1) if o.samples else save_times
     pick = sorted(set(np.searchsorted(save_times, reg).tolist()) & set(range(len(frames))))

@@ -345,6 +345,7 @@ def _write(scene, solved, out: Path, summary: dict, *, figures=True) -> None:
 
 def _frames(scene, run, out: Path) -> list:
     """``mesh_<k>_{top,iso}.png`` per mesh (edges drawn) and their GIF ``remesh.gif``."""
+    from rftstatic.io.solids import run_solids
     from rftstatic.io.views import plot_views
 
     u = scene.units
@@ -358,13 +359,15 @@ def _frames(scene, run, out: Path) -> list:
         states.append((k, m, mesh, x))
         lo = x.min(axis=0) if lo is None else np.minimum(lo, x.min(axis=0))
         hi = x.max(axis=0) if hi is None else np.maximum(hi, x.max(axis=0))
+    solids = run_solids(scene.data, states[0][2].X3 / u.length, np.concatenate([x for *_, x in states]))
     for k, m, mesh, x in states:
         label = "final" if m.get("final") else f"mesh {k}"
         when = (f"t = {m['t'] / u.time:.3g} s" if run["route"] == "remesh_relax" else
                 ("equilibrium" if m["U"] is not None else "flat reference"))
         title = f"{scene.name}: {label}, {mesh.n_nodes} nodes, {when}"
         name = f"mesh_{k:02d}" if not m.get("final") else "mesh_final"
-        files = plot_views(str(out / name), x, mesh.tri, views=("top", "iso"), title=title, length_unit=lu)
+        files = plot_views(str(out / name), x, mesh.tri, views=("top", "iso"), title=title, length_unit=lu,
+                           solids=solids)
         frames.append({"mesh": label, "nodes": mesh.n_nodes, "triangles": mesh.n_elements,
                        "time": None if run["route"] != "remesh_relax" else m["t"] / u.time,
                        "files": {v: p.name for v, p in files.items()}})

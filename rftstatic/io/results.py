@@ -18,7 +18,7 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
     into ``out``: ``summary.json`` is written once, last, so a run folder with one is complete.
 
     The views draw what the sheet rests on (:func:`rftstatic.io.solids.run_solids`: the obstacles and a tester's
-    clamping disc, from ``summary["resolved_scene"]``) and are coloured by the relative curvature |kappa| h.
+    clamping disc of the scene) and are coloured by the relative curvature |kappa| h.
     ``view.html`` (with ``figures`` and the VTU) is built from the files just written, as
     ``python -m rftstatic view`` builds it later."""
     u = scene.units.length
@@ -36,7 +36,7 @@ def write_outputs(scene, model, extras, U, out: Path, summary: dict, *, figures=
         x = model.positions(U) / u
         plot_views(str(out / "view"), x, model.mesh.tri, views=views, title=title,
                    color_by=cell["relative_curvature"], color_label=CURVATURE_LABEL,
-                   length_unit=LENGTH_UNITS.get(scene.units.name, ""), solids=run_solids(summary, model.X3 / u, x))
+                   length_unit=LENGTH_UNITS.get(scene.units.name, ""), solids=run_solids(scene.data, model.X3 / u, x))
         drape = summary.get("drape") or {}
         if extras.get("disc") is not None and drape.get("drape_coefficient") is not None:
             _shadow(scene, model, extras["disc"], U, out, drape)

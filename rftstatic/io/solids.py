@@ -5,7 +5,7 @@
   here;
 - :func:`support_disc`: the clamping disc of a drape tester (Cusick: the specimen lies on an 18 cm disc,
   modelled as clamped nodes, not as an obstacle), as a thin round pedestal under the specimen;
-- :func:`run_solids`: every solid of a run, from its ``summary.json`` (the resolved scene's
+- :func:`run_solids`: every solid of a run, from its resolved scene (``summary.json``'s ``resolved_scene``:
   ``[[obstacles]]`` and clamped ``[[supports]]`` with a ``radius``) and the sheet's reference positions, so
   the solids of any past run can be drawn.
 
@@ -121,19 +121,20 @@ def support_disc(centre, radius: float, z: float) -> tuple[np.ndarray, np.ndarra
     return obstacle_surface(disc, lo - radius, hi + radius)
 
 
-def run_solids(summary: dict, x_ref: np.ndarray, x: np.ndarray) -> list[Solid]:
-    """The solids of a run, in its scene's length unit, from its ``summary`` (``resolved_scene``).
+def run_solids(scene: dict | None, x_ref: np.ndarray, x: np.ndarray) -> list[Solid]:
+    """The solids of a run, in its scene's length unit.
 
     Parameters
     ----------
-    summary : the run's ``summary.json`` (its ``resolved_scene``: ``obstacles`` and ``supports``)
+    scene : the run's resolved scene data (``Scene.data``, ``summary.json``'s ``resolved_scene``): its
+        ``obstacles`` and ``supports`` [scene units]
     x_ref : (N, 3) the sheet's reference positions [scene length] (the height of a clamping disc)
     x : (N, 3) positions the drawing box is made for (every state shown) [scene length]
     """
     from rftstatic.contact.obstacles import from_spec
     from rftstatic.contact.obstacles.base import type_name_of
 
-    scene = summary.get("resolved_scene") or {}
+    scene = scene or {}
     lo, hi = drawing_box(np.asarray(x, float))
     out = []
     for spec in scene.get("obstacles", []) or []:

@@ -211,7 +211,7 @@ def build_figure(run_dir: Path, summary: dict, field: str = DEFAULT_FIELD, *, mo
     last = states[-1]
     x_ref = last.x - np.asarray(last.point_data.get("displacement", np.zeros_like(last.x)), float)
     every = np.concatenate([s.x for s in states])
-    solids = run_solids(summary, x_ref, every)
+    solids = run_solids(summary.get("resolved_scene"), x_ref, every)
     data = [_mesh_trace(last, values[-1], spec, unit, clim)]    # the final state first; the slider goes back
     for solid in solids:
         v, t = solid.vertices.astype(np.float32), solid.triangles.astype(np.int32)

@@ -141,7 +141,7 @@ def test_the_cusick_pictures_draw_the_disc_with_equal_scales_and_a_named_colour_
 
     mesh = meshio.read(cusick_run / "deformed.vtu")
     x, tri = mesh.points, mesh.cells[0].data
-    solids = run_solids(summary, x - mesh.point_data["displacement"], x)
+    solids = run_solids(summary["resolved_scene"], x - mesh.point_data["displacement"], x)
     assert [s.name for s in solids] == ["support disc"]
     figs = {}
     monkeypatch.setattr(views, "save_png", lambda fig, path: figs.setdefault(str(path), fig))
