@@ -40,7 +40,7 @@ import numpy as np
 from rftstatic.app.result import RunResult
 from rftstatic.errors import CheckpointError, StepLimitError
 from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
-from rftstatic.io.results import write_run_view
+from rftstatic.io.results import run_label, write_run_view
 from rftstatic.io.summary import self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model
@@ -317,7 +317,7 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     from rftstatic.io.views import plot_views
 
     lu = {"cm-gf-s": "cm", "mm-N-s": "mm", "SI": "m"}.get(u.name, "")
-    short = f"{scene.name} ({model.element}, {model.mesh.n_nodes} nodes)"
+    short = f"{scene.name} ({run_label(model)})"
     views = [v for v in scene.get("output.views", ["iso", "side"]) if v in ("iso", "side", "top")]
     shown = [(X3 + frames[i][1]) / u.length for i in idx[: len(summary["frames"])]]
     solids = run_solids(scene.data, X3 / u.length, np.concatenate(shown)) if shown else []

@@ -364,7 +364,7 @@ def _frames(scene, run, out: Path) -> list:
         label = "final" if m.get("final") else f"mesh {k}"
         when = (f"t = {m['t'] / u.time:.3g} s" if run["route"] == "remesh_relax" else
                 ("equilibrium" if m["U"] is not None else "flat reference"))
-        title = f"{scene.name}: {label}, {mesh.n_nodes} nodes, {when}"
+        title = f"{scene.name}: {label}, {mesh.n_nodes} nodes, {when} (fabric {run['model'].material.name})"
         name = f"mesh_{k:02d}" if not m.get("final") else "mesh_final"
         files = plot_views(str(out / name), x, mesh.tri, views=("top", "iso"), title=title, length_unit=lu,
                            solids=solids)

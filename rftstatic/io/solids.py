@@ -61,7 +61,7 @@ def _uv_sphere(n_lat: int, n_lon: int) -> tuple[np.ndarray, np.ndarray]:
     return pts, np.vstack([top, side, bottom]).astype(np.int64)
 
 
-def obstacle_surface(obstacle, lo, hi, *, n_lat: int = 48, n_lon: int = 96) -> tuple[np.ndarray, np.ndarray]:
+def obstacle_surface(obstacle, lo, hi, *, n_lat: int = 32, n_lon: int = 64) -> tuple[np.ndarray, np.ndarray]:
     """The surface of ``obstacle`` within the box ``lo (3,)``, ``hi (3,)``, triangulated (module notes).
 
     Parameters
@@ -121,7 +121,7 @@ def support_disc(centre, radius: float, z: float) -> tuple[np.ndarray, np.ndarra
     return obstacle_surface(disc, lo - radius, hi + radius)
 
 
-def run_solids(scene: dict | None, x_ref: np.ndarray, x: np.ndarray) -> list[Solid]:
+def run_solids(scene: dict | None, x_ref: np.ndarray, x: np.ndarray, *, obstacles=None) -> list[Solid]:
     """The solids of a run, in its scene's length unit.
 
     Parameters
@@ -130,6 +130,7 @@ def run_solids(scene: dict | None, x_ref: np.ndarray, x: np.ndarray) -> list[Sol
         ``obstacles`` and ``supports`` [scene units]
     x_ref : (N, 3) the sheet's reference positions [scene length] (the height of a clamping disc)
     x : (N, 3) positions the drawing box is made for (every state shown) [scene length]
+    obstacles : the obstacles [scene units], when the caller has built them (default: from ``scene``)
     """
     from rftstatic.contact.obstacles import from_spec
     from rftstatic.contact.obstacles.base import type_name_of
@@ -137,8 +138,9 @@ def run_solids(scene: dict | None, x_ref: np.ndarray, x: np.ndarray) -> list[Sol
     scene = scene or {}
     lo, hi = drawing_box(np.asarray(x, float))
     out = []
-    for spec in scene.get("obstacles", []) or []:
-        ob = from_spec(spec, 1.0)                                 # scene units throughout
+    if obstacles is None:
+        obstacles = [from_spec(spec, 1.0) for spec in scene.get("obstacles", []) or []]   # scene units throughout
+    for ob in obstacles:
         surface = obstacle_surface(ob, lo, hi)
         if surface is not None:
             out.append(Solid(type_name_of(ob), *surface))

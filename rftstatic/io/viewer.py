@@ -23,6 +23,7 @@ Lengths are in the scene's units, as in the files. plotly is imported when a vie
 from __future__ import annotations
 
 import json
+import logging
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -31,6 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from rftstatic.io.figure import LENGTH_UNITS
+
+log = logging.getLogger(__name__)
 
 __all__ = ["FIELDS", "MAX_FRAMES", "VIEW_FILE", "ViewError", "available_fields", "read_states", "write_view"]
 
@@ -125,9 +128,14 @@ def read_states(run_dir: Path, summary: dict, *, most: int = MAX_FRAMES) -> list
 
 
 def _obstacles(summary: dict) -> list:
+    """The run's obstacles [scene units]; none when its summary's scene cannot be read back (a foreign version)."""
     from rftstatic.contact.obstacles import from_spec
 
-    return [from_spec(spec, 1.0) for spec in (summary.get("resolved_scene") or {}).get("obstacles", []) or []]
+    try:
+        return [from_spec(spec, 1.0) for spec in (summary.get("resolved_scene") or {}).get("obstacles", []) or []]
+    except (ValueError, TypeError, AttributeError) as exc:
+        log.warning("the obstacles of summary.json's resolved_scene cannot be rebuilt (%s): they are not drawn", exc)
+        return []
 
 
 def available_fields(state: SavedState, obstacles) -> list[str]:
@@ -211,7 +219,7 @@ def build_figure(run_dir: Path, summary: dict, field: str = DEFAULT_FIELD, *, mo
     last = states[-1]
     x_ref = last.x - np.asarray(last.point_data.get("displacement", np.zeros_like(last.x)), float)
     every = np.concatenate([s.x for s in states])
-    solids = run_solids(summary.get("resolved_scene"), x_ref, every)
+    solids = run_solids(summary.get("resolved_scene"), x_ref, every, obstacles=obstacles)
     data = [_mesh_trace(last, values[-1], spec, unit, clim)]    # the final state first; the slider goes back
     for solid in solids:
         v, t = solid.vertices.astype(np.float32), solid.triangles.astype(np.int32)

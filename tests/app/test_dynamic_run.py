@@ -216,3 +216,4 @@ def test_the_summary_is_written_once_and_names_its_rest_test(tmp_path, monkeypat
         "at_rest": {"criterion": "kinetic+force", "tol_kinetic": 1e-3, "tol_force": 0.5},
         "time_at_rest": {"criterion": "kinetic", "tol_kinetic": 1e-3, "tol_force": None}}
     assert "critical step" in on_disk["dt_reason"] and ("energy_plot" in on_disk) == figures
+    assert (tmp_path / "view.html").exists() == ("view" in on_disk) == figures
