@@ -25,7 +25,9 @@ from __future__ import annotations
 import json
 import logging
 import os
+import textwrap
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,25 +48,6 @@ DEFAULT_FIELD = "relative_curvature"
 
 class ViewError(ValueError):
     """A run folder the viewer cannot draw: missing, without ``summary.json`` or VTU, or an unknown field."""
-
-
-@dataclass(frozen=True)
-class Field:
-    """A colouring of the sheet: its label, unit (``"-"``, ``"L"`` a length, ``"1/L"``) and where it lives."""
-
-    label: str
-    unit: str
-    where: str  # "cell" or "point"
-
-
-FIELDS = {
-    "relative_curvature": Field("relative curvature |kappa| h", "-", "cell"),
-    "curvature": Field("curvature |kappa|", "1/L", "cell"),
-    "displacement": Field("displacement |u|", "L", "point"),
-    "membrane_strain": Field("membrane strain (largest principal)", "-", "cell"),
-    "height": Field("height z", "L", "point"),
-    "gap": Field("gap to the nearest obstacle", "L", "point"),
-}
 
 
 @dataclass(frozen=True)
@@ -101,7 +84,7 @@ def _pick(n: int, most: int) -> list[int]:
     return sorted(set(np.linspace(0, n - 1, most).round().astype(int).tolist()))
 
 
-def read_states(run_dir: Path, summary: dict, *, most: int = MAX_FRAMES) -> list[SavedState]:
+def read_states(run_dir: Path, *, most: int = MAX_FRAMES) -> list[SavedState]:
     """The sheet's saved states in ``run_dir``: a series (dynamic ``series.pvd``, remeshed ``meshes.pvd``) or the
     final ``deformed.vtu``; :class:`ViewError` when there is none."""
     for pvd, kind in (("series.pvd", "time"), ("meshes.pvd", "mesh")):
@@ -138,35 +121,49 @@ def _obstacles(summary: dict) -> list:
         return []
 
 
+@dataclass(frozen=True)
+class Field:
+    """A colouring of the sheet: its label, unit (``"-"``, ``"L"`` a length, ``"1/L"``), where it lives
+    (``"cell"`` or ``"point"``), what it needs (a ``point_data``/``cell_data`` name of the VTU, or ``"obstacles"``)
+    and ``values(state, obstacles)``, (E,) or (N,)."""
+
+    label: str
+    unit: str
+    where: str
+    needs: str | None
+    values: Callable[[SavedState, list], np.ndarray]
+
+
+def _curvature_norm(state, _):
+    from rftstatic.element.curvature import curvature_norm
+
+    return curvature_norm(np.asarray(state.cell_data["curvature"], float))
+
+
+def _largest_principal_strain(state, _):
+    e = np.asarray(state.cell_data["membrane_strain"], float)      # (e_xx, e_yy, 2 e_xy)
+    return 0.5 * (e[:, 0] + e[:, 1]) + np.hypot(0.5 * (e[:, 0] - e[:, 1]), 0.5 * e[:, 2])
+
+
+FIELDS = {
+    "relative_curvature": Field("relative curvature |kappa| h", "-", "cell", "relative_curvature",
+                                lambda s, _: np.asarray(s.cell_data["relative_curvature"], float).ravel()),
+    "curvature": Field("curvature |kappa|", "1/L", "cell", "curvature", _curvature_norm),
+    "displacement": Field("displacement |u|", "L", "point", "displacement",
+                          lambda s, _: np.linalg.norm(np.asarray(s.point_data["displacement"], float), axis=1)),
+    "membrane_strain": Field("membrane strain (largest principal)", "-", "cell", "membrane_strain",
+                             _largest_principal_strain),
+    "height": Field("height z", "L", "point", None, lambda s, _: s.x[:, 2].copy()),
+    "gap": Field("gap to the nearest obstacle", "L", "point", "obstacles",
+                 lambda s, obs: np.min([ob.signed_distance(s.x)[0] for ob in obs], axis=0)),
+}
+"""The fields the view can colour the sheet by (``--field``), in the order the error lists them."""
+
+
 def available_fields(state: SavedState, obstacles) -> list[str]:
     """The names of :data:`FIELDS` that ``state`` (and the run's ``obstacles``) can colour the sheet by."""
-    have = {"height"}
-    if "displacement" in state.point_data:
-        have.add("displacement")
-    have |= {k for k in ("relative_curvature", "curvature", "membrane_strain") if k in state.cell_data}
-    if obstacles:
-        have.add("gap")
-    return [name for name in FIELDS if name in have]
-
-
-def field_values(name: str, state: SavedState, obstacles) -> np.ndarray:
-    """The values of field ``name`` on ``state``: (E,) per triangle or (N,) per node (:data:`FIELDS`)."""
-    if name == "relative_curvature":
-        return np.asarray(state.cell_data["relative_curvature"], float).ravel()
-    if name == "curvature":
-        from rftstatic.element.curvature import curvature_norm
-
-        return curvature_norm(np.asarray(state.cell_data["curvature"], float))
-    if name == "membrane_strain":
-        e = np.asarray(state.cell_data["membrane_strain"], float)  # (e_xx, e_yy, 2 e_xy)
-        return 0.5 * (e[:, 0] + e[:, 1]) + np.hypot(0.5 * (e[:, 0] - e[:, 1]), 0.5 * e[:, 2])
-    if name == "displacement":
-        return np.linalg.norm(np.asarray(state.point_data["displacement"], float), axis=1)
-    if name == "height":
-        return state.x[:, 2].copy()
-    if name == "gap":
-        return np.min([ob.signed_distance(state.x)[0] for ob in obstacles], axis=0)
-    raise KeyError(name)
+    have = {None, *state.point_data, *state.cell_data, *(["obstacles"] if obstacles else [])}
+    return [name for name, f in FIELDS.items() if f.needs in have]
 
 
 def _title(summary: dict) -> str:
@@ -174,8 +171,6 @@ def _title(summary: dict) -> str:
     what = ", ".join(p for p in (f"fabric {material}" if material else "", summary.get("element", ""),
                                  f"{summary.get('nodes')} nodes" if summary.get("nodes") else "") if p)
     status = "" if summary.get("converged", True) else "NOT CONVERGED; "
-    import textwrap
-
     title = "<br>".join(textwrap.wrap(summary.get("title") or summary.get("scene", ""), 90)[:2])
     return f"{title}<br><sub>{status}{what}</sub>"
 
@@ -204,7 +199,7 @@ def build_figure(run_dir: Path, summary: dict, field: str = DEFAULT_FIELD, *, mo
 
     from rftstatic.io.solids import run_solids
 
-    states = read_states(run_dir, summary, most=most)
+    states = read_states(run_dir, most=most)
     obstacles = _obstacles(summary)
     fields = [f for f in available_fields(states[-1], obstacles)
               if all(f in available_fields(s, obstacles) for s in states[:-1])]
@@ -212,7 +207,7 @@ def build_figure(run_dir: Path, summary: dict, field: str = DEFAULT_FIELD, *, mo
         raise ViewError(f"field {field!r} is not in the run {run_dir}; its fields are {', '.join(fields)}")
     spec = FIELDS[field]
     unit = _unit(spec, LENGTH_UNITS.get(summary.get("units", ""), ""))
-    values = [field_values(field, s, obstacles) for s in states]
+    values = [spec.values(s, obstacles) for s in states]
     finite = np.concatenate([v[np.isfinite(v)] for v in values] + [np.zeros(0)])
     lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
     clim = (lo, hi if hi > lo else lo + 1.0)
