@@ -331,7 +331,7 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     if pick:
         animate(out / "animation.gif", [(X3 + frames[i][1]) / u.length for i in pick], tri,
                 times=[frames[i][0] / u.time for i in pick], view="iso", fps=12, title=scene.name,
-                length_unit=lu)
+                length_unit=lu, solids=solids)
         summary["animation"] = {"file": "animation.gif", "frames": len(pick)}
     h = run.history
     plot_history(out / "energy.png", h["time"] / u.time,

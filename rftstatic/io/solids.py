@@ -61,14 +61,15 @@ def _uv_sphere(n_lat: int, n_lon: int) -> tuple[np.ndarray, np.ndarray]:
     return pts, np.vstack([top, side, bottom]).astype(np.int64)
 
 
-def obstacle_surface(obstacle, lo, hi, *, n_lat: int = 32, n_lon: int = 64) -> tuple[np.ndarray, np.ndarray]:
+def obstacle_surface(obstacle, lo, hi, *, n_lat: int = 24, n_lon: int = 48) -> tuple[np.ndarray, np.ndarray]:
     """The surface of ``obstacle`` within the box ``lo (3,)``, ``hi (3,)``, triangulated (module notes).
 
     Parameters
     ----------
     obstacle : any :class:`~rftstatic.contact.obstacles.Obstacle` (``signed_distance`` in the box's unit)
     lo, hi : (3,) the drawing box: an unbounded solid (a floor, an infinitely tall pedestal) ends at its faces
-    n_lat, n_lon : rings and meridians of the sphere that is projected
+    n_lat, n_lon : rings and meridians of the sphere that is projected (24 x 48: about 2200 triangles, which add
+        60 % to the GIF of a 13 x 13 sheet; edges stay sharp at any count, a sphere shows facets below it)
 
     Returns
     -------
