@@ -1,5 +1,6 @@
-"""Command line: ``python -m rftstatic {case, view, list, fabrics, options, sweep, fit, bench, validate}``, on the Python API
-(:mod:`rftstatic.api`) and the studies on Dask (:mod:`rftstatic.study`).
+"""Command line: ``python -m rftstatic {case, view, list, fabrics, options, sweep, fit, bench, validate}``, on the
+Python API (:mod:`rftstatic.api`), the run viewer (:mod:`rftstatic.io.viewer`) and the studies on Dask
+(:mod:`rftstatic.study`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
 not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs

@@ -33,7 +33,8 @@ def cusick_run(tmp_path_factory):
 
 
 def test_import_is_light():
-    code = "import sys, rftstatic.io.viewer, rftstatic.io.solids; print('plotly' in sys.modules, 'meshio' in sys.modules)"
+    code = ("import sys, rftstatic.io.viewer, rftstatic.io.solids; "
+            "print('plotly' in sys.modules, 'meshio' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
 
