@@ -1,5 +1,6 @@
-"""Command line: ``python -m rftstatic {case, list, fabrics, options, sweep, fit, bench, validate}``, on the Python API
-(:mod:`rftstatic.api`) and the studies on Dask (:mod:`rftstatic.study`).
+"""Command line: ``python -m rftstatic {case, view, list, fabrics, options, sweep, fit, bench, validate}``, on the
+Python API (:mod:`rftstatic.api`), the run viewer (:mod:`rftstatic.io.viewer`) and the studies on Dask
+(:mod:`rftstatic.study`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
 not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs
@@ -35,9 +36,22 @@ def main(argv=None) -> int:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene key, e.g. --set element=RFT3 --set mesh.nodes=[21,101]")
     p.add_argument("--out", default=None, help="output folder (default out/NAME)")
-    p.add_argument("--no-figures", action="store_true", help="skip the PNG views")
+    p.add_argument("--no-figures", action="store_true", help="skip the PNG views and view.html")
     p.add_argument("--resume", action="store_true", help="continue a run (static, dynamic, relax) from its last checkpoint")
 
+    w = sub.add_parser("view", parents=[common], help="write RUN_DIR/view.html: the run's sheet in 3-D, rotatable, "
+                       "with its obstacles, one file that opens offline in a browser",
+                       description="Write an interactive 3-D view of a finished run (its summary.json and VTU "
+                       "files): the deformed sheet coloured by a field, with a colour bar naming the field and "
+                       "its unit, the obstacles and a tester's disc translucent, equal axis scales, and for "
+                       "dynamic and remeshed runs a slider over the saved states. A run writes it by default "
+                       "(--no-figures skips it).")
+    w.add_argument("run_dir", help="a run's output folder (e.g. out/cusick-30)")
+    w.add_argument("--field", default="relative_curvature",
+                   help="colour the sheet by relative_curvature (|kappa| h, default), curvature (|kappa|), "
+                   "displacement (|u|), membrane_strain (largest principal), height (z) or gap (to the "
+                   "nearest obstacle), as the run has them")
+    w.add_argument("--out", default=None, help="the HTML file to write (default RUN_DIR/view.html)")
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
     sub.add_parser("fabrics", parents=[common], help="list the fabric library with bending lengths and sources")
     o = sub.add_parser("options", parents=[common], help="list a scene table's keys with type, unit, range, default "
@@ -161,6 +175,16 @@ def _command(args) -> int:
                 print(f"not from the source: {rule}")
             print("sources in full: rftstatic.fabrics.library.FABRICS[name].source")
             return 0
+        if args.command == "view":
+            from rftstatic.io.viewer import ViewError, write_view
+
+            try:
+                path = write_view(args.run_dir, field=args.field, path=args.out)
+            except ViewError as exc:
+                print(f"error: {exc}", file=sys.stderr)
+                return EXIT["input"]
+            print(f"view written to {path} (open it in a browser)")
+            return EXIT["done"]
         if args.command == "options":
             print(api.format_rows(api.option_rows(args.section), args.format))
             return 0

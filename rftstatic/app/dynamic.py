@@ -15,7 +15,7 @@ Outputs in the run folder, every number in the scene's units:
 * ``frame_t<time>_{iso,side}.png`` at the scene's ``frames`` times;
 * ``series/state_<k>.vtu`` (the frames and ``samples`` regular states) indexed by ``series.pvd``;
 * ``animation.gif`` (the sampled states, isometric view), ``energy.png`` (kinetic and potential
-  energy against time);
+  energy against time), ``view.html`` (:mod:`rftstatic.io.viewer`: the saved states in 3-D, with a slider);
 * ``summary.json`` (written once, at the end): counts, step, its estimate and why it was chosen (``dt_reason``,
   :func:`~rftstatic.solvers.step_plan.plan_steps`), steps, wall time, element-steps per second, probe
   trajectories (t, x, y, z), time at rest and the at-rest test's criterion and tolerances (``rest_test``:
@@ -40,6 +40,7 @@ import numpy as np
 from rftstatic.app.result import RunResult
 from rftstatic.errors import CheckpointError, StepLimitError
 from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
+from rftstatic.io.results import run_label, write_run_view
 from rftstatic.io.summary import self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model
@@ -305,6 +306,8 @@ def _write(scene, model, out: Path, run, summary, o, save_times, *, figures=True
     try:
         if figures:
             _figures(scene, model, out, run, summary, o, save_times, idx)
+            if series:  # view.html: a slider over the saved states
+                write_run_view(out, summary)
     finally:  # written once, with the figures drawn so far (a plot that fails leaves the numbers written)
         write_json(out / "summary.json", summary)
 
@@ -317,22 +320,25 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     frames = run.frames
     from rftstatic.io.animation import animate
     from rftstatic.io.charts import plot_history
+    from rftstatic.io.solids import run_solids
     from rftstatic.io.views import plot_views
 
     lu = {"cm-gf-s": "cm", "mm-N-s": "mm", "SI": "m"}.get(u.name, "")
-    short = f"{scene.name} ({model.element}, {model.mesh.n_nodes} nodes)"
+    short = f"{scene.name} ({run_label(model)})"
     views = [v for v in scene.get("output.views", ["iso", "side"]) if v in ("iso", "side", "top")]
+    shown = [(X3 + frames[i][1]) / u.length for i in idx[: len(summary["frames"])]]
+    solids = run_solids(scene.data, X3 / u.length, np.concatenate(shown)) if shown else []
     for entry, i in zip(summary["frames"], idx):
         t, U = frames[i]
         files = plot_views(str(out / f"frame_t{_tag(entry['time'])}"), (X3 + U) / u.length, tri, views=views,
-                           title=f"{short}: t = {entry['time']:g} s", length_unit=lu)
+                           title=f"{short}: t = {entry['time']:g} s", length_unit=lu, solids=solids)
         entry["files"] = {v: p.name for v, p in files.items()}
     reg = np.linspace(0.0, o.t_end, o.samples + 1) if o.samples else save_times
     pick = sorted(set(np.searchsorted(save_times, reg).tolist()) & set(range(len(frames))))
     if pick:
         animate(out / "animation.gif", [(X3 + frames[i][1]) / u.length for i in pick], tri,
                 times=[frames[i][0] / u.time for i in pick], view="iso", fps=12, title=scene.name,
-                length_unit=lu)
+                length_unit=lu, solids=solids)
         summary["animation"] = {"file": "animation.gif", "frames": len(pick)}
     h = run.history
     plot_history(out / "energy.png", h["time"] / u.time,

@@ -24,6 +24,8 @@ Outputs in the run folder, every number in the scene's units:
   known for the last mesh, so the earlier ones are drawn flat in the top view), ``remesh.gif``
   (the isometric frames), ``nodes.png`` (node count against time or cycle);
 * ``deformed.vtu`` and ``view_{side,top,iso}.png`` of the final state (:func:`rftstatic.io.results.write_outputs`);
+* ``meshes/mesh_<k>.vtu`` indexed by ``meshes.pvd`` (each mesh's state, as the PNGs draw it) and ``view.html``
+  (:mod:`rftstatic.io.viewer`, a slider over the meshes);
 * ``checkpoint.npz`` (:mod:`rftstatic.remesh.checkpoint`): after every solved cycle (static), after every
   remesh, at most every 10 s between remeshes and at the end (relax); ``--resume`` (:func:`resume_scene`)
   continues from it to the meshes and state of the uninterrupted run.
@@ -42,7 +44,7 @@ from rftstatic.app.result import RunResult
 from rftstatic.contact.kinematic import contact_reaction_residual
 from rftstatic.errors import CheckpointError, InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable
-from rftstatic.io.results import write_outputs
+from rftstatic.io.results import write_mesh_series, write_outputs
 from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_summary, self_intersection_summary,
                                    summary_header)
 from rftstatic.optionspec import scene_values
@@ -345,11 +347,13 @@ def _write(scene, solved, out: Path, summary: dict, *, figures=True) -> None:
         summary["frames"] = _frames(scene, solved, out)
         _node_plot(scene, summary, out)
         summary["node_plot"] = "nodes.png"
+    write_mesh_series(scene, solved["meshes"], out)  # meshes.pvd: the viewer's slider over the meshes
     write_outputs(scene, solved["model"], solved["extras"], solved["U"], out, summary, figures=figures)
 
 
 def _frames(scene, run, out: Path) -> list:
     """``mesh_<k>_{top,iso}.png`` per mesh (edges drawn) and their GIF ``remesh.gif``."""
+    from rftstatic.io.solids import run_solids
     from rftstatic.io.views import plot_views
 
     u = scene.units
@@ -363,13 +367,15 @@ def _frames(scene, run, out: Path) -> list:
         states.append((k, m, mesh, x))
         lo = x.min(axis=0) if lo is None else np.minimum(lo, x.min(axis=0))
         hi = x.max(axis=0) if hi is None else np.maximum(hi, x.max(axis=0))
+    solids = run_solids(scene.data, states[0][2].X3 / u.length, np.concatenate([x for *_, x in states]))
     for k, m, mesh, x in states:
         label = "final" if m.get("final") else f"mesh {k}"
         when = (f"t = {m['t'] / u.time:.3g} s" if run["route"] == "remesh_relax" else
                 ("equilibrium" if m["U"] is not None else "flat reference"))
-        title = f"{scene.name}: {label}, {mesh.n_nodes} nodes, {when}"
+        title = f"{scene.name}: {label}, {mesh.n_nodes} nodes, {when} (fabric {run['model'].material.name})"
         name = f"mesh_{k:02d}" if not m.get("final") else "mesh_final"
-        files = plot_views(str(out / name), x, mesh.tri, views=("top", "iso"), title=title, length_unit=lu)
+        files = plot_views(str(out / name), x, mesh.tri, views=("top", "iso"), title=title, length_unit=lu,
+                           solids=solids)
         frames.append({"mesh": label, "nodes": mesh.n_nodes, "triangles": mesh.n_elements,
                        "time": None if run["route"] != "remesh_relax" else m["t"] / u.time,
                        "files": {v: p.name for v, p in files.items()}})

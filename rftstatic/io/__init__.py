@@ -8,8 +8,11 @@
   load-deflection curves;
 - :mod:`.animation`: a GIF of the drape over time (:func:`~.animation.animate`);
 - :mod:`.outlines`: obstacle outlines and the callables that draw them in the views;
-- :mod:`.drape_figures`: the validation reports' drape figures (obstacle drawers, boundaries, Fig. 8).
+- :mod:`.drape_figures`: the validation reports' drape figures (obstacle drawers, boundaries, Fig. 8);
+- :mod:`.solids`: what the sheet rests on (obstacles, a tester's disc) as triangulated surfaces to draw;
+- :mod:`.viewer`: the interactive 3-D view of a run, ``view.html`` (plotly), from its files;
+- :mod:`.results`: what a solved run writes (VTU, PNG views, view.html, summary.json).
 
-matplotlib is imported inside the plotting functions only, so importing this layer stays light.
+matplotlib, plotly and meshio are imported inside the functions only, so importing this layer stays light.
 Imports from ``scenes`` and below.
 """

@@ -21,11 +21,14 @@ import numpy as np
 
 from rftstatic.io.files import atomic_write
 
-__all__ = ["DPI", "as_curve", "axis_labels", "figsize_2d", "new_figure", "padded_limits", "save_png",
+__all__ = ["DPI", "LENGTH_UNITS", "as_curve", "axis_labels", "figsize_2d", "new_figure", "padded_limits", "save_png",
            "set_2d_limits", "set_title", "wrap_title"]
 
 DPI = 120
 """Resolution of every PNG and GIF frame [dots per inch]."""
+
+LENGTH_UNITS = {"cm-gf-s": "cm", "cm-dyn-s": "cm", "mm-N-s": "mm", "SI": "m"}
+"""The length unit of a scene's unit system (its name), for axis labels and colour bars."""
 
 
 def new_figure(figsize=(6.4, 4.8)):

@@ -18,10 +18,12 @@ import numpy as np
 
 from rftstatic.io.figure import padded_limits
 
-__all__ = ["AXES_2D", "AZIM", "CAMERA", "ELEV", "FABRIC_RGB", "add_surface_2d", "add_surface_3d", "check_mesh",
-           "set_3d_limits"]
+__all__ = ["AXES_2D", "AZIM", "CAMERA", "ELEV", "FABRIC_RGB", "SOLID_RGB", "add_solids_2d", "add_surface_2d",
+           "add_surface_3d", "check_mesh", "set_3d_limits"]
 
 FABRIC_RGB = np.array([0.85, 0.62, 0.38])  # a warm cloth colour; grey shading alone hides folds less well
+SOLID_RGB = np.array([0.62, 0.66, 0.74])   # what the sheet rests on: a cool grey, apart from any colour map
+SOLID_ALPHA = 0.35                         # translucent in 3-D, so that the sheet under and behind shows
 ELEV, AZIM = 30.0, -60.0                    # iso camera elevation and azimuth [deg]
 
 # Camera direction (towards the viewer) of each view, and the "up" of its image for the light offset:
@@ -56,8 +58,8 @@ def _light(view: str) -> np.ndarray:
     return light / np.linalg.norm(light)
 
 
-def _face_colors(x, tri, view, color_by=None, *, cmap="viridis", clim=None):
-    """Per-triangle RGBA (E, 4): base colour (or colormap of ``color_by``) times the shading factor."""
+def _face_colors(x, tri, view, color_by=None, *, cmap="viridis", clim=None, base=FABRIC_RGB):
+    """Per-triangle RGBA (E, 4): ``base`` colour (or colormap of ``color_by``) times the shading factor."""
     from matplotlib import colormaps
     from matplotlib.colors import Normalize
 
@@ -68,7 +70,7 @@ def _face_colors(x, tri, view, color_by=None, *, cmap="viridis", clim=None):
     shade = 0.35 + 0.65 * np.abs(n @ _light(view))
     mappable = None
     if color_by is None:
-        rgb = np.broadcast_to(FABRIC_RGB, (len(tri), 3))
+        rgb = np.broadcast_to(base, (len(tri), 3))
     else:
         c = np.asarray(color_by, dtype=float)
         if c.shape != (len(tri),):
@@ -133,17 +135,45 @@ def add_surface_2d(ax, x, tri, view, color_by=None, *, clim=None):
     return coll, mappable
 
 
-def add_surface_3d(ax, x, tri, color_by=None, *, clim=None):
+def add_surface_3d(ax, x, tri, color_by=None, *, clim=None, solids=()):
     """Add the shaded surface to a 3-D axes as one ``Poly3DCollection`` (lit for the iso view).
 
-    Same arguments and return as :func:`add_surface_2d`, without ``view``.
+    Same arguments and return as :func:`add_surface_2d`, without ``view``; ``solids``: what the sheet rests on,
+    :class:`~rftstatic.io.solids.Solid` surfaces drawn translucent (:data:`SOLID_ALPHA`) in the same collection,
+    so that matplotlib sorts their triangles and the sheet's together by depth (two collections are sorted as
+    wholes: a pedestal would be drawn over the whole sheet or under it).
     """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     rgba, mappable = _face_colors(x, tri, "iso", color_by, clim=clim)
-    coll = Poly3DCollection(x[tri], facecolors=rgba, **_edges(rgba))
+    edges = _edges(rgba)
+    verts, faces = [x[tri]], [rgba]
+    edge_rgba = [edges.pop("edgecolors")]
+    for solid in solids:
+        solid_rgba, _ = _face_colors(solid.vertices, solid.triangles, "iso", base=SOLID_RGB)
+        solid_rgba[:, 3] = SOLID_ALPHA
+        verts.append(solid.vertices[solid.triangles])
+        faces.append(solid_rgba)
+        edge_rgba.append(np.zeros_like(solid_rgba))                # no edges: a smooth solid
+    coll = Poly3DCollection(np.concatenate(verts), facecolors=np.concatenate(faces),
+                            edgecolors=np.concatenate(edge_rgba), **edges)
     ax.add_collection3d(coll)
     return coll, mappable
+
+
+def add_solids_2d(ax, solids, view) -> None:
+    """Draw ``solids`` (:class:`~rftstatic.io.solids.Solid`) in a 2-D view, shaded, depth-sorted and under the
+    sheet (``zorder`` 1): the sheet covers them where it lies in front."""
+    from matplotlib.collections import PolyCollection
+
+    i, j = AXES_2D[view]
+    cam, _ = CAMERA[view]
+    for solid in solids:
+        x, tri = solid.vertices, solid.triangles
+        order = np.argsort((x @ cam)[tri].mean(axis=1), kind="stable")
+        rgba, _ = _face_colors(x, tri[order], view, base=SOLID_RGB)
+        ax.add_collection(PolyCollection(x[tri[order]][:, :, (i, j)], facecolors=rgba, edgecolors=rgba,
+                                         linewidths=0.2, zorder=1))
 
 
 def set_3d_limits(ax, lo, hi):

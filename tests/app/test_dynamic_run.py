@@ -63,6 +63,8 @@ def test_tiny_hang_writes_well_formed_outputs(tmp_path):
             assert (out / name).stat().st_size > 0
     assert (out / "animation.gif").read_bytes()[:3] == b"GIF" and (out / "energy.png").stat().st_size > 0
     assert (out / "checkpoint.npz").exists()
+    assert s["view"] == "view.html" and (out / "view.html").stat().st_size > 1_000_000   # a slider over the states
+    assert (out / "view.html").read_text().count('"label":"') >= s["vtu_series"]["states"]
     # every saved state checked for self-intersection: a sheet falling for 0.05 s crosses nothing
     si = s["self_intersections"]
     assert si["saved_states"] == s["vtu_series"]["states"] == len(si["pairs_saved"]) and si["saved_skipped"] == 0
@@ -214,3 +216,4 @@ def test_the_summary_is_written_once_and_names_its_rest_test(tmp_path, monkeypat
         "at_rest": {"criterion": "kinetic+force", "tol_kinetic": 1e-3, "tol_force": 0.5},
         "time_at_rest": {"criterion": "kinetic", "tol_kinetic": 1e-3, "tol_force": None}}
     assert "critical step" in on_disk["dt_reason"] and ("energy_plot" in on_disk) == figures
+    assert (tmp_path / "view.html").exists() == ("view" in on_disk) == figures

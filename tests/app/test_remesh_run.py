@@ -50,6 +50,20 @@ def test_relax_outputs_exist_and_are_well_formed(tiny_run):
     assert (out / "nodes.png").stat().st_size > 0
 
 
+def test_the_view_has_a_slider_over_the_meshes(tiny_run):
+    """meshes.pvd lists every mesh's state (the last is deformed.vtu's), and view.html steps through them."""
+    from rftstatic.io.viewer import build_figure, load_summary
+
+    out, _ = load_summary(tiny_run[0])
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["view"] == "view.html" and (out / "view.html").exists()
+    fig = build_figure(out, summary)
+    nodes = [r["nodes"] for r in summary["records"]] + [summary["nodes"]]
+    assert [len(f.data[0].x) for f in fig.frames] == nodes
+    assert all(len(f.data[0].i) > 0 for f in fig.frames)                        # each mesh its own triangles
+    assert fig.layout.sliders[0].steps[-1].label == f"{len(nodes) - 1} ({summary['nodes']} nodes)"
+
+
 def test_remesh_options_scene_units_and_errors():
     s = load_scene("remesh-pedestal-round-50")
     o = remesh_options(s)
