@@ -259,7 +259,10 @@ def _relax_plan(model, first) -> _RelaxPlan:
         raise refuse(f"no dynamic relaxation: {exc}") from None
     if not max_time / est.dt <= MAX_RELAX_STEPS:  # a membrane far stiffer than the bending: too many steps
         raise refuse(f"dynamic relaxation would need up to {max_time / est.dt:.3g} explicit steps (dt {est.dt:.3g} "
-                     f"s); not attempted (limit {MAX_RELAX_STEPS:g})")
+                     f"s); not attempted (the static route's limit is {MAX_RELAX_STEPS:g} steps, which "
+                     "dynamics.max_steps does not change). Try solver.start = \"load-steps\" (Newton from the "
+                     "flat sheet, no explicit steps) or solver.continuation = \"arc-length\"; or a coarser mesh, or "
+                     "a smaller membrane stiffness, which lengthen the stable step")
     # settling folds on fine meshes (31 x 240 rings) take longer
     return _RelaxPlan(mass_scale=mass_scale, alpha=alpha, max_time=max_time * RELAX_TIME_ALLOWANCE,
                       chunk=4.0 / alpha, min_span=10 * est.dt)

@@ -423,3 +423,27 @@ def test_a_rest_tolerance_of_one_or_more_is_an_input_error(capsys, tmp_path):
     # the kinetic-energy ratio of the at-rest test (rftstatic.solvers.rest) lies in (0, 1)
     code, err = _run(capsys, tmp_path, "hang-20", ["mesh.nodes=[5,5]", "dynamics.rest_tolerance=1.5"])
     _assert_input_error(code, err, "dynamics.rest_tolerance", "1.5 is out of range: must be in (0, 1)")
+
+
+def test_a_refused_relaxation_names_the_keys_and_the_route_that_get_past_it(capsys, tmp_path):
+    """A membrane far stiffer than the bending makes the relaxation route's explicit steps too many: exit 3, and
+    the message says which route gets past it and that dynamics.max_steps does not."""
+    code, err = _run(capsys, tmp_path, "strip", ["mesh.nodes=[11,3]", "solver.start=relax", "material.C_warp=1e9",
+                                                  "material.C_weft=1e9"])
+    assert code == 3, err
+    assert "would need up to" in err and 'solver.start = "load-steps"' in err
+    assert "dynamics.max_steps does not change" in err
+
+
+def test_a_relaxation_segment_that_ends_before_rest_is_no_warning(caplog):
+    """The static route relaxes on or hands over to Newton when a segment ends before rest: nothing for the user
+    to do, so nothing at WARNING (it was printed three times on a run that then converged)."""
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.schema import load_scene
+    from rftstatic.solvers.relaxation import RelaxOptions, relax
+
+    model, _ = build_model(load_scene("strip", ["mesh.nodes=[11,3]"]))
+    with caplog.at_level("INFO"):
+        r = relax(model, RelaxOptions(alpha=1.0, max_time=1e-3, progress=False))
+    assert not r.converged and "not at rest" in caplog.text
+    assert not [rec for rec in caplog.records if rec.levelname == "WARNING" and "not at rest" in rec.message]
