@@ -241,8 +241,8 @@ def _command(args) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT["input"]
     except api.ConvergenceError as exc:
-        print(f"error: the solve did not converge: {exc}\nThe last equilibrium (if any) was written, labelled "
-              "converged = false.", file=sys.stderr)
+        print(f"error: the solve did not converge (the last equilibrium, if any, was written, labelled converged = "
+              f"false): {exc}", file=sys.stderr)
         return EXIT["goal"]
     except api.InstabilityError as exc:
         print(f"error: the explicit run became unstable: {exc}", file=sys.stderr)

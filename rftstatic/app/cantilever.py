@@ -114,7 +114,8 @@ def find_overhang(tester: _Tester, l0: float, opts) -> float:
             return c
         if len(tester.history) >= opts.max_solves:
             raise ConvergenceError(f"cantilever: the overhang root find did not settle in {opts.max_solves} solves "
-                                   f"(last {c:.8g}, angle error {math.degrees(fc):.3g} deg)", None)
+                                   f"(last {c:.8g}, angle error {math.degrees(fc):.3g} deg); raise cantilever.max_solves "
+                                   "or cantilever.tolerance", None)
         if fc * fb < 0:
             a, fa = b, fb
             side = 0

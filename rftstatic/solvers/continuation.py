@@ -307,8 +307,8 @@ def _start(path, U, result) -> _Point:
     if start is None:
         r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs).ravel()[path.free]
         raise ConvergenceError(f"arc-length start, load factor {LAM_START:g}: Newton did not converge in "
-                               f"{START_ITERATIONS} iterations; |r| = {np.linalg.norm(r):.3e} N at the lifted start",
-                               None)
+                               f"{START_ITERATIONS} iterations; |r| = {np.linalg.norm(r):.3e} N at the lifted start; "
+                               "try solver.continuation = \"load\" (load steps) or solver.start = \"relax\"", None)
     path.tangent(start, None)
     return start
 
@@ -374,7 +374,8 @@ def _follow(path, pt, result, record, bar, callback):
                 raise ConvergenceError(
                     f"arc-length step {len(record['steps']) + 1}, load factor {pt.lam:.6g}: the corrector did not "
                     f"converge even with arc length {ds:.3g}; |r| = {np.linalg.norm(r.ravel()[path.free]):.3e} N at "
-                    f"the last point", None)
+                    f"the last point; try solver.start = \"relax\" (dynamic relaxation at full load) or a finer mesh",
+                    None)
             continue
         path.tangent(new, pt)
         changed = new.fac.negative != pt.fac.negative
@@ -487,7 +488,8 @@ def _finish(path, result, record, pt):
         result.iterations += nt.iterations
         if not nt.converged:
             raise ConvergenceError(f"arc-length final point, load factor 1, iteration {nt.iterations}: {nt.reason}, "
-                                   f"|r| = {nt.residual:.3e} N", None)
+                                   f"|r| = {nt.residual:.3e} N; try a larger solver.max_iterations or solver.start = "
+                                   "\"relax\"", None)
         result.U, result.lam, result.residual = nt.U, 1.0, nt.residual
         end = path.point(nt.U, 1.0)
         record["final_negative"] = end.fac.negative

@@ -206,7 +206,10 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                 raise ConvergenceError(
                     f"load factor {lam_next:.6g} (increment {len(result.load_steps) + 1}), iteration "
                     f"{nt.iterations}: {nt.reason}, |r| = {nt.residual:.3e} N; the increment fell below "
-                    f"min_increment = {opts.increments.min_increment:g}. Last equilibrium at load factor {lam:.6g}.")
+                    f"min_increment = {opts.increments.min_increment:g}. Last equilibrium at load factor {lam:.6g}. "
+                    "Try solver.start = \"relax\" (dynamic relaxation at full load, then Newton) or "
+                    "solver.continuation = \"arc-length\" (path following through the snap-throughs), or a larger "
+                    "solver.max_iterations")
     except ConvergenceError as exc:
         close_record(model, result, state, t0, exc)
         raise

@@ -447,3 +447,16 @@ def test_a_relaxation_segment_that_ends_before_rest_is_no_warning(caplog):
         r = relax(model, RelaxOptions(alpha=1.0, max_time=1e-3, progress=False))
     assert not r.converged and "not at rest" in caplog.text
     assert not [rec for rec in caplog.records if rec.levelname == "WARNING" and "not at rest" in rec.message]
+
+
+@pytest.mark.parametrize("sets", [
+    ["mesh.nodes=[11,3]", "solver.max_load_steps=1", "solver.relax_fallback=false"],  # increments used up
+    ["mesh.nodes=[11,3]", "solver.max_iterations=1", "solver.min_increment=0.05", "solver.relax_fallback=false"],
+    ["mesh.nodes=[11,3]", "solver.start=relax", "material.C_warp=1e9", "material.C_weft=1e9"],  # refused relaxation
+])
+def test_an_unconverged_solve_says_what_to_try_last(capsys, tmp_path, sets):
+    """Exit status 3: the message's last clause names a key or a route to try (issue 38, item 5)."""
+    code, err = _run(capsys, tmp_path, "strip", sets)
+    assert code == 3, err
+    last = err.replace(". ", "; ").split("; ")[-1]
+    assert any(word in last for word in ("solver.", "mesh", "material", "dynamics.")), err
