@@ -1,5 +1,7 @@
 """Command line: ``python -m rftstatic {case, list, fabrics, options, sweep, fit, bench, validate}``, on the Python API
-(:mod:`rftstatic.api`) and the studies on Dask (:mod:`rftstatic.study`).
+(:mod:`rftstatic.api`) and the studies on Dask (:mod:`rftstatic.study`). ``fabrics --explain [SCENE --set ...]``
+prints the lab keys, their ranges and the rules that fill a lab fabric's missing values, and where each value
+of a scene's fabric comes from (:mod:`rftstatic.scenes.fabric_explain`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
 not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs

@@ -68,6 +68,8 @@ compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measu
 (C12 = B12 = 0) and the twisting rigidity, which defaults to ``B_twist = sqrt(B_warp B_weft) / 2`` (the
 orthotropic plate with zero Poisson ratio, M_xy = D (1 - nu)/2 * 2 k_xy; Kang & Yu's wool has 0.37 instead
 of 0.5 of the mean) unless the scene gives ``B_twist``.
+A fabric given by lab data and no preset gets every quantity it lacks (tensile, shear, twist, Poisson) by
+the stated rules of :mod:`rftstatic.fabrics.rules`, each listed in the run's summary (``material.filled``).
 
 Range checks (:data:`RANGES`): a value outside them is almost surely a slip of unit or decimal point.
 What the bounds rest on (searched for through public material on 2026-12-02; nothing entered from memory):
