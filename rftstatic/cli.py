@@ -1,6 +1,8 @@
 """Command line: ``python -m rftstatic {case, view, list, fabrics, options, sweep, fit, bench, validate}``, on the
 Python API (:mod:`rftstatic.api`), the run viewer (:mod:`rftstatic.io.viewer`) and the studies on Dask
-(:mod:`rftstatic.study`).
+(:mod:`rftstatic.study`). ``fabrics --explain [SCENE --set ...]`` prints the lab keys, their ranges and the rules
+that fill a lab fabric's missing values, and where each value of a scene's fabric comes from
+(:mod:`rftstatic.scenes.fabric_explain`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
 not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs
@@ -53,7 +55,11 @@ def main(argv=None) -> int:
                    "nearest obstacle), as the run has them")
     w.add_argument("--out", default=None, help="the HTML file to write (default RUN_DIR/view.html)")
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
-    sub.add_parser("fabrics", parents=[common], help="list the fabric library with bending lengths and sources")
+    fb = sub.add_parser("fabrics", parents=[common], help="list the fabric library with bending lengths and sources")
+    fb.add_argument("--explain", action="store_true", help="the lab keys, their ranges and the rules that fill what a "
+                    "lab fabric does not give, with sources; with SCENE: where each of its fabric's values comes from")
+    fb.add_argument("scene", nargs="?", default=None, help="with --explain: a scene (cases/NAME.toml or a path)")
+    fb.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="with SCENE: override a key")
     o = sub.add_parser("options", parents=[common], help="list a scene table's keys with type, unit, range, default "
                        "and meaning (e.g. options solver)")
     o.add_argument("section", nargs="?", default=None, help="the scene table (default: every declared one)")
@@ -162,6 +168,11 @@ def _command(args) -> int:
         if args.command == "list":
             for name, title in api.list_scenes():
                 print(f"{name:32s} {title}")
+            return 0
+        if args.command == "fabrics" and (args.explain or args.scene):
+            from rftstatic.scenes.fabric_explain import explain_fabrics
+
+            print(explain_fabrics(api.load_scene(args.scene, args.set) if args.scene else None))
             return 0
         if args.command == "fabrics":
             rows = api.list_fabrics()

@@ -2,10 +2,19 @@
 
 A fabric is given by a library preset (:data:`rftstatic.fabrics.library.FABRICS`), by the model's
 rigidities in the scene's units, by lab values (KES-F ``kes_*``, FAST ``fast_*``: :mod:`rftstatic.fabrics.lab`,
-each in its instrument's unit), or a mixture of them for *different* quantities. Two keys for the same
-quantity in one table (``B_warp`` and ``kes_B_warp``) are a scene error naming both; a key given next to a
-preset replaces the preset's value of that quantity, whatever form the preset gives it in
-(``--set material.C_warp=900`` on the wool; ``--set material.kes_B_warp=0.1``).
+each in its instrument's unit), or a mixture of the last two for *different* quantities. Two keys for the
+same quantity in one table (``B_warp`` and ``kes_B_warp``) are a scene error naming both.
+
+A fabric given by lab data (no preset) needs its bending rigidities and weight (``kes_B_warp``, ``kes_B_weft``,
+``kes_W``; the kes_B without its kes_W is refused by name); every other quantity it does not give is filled by
+the stated rules of :mod:`rftstatic.fabrics.rules` (tensile from B and the thickness ``kes_T``, shear,
+twist, Poisson), listed in the summary's ``material.filled`` with unit, rule and source.
+
+A preset never lends values to lab data: lab keys next to ``preset`` are refused (the message says how to give
+the lab fabric alone: ``--set "material={kes_B_warp=0.05, kes_B_weft=0.04, kes_W=15.0, kes_T=0.5}"``
+replaces the whole table). A *model* key next to a preset (``--set material.C_warp=900``, what ``fit``
+varies) changes that one value of the preset: the fabric is labelled "(modified)" and the summary lists
+the changed keys (``material.changed``).
 """
 
 from __future__ import annotations
@@ -14,8 +23,9 @@ import numpy as np
 
 from rftstatic import material as mat
 from rftstatic.errors import ParameterError
-from rftstatic.fabrics.lab import LAB_KEYS, QUANTITY_KEYS, default_twist, lab_to_si, sources_of
+from rftstatic.fabrics.lab import LAB_KEYS, QUANTITY_KEYS, lab_to_si, sources_of
 from rftstatic.fabrics.library import FABRICS, bending_lengths
+from rftstatic.fabrics.rules import NEEDS_KEYS, fill, unit_label
 from rftstatic.scenes.ranges import SHEET_RANGE_M
 from rftstatic.units import UnitSystem, unit_system
 
@@ -52,6 +62,53 @@ def _to_si(values: dict, units: UnitSystem) -> tuple[dict, dict]:
     return si, record
 
 
+_LAB_PAIRS = {"kes": ("kes_B_warp", "kes_B_weft", "kes_W"), "fast": ("fast_B_warp", "fast_B_weft", "fast_W"),
+              "ctd": ("ctd_B_warp", "ctd_B_weft", "ctd_density")}
+"""Per instrument: the bending rigidities and the mass per area a lab fabric gives together."""
+
+
+def _check_lab_fabric(m: dict, si: dict) -> None:
+    """ParameterError naming the missing key of a lab fabric: a lab bending rigidity without the other
+    direction's, or without a weight (the drape follows the bending length c = (B/W)^(1/3))."""
+    for warp, weft, weight in _LAB_PAIRS.values():
+        given = [k for k in (warp, weft) if k in m]
+        if not given:
+            continue
+        shown = f"{given[0]} = {m[given[0]]!r}"
+        for key, q in ((weft, "B_weft"), (warp, "B_warp")):
+            if q not in si:
+                raise ParameterError(key, f"missing: {shown} is given without {key} ({LAB_KEYS[key][0]}); a fabric "
+                                     "needs its bending rigidity along both warp and weft")
+        if "weight" not in si:
+            raise ParameterError(weight, f"missing: {shown} is given without {weight} ({LAB_KEYS[weight][0]}, "
+                                 f"{LAB_KEYS[weight][1]}); the drape follows the bending length (B/W)^(1/3), so the "
+                                 "bending rigidity needs the mass per area of the same fabric")
+
+
+def _preset(name: str, lab_given: list) -> tuple[dict, dict, dict]:
+    """A library preset's SI values, lab record and filled record (its ``derived`` values by its rule)."""
+    if name not in FABRICS:
+        raise ParameterError("preset", f'"{name}" is not a fabric of the library; known: {", ".join(FABRICS)} '
+                             "(python -m rftstatic fabrics lists them)")
+    if lab_given:
+        shown = ", ".join(lab_given)
+        raise ParameterError(lab_given[0], f'lab data ({shown}) next to preset = "{name}": the preset would lend '
+                             "the values the lab data do not give to a fabric it does not describe. Give the lab "
+                             "fabric without the preset (the missing values are then filled by stated rules: python "
+                             "-m rftstatic fabrics --explain), e.g. --set \"material={kes_B_warp=0.05, kes_B_weft=0.04, "
+                             "kes_W=15.0, kes_T=0.5}\" replaces the table; or change the preset's own rigidities "
+                             "(B_warp, C_warp, weight, ... in the scene's units)")
+    fab = FABRICS[name]
+    si, record = _to_si(fab.values, unit_system(fab.units))
+    derived, _ = _to_si(fab.derived, unit_system(fab.units))
+    filled = {}
+    for q in sorted(set(derived) - set(si)):  # what the source does not give, by the preset's stated rule
+        si[q] = derived[q]
+        filled[q] = {"si": si[q], "kind": mat._FABRIC_KINDS[q], "rule": fab.derived_rule,
+                     "source": f"preset {name}: {fab.short_source or fab.source}"}
+    return si, record, filled
+
+
 def _fabric(scene, m: dict, angle: float) -> mat.Material:
     name = m.pop("preset", None)
     foreign = sorted(set(m) - FABRIC_KEYS - {"kind"})
@@ -63,34 +120,38 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
         raise scene.error("material.kind", f'does not apply next to preset = "{name}" (a preset is a fabric '
                           "with its rigidities); remove kind, or the preset and give the rigidities")
     m.pop("kind", None)
-    si, record = {}, {}
-    if name is not None:
-        if name not in FABRICS:
-            raise scene.error("material.preset", f'"{name}" is not a fabric of the library; known: '
-                              f'{", ".join(FABRICS)} (python -m rftstatic fabrics lists them)')
-        fab = FABRICS[name]
-        si, record = _to_si(fab.values, unit_system(fab.units))
-        derived, _ = _to_si(fab.derived, unit_system(fab.units))
-        for q in set(derived) - set(si):  # what the source does not give, by the preset's stated rule
-            si[q] = derived[q]
-            record[q] = {"rule": fab.derived_rule}
+    lab_given = sorted(k for k in m if k in LAB_KEYS)
+    si, record, filled = _preset(name, lab_given) if name is not None else ({}, {}, {})
     own_si, own_record = _to_si(m, scene.units)
-    for q in own_si:  # a scene key replaces the preset's value of its quantity, whatever its form
+    for q in own_si:  # a scene key replaces the preset's value of its quantity
         record.pop(q, None)
+        filled.pop(q, None)
     si.update(own_si)
     record.update(own_record)
+    if lab_given:
+        _check_lab_fabric(m, si)
+        try:
+            filled.update(fill(si))
+        except KeyError as exc:
+            key, given = NEEDS_KEYS.get(exc.args[0], (exc.args[0], exc.args[0]))
+            raise ParameterError(key, f"missing: the rule that fills {', '.join(q for q in ('C_warp', 'C_weft') if q not in si)} "
+                                 f"(python -m rftstatic fabrics --explain) needs the fabric's {exc.args[0]}: give {given}, "
+                                 "or the tensile data (kes_EMT_warp and kes_EMT_weft, or C_warp and C_weft)") from None
     missing = [q for q in _REQUIRED if q not in si]
     if missing:
         options = ", ".join(f"{q} (or {' / '.join(QUANTITY_KEYS[q])})" for q in missing)
-        raise scene.error("material", f"a fabric needs {options}; or a preset (python -m rftstatic fabrics)")
-    if "B_twist" not in si:
-        si["B_twist"] = default_twist(si["B_warp"], si["B_weft"])
-        record["B_twist"] = {"rule": "sqrt(B_warp B_weft) / 2 (not measured: orthotropic plate, zero Poisson ratio)"}
+        raise scene.error("material", f"a fabric needs {options}; or a preset (python -m rftstatic fabrics), or lab "
+                          "data (kes_B_warp, kes_B_weft, kes_W, kes_T: the rest filled by stated rules)")
+    filled.update(fill(si, only=("B_twist", "C12", "B12")))
     for key in _POSITIVE:
         if key in m and not m[key] > 0:
             kind = "tensile or shear" if key[0] == "C" else "bending or twisting"
             raise ParameterError(key, f"{m[key]!r} must be > 0 (a fabric's {kind} rigidity, scene units)")
-    label = (name or "fabric") + (" (modified)" if name and m else "")
+    if name is None and lab_given:
+        label = "lab fabric (" + ", ".join(f"{k} {m[k]:g}" for k in lab_given[:4]) + (", ..." if len(lab_given) > 4
+                                                                                     else "") + ")"
+    else:
+        label = (name or "fabric") + (" (modified)" if name and m else "")
     try:
         material = mat.fabric(**{k: si[k] for k in mat._FABRIC_KINDS if k in si}, warp_angle=np.radians(angle),
                               name=label)
@@ -105,6 +166,10 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
         rec["si"] = si[q]
     if record:
         material.info["lab"] = record
+    material.info["filled"] = filled
+    if name is not None:
+        material.info["preset"] = name
+        material.info["changed"] = sorted(m)
     return material
 
 
@@ -173,13 +238,21 @@ def material_summary(scene, material: mat.Material) -> dict:
         out["lab"] = {q: {**{k: v for k, v in rec.items() if k != "si"},
                           "converted": u.from_si(rec["si"], kinds[q]), "converted_units": u.name}
                       for q, rec in material.info["lab"].items()}
+    if "filled" in material.info:
+        out["filled"] = {q: {"value": u.from_si(rec["si"], rec["kind"]), "unit": unit_label(u, rec["kind"]),
+                             "rule": rec["rule"], "source": rec["source"]}
+                         for q, rec in material.info["filled"].items()}
+    for key in ("preset", "changed"):
+        if key in material.info:
+            out[key] = material.info[key]
     return out
 
 
 def list_fabrics() -> list[dict]:
     """Every library fabric as built for a scene in cm-gf-s: name, bending rigidities B [gf cm] and bending
     lengths c = (B/W)^(1/3) [cm] along warp and weft, weight [gf/cm^2], description and source (full and
-    short), ``derived``: the quantities not from the source (by ``derived_rule``, or B_twist by default),
+    short), ``derived``: the quantities not from the source (by ``derived_rule``, or B_twist by default; the
+    Poisson couplings C12 = B12 = 0 of every fabric are not listed),
     and ``not_used``: published values the linear model does not take."""
     from rftstatic.scenes.schema import scene_from_dict
 
@@ -191,6 +264,6 @@ def list_fabrics() -> list[dict]:
                      "c_warp": m["bending_length_warp"], "c_weft": m["bending_length_weft"],
                      "published_units": fab.units, "description": fab.description, "source": fab.source,
                      "short_source": fab.short_source or fab.source, "measured_dc": dict(fab.measured_dc),
-                     "derived": sorted(q for q, rec in m.get("lab", {}).items() if "from" not in rec),
+                     "derived": sorted(q for q in m.get("filled", {}) if q not in ("C12", "B12")),
                      "derived_rule": fab.derived_rule, "not_used": dict(fab.not_used)})
     return rows

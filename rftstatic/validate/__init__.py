@@ -48,6 +48,14 @@ BENCHMARKS = {
 }
 
 
+TOOL_REPORTS = {
+    "fabric_rules": "a fabric from KES-F B, W, T alone: the fill rules, the Cusick DC's sensitivity to each, the "
+                    "Cusick mesh (pattern, rings, sectors, element) and RFT6 locking numbers (tools/"
+                    "fabric_rule_sensitivity.py, tools/cusick_mesh_study.py)",
+}
+"""Hand-made reports in ``validation/`` that the index lists below its table."""
+
+
 def default_out() -> Path:
     """The repository's ``validation/`` folder."""
     import rftstatic
@@ -146,5 +154,7 @@ def write_index(results, out: Path, *, quick: bool) -> Path:
              "|---|---|---|---|---|---|---|---|---|"]
     for key in sorted(rows):
         lines += rows[key]
+    lines += ["", "Reports written from the runs of a tool (not by `validate`; each gives its commands):", ""]
+    lines += [f"- [{name}]({name}.md): {what}" for name, what in TOOL_REPORTS.items()]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path

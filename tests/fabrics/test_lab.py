@@ -97,13 +97,26 @@ def test_out_of_range_kes_value_names_the_scene_key():
         _material({**WOOL_KES, "kes_W": 1900.0})
 
 
-def test_preset_overrides_replace_the_quantity_whatever_its_form():
+def test_a_model_key_changes_one_value_of_a_preset_and_the_summary_says_which():
+    from rftstatic.scenes.material import material_summary
+
     base = load_scene("strip")
     wool = build_material(base)
-    c = build_material(load_scene("strip", ["material.C_warp=900.0"]))
+    scene = load_scene("strip", ["material.C_warp=900.0"])
+    c = build_material(scene)
     assert c.Dm[0, 0] == pytest.approx(900 * GF_CM) and c.Dm[1, 1] == pytest.approx(wool.Dm[1, 1])
-    k = build_material(load_scene("strip", ["material.kes_B_warp=0.1"]))
-    assert k.Db[0, 0] == pytest.approx(0.1 * GF_CM_MOMENT) and k.Db[2, 2] == pytest.approx(wool.Db[2, 2])
+    summary = material_summary(scene, c)
+    assert summary["preset"] == "wool-kang-yu" and summary["changed"] == ["C_warp"]
+    assert c.name == "wool-kang-yu (modified)"
+
+
+def test_lab_data_next_to_a_preset_are_refused():
+    """A preset never lends its other values to lab data (issue 35): the message says how to give the lab
+    fabric alone. (Before, kes_B_warp on the wool silently kept the wool's membrane and twist.)"""
+    with pytest.raises(SceneError) as err:
+        build_material(load_scene("strip", ["material.kes_B_warp=0.1"]))
+    text = str(err.value)
+    assert "material.kes_B_warp" in text and 'preset = "wool-kang-yu"' in text and "material={kes_B_warp" in text
 
 
 def test_twist_default_without_measurement():
@@ -112,7 +125,11 @@ def test_twist_default_without_measurement():
 
 
 def test_missing_quantity_names_its_lab_keys():
+    model_keys = {"C_warp": 1118.2, "C_weft": 759.5, "C_shear": 41.8, "B_warp": 0.083, "B_weft": 0.063}
     with pytest.raises(SceneError, match="weight \\(or kes_W / fast_W / ctd_density\\)"):
+        _material(model_keys)
+    # a lab bending rigidity without its weight names the lab key (issue 35 item 6)
+    with pytest.raises(SceneError, match=r"material\.kes_W: missing: kes_B_warp = 0\.083 is given without kes_W"):
         _material({k: v for k, v in WOOL_KES.items() if k != "kes_W"})
 
 

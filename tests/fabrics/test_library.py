@@ -77,9 +77,11 @@ def test_what_the_data_set_does_not_give_comes_from_the_stated_rule():
     assert m.Dm[2, 2] == pytest.approx(wool["C_shear"] * GF_CM, rel=1e-12)
     assert m.Dm[0, 1] == 0.0 and m.Db[0, 1] == 0.0
     assert m.Db[2, 2] == pytest.approx(0.5 * math.sqrt(m.Db[0, 0] * m.Db[1, 1]), rel=1e-12)
-    lab = m.info["lab"]
+    lab, filled = m.info["lab"], m.info["filled"]
     assert lab["B_warp"]["from"] == "ctd_B_warp" and lab["weight"]["from"] == "ctd_density"
-    assert "wool-kang-yu" in lab["C_warp"]["rule"] and "from" not in lab["C_shear"]
+    # the values not from the data set are listed as filled (with rule and source), not as lab conversions
+    assert "wool-kang-yu" in filled["C_warp"]["rule"] and "C_shear" not in lab
+    assert set(filled) == {"C_warp", "C_weft", "C_shear", "B_twist", "C12", "B12"}
     row = next(r for r in list_fabrics() if r["name"] == "ctd-213-medium")
     assert row["derived"] == ["B_twist", "C_shear", "C_warp", "C_weft"] and "wool" in row["derived_rule"]
     assert next(r for r in list_fabrics() if r["name"] == "wool-kang-yu")["derived"] == []
