@@ -23,8 +23,8 @@ REFERENCES = {
     "sphere_drape": ("drape coefficient", 0.3462, 0.02, "round-off between kernel back ends and BLAS builds"),
     # the tester's c = l/2 against the given (B/W)^(1/3) = 1.4918 cm: the coarse 17 x 5 RFT3 mesh reads 0.23 % low
     "cantilever_lab_units": ("bending length", 1.4884, 0.002, "root find tolerance 1e-7, round-off"),
-    # cusick-30 on 7 x 80: 50.4 % (the default 13 x 160 mesh: 44.7 %, validation/textile_tests.md)
-    "cusick_coarse": ("drape coefficient", 50.43, 0.02, "round-off between kernel back ends and BLAS builds"),
+    # cusick-30 (pattern right) on 7 x 80: 58.4 % (the default 13 x 160 mesh: 52.1 %, validation/fabric_rules.md)
+    "cusick_coarse": ("drape coefficient", 58.38, 0.02, "round-off between kernel back ends and BLAS builds"),
     # the declared [solver] keys of rftstatic.scenes.run_options.SOLVER_GROUPS
     "scene_options": ("solver keys", 29, 0.0, "exact: a count"),
 }
