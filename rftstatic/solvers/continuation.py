@@ -12,8 +12,7 @@ RMS displacement or the whole load:
 - corrector: Newton on R = 0 with the linear constraint t . ((U, lam) - (U_n, lam_n)) = ds, solved by
   the bordering algorithm: two back-substitutions with the factorisation of the exact tangent,
   K dU_r = -R, K dU_P = P, dlam = -(t_u . dU_r / c) / (t_u . dU_P / c + t_lam), dU = dU_r + dlam dU_P;
-  each step is capped (``max_step``) and bounded by the self-contact collision test, both scaling dU
-  and dlam alike;
+  each step is capped (``max_step``) and bounded by the self-contact collision test, alike on dU and dlam;
 - ds doubles after a step that took at most 4 iterations, halves after one that took more than 8 or
   failed; a failed step restarts from the last point (penalty contact makes the path only piecewise
   smooth: its kinks are passed with smaller steps).
@@ -262,11 +261,11 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
     state = state if state is not None else start_state(model, opts.newton.linear_solver)
     state.modes = {"exact": 0, "psd": 0, "shift": 0}
     path = _Path(model, opts, state)
-    result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=path.inertia.name, seed=seed,
-                          route="arc-length")
     record = {"steps": [], "critical_points": [], "switches": [], "arc_length": 0.0}
-    result.path = record
+    result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=path.inertia.name, seed=seed,
+                          route="arc-length", path=record)
     bar = Progress(1.0, f"arc-length {model.element}", enabled=opts.progress)
+
     def inertia_counters(res):
         res.factorisations += path.inertia.factorisations
         res.tangent_modes["ldl"] = path.inertia.ldl

@@ -29,7 +29,7 @@ from rftstatic.validate.report import BenchmarkResult, Study, convergence_figure
 
 TOLERANCE = 0.005
 CANTILEVER_MESHES = [(9, 3), (17, 5), (33, 9), (65, 17)]
-CUSICK_MESHES = [(7, 80, 4.0), (10, 120, 4.0), (13, 160, 4.0), (19, 240, 4.0)]
+CUSICK_MESHES = [(7, 80, 4.0), (10, 120, 4.0), (13, 160, 4.0), (16, 200, 4.0)]
 """(rings, nodes per ring, grading) of the graded study; the last is the reference."""
 UNIFORM_MESHES = [(13, 160, 1.0), (19, 160, 1.0), (25, 160, 1.0)]
 """Uniform rings (0.5, 0.33, 0.25 cm): the bend at the disc's edge under-resolved."""
@@ -143,7 +143,12 @@ def _dc_vs_group(result, tmp, out, factors, library=()):
         s, t = _run(f"cusick-{size}", [], tmp)
         curves.setdefault(f"{size} cm specimen, wool", []).append(_group_row(s, "wool", size, t, lines))
     for name in library:
-        s, t = _run("cusick-30", [f"material.preset={name}"], tmp)
+        try:
+            s, t = _run("cusick-30", [f"material.preset={name}"], tmp)
+        except api.ConvergenceError as exc:  # a stiff membrane: the relaxation route refuses (reported, not hidden)
+            lines.append(f"| {name} | 30 | not run: {str(exc).split('; not attempted')[0]} (the relaxation route's "
+                         "step limit) | | | | |")
+            continue
         curves.setdefault("30 cm specimen, library fabrics", []).append(_group_row(s, name, 30, t, lines))
     for points in curves.values():
         points.sort(key=lambda p: p[0])
