@@ -222,6 +222,22 @@ class Obstacle(abc.ABC):
     def params(self) -> dict[str, Any]:
         """Defining parameters in metres, keyed as in a scene table (without ``type``)."""
 
+    psd_tangent: ClassVar[bool] = False
+    """The curvature of ``phi`` is unbounded (sharp edges and corners, a triangle surface): the penalty
+    contact projects each node's tangent block onto the positive semi-definite matrices
+    (:class:`rftstatic.contact.penalty.PenaltyContact`) instead of using ``normal_gradient`` as it is."""
+
+    def surface(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The triangles bounding the solid, ``(V (n, 3) [m], T (t, 3))``, for an independent crossing check
+        of the sheet against them; None for an analytic obstacle."""
+        return None
+
+    def sharp_features(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """Sharp edges and corners that must not cut the sheet between its nodes: ``(points (n, 3) [m],
+        edges (f, 2) into points, corners (c,) into points)``; None: the obstacle has none (its normal is
+        continuous, e.g. the rounded pedestals), the node penalty is all its contact needs."""
+        return None
+
     def footprint(self) -> tuple[float | None, np.ndarray]:
         """Area [m^2] and centre ``(2,)`` [m] of the support in top view (the "disc" of the drape
         coefficient); area ``None`` for an unbounded obstacle (a floor)."""

@@ -1,0 +1,181 @@
+"""Contact of an obstacle's sharp features with the sheet between its nodes: edge-edge and corner-triangle pairs.
+
+The node penalty (:mod:`rftstatic.contact.penalty`) keeps the sheet's *nodes* out of an obstacle; a sharp
+edge of the obstacle (a table's rim, a box's edge: :meth:`rftstatic.contact.obstacles.Obstacle.sharp_features`)
+can still cut through the sheet *between* nodes, and a corner through a triangle. Every pair of an obstacle
+feature edge and a sheet edge, and of an obstacle corner and a sheet triangle, at distance ``delta`` below
+the gap ``d`` [m] contributes
+
+    E_f = k / (3 d) (d - delta)^3                                                [J]
+
+(``k`` [N/m]: :data:`rftstatic.contact.penalty.FEATURE_STIFFNESS` times a node's penalty spring
+``k_penalty A``): slope and curvature vanish at
+``delta = d`` (C2 onset), the largest push is ``k d``. ``delta`` and its derivatives are those of the
+self-contact (:mod:`rftstatic.contact.self_contact.distance`: exact squared distances, gradients and
+Hessians of the point-triangle and edge-edge pairs) with the obstacle's points held; each pair's Hessian
+of the sheet's dofs (6 x 6 for an edge, 9 x 9 for a triangle) is projected onto the positive semi-definite
+matrices (eigenvalues clamped at 0), as the self-contact does, so the Newton tangent stays PSD. Energy
+and force are exact.
+
+Broad phase: the obstacle's feature edges are sampled at the sheet's mean edge length; a ``cKDTree`` of the
+sheet's edge midpoints (triangle centroids) lists the pairs within ``d + margin``; the list is kept in the
+solve's :class:`~rftstatic.contact.candidates.CandidateList` (``pairs``) and rebuilt once a node moved more
+than ``margin / 2``: a pair left out is farther than ``d``, so the result is the same as with every pair.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
+from rftstatic.contact.self_contact.law_kernels import psd_project
+
+__all__ = ["FeatureContact", "FeatureState"]
+
+
+class FeatureState:
+    """Feature contact at one configuration: ``energy`` [J], ``force (N, 3)`` [N], and the tangent as node
+    pair blocks ``rows (B,), cols (B,), blocks (B, 3, 3)`` [N/m] (all node pairs of each active pair), and
+    ``min_distance`` [m] over the listed pairs (inf without)."""
+
+    def __init__(self, energy, force, rows, cols, blocks, min_distance):
+        self.energy, self.force = energy, force
+        self.rows, self.cols, self.blocks = rows, cols, blocks
+        self.min_distance = min_distance
+
+
+class FeatureContact:
+    """Sharp features of the obstacles against the sheet's edges and triangles (module docstring).
+
+    Parameters
+    ----------
+    obstacles : the obstacles; those whose ``sharp_features()`` is not None take part
+    tri : (E, 3) the sheet's triangles
+    edges : (M, 2) the sheet's unique edges
+    X : (N, 3) reference positions [m] (edge lengths for the broad phase)
+    gap : ``d`` [m]
+    stiffness : ``k`` [N/m]
+    margin : broad-phase margin [m]
+    """
+
+    def __init__(self, obstacles, tri, edges, X, gap: float, stiffness: float, margin: float):
+        pts, fedges, corners = [], [], []
+        offset = 0
+        for ob in obstacles:
+            f = ob.sharp_features()
+            if f is None:
+                continue
+            p, e, c = f
+            pts.append(np.asarray(p, float))
+            fedges.append(np.asarray(e, np.int64).reshape(-1, 2) + offset)
+            corners.append(np.asarray(c, np.int64).ravel() + offset)
+            offset += len(p)
+        self.points = np.vstack(pts) if pts else np.zeros((0, 3))
+        self.fedges = np.vstack(fedges) if fedges else np.zeros((0, 2), np.int64)
+        self.corners = np.concatenate(corners) if corners else np.zeros(0, np.int64)
+        self.tri, self.edges = np.asarray(tri, np.int64), np.asarray(edges, np.int64)
+        self.gap, self.stiffness, self.margin = float(gap), float(stiffness), float(margin)
+        length = np.linalg.norm(X[self.edges[:, 1]] - X[self.edges[:, 0]], axis=1)
+        self.spacing = float(length.mean())
+        # samples along every feature edge, no farther apart than the sheet's mean edge length
+        a, b = self.points[self.fedges[:, 0]], self.points[self.fedges[:, 1]]
+        n = np.maximum(1, np.ceil(np.linalg.norm(b - a, axis=1) / self.spacing).astype(np.int64))
+        owner = np.repeat(np.arange(len(self.fedges)), n + 1)
+        t = (np.arange(int((n + 1).sum())) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)) / np.repeat(n, n + 1)
+        self.samples = a[owner] + t[:, None] * (b - a)[owner]
+        self.sample_owner = owner
+        self.sample_step = float(np.max(np.linalg.norm(b - a, axis=1) / n, initial=0.0))
+
+    @property
+    def empty(self) -> bool:
+        return len(self.fedges) == 0 and len(self.corners) == 0
+
+    def _pairs(self, x, cache):
+        """``(edge pairs (P, 2): feature edge, sheet edge; corner pairs (Q, 2): corner, sheet triangle)``."""
+        if cache is not None and cache.pairs is not None:
+            x0, pairs = cache.pairs
+            if x0.shape == x.shape and np.sqrt(np.max(np.einsum("ni,ni->n", x - x0, x - x0), initial=0.0)) \
+                    <= 0.5 * self.margin:
+                return pairs
+        from scipy.spatial import cKDTree
+
+        reach = self.gap + self.margin
+        mid = 0.5 * (x[self.edges[:, 0]] + x[self.edges[:, 1]])
+        half = 0.5 * float(np.max(np.linalg.norm(x[self.edges[:, 1]] - x[self.edges[:, 0]], axis=1)))
+        ee = np.zeros((0, 2), np.int64)
+        if len(self.samples):
+            m = cKDTree(self.samples).sparse_distance_matrix(cKDTree(mid), half + 0.5 * self.sample_step + reach,
+                                                             output_type="ndarray")
+            ee = np.unique(np.stack([self.sample_owner[m["i"]], m["j"]], axis=1), axis=0)
+        pt = np.zeros((0, 2), np.int64)
+        if len(self.corners):
+            c = x[self.tri].mean(axis=1)
+            r = float(np.max(np.linalg.norm(x[self.tri] - c[:, None, :], axis=2)))
+            m = cKDTree(self.points[self.corners]).sparse_distance_matrix(cKDTree(c), r + reach, output_type="ndarray")
+            pt = np.stack([m["i"], m["j"]], axis=1).astype(np.int64)
+        pairs = (ee, pt)
+        if cache is not None:
+            cache.pairs = (np.array(x, copy=True), pairs)
+        return pairs
+
+    def _close(self, x, ee, pt):
+        """The listed pairs whose distance may be below ``d``: a bound from the segments' midpoints and half
+        lengths, and the triangles' centroids and radii (cheaper than the exact distance of every pair)."""
+        a, b = x[self.edges[ee[:, 1], 0]], x[self.edges[ee[:, 1], 1]]
+        p, q = self.points[self.fedges[ee[:, 0], 0]], self.points[self.fedges[ee[:, 0], 1]]
+        bound = (np.linalg.norm(0.5 * (a + b - p - q), axis=1)
+                 - 0.5 * (np.linalg.norm(b - a, axis=1) + np.linalg.norm(q - p, axis=1)))
+        ee = ee[bound < self.gap]
+        t = x[self.tri[pt[:, 1]]]
+        c = t.mean(axis=1)
+        bound = (np.linalg.norm(self.points[self.corners[pt[:, 0]]] - c, axis=1)
+                 - np.max(np.linalg.norm(t - c[:, None], axis=2), axis=1, initial=0.0))
+        return ee, pt[bound < self.gap]
+
+    def evaluate(self, x: np.ndarray, *, tangent: bool = True, cache=None) -> FeatureState:
+        """Energy, force and (``tangent``) the PSD node-pair blocks at ``x (N, 3)`` [m]."""
+        n = len(x)
+        force = np.zeros((n, 3))
+        none = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 3, 3)))
+        if self.empty:
+            return FeatureState(0.0, force, *none, np.inf)
+        ee, pt = self._pairs(x, cache)
+        ee, pt = self._close(x, ee, pt)
+        energy, rows, cols, blocks, dmin = 0.0, [], [], [], np.inf
+        parts = (  # (x4 rows, the sheet nodes, their slots in x4, the kernel)
+            (np.concatenate([x[self.edges[ee[:, 1]]], self.points[self.fedges[ee[:, 0]]]], axis=1),
+             self.edges[ee[:, 1]], slice(0, 2), edge_edge),
+            (np.concatenate([self.points[self.corners[pt[:, 0]], None], x[self.tri[pt[:, 1]]]], axis=1),
+             self.tri[pt[:, 1]], slice(1, 4), point_triangle),
+        )
+        d, k = self.gap, self.stiffness
+        for x4, nodes, slot, kernel in parts:  # the two pair kinds
+            if not len(x4):
+                continue
+            s, g, H, _ = kernel(x4, hessian=tangent)
+            delta = np.sqrt(np.maximum(s, 0.0))
+            dmin = min(dmin, float(delta.min()))
+            act = delta < d
+            if not act.any():
+                continue
+            delta, g, nodes = delta[act], g[act][:, slot], nodes[act]
+            gap = d - delta
+            e1, e2 = -k / d * gap**2, 2.0 * k / d * gap  # dE/ddelta, d2E/ddelta2
+            energy += float(np.sum(k / (3.0 * d) * gap**3))
+            safe = np.maximum(delta, 1e-300)
+            gd = g / (2.0 * safe)[:, None, None]  # grad delta = grad s / (2 delta)
+            np.add.at(force, nodes.ravel(), (e1[:, None, None] * gd).reshape(-1, 3))
+            if tangent:
+                m = nodes.shape[1]
+                sl = slice(3 * slot.start, 3 * slot.stop)
+                Hs = H[act][:, sl, sl]
+                gs = gd.reshape(len(delta), -1)
+                hd = Hs / (2.0 * safe)[:, None, None] - np.einsum("pi,pj->pij", gs, gs) / safe[:, None, None]
+                B = psd_project(e2[:, None, None] * np.einsum("pi,pj->pij", gs, gs) + e1[:, None, None] * hd)
+                B = B.reshape(len(delta), m, 3, m, 3).transpose(0, 1, 3, 2, 4)  # (P, a, b, 3, 3)
+                rows.append(np.repeat(nodes, m, axis=1).ravel())
+                cols.append(np.tile(nodes, (1, m)).ravel())
+                blocks.append(B.reshape(-1, 3, 3))
+        if rows:
+            return FeatureState(energy, force, np.concatenate(rows), np.concatenate(cols), np.concatenate(blocks), dmin)
+        return FeatureState(energy, force, *none, dmin)
