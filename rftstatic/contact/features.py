@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rftstatic.compiled import numba_available
 from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
 from rftstatic.contact.self_contact.law_kernels import psd_project
 
@@ -55,7 +56,8 @@ class FeatureContact:
     X : (N, 3) reference positions [m] (edge lengths for the broad phase)
     gap : ``d`` [m]
     stiffness : ``k`` [N/m]
-    margin : broad-phase margin [m]
+    margin : broad-phase margin [m]: pairs are listed within ``d + margin`` (by a lower bound of their
+        distance) and the list is rebuilt once a node moved ``margin / 2``
     """
 
     def __init__(self, obstacles, tri, edges, X, gap: float, stiffness: float, margin: float):
@@ -75,6 +77,7 @@ class FeatureContact:
         self.corners = np.concatenate(corners) if corners else np.zeros(0, np.int64)
         self.tri, self.edges = np.asarray(tri, np.int64), np.asarray(edges, np.int64)
         self.gap, self.stiffness, self.margin = float(gap), float(stiffness), float(margin)
+        self.compiled = numba_available()  # few pairs a call: the numpy path's ~0.5 ms a call would dominate
         length = np.linalg.norm(X[self.edges[:, 1]] - X[self.edges[:, 0]], axis=1)
         self.spacing = float(length.mean())
         # samples along every feature edge, no farther apart than the sheet's mean edge length
@@ -91,12 +94,26 @@ class FeatureContact:
         return len(self.fedges) == 0 and len(self.corners) == 0
 
     def _pairs(self, x, cache):
-        """``(edge pairs (P, 2): feature edge, sheet edge; corner pairs (Q, 2): corner, sheet triangle)``."""
+        """The pairs that may be closer than ``d`` at ``x``: ``(edge pairs (P, 2): feature edge, sheet edge;
+        corner pairs (Q, 2): corner, sheet triangle)``. The list holds the pairs whose distance bound
+        (:meth:`_bounds`) was below ``d + margin`` at its build; since then a bound fell by at most 3 x the
+        largest node motion (a midpoint or centroid moves as far as the nodes, a half length or radius
+        changes by at most twice that), so comparing the stored bounds with that is enough at every step."""
+        moved = np.inf
         if cache is not None and cache.pairs is not None:
-            x0, pairs = cache.pairs
-            if x0.shape == x.shape and np.sqrt(np.max(np.einsum("ni,ni->n", x - x0, x - x0), initial=0.0)) \
-                    <= 0.5 * self.margin:
-                return pairs
+            x0, listed = cache.pairs
+            if x0.shape == x.shape:
+                moved = float(np.sqrt(np.max(np.einsum("ni,ni->n", x - x0, x - x0), initial=0.0)))
+        if moved > 0.5 * self.margin:
+            listed, x0 = self._build(x), np.array(x, copy=True)
+            moved = 0.0
+            if cache is not None:
+                cache.pairs = (x0, listed)
+        ee, bee, pt, bpt = listed
+        return ee[bee - 3.0 * moved < self.gap], pt[bpt - 3.0 * moved < self.gap]
+
+    def _build(self, x):
+        """Pairs within ``d + margin`` (by their bounds) and their bounds: ``(ee, bound_ee, pt, bound_pt)``."""
         from scipy.spatial import cKDTree
 
         reach = self.gap + self.margin
@@ -106,31 +123,30 @@ class FeatureContact:
         if len(self.samples):
             m = cKDTree(self.samples).sparse_distance_matrix(cKDTree(mid), half + 0.5 * self.sample_step + reach,
                                                              output_type="ndarray")
-            ee = np.unique(np.stack([self.sample_owner[m["i"]], m["j"]], axis=1), axis=0)
+            key = np.unique(self.sample_owner[m["i"]] * len(self.edges) + m["j"])  # a pair once
+            ee = np.stack([key // len(self.edges), key % len(self.edges)], axis=1)
         pt = np.zeros((0, 2), np.int64)
         if len(self.corners):
             c = x[self.tri].mean(axis=1)
             r = float(np.max(np.linalg.norm(x[self.tri] - c[:, None, :], axis=2)))
             m = cKDTree(self.points[self.corners]).sparse_distance_matrix(cKDTree(c), r + reach, output_type="ndarray")
             pt = np.stack([m["i"], m["j"]], axis=1).astype(np.int64)
-        pairs = (ee, pt)
-        if cache is not None:
-            cache.pairs = (np.array(x, copy=True), pairs)
-        return pairs
+        bee, bpt = self._bounds(x, ee, pt)
+        keep_e, keep_t = bee < reach, bpt < reach
+        return ee[keep_e], bee[keep_e], pt[keep_t], bpt[keep_t]
 
-    def _close(self, x, ee, pt):
-        """The listed pairs whose distance may be below ``d``: a bound from the segments' midpoints and half
-        lengths, and the triangles' centroids and radii (cheaper than the exact distance of every pair)."""
+    def _bounds(self, x, ee, pt):
+        """Lower bounds of the pairs' distances [m]: from the segments' midpoints and half lengths, and the
+        triangles' centroids and radii."""
         a, b = x[self.edges[ee[:, 1], 0]], x[self.edges[ee[:, 1], 1]]
         p, q = self.points[self.fedges[ee[:, 0], 0]], self.points[self.fedges[ee[:, 0], 1]]
-        bound = (np.linalg.norm(0.5 * (a + b - p - q), axis=1)
-                 - 0.5 * (np.linalg.norm(b - a, axis=1) + np.linalg.norm(q - p, axis=1)))
-        ee = ee[bound < self.gap]
+        bee = (np.linalg.norm(0.5 * (a + b - p - q), axis=1)
+               - 0.5 * (np.linalg.norm(b - a, axis=1) + np.linalg.norm(q - p, axis=1)))
         t = x[self.tri[pt[:, 1]]]
         c = t.mean(axis=1)
-        bound = (np.linalg.norm(self.points[self.corners[pt[:, 0]]] - c, axis=1)
-                 - np.max(np.linalg.norm(t - c[:, None], axis=2), axis=1, initial=0.0))
-        return ee, pt[bound < self.gap]
+        bpt = (np.linalg.norm(self.points[self.corners[pt[:, 0]]] - c, axis=1)
+               - np.max(np.linalg.norm(t - c[:, None], axis=2), axis=1, initial=0.0))
+        return bee, bpt
 
     def evaluate(self, x: np.ndarray, *, tangent: bool = True, cache=None) -> FeatureState:
         """Energy, force and (``tangent``) the PSD node-pair blocks at ``x (N, 3)`` [m]."""
@@ -140,7 +156,6 @@ class FeatureContact:
         if self.empty:
             return FeatureState(0.0, force, *none, np.inf)
         ee, pt = self._pairs(x, cache)
-        ee, pt = self._close(x, ee, pt)
         energy, rows, cols, blocks, dmin = 0.0, [], [], [], np.inf
         parts = (  # (x4 rows, the sheet nodes, their slots in x4, the kernel)
             (np.concatenate([x[self.edges[ee[:, 1]]], self.points[self.fedges[ee[:, 0]]]], axis=1),
@@ -152,7 +167,7 @@ class FeatureContact:
         for x4, nodes, slot, kernel in parts:  # the two pair kinds
             if not len(x4):
                 continue
-            s, g, H, _ = kernel(x4, hessian=tangent)
+            s, g, H, _ = kernel(x4, hessian=tangent, compiled=self.compiled)
             delta = np.sqrt(np.maximum(s, 0.0))
             dmin = min(dmin, float(delta.min()))
             act = delta < d
@@ -164,7 +179,9 @@ class FeatureContact:
             energy += float(np.sum(k / (3.0 * d) * gap**3))
             safe = np.maximum(delta, 1e-300)
             gd = g / (2.0 * safe)[:, None, None]  # grad delta = grad s / (2 delta)
-            np.add.at(force, nodes.ravel(), (e1[:, None, None] * gd).reshape(-1, 3))
+            fn = (e1[:, None, None] * gd).reshape(-1, 3)
+            for i in range(3):  # the three components
+                force[:, i] += np.bincount(nodes.ravel(), fn[:, i], minlength=n)
             if tangent:
                 m = nodes.shape[1]
                 sl = slice(3 * slot.start, 3 * slot.stop)

@@ -53,6 +53,11 @@ FEATURE_STIFFNESS = 0.1
 several pairs at once (the vertices and edges of a fine obstacle near it), and the largest push of one pair,
 ``k d``, is still about 30 x the weight of the whole 30 cm wool sheet of sphere-30 at 33 x 33 nodes."""
 
+FEATURE_MARGIN = 0.25
+"""Broad-phase margin of the sharp-feature pairs, in mean sheet edge lengths: their list is rebuilt once a node
+moved half of it (a smaller margin than the nodes' candidate list: a fine obstacle has many features near each
+node, and every listed pair's distance bound is computed at every evaluation)."""
+
 __all__ = [
     "PenaltyContact",
     "ContactState",
@@ -151,7 +156,7 @@ class PenaltyContact(Frozen):
             h = float(np.mean(np.linalg.norm(X[edges[:, 1]] - X[edges[:, 0]], axis=1)))
             self.features = FeatureContact(self.obstacles, sheet.tri, edges, X, gap=max(self.smoothing, FEATURE_GAP * h),
                                            stiffness=FEATURE_STIFFNESS * self.stiffness * float(np.mean(area)),
-                                           margin=self.margin)
+                                           margin=max(4.0 * self.smoothing, FEATURE_MARGIN * h))
         self._freeze()
 
     def new_candidates(self) -> CandidateList:

@@ -187,8 +187,10 @@ def obstacle_crossing_summary(scene, model, extras, U) -> list | None:
     independent crossing check of the state ``U (N, 3)`` [m]
     (:func:`~rftstatic.post.measures.obstacle_crossings.obstacle_crossings`: ``pairs`` of sheet and obstacle
     triangles that cross, ``smallest_distance`` between the surfaces) and ``smallest_node_distance``, the least
-    signed distance of a node to it (the obstacle's own distance: negative inside), lengths in scene units;
-    None when no obstacle has a surface."""
+    signed distance of a node to it (the obstacle's own distance: negative inside) and ``deepest_chord``, the
+    least signed distance (0 if none is negative) of a sheet triangle's centroid or edge midpoint (how far the
+    flat triangles dip into it between their nodes), lengths in scene units; None when no obstacle has a
+    surface."""
     u = scene.units.length
     x = model.positions(U)
     out = []
@@ -200,8 +202,10 @@ def obstacle_crossing_summary(scene, model, extras, U) -> list | None:
             out.append({"obstacle": i, "applicable": False, "reason": "non-finite positions"})
             continue
         r = obstacle_crossings(x, model.mesh.tri, *surface)
+        mids = np.concatenate([x[model.mesh.tri].mean(axis=1), 0.5 * (x[model.mesh.topology.edges].sum(axis=1))])
         out.append({"obstacle": i, "pairs": r["pairs"], "first": r["first"],
                     "smallest_distance": r["smallest_distance"] / u,
                     "smallest_node_distance": float(ob.signed_distance(x)[0].min()) / u,
+                    "deepest_chord": float(min(0.0, ob.signed_distance(mids)[0].min())) / u,
                     "within": r["within"] / u, "tol": r["tol"] / u, "seconds": r["seconds"]})
     return out or None

@@ -38,9 +38,17 @@ def check_surface_obstacles(scene, mesh, obstacles, law: str) -> None:
                               '(with solver.start = "relax" for a dynamic-relaxation start)')
         V, T = surface
         r = obstacle_crossings(mesh.X3, mesh.tri, V, T, tol=START_TOUCH * edge, within=edge)
-        if r["pairs"]:
-            at = np.round(np.asarray(r["first_at"]) / u, 6).tolist()
-            raise scene.error(f"obstacles.{i}", f"the obstacle cuts through the flat sheet at the start: {r['pairs']} "
-                              f"sheet/obstacle triangle pairs cross, the first at {at} (sheet triangle "
-                              f"{r['first'][0]}, obstacle triangle {r['first'][1]}); move it (translate) so that it "
-                              f"lies on one side of the sheet (touching within {START_TOUCH:g} edge lengths is allowed)")
+        phi = ob.signed_distance(mesh.X3)[0]
+        inside = phi < -START_TOUCH * edge
+        if r["pairs"] or inside.any():
+            if r["pairs"]:
+                at = np.round(np.asarray(r["first_at"]) / u, 6).tolist()
+                what = (f"{r['pairs']} sheet/obstacle triangle pairs cross, the first at {at} (sheet triangle "
+                        f"{r['first'][0]}, obstacle triangle {r['first'][1]})")
+            else:
+                n = int(np.argmin(phi))
+                what = (f"{int(inside.sum())} sheet nodes lie inside it, the deepest (node {n}) at "
+                        f"{np.round(mesh.X3[n] / u, 6).tolist()}, {-phi[n] / u:.6g} deep")
+            raise scene.error(f"obstacles.{i}", f"the obstacle cuts through the flat sheet at the start: {what}; move "
+                              "it (translate) so that it lies on one side of the sheet (touching within "
+                              f"{START_TOUCH:g} edge lengths is allowed)")

@@ -24,7 +24,7 @@ and never above the true distance, which is all the contact candidate lists need
 inside its bounding box), and its Hessian is 0.
 
 Sharp features (:meth:`SurfaceObstacle.sharp_features`): the convex edges whose faces meet at more than
-``feature_angle`` (default 30 deg) from flat and the open boundary, and their end corners: the contact
+``feature_angle`` (:data:`FEATURE_ANGLE`) from flat and the open boundary, and their end corners: the contact
 law keeps the sheet's edges and triangles off them (:mod:`rftstatic.contact.features`).
 """
 
@@ -52,8 +52,13 @@ BAND = 0.25
 NEAREST = 12
 """Triangle centroids each point's nearest triangle is first sought among (then proven, or searched wider)."""
 
-FEATURE_ANGLE = 1.0
-"""Default angle [deg] between two faces' normals above which their common (convex) edge is a sharp feature."""
+FEATURE_ANGLE = 30.0
+"""Default angle [deg] between two faces' normals above which their common (convex) edge is a sharp feature: a
+box's or a table's edges (90 deg) are, the edges of a tessellated curved body (an icosphere of 1,280
+triangles: 7.5 deg) are not. On a curved body the sheet's flat triangles then dip into the obstacle between
+their nodes by about the chord sagitta ``h^2 / (8 R)``, as they do into an analytic sphere; ``feature_angle =
+1`` keeps every convex edge and vertex off the sheet (0 crossing pairs) at the cost measured in
+validation/mesh_obstacles.md."""
 
 
 def _rotation(angles_deg) -> np.ndarray:
