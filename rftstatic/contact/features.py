@@ -9,13 +9,19 @@ the gap ``d`` [m] contributes
     E_f = k / (3 d) (d - delta)^3                                                [J]
 
 (``k`` [N/m]: :data:`rftstatic.contact.penalty.FEATURE_STIFFNESS` times a node's penalty spring
-``k_penalty A``): slope and curvature vanish at
-``delta = d`` (C2 onset), the largest push is ``k d``. ``delta`` and its derivatives are those of the
-self-contact (:mod:`rftstatic.contact.self_contact.distance`: exact squared distances, gradients and
-Hessians of the point-triangle and edge-edge pairs) with the obstacle's points held; each pair's Hessian
-of the sheet's dofs (6 x 6 for an edge, 9 x 9 for a triangle) is projected onto the positive semi-definite
-matrices (eigenvalues clamped at 0), as the self-contact does, so the Newton tangent stays PSD. Energy
-and force are exact.
+``k_penalty A``): slope and curvature vanish at ``delta = d`` (C2 onset). ``delta`` is the distance of the
+self-contact kernels (:mod:`rftstatic.contact.self_contact.distance`: exact squared distances and gradients
+of the point-triangle and edge-edge pairs, the obstacle's points held), *signed* by the
+side: negative when the sheet's closest point lies inside the obstacle (its signed distance, by more than
+:data:`SIDE_DEPTH` of the pair's distance). So a sheet that starts touching a rim (``delta = 0``, a cloth laid on a table) or is pushed past
+it within a step is pushed back out, never further through (an unsigned distance would push it on once it
+crossed), and the energy keeps growing behind the feature. Energy and force are exact (``grad delta =
++-grad s / (2 |delta|)``); the tangent is the Gauss-Newton part ``e'' grad delta grad delta^T`` (positive
+semi-definite): the remaining ``e' hess delta`` grows as ``1 / delta`` for a sheet edge touching an obstacle
+edge (parallel edges at zero distance make it singular), and with ``e' < 0`` its PSD projection keeps
+little of it. Limitation: the side is read at one point; a sheet edge passing under a 90 deg rim exactly
+along one of its faces' planes has that point on the surface (``phi = 0``) and reads as outside (the
+independent crossing check, :mod:`rftstatic.post.measures.obstacle_crossings`, would count it).
 
 Broad phase: the obstacle's feature edges are sampled at the sheet's mean edge length; a ``cKDTree`` of the
 sheet's edge midpoints (triangle centroids) lists the pairs within ``d + margin``; the list is kept in the
@@ -29,9 +35,13 @@ import numpy as np
 
 from rftstatic.compiled import numba_available
 from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
-from rftstatic.contact.self_contact.law_kernels import psd_project
 
-__all__ = ["FeatureContact", "FeatureState"]
+__all__ = ["FeatureContact", "FeatureState", "SIDE_DEPTH"]
+
+SIDE_DEPTH = 0.1
+"""A pair is behind its feature when the sheet's closest point lies inside the obstacle deeper than this
+fraction of the pair's distance (:meth:`FeatureContact._side`): a sheet resting on a face beside a rim is not,
+one passing under a rim bent by up to about 170 deg is."""
 
 
 class FeatureState:
@@ -61,20 +71,24 @@ class FeatureContact:
     """
 
     def __init__(self, obstacles, tri, edges, X, gap: float, stiffness: float, margin: float):
-        pts, fedges, corners = [], [], []
+        pts, fedges, corners, en, cn = [], [], [], [], []
         offset = 0
         for ob in obstacles:
             f = ob.sharp_features()
             if f is None:
                 continue
-            p, e, c = f
-            pts.append(np.asarray(p, float))
-            fedges.append(np.asarray(e, np.int64).reshape(-1, 2) + offset)
-            corners.append(np.asarray(c, np.int64).ravel() + offset)
-            offset += len(p)
+            pts.append(np.asarray(f.points, float))
+            fedges.append(np.asarray(f.edges, np.int64).reshape(-1, 2) + offset)
+            corners.append(np.asarray(f.corners, np.int64).ravel() + offset)
+            en.append(np.asarray(f.edge_normals, float).reshape(-1, 3))
+            cn.append(np.asarray(f.corner_normals, float).reshape(-1, 3))
+            offset += len(f.points)
+        self.obstacles = [ob for ob in obstacles if ob.sharp_features() is not None]
         self.points = np.vstack(pts) if pts else np.zeros((0, 3))
         self.fedges = np.vstack(fedges) if fedges else np.zeros((0, 2), np.int64)
         self.corners = np.concatenate(corners) if corners else np.zeros(0, np.int64)
+        self.edge_normals = np.vstack(en) if en else np.zeros((0, 3))
+        self.corner_normals = np.vstack(cn) if cn else np.zeros((0, 3))
         self.tri, self.edges = np.asarray(tri, np.int64), np.asarray(edges, np.int64)
         self.gap, self.stiffness, self.margin = float(gap), float(stiffness), float(margin)
         self.compiled = numba_available()  # few pairs a call: the numpy path's ~0.5 ms a call would dominate
@@ -148,6 +162,22 @@ class FeatureContact:
                - np.max(np.linalg.norm(t - c[:, None], axis=2), axis=1, initial=0.0))
         return bee, bpt
 
+    def _side(self, xs, g, delta):
+        """-1 for the pairs (sheet points ``xs (P, m, 3)``, their ``ds/dx`` ``g (P, m, 3)``, distances ``delta (P,)``)
+        whose sheet closest point lies inside an obstacle deeper than ``SIDE_DEPTH |delta|``, else +1. The
+        closest point is the sheet nodes weighted by ``|ds/dx_k|`` (``2 w_k (c_sheet - c_feature)``, ``w_k`` its
+        barycentric weights). A sheet lying on a face next to a rim has its closest point on the face
+        (``phi ~ 0``): outside; one passing under a rim has it inside, about ``|delta| cos(half the rim angle)``
+        deep."""
+        if len(self.obstacles) == 0 or not len(xs):
+            return np.ones(len(xs))
+        w = np.linalg.norm(g, axis=2)
+        tot = w.sum(axis=1, keepdims=True)
+        w = np.where(tot > 0, w / np.where(tot > 0, tot, 1.0), 1.0 / xs.shape[1])
+        c = np.einsum("pk,pki->pi", w, xs)
+        phi = np.min([ob.signed_distance(c)[0] for ob in self.obstacles], axis=0)
+        return np.where(phi < -SIDE_DEPTH * delta, -1.0, 1.0)
+
     def evaluate(self, x: np.ndarray, *, tangent: bool = True, cache=None) -> FeatureState:
         """Energy, force and (``tangent``) the PSD node-pair blocks at ``x (N, 3)`` [m]."""
         n = len(x)
@@ -167,32 +197,30 @@ class FeatureContact:
         for x4, nodes, slot, kernel in parts:  # the two pair kinds
             if not len(x4):
                 continue
-            s, g, H, _ = kernel(x4, hessian=tangent, compiled=self.compiled)
+            s, g, _, _ = kernel(x4, hessian=False, compiled=self.compiled)
+            g = g[:, slot]
             delta = np.sqrt(np.maximum(s, 0.0))
+            side = self._side(x4[:, slot], g, delta)
+            delta = side * delta
             dmin = min(dmin, float(delta.min()))
             act = delta < d
             if not act.any():
                 continue
-            delta, g, nodes = delta[act], g[act][:, slot], nodes[act]
+            delta, g, nodes, side = delta[act], g[act], nodes[act], side[act]
             gap = d - delta
             e1, e2 = -k / d * gap**2, 2.0 * k / d * gap  # dE/ddelta, d2E/ddelta2
             energy += float(np.sum(k / (3.0 * d) * gap**3))
-            safe = np.maximum(delta, 1e-300)
-            gd = g / (2.0 * safe)[:, None, None]  # grad delta = grad s / (2 delta)
+            gd = g * (side / (2.0 * np.maximum(np.abs(delta), 1e-300)))[:, None, None]  # grad delta = +-grad s / (2 |delta|)
             fn = (e1[:, None, None] * gd).reshape(-1, 3)
             for i in range(3):  # the three components
                 force[:, i] += np.bincount(nodes.ravel(), fn[:, i], minlength=n)
-            if tangent:
+            if tangent:  # Gauss-Newton: e'' grad delta grad delta^T, PSD (module docstring)
                 m = nodes.shape[1]
-                sl = slice(3 * slot.start, 3 * slot.stop)
-                Hs = H[act][:, sl, sl]
                 gs = gd.reshape(len(delta), -1)
-                hd = Hs / (2.0 * safe)[:, None, None] - np.einsum("pi,pj->pij", gs, gs) / safe[:, None, None]
-                B = psd_project(e2[:, None, None] * np.einsum("pi,pj->pij", gs, gs) + e1[:, None, None] * hd)
-                B = B.reshape(len(delta), m, 3, m, 3).transpose(0, 1, 3, 2, 4)  # (P, a, b, 3, 3)
+                B = (e2[:, None, None] * np.einsum("pi,pj->pij", gs, gs)).reshape(len(delta), m, 3, m, 3)
                 rows.append(np.repeat(nodes, m, axis=1).ravel())
                 cols.append(np.tile(nodes, (1, m)).ravel())
-                blocks.append(B.reshape(-1, 3, 3))
+                blocks.append(B.transpose(0, 1, 3, 2, 4).reshape(-1, 3, 3))  # (P, a, b, 3, 3) -> node pairs
         if rows:
             return FeatureState(energy, force, np.concatenate(rows), np.concatenate(cols), np.concatenate(blocks), dmin)
         return FeatureState(energy, force, *none, dmin)

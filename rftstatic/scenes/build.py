@@ -324,7 +324,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh), obstacles
 
 
-OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z"}
+OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z", "translate": "xyz"}
 """``[[obstacles]]`` keys that place an obstacle, and the axes of their numbers."""
 
 MAX_OBSTACLE_DISTANCE = 1000.0

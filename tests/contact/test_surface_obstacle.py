@@ -105,6 +105,9 @@ def _bent_sheet():
 def test_penalty_and_feature_pairs_force_is_the_energy_gradient_and_tangent_psd(tmp_path):
     box = SurfaceObstacle(_write(tmp_path / "box.obj", BOX_V, BOX_F), scene_length=0.01)
     assert box.closed and len(box.feature_edges) == 12 and len(box.feature_corners) == 8
+    f = box.sharp_features()
+    mid = f.points[f.edges].mean(axis=1) - f.points.mean(axis=0)  # from the box's centre
+    assert np.allclose(np.linalg.norm(f.edge_normals, axis=1), 1.0) and np.all(np.einsum("ei,ei->e", mid, f.edge_normals) > 0)
     m, x = _bent_sheet()
     pc = PenaltyContact([box], m.node_area, 1e7, smoothing=1e-4, sheet=m)
     cs = pc.evaluate(x)
@@ -198,3 +201,21 @@ def test_bad_mesh_files_are_refused_with_the_file_and_the_problem(tmp_path):
     # quads are split (and said), not refused
     ob = SurfaceObstacle(_write(tmp_path / "quad.vtu", P[:4], [[0, 1, 2, 3]], "quad"), side="front")
     assert len(ob.T) == 2 and "quad" in ob.notes[0]
+
+
+def test_a_sheet_edge_pushed_under_a_rim_is_pushed_back_out(tmp_path):
+    """A sheet edge bent 45 deg over the box's top rim x = 1 cm, its ends on either side: 0.1 d outside the rim,
+    the feature pair pushes it outward; moved 0.2 d through the rim it is pushed outward again, harder (the signed
+    distance: an unsigned one would push it on through)."""
+    from rftstatic.contact.features import FeatureContact
+
+    box = SurfaceObstacle(_write(tmp_path / "box.obj", BOX_V, BOX_F), scene_length=0.01)
+    X = np.array([[0.009, 0.0, 0.001], [0.011, 0.0, -0.001], [0.009, 0.001, 0.001]])  # through the rim
+    tri, edges = np.array([[0, 1, 2]]), np.array([[0, 1], [1, 2], [0, 2]])
+    fc = FeatureContact([box], tri, edges, X, gap=1e-4, stiffness=10.0, margin=1e-3)
+    pushes = []
+    out = np.array([1.0, 0.0, 1.0]) / np.sqrt(2.0)  # the rim's outward normal
+    for shift in (1e-5, -2e-5):
+        fs = fc.evaluate(X + shift * out)
+        pushes.append(-fs.force[:2].sum(axis=0) @ out)  # what the pair does to the edge's two nodes, outward
+    assert 0 < pushes[0] < pushes[1]

@@ -28,7 +28,7 @@ read)::
 checks the declared keys, and the contact code uses only the :class:`Obstacle` interface.
 """
 
-from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey
+from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures
 from rftstatic.contact.obstacles.floor import Floor
 from rftstatic.contact.obstacles.registry import (
     from_spec,
@@ -50,6 +50,7 @@ __all__ = [
     "Obstacle",
     "RoundPedestal",
     "SceneKey",
+    "SharpFeatures",
     "Sphere",
     "SquarePedestal",
     "SurfaceObstacle",

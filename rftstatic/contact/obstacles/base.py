@@ -38,7 +38,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-__all__ = ["NUMBER", "NUMBERS", "Obstacle", "SceneKey", "type_name_of"]
+__all__ = ["NUMBER", "NUMBERS", "Obstacle", "SceneKey", "SharpFeatures", "type_name_of"]
 
 NUMBER = (int, float)  # scene value types of a number
 NUMBERS = (list,)      # ... of a list of numbers
@@ -169,6 +169,26 @@ def _vertical_q(z: np.ndarray, top_z: float, height: float, r: float) -> tuple[n
     return z - (top_z - r), np.ones_like(z)
 
 
+@dataclass(frozen=True)
+class SharpFeatures:
+    """An obstacle's sharp features (:meth:`Obstacle.sharp_features`, :mod:`rftstatic.contact.features`).
+
+    Attributes
+    ----------
+    points : (n, 3) [m]
+    edges : (f, 2) sharp edges, into ``points``
+    corners : (c,) corners, into ``points``
+    edge_normals : (f, 3) outward unit normal of each edge (its faces' normals summed)
+    corner_normals : (c, 3) outward unit normal of each corner (angle-weighted pseudo-normal)
+    """
+
+    points: np.ndarray
+    edges: np.ndarray
+    corners: np.ndarray
+    edge_normals: np.ndarray
+    corner_normals: np.ndarray
+
+
 def type_name_of(obstacle: Obstacle) -> str:
     """The scene type name declared by the obstacle's own class (not inherited), else its class name."""
     return vars(type(obstacle)).get("type_name") or type(obstacle).__name__
@@ -232,10 +252,10 @@ class Obstacle(abc.ABC):
         of the sheet against them; None for an analytic obstacle."""
         return None
 
-    def sharp_features(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """Sharp edges and corners that must not cut the sheet between its nodes: ``(points (n, 3) [m],
-        edges (f, 2) into points, corners (c,) into points)``; None: the obstacle has none (its normal is
-        continuous, e.g. the rounded pedestals), the node penalty is all its contact needs."""
+    def sharp_features(self) -> SharpFeatures | None:
+        """Sharp edges and corners that must not cut the sheet between its nodes (:class:`SharpFeatures`);
+        None: the obstacle has none (its normal is continuous, e.g. the rounded pedestals), the node penalty
+        is all its contact needs."""
         return None
 
     def footprint(self) -> tuple[float | None, np.ndarray]:

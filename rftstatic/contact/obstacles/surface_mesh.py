@@ -21,7 +21,10 @@ distance to the nearest vertex and ``R`` the largest centroid-to-corner radius).
 ``band`` from every triangle gets the lower bound ``d_c - R`` (``d_c`` the nearest centroid): 1-Lipschitz
 and never above the true distance, which is all the contact candidate lists need
 (:mod:`rftstatic.contact.candidates`); its side comes from the winding number (a closed surface, a point
-inside its bounding box), and its Hessian is 0.
+inside its bounding box), and its Hessian is 0. The Hessian is 0 inside too: inside a convex edge or corner
+the closest point is on a face (phi linear), except for a point on the surface itself, where the edge's
+``1 / r`` is round-off (a sheet node laid exactly on a box's edge); at a reflex (concave) edge the face value
+is a one-sided choice, a softer PSD tangent (the penalty's slope is negative there).
 
 Sharp features (:meth:`SurfaceObstacle.sharp_features`): the convex edges whose faces meet at more than
 ``feature_angle`` (:data:`FEATURE_ANGLE`) from flat and the open boundary, and their end corners: the contact
@@ -36,7 +39,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, _as_points
+from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures, _as_points
 from rftstatic.contact.obstacles.registry import register
 from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, pseudo_normals,
                                                           winding_number)
@@ -48,6 +51,10 @@ FILE_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
 
 BAND = 0.25
 """Exact-distance band, in bounding-box diagonals of the obstacle (module docstring)."""
+
+SIZE_RANGE = (1e-6, 1e4)
+"""Sizes [m] (bounding-box diagonal after scale and units) a mesh obstacle may have: a scale that makes it
+smaller or larger is a mistake (its triangles would be degenerate, or its coordinates overflow)."""
 
 NEAREST = 12
 """Triangle centroids each point's nearest triangle is first sought among (then proven, or searched wider)."""
@@ -147,7 +154,14 @@ class SurfaceObstacle(Obstacle):
         P, tri, notes = read_triangles(self.path, quads="triangulate")
         P, tri = _merge(P, tri)
         unit = FILE_UNITS[units] if units is not None else self.scene_length
-        V = (P * (unit * self.scale)) @ _rotation(self.rotate).T + self.translate
+        if not (np.isfinite(self.rotate).all() and np.isfinite(self.translate).all()):
+            raise ValueError(f"rotate and translate must be finite, got {rotate!r} and {translate!r}")
+        with np.errstate(over="ignore", invalid="ignore"):
+            V = (P * (unit * self.scale)) @ _rotation(self.rotate).T + self.translate
+            size = float(np.linalg.norm(np.ptp(V, axis=0)))
+        if not (np.isfinite(V).all() and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
+            raise ValueError(f"scale = {scale!r} (file units {units or 'of the scene'}) makes the obstacle {size:.3g} m "
+                             f"across; give a scale (and units) that make it {SIZE_RANGE[0]:g} m to {SIZE_RANGE[1]:g} m")
         info = check_triangles(V, tri, where=str(self.path), oriented=self.thickness is None)
         self.closed = info["closed"]
         if self.closed and (side is not None or self.thickness is not None):
@@ -216,8 +230,11 @@ class SurfaceObstacle(Obstacle):
         T = self.T[tri]
         q, kind, local = closest_on_triangles(xp, self.V[T[:, 0]], self.V[T[:, 1]], self.V[T[:, 2]])
         d2 = np.einsum("pi,pi->p", xp - q, xp - q)
-        pt = np.repeat(np.arange(len(counts)), counts)
-        best = np.lexsort((d2, pt))[np.r_[0, np.cumsum(counts)[:-1]]]  # per point, the nearest pair first
+        if np.all(counts == counts[0]):  # K each: the nearest along the rows
+            best = np.argmin(d2.reshape(len(counts), -1), axis=1) + counts[0] * np.arange(len(counts))
+        else:
+            pt = np.repeat(np.arange(len(counts)), counts)
+            best = np.lexsort((d2, pt))[np.r_[0, np.cumsum(counts)[:-1]]]  # per point, the nearest pair first
         return q[best], kind[best], local[best], tri[best]
 
     def _near_far(self, x):
@@ -270,7 +287,9 @@ class SurfaceObstacle(Obstacle):
                 t = self.V[e[:, 1]] - self.V[e[:, 0]]
                 t /= np.linalg.norm(t, axis=1, keepdims=True)
                 P = P - (kind == EDGE)[:, None, None] * np.einsum("pi,pj->pij", t, t)
-                scale = np.where((kind == FACE) | tiny, 0.0, s / np.where(tiny, 1.0, r))
+                # inside (s < 0) the closest point is on a face except at a reflex edge or exactly on the surface
+                # (r ~ 0, where 1 / r would be round-off): 0 there (module docstring)
+                scale = np.where((kind == FACE) | tiny | (s < 0), 0.0, s / np.where(tiny, 1.0, r))
                 H[idx] = scale[:, None, None] * P
         return phi, normal, H
 
@@ -349,10 +368,28 @@ class SurfaceObstacle(Obstacle):
         far = self.V[t1].sum(axis=1) - self.V[self.edges].sum(axis=1)  # the corner not on the edge
         convex = np.einsum("ei,ei->e", far - self.V[self.edges[:, 0]], n0) < 0
         sharp = (two & convex & (bend > self.feature_angle)) | self.boundary_edge
+        # an open rim's outward direction: in the plane of its face, away from it (and along the face's normal
+        # for a one-sided surface)
+        rim = self.boundary_edge
+        e0, e1 = self.V[self.edges[rim, 0]], self.V[self.edges[rim, 1]]
+        nf = self.nf[e_tris[rim, 0]]
+        out = np.cross(nf, e1 - e0)
+        third = self.V[self.T[e_tris[rim, 0]]].sum(axis=1) - e0 - e1
+        out *= np.where(np.einsum("ei,ei->e", out, 0.5 * (e0 + e1) - third) < 0, -1.0, 1.0)[:, None]
+        out /= np.linalg.norm(out, axis=1, keepdims=True)
+        if self.thickness is None:
+            out = out + nf
+            out /= np.linalg.norm(out, axis=1, keepdims=True)
+        normals = self.ne.copy()
+        normals[rim] = out
         self.feature_edges = self.edges[sharp]
+        self.feature_normals = normals[sharp]
         deg = np.bincount(self.feature_edges.ravel(), minlength=len(self.V))
         self.feature_corners = np.flatnonzero((deg > 0) & (deg != 2))
 
     def sharp_features(self):
-        """``(points (n, 3) [m], edges (f, 2), corners (c,))``: the sharp edges and their end or junction corners."""
-        return self.V, self.feature_edges, self.feature_corners
+        """The sharp edges and their end or junction corners, with their pseudo-normals."""
+        if not len(self.feature_edges):
+            return None
+        return SharpFeatures(self.V, self.feature_edges, self.feature_corners, self.feature_normals,
+                             self.nv[self.feature_corners])
