@@ -219,3 +219,19 @@ def test_a_sheet_edge_pushed_under_a_rim_is_pushed_back_out(tmp_path):
         fs = fc.evaluate(X + shift * out)
         pushes.append(-fs.force[:2].sum(axis=0) @ out)  # what the pair does to the edge's two nodes, outward
     assert 0 < pushes[0] < pushes[1]
+
+
+def test_open_surfaces_with_a_side_or_a_thickness(tmp_path):
+    """A 2 x 2 cm plate (two counter-clockwise triangles, normals +z) at z = 0: two-sided with a thickness, or
+    solid behind its front (the side its normals face) or its back; beyond the rim every point is outside."""
+    path = _write(tmp_path / "plate.obj", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], [[0, 1, 2], [0, 2, 3]])
+    x = np.array([[0.0, 0.0, 0.001], [0.0, 0.0, -0.001], [0.02, 0.0, -0.005]])
+    beside = np.hypot(0.01, 0.005)
+    shell = SurfaceObstacle(path, thickness=0.0004, scene_length=0.01)
+    assert np.allclose(shell.signed_distance(x)[0], [0.0008, 0.0008, beside - 0.0002])
+    front = SurfaceObstacle(path, side="front", scene_length=0.01)
+    phi, n = front.signed_distance(x)
+    assert np.allclose(phi, [0.001, -0.001, beside]) and np.allclose(n[:2], [[0, 0, 1], [0, 0, 1]])
+    back = SurfaceObstacle(path, side="back", scene_length=0.01)
+    assert np.allclose(back.signed_distance(x)[0], [-0.001, 0.001, beside])
+    assert len(shell.feature_edges) == 4 and len(front.feature_edges) == 4  # the rim is a sharp feature
