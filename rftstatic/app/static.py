@@ -23,7 +23,8 @@ from rftstatic.app.result import RunResult
 from rftstatic.errors import ConvergenceError
 from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_outputs
-from rftstatic.io.summary import drape_summary, probe_summary, self_contact_summary, self_intersection_summary, summary_header
+from rftstatic.io.summary import (drape_summary, obstacle_crossing_summary, probe_summary, self_contact_summary,
+                                  self_intersection_summary, summary_header)
 from rftstatic.scenes.build import build_model
 from rftstatic.app.specimens import seeded_specimens
 from rftstatic.scenes.options import run_options, seed_count, static_options
@@ -128,6 +129,8 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         "max_relative_curvature": float(model.relative_curvature(U).max()),
         "self_intersections": self_intersection_summary(scene, model, U),
     })
+    if (crossings := obstacle_crossing_summary(scene, model, extras, U)) is not None:
+        summary["obstacle_crossings"] = crossings
     if model.self_contact is not None:
         summary["self_contact"] = self_contact_summary(scene, model, scale=result.self_contact_scale)
         crossing = summary["self_intersections"].get("pairs", 0)

@@ -27,12 +27,13 @@ class CandidateList:
         self._indices = None  # (C,) candidate indices
         self._x = None  # (N, 3) positions at the refresh [m]
         self._gap = None  # (N,) distances at the refresh [m]
+        self.pairs = None  # a law's pair list and the positions it was built at (rftstatic.contact.features)
 
     def reset(self, margin: float | None = None) -> None:
         """Forget the list (e.g. a new mesh); optionally a new ``margin`` [m]."""
         if margin is not None:
             self.margin = float(margin)
-        self._indices = self._x = self._gap = None
+        self._indices = self._x = self._gap = self.pairs = None
 
     def lookup(self, x: np.ndarray):
         """``(indices (C,), lower bounds (N,) of every point's distance [m])`` while the list is valid for

@@ -13,8 +13,12 @@ to the total potential energy. Its gradient ``f_n = k A_n min(phi, 0) n`` (``n =
     K_n = d f_n / d x_n = k A_n (n n^T + phi H)     for phi < 0,  0 otherwise,
 
 with ``H`` the Hessian of ``phi`` (:meth:`rftstatic.contact.obstacles.Obstacle.normal_gradient`); the global
-tangent only needs these ``(N, 3, 3)`` diagonal blocks. The ``phi H`` term is negative semi-definite on a
-convex obstacle (it softens the tangential directions on a sphere or a rounded edge) and is tiny next to
+tangent only needs these ``(N, 3, 3)`` diagonal blocks. An obstacle with sharp edges (a triangle surface,
+``Obstacle.psd_tangent``) has a curvature ``H`` that grows without bound near an edge (``1 / r``): there each
+block is projected onto the positive semi-definite matrices (:func:`psd_blocks`); since ``H n = 0``, ``H``
+is PSD and the slope ``<= 0``, this keeps ``k A e'' n n^T`` and drops the negative ``e' H`` (exact on the
+faces, where ``H = 0``; a Gauss-Newton tangent at the edges and corners). The ``phi H`` term is negative
+semi-definite on a convex obstacle (it softens the tangential directions on a sphere or a rounded edge) and is tiny next to
 ``n n^T`` because ``|phi| << 1 / |H|``.
 
 A node pressed with a contact pressure ``p`` [Pa] penetrates ``p / k`` (:func:`estimate_penetration`);
@@ -40,6 +44,20 @@ from rftstatic.contact.common import positive as _positive
 from rftstatic.contact.obstacles import Obstacle
 from rftstatic.model.frozen import Frozen
 
+FEATURE_GAP = 0.05
+"""Gap ``d`` of the sharp-feature pairs (:mod:`rftstatic.contact.features`), in mean sheet edge lengths (at
+least the penalty's onset width): the sheet passes over a sharp obstacle edge this far from it."""
+
+FEATURE_STIFFNESS = 0.1
+"""Stiffness of a sharp-feature pair in units of a node's penalty spring ``k A`` (mean node area): a node sees
+several pairs at once (the vertices and edges of a fine obstacle near it), and the largest push of one pair,
+``k d``, is still about 30 x the weight of the whole 30 cm wool sheet of sphere-30 at 33 x 33 nodes."""
+
+FEATURE_MARGIN = 0.25
+"""Broad-phase margin of the sharp-feature pairs, in mean sheet edge lengths: their list is rebuilt once a node
+moved half of it (a smaller margin than the nodes' candidate list: a fine obstacle has many features near each
+node, and every listed pair's distance bound is computed at every evaluation)."""
+
 __all__ = [
     "PenaltyContact",
     "ContactState",
@@ -59,6 +77,8 @@ class ContactState:
     tangent_blocks : (N, 3, 3) node-diagonal blocks of ``d force / dx`` [N/m]
     gap : (N,) smallest signed distance over the obstacles [m]
     active : (N,) node penetrates at least one obstacle
+    pair_blocks : the tangent's node-pair blocks of the obstacles' sharp features
+        ``(rows (B,), cols (B,), blocks (B, 3, 3))`` [N/m] (:mod:`rftstatic.contact.features`), or None
     """
 
     energy: float
@@ -66,6 +86,7 @@ class ContactState:
     tangent_blocks: np.ndarray
     gap: np.ndarray
     active: np.ndarray
+    pair_blocks: tuple | None = None
 
     @property
     def max_penetration(self) -> float:
@@ -111,7 +132,7 @@ class PenaltyContact(Frozen):
     """
 
     def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float,
-                 smoothing: float = 0.0):
+                 smoothing: float = 0.0, sheet=None):
         self.obstacles = _as_list(obstacles)
         self.smoothing = _positive("smoothing", smoothing, allow_zero=True)
         area = np.asarray(node_area, dtype=float)
@@ -126,6 +147,16 @@ class PenaltyContact(Frozen):
         # list margin [m]: a few onset widths, and half a node spacing so explicit runs refresh seldom
         spacing = float(np.sqrt(np.mean(area))) if area.size and np.mean(area) > 0 else 0.0
         self.margin = max(4.0 * self.smoothing, 0.5 * spacing)
+        self.features = None
+        if sheet is not None and any(ob.sharp_features() is not None for ob in self.obstacles):
+            from rftstatic.contact.features import FeatureContact
+
+            X = np.asarray(sheet.X3, float)
+            edges = np.asarray(sheet.topology.edges)
+            h = float(np.mean(np.linalg.norm(X[edges[:, 1]] - X[edges[:, 0]], axis=1)))
+            self.features = FeatureContact(self.obstacles, sheet.tri, edges, X, gap=max(self.smoothing, FEATURE_GAP * h),
+                                           stiffness=FEATURE_STIFFNESS * self.stiffness * float(np.mean(area)),
+                                           margin=max(4.0 * self.smoothing, FEATURE_MARGIN * h))
         self._freeze()
 
     def new_candidates(self) -> CandidateList:
@@ -182,12 +213,21 @@ class PenaltyContact(Frozen):
                     continue
                 H = ob.normal_gradient(xc[act])
                 nn = np.einsum("ni,nj->nij", normal[m, act], normal[m, act])
-                blocks[cand[act]] += ka[act, None, None] * (d2[m, act, None, None] * nn + d1[m, act, None, None] * H)
+                block = d2[m, act, None, None] * nn + d1[m, act, None, None] * H
+                if ob.psd_tangent:
+                    block = psd_blocks(block)
+                blocks[cand[act]] += ka[act, None, None] * block
         active = np.zeros(n, dtype=bool)
         if phi.shape[0]:
             gap[cand] = phi.min(axis=0)
             active[cand] = np.any(phi < 0.0, axis=0)
-        return ContactState(energy, force, blocks, gap, active)
+        pairs = None
+        if self.features is not None:
+            fs = self.features.evaluate(x, tangent=tangent, cache=candidates)
+            energy += fs.energy
+            force += fs.force
+            pairs = (fs.rows, fs.cols, fs.blocks) if len(fs.rows) else None
+        return ContactState(energy, force, blocks, gap, active, pairs)
 
     def _near(self, x, candidates):
         """Indices of the candidate nodes and an ``(N,)`` gap array: exact values are filled in by
@@ -249,6 +289,8 @@ class PenaltyContact(Frozen):
             phi, normal = self._distances_of(x[cand])
             d1 = self._slope(phi)
             force[cand] = np.einsum("n,mn,mni->ni", self.stiffness * self.node_area[cand], d1, normal)
+        if self.features is not None:
+            force += self.features.evaluate(x, tangent=False, cache=candidates).force
         return force
 
     def tangent_blocks(self, x: np.ndarray, *, candidates: CandidateList | None = None) -> np.ndarray:
@@ -292,6 +334,13 @@ class PenaltyContact(Frozen):
     def active(self, x: np.ndarray) -> np.ndarray:
         """``(N,)`` bool: node penetrates at least one obstacle at ``x (N, 3)`` [m]."""
         return self.gaps(x) < 0.0
+
+
+def psd_blocks(blocks: np.ndarray) -> np.ndarray:
+    """Symmetric ``(n, 3, 3)`` blocks with their negative eigenvalues set to 0 (the nearest positive
+    semi-definite matrices in the Frobenius norm)."""
+    w, Q = np.linalg.eigh(0.5 * (blocks + np.swapaxes(blocks, 1, 2)))
+    return np.einsum("nik,nk,njk->nij", Q, np.maximum(w, 0.0), Q)
 
 
 def auto_penalty(

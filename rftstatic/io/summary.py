@@ -5,7 +5,9 @@
 - :func:`drape_summary`: drape coefficient, fold count and the sharp-fold indicator (§3, Figs. 1 and 8);
 - :func:`probe_summary`: reference and deformed positions of the scene's probes;
 - :func:`self_intersection_summary`: the self-intersection check (crossing triangle pairs, smallest
-  distance between non-adjacent triangles) of the final state, and of every saved state of a dynamic run.
+  distance between non-adjacent triangles) of the final state, and of every saved state of a dynamic run;
+- :func:`obstacle_crossing_summary`: the sheet against each triangle-surface obstacle (crossing pairs,
+  smallest surface distance, smallest node distance).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import numpy as np
 
 from rftstatic.post.measures.boundary import boundary_loop, outline_surrounds
 from rftstatic.post.measures.intersections import self_intersections
+from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
 from rftstatic.post.measures.summary import drape_measures
 from rftstatic.post.probes import probe_positions
 from rftstatic.provenance import peak_memory_mb, software
@@ -177,3 +180,32 @@ def self_intersection_summary(scene, model, U, *, states=()) -> dict:
             out.update(max_pairs_saved=pairs[k], max_pairs_at=times[k])
     out["seconds"] = seconds
     return out
+
+
+def obstacle_crossing_summary(scene, model, extras, U) -> list | None:
+    """For each obstacle with a triangle surface (:meth:`~rftstatic.contact.obstacles.Obstacle.surface`), the
+    independent crossing check of the state ``U (N, 3)`` [m]
+    (:func:`~rftstatic.post.measures.obstacle_crossings.obstacle_crossings`: ``pairs`` of sheet and obstacle
+    triangles that cross, ``smallest_distance`` between the surfaces) and ``smallest_node_distance``, the least
+    signed distance of a node to it (the obstacle's own distance: negative inside) and ``deepest_chord``, the
+    least signed distance (0 if none is negative) of a sheet triangle's centroid or edge midpoint (how far the
+    flat triangles dip into it between their nodes), lengths in scene units; None when no obstacle has a
+    surface."""
+    u = scene.units.length
+    x = model.positions(U)
+    out = []
+    for i, ob in enumerate(extras.get("obstacles", ())):
+        surface = ob.surface()
+        if surface is None:
+            continue
+        if not np.isfinite(x).all():
+            out.append({"obstacle": i, "applicable": False, "reason": "non-finite positions"})
+            continue
+        r = obstacle_crossings(x, model.mesh.tri, *surface)
+        mids = np.concatenate([x[model.mesh.tri].mean(axis=1), 0.5 * (x[model.mesh.topology.edges].sum(axis=1))])
+        out.append({"obstacle": i, "pairs": r["pairs"], "first": r["first"],
+                    "smallest_distance": r["smallest_distance"] / u,
+                    "smallest_node_distance": float(ob.signed_distance(x)[0].min()) / u,
+                    "deepest_chord": float(min(0.0, ob.signed_distance(mids)[0].min())) / u,
+                    "within": r["within"] / u, "tol": r["tol"] / u, "seconds": r["seconds"]})
+    return out or None

@@ -448,7 +448,8 @@ def square_polar(half_side, n_radial, n_circ, *, centre=(0.0, 0.0), core_radius=
 
 
 def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
-    """Read a flat triangle mesh with meshio (any format it reads).
+    """Read a flat triangle mesh with meshio (any format it reads), checked as every surface file is
+    (:func:`rftstatic.mesh.surface.check_triangles`: degenerate, duplicate triangles, non-manifold edges).
 
     Parameters
     ----------
@@ -456,31 +457,11 @@ def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
     length_scale : SI value of the file's length unit [m]
     z0 : height of the reference plane [m]; default: the file's (constant) z
     """
-    import meshio
+    from rftstatic.mesh.surface import check_triangles, read_triangles
 
-    try:
-        m = meshio.read(path)
-    except Exception as exc:  # meshio raises many types; re-raise with the file name
-        raise MeshError(f"{path}: meshio could not read it ({exc})") from exc
-    except SystemExit:  # meshio's VTU reader exits the interpreter on an empty or truncated file
-        raise MeshError(f"{path}: meshio could not read it (an empty or truncated file?); export the mesh "
-                        "again") from None
-    tris = [c.data for c in m.cells if c.type == "triangle"]
-    if not tris:
-        kinds = sorted({c.type for c in m.cells})
-        raise MeshError(f"{path}: no triangle cells (found {kinds}); export the mesh as triangles")
-    other = sorted({c.type for c in m.cells} - {"triangle", "vertex", "line"})
-    if other:
-        raise MeshError(f"{path}: holds {', '.join(other)} cells besides triangles; the RF triangle needs a "
-                        "triangle mesh: split the other cells into triangles before exporting")
-    tri = np.vstack(tris)
-    P = np.asarray(m.points, float) * length_scale
-    if tri.size and (tri.min() < 0 or tri.max() >= len(P)):
-        bad = int(tri.max()) if tri.max() >= len(P) else int(tri.min())
-        raise MeshError(f"{path}: a triangle names node {bad}, but the file has nodes 0..{len(P) - 1}")
-    if not np.isfinite(P).all():
-        raise MeshError(f"{path}: node coordinates are not all finite (NaN or inf)")
-    z = P[:, 2] if P.shape[1] == 3 else np.zeros(len(P))
+    P, tri, _ = read_triangles(path, quads="refuse")
+    P = P * length_scale
+    z = P[:, 2]
     span = max(np.ptp(P[:, :2], axis=0).max(), 1e-300)
     if np.ptp(z) > 1e-9 * span:
         raise MeshError(
@@ -493,6 +474,7 @@ def read(path, *, length_scale=1.0, z0=None) -> TriMesh:
         i = int(used[first[np.argmax(count > 1)]])
         raise MeshError(f"{path}: node {i} at {P[i, :2].tolist()} is repeated (coincident nodes); merge "
                         "duplicate nodes before exporting (the sheet would come apart there)")
+    check_triangles(P, tri, where=str(path))
     remap = np.full(len(P), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
     mesh_z0 = float(z[used].mean()) if z0 is None else z0

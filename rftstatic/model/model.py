@@ -270,6 +270,9 @@ class Model(Frozen):
             cs = self.contact.evaluate(x, candidates=candidates)
             f += cs.force
             data += scatter_matrices(plan.diag_positions, cs.tangent_blocks, plan.nnz)
+            if cs.pair_blocks is not None:  # an obstacle's sharp features against sheet edges and triangles
+                rows, cols, blocks = cs.pair_blocks
+                data += scatter_matrices(plan.positions(rows, cols), blocks, plan.nnz)
         for term in self.load_terms:  # load stiffness of potential loads (not part of f)
             rows, cols, blocks = term.tangent_blocks(x)
             data += scatter_matrices(plan.positions(rows, cols), lam * blocks, plan.nnz)

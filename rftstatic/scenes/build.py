@@ -15,6 +15,7 @@ from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
 from rftstatic.scenes.material import build_material
+from rftstatic.scenes.obstacle_checks import check_surface_obstacles
 from rftstatic.scenes.options import contact_options, declared_run_options, static_options
 from rftstatic.scenes.ranges import (
     check_mesh_table,
@@ -284,7 +285,8 @@ def build_obstacles(scene: Scene) -> list:
     obstacles = []
     for i, spec in enumerate(scene.get("obstacles", [])):
         try:
-            obstacles.append(from_spec(spec, scene.units.length))
+            obstacles.append(from_spec(spec, scene.units.length,
+                                       base_dir=None if scene.path is None else scene.path.parent))
         except ValueError as exc:
             raise scene.error(f"obstacles.{i}", str(exc)) from None
     return obstacles
@@ -303,6 +305,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     obstacles = build_obstacles(scene)
     if not obstacles:
         return None, []
+    check_surface_obstacles(scene, mesh, obstacles, law)
     c = contact_options(scene)
     hold = c.hold_inplane
     if law == "kinematic":
@@ -318,10 +321,10 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
                          weight=max(material.weight, 1e-300), h=h, factor=c.factor)
     if hold:
         hold_inplane_rigid_modes(mesh, supports)
-    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h), obstacles
+    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh), obstacles
 
 
-OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z"}
+OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z", "translate": "xyz"}
 """``[[obstacles]]`` keys that place an obstacle, and the axes of their numbers."""
 
 MAX_OBSTACLE_DISTANCE = 1000.0

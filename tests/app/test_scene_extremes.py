@@ -54,8 +54,12 @@ ISOTROPIC = {
 
 
 def tiny(data: dict) -> dict:
-    """``data`` with a mesh of a few dozen nodes."""
+    """``data`` with a mesh of a few dozen nodes, its obstacles' file paths taken from cases/ (the data is read
+    without its scene file)."""
     data = copy.deepcopy(data)
+    for ob in data.get("obstacles", []):
+        if "path" in ob:
+            ob["path"] = str(CASES_DIR / ob["path"])
     m = data.setdefault("mesh", {})
     kind = m.get("kind", "rectangle")
     if kind in TINY_NODES:

@@ -3,7 +3,8 @@
 The obstacles of the paper (Sze & Zhou 2016, §4-6) are a floor plane (:class:`Floor`), a sphere
 (:class:`Sphere`, §4.5, §6.3, Ø10 cm), a square pedestal (:class:`SquarePedestal`, §4.2-4.3, 10-40 cm
 wide) and a circular pedestal (:class:`RoundPedestal`, §4.4, §6.2, Ø20 cm), the pedestals with rounded
-edges so that the contact normal is continuous. The interface every obstacle answers (signed distance
+edges so that the contact normal is continuous; and a user's own object given as a triangle surface file
+(:class:`SurfaceObstacle`, scene type ``mesh``). The interface every obstacle answers (signed distance
 ``phi (N,) [m]``, outward unit normal ``(N, 3)``, its gradient ``(N, 3, 3) [1/m]``, closest point,
 projection) and the notes on the exact rounded-box distance are in :mod:`.base`.
 
@@ -27,7 +28,7 @@ read)::
 checks the declared keys, and the contact code uses only the :class:`Obstacle` interface.
 """
 
-from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey
+from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures
 from rftstatic.contact.obstacles.floor import Floor
 from rftstatic.contact.obstacles.registry import (
     from_spec,
@@ -39,6 +40,7 @@ from rftstatic.contact.obstacles.registry import (
 )
 from rftstatic.contact.obstacles.round_pedestal import RoundPedestal
 from rftstatic.contact.obstacles.sphere import Sphere
+from rftstatic.contact.obstacles.surface_mesh import SurfaceObstacle
 from rftstatic.contact.obstacles.square_pedestal import SquarePedestal
 
 __all__ = [
@@ -48,8 +50,10 @@ __all__ = [
     "Obstacle",
     "RoundPedestal",
     "SceneKey",
+    "SharpFeatures",
     "Sphere",
     "SquarePedestal",
+    "SurfaceObstacle",
     "from_spec",
     "obstacle_class",
     "obstacle_types",

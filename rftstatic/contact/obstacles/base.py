@@ -38,7 +38,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-__all__ = ["NUMBER", "NUMBERS", "Obstacle", "SceneKey", "type_name_of"]
+__all__ = ["NUMBER", "NUMBERS", "Obstacle", "SceneKey", "SharpFeatures", "type_name_of"]
 
 NUMBER = (int, float)  # scene value types of a number
 NUMBERS = (list,)      # ... of a list of numbers
@@ -169,6 +169,26 @@ def _vertical_q(z: np.ndarray, top_z: float, height: float, r: float) -> tuple[n
     return z - (top_z - r), np.ones_like(z)
 
 
+@dataclass(frozen=True)
+class SharpFeatures:
+    """An obstacle's sharp features (:meth:`Obstacle.sharp_features`, :mod:`rftstatic.contact.features`).
+
+    Attributes
+    ----------
+    points : (n, 3) [m]
+    edges : (f, 2) sharp edges, into ``points``
+    corners : (c,) corners, into ``points``
+    edge_normals : (f, 3) outward unit normal of each edge (its faces' normals summed)
+    corner_normals : (c, 3) outward unit normal of each corner (angle-weighted pseudo-normal)
+    """
+
+    points: np.ndarray
+    edges: np.ndarray
+    corners: np.ndarray
+    edge_normals: np.ndarray
+    corner_normals: np.ndarray
+
+
 def type_name_of(obstacle: Obstacle) -> str:
     """The scene type name declared by the obstacle's own class (not inherited), else its class name."""
     return vars(type(obstacle)).get("type_name") or type(obstacle).__name__
@@ -221,6 +241,22 @@ class Obstacle(abc.ABC):
     @abc.abstractmethod
     def params(self) -> dict[str, Any]:
         """Defining parameters in metres, keyed as in a scene table (without ``type``)."""
+
+    psd_tangent: ClassVar[bool] = False
+    """The curvature of ``phi`` is unbounded (sharp edges and corners, a triangle surface): the penalty
+    contact projects each node's tangent block onto the positive semi-definite matrices
+    (:class:`rftstatic.contact.penalty.PenaltyContact`) instead of using ``normal_gradient`` as it is."""
+
+    def surface(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The triangles bounding the solid, ``(V (n, 3) [m], T (t, 3))``, for an independent crossing check
+        of the sheet against them; None for an analytic obstacle."""
+        return None
+
+    def sharp_features(self) -> SharpFeatures | None:
+        """Sharp edges and corners that must not cut the sheet between its nodes (:class:`SharpFeatures`);
+        None: the obstacle has none (its normal is continuous, e.g. the rounded pedestals), the node penalty
+        is all its contact needs."""
+        return None
 
     def footprint(self) -> tuple[float | None, np.ndarray]:
         """Area [m^2] and centre ``(2,)`` [m] of the support in top view (the "disc" of the drape

@@ -117,7 +117,13 @@ def _scale(key: str, value: Any, factor: float, where: str) -> Any:
     return float(scaled) if scaled.ndim == 0 else scaled
 
 
-def from_spec(spec: Mapping[str, Any], length_scale: float = 1.0) -> Obstacle:
+CONTEXT = ("scene_length", "base_dir")
+"""Keyword arguments :func:`from_spec` passes to a constructor that declares them: the scene's length unit
+[m] (a file's coordinates are in it unless said otherwise) and the directory of the scene file (a relative
+file path is taken from it)."""
+
+
+def from_spec(spec: Mapping[str, Any], length_scale: float = 1.0, base_dir=None) -> Obstacle:
     """Build an obstacle from a scene table.
 
     Parameters
@@ -131,10 +137,14 @@ def from_spec(spec: Mapping[str, Any], length_scale: float = 1.0) -> Obstacle:
         - ``square-pedestal``: ``centre`` (2 numbers, default origin), ``half_width`` or ``size``
           (number or 2 numbers), ``top`` (default 0), ``edge_radius`` (default 0), ``height``
           (default infinitely tall);
-        - ``round-pedestal``: ``centre``, ``radius``, ``top``, ``edge_radius``, ``height`` as above.
+        - ``round-pedestal``: ``centre``, ``radius``, ``top``, ``edge_radius``, ``height`` as above;
+        - ``mesh``: ``path`` of a surface file, ``units``, ``scale``, ``rotate``, ``translate``, ``side`` or
+          ``thickness`` (an open surface), ``feature_angle``
+          (:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`).
 
         Underscores in the type name are accepted for dashes (``round_pedestal``).
     length_scale : metres per scene length unit [m] (0.01 for ``cm-gf-s``); multiplies the length keys
+    base_dir : the scene file's directory (relative file paths, :data:`CONTEXT`); None: the working directory
 
     Returns
     -------
@@ -170,6 +180,9 @@ def from_spec(spec: Mapping[str, Any], length_scale: float = 1.0) -> Obstacle:
             kwargs[sk.arg] = _scale(key, spec[key], factor, where) if sk.length else spec[key]
         elif sk.default is not None:
             kwargs[sk.arg] = sk.default
+    params = inspect.signature(cls).parameters
+    context = {"scene_length": factor, "base_dir": base_dir}
+    kwargs.update({k: v for k, v in context.items() if k in params})
     try:
         return cls(**kwargs)
     except ValueError as err:

@@ -1,0 +1,395 @@
+"""A rigid obstacle given as a triangle surface file (scene type ``mesh``): a user's own object.
+
+Scene keys: ``path`` (any surface meshio reads: OBJ, STL, PLY, VTU, ...; relative to the scene file, or
+absolute), ``units`` of the file (``m``, ``cm``, ``mm``, ``in``, ``ft``; default: the scene's length unit),
+``scale`` (a factor), ``rotate`` ``[rx, ry, rz]`` [deg] (about x, then y, then z, about the file's origin),
+``translate`` ``[x, y, z]`` (scene lengths), applied in that order. The file is checked on the way in
+(:func:`rftstatic.mesh.surface.check_triangles`: degenerate or duplicate triangles, non-manifold edges,
+orientation), quads are split into triangles (said in :attr:`SurfaceObstacle.notes`), coincident nodes
+are merged.
+
+A closed surface is a solid: inside and outside come from its winding (an inward-wound file is turned
+round, said in the notes). An open one (a table top, a shell) needs either ``side = "front"`` (the solid
+lies behind the side its triangles' right-hand normals face; ``"back"`` the other way: a point whose
+closest surface point is on the open boundary is outside) or ``thickness`` (a two-sided shell: ``phi =
+r - thickness / 2``).
+
+The signed distance and its derivatives are those of :mod:`.surface_geometry`, exact for the points
+within ``band`` of the surface (the closest triangle found through a ``cKDTree`` of the triangle
+centroids, built once: every triangle whose centroid lies within ``d_v + R`` of the point, ``d_v`` the
+distance to the nearest vertex and ``R`` the largest centroid-to-corner radius). A point farther than
+``band`` from every triangle gets the lower bound ``d_c - R`` (``d_c`` the nearest centroid): 1-Lipschitz
+and never above the true distance, which is all the contact candidate lists need
+(:mod:`rftstatic.contact.candidates`); its side comes from the winding number (a closed surface, a point
+inside its bounding box), and its Hessian is 0. The Hessian is 0 inside too: inside a convex edge or corner
+the closest point is on a face (phi linear), except for a point on the surface itself, where the edge's
+``1 / r`` is round-off (a sheet node laid exactly on a box's edge); at a reflex (concave) edge the face value
+is a one-sided choice, a softer PSD tangent (the penalty's slope is negative there).
+
+Sharp features (:meth:`SurfaceObstacle.sharp_features`): the convex edges whose faces meet at more than
+``feature_angle`` (:data:`FEATURE_ANGLE`) from flat and the open boundary, and their end corners: the contact
+law keeps the sheet's edges and triangles off them (:mod:`rftstatic.contact.features`).
+"""
+
+from __future__ import annotations
+
+from itertools import chain
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+
+from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures, _as_points
+from rftstatic.contact.obstacles.registry import register
+from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, pseudo_normals,
+                                                          winding_number)
+
+__all__ = ["FILE_UNITS", "SurfaceObstacle"]
+
+FILE_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
+"""Length units a mesh file may be in [m]."""
+
+BAND = 0.25
+"""Exact-distance band, in bounding-box diagonals of the obstacle (module docstring)."""
+
+SIZE_RANGE = (1e-6, 1e4)
+"""Sizes [m] (bounding-box diagonal after scale and units) a mesh obstacle may have: a scale that makes it
+smaller or larger is a mistake (its triangles would be degenerate, or its coordinates overflow)."""
+
+NEAREST = 12
+"""Triangle centroids each point's nearest triangle is first sought among (then proven, or searched wider)."""
+
+FEATURE_ANGLE = 30.0
+"""Default angle [deg] between two faces' normals above which their common (convex) edge is a sharp feature: a
+box's or a table's edges (90 deg) are, the edges of a tessellated curved body (an icosphere of 1,280
+triangles: 7.5 deg) are not. On a curved body the sheet's flat triangles then dip into the obstacle between
+their nodes by about the chord sagitta ``h^2 / (8 R)``, as they do into an analytic sphere; ``feature_angle =
+1`` keeps every convex edge and vertex off the sheet (0 crossing pairs) at the cost measured in
+validation/mesh_obstacles.md."""
+
+
+def _rotation(angles_deg) -> np.ndarray:
+    rx, ry, rz = np.radians(np.asarray(angles_deg, float))
+    cx, sx, cy, sy, cz, sz = np.cos(rx), np.sin(rx), np.cos(ry), np.sin(ry), np.cos(rz), np.sin(rz)
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+def _merge(P, tri):
+    """Merge coincident nodes (1e-12 of the bounding-box diagonal; an STL file repeats them per facet)."""
+    diag = float(np.linalg.norm(np.ptp(P, axis=0))) or 1.0
+    key = np.round(P / (1e-12 * diag)).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    used = np.unique(inverse.ravel()[tri.ravel()])
+    remap = np.full(len(first), -1, np.int64)
+    remap[used] = np.arange(len(used))
+    return P[first[used]], remap[inverse.ravel()[tri]]
+
+
+@register
+class SurfaceObstacle(Obstacle):
+    """Rigid obstacle bounded by a triangle surface (module docstring); lengths in metres.
+
+    Parameters
+    ----------
+    path : the surface file
+    units : the file's length unit (:data:`FILE_UNITS`), or None: ``scene_length``
+    scale : factor on the file's coordinates
+    rotate : (3,) angles [deg] about x, y, z
+    translate : (3,) offset [m]
+    side : ``"front"`` or ``"back"`` for an open surface (module docstring)
+    thickness : of a two-sided open shell [m]
+    feature_angle : [deg] (:data:`FEATURE_ANGLE`)
+    scene_length : metres per scene length unit (the file's unit when ``units`` is None)
+    base_dir : directory a relative ``path`` is taken from (the scene file's)
+    """
+
+    type_name = "mesh"
+    scene_keys: ClassVar[dict[str, SceneKey]] = {
+        "path": SceneKey("path", required=True, length=False, kinds=(str,),
+                         help="surface file meshio reads (OBJ, STL, PLY, VTU, ...), relative to the scene file"),
+        "units": SceneKey("units", length=False, kinds=(str,),
+                          help="length unit of a mesh file: " + ", ".join(FILE_UNITS) + " (default: the scene's)"),
+        "scale": SceneKey("scale", length=False, help="factor on a mesh file's coordinates (default 1)"),
+        "rotate": SceneKey("rotate", length=False, kinds=NUMBERS,
+                           help="[rx, ry, rz] rotation of a mesh [deg] about x, then y, then z"),
+        "translate": SceneKey("translate", kinds=NUMBERS, help="[x, y, z] offset of a mesh, after scale and rotate"),
+        "side": SceneKey("side", length=False, kinds=(str,),
+                         help='open mesh: "front" (solid behind the side its normals face) or "back"'),
+        "thickness": SceneKey("thickness", kinds=NUMBER, help="open mesh: two-sided shell of this thickness"),
+        "feature_angle": SceneKey("feature_angle", length=False,
+                                  help=f"mesh edges bent more than this [deg] are sharp features (default {FEATURE_ANGLE:g})"),
+    }
+
+    def __init__(self, path, units=None, scale=1.0, rotate=(0.0, 0.0, 0.0), translate=(0.0, 0.0, 0.0),
+                 side=None, thickness=None, feature_angle=FEATURE_ANGLE, *, scene_length=1.0, base_dir=None):
+        from rftstatic.errors import MeshError
+        from rftstatic.mesh.surface import check_triangles, read_triangles
+
+        self.path = Path(path) if base_dir is None or Path(path).is_absolute() else Path(base_dir) / path
+        if units is not None and units not in FILE_UNITS:
+            raise ValueError(f"units {units!r} is not a length unit; use one of {list(FILE_UNITS)}")
+        self.units = units
+        self.scale = float(scale)
+        if not (np.isfinite(self.scale) and self.scale > 0):
+            raise ValueError(f"scale must be a finite number > 0, got {scale!r}")
+        self.rotate = np.asarray(rotate, float).reshape(3)
+        self.translate = np.asarray(translate, float).reshape(3)
+        self.side = side
+        self.thickness = None if thickness is None else float(thickness)
+        self.feature_angle = float(feature_angle)
+        self.scene_length = float(scene_length)
+        if side not in (None, "front", "back"):
+            raise ValueError(f'side must be "front" or "back", got {side!r}')
+        if self.thickness is not None and not (np.isfinite(self.thickness) and self.thickness > 0):
+            raise ValueError(f"thickness must be a finite number > 0, got {thickness!r}")
+        if side is not None and self.thickness is not None:
+            raise ValueError("thickness and side are exclusive: a shell of a thickness has two sides; give one")
+        if not (0.0 < self.feature_angle < 180.0):
+            raise ValueError(f"feature_angle must lie in (0, 180) deg, got {feature_angle!r}")
+        if not self.path.is_file():
+            raise MeshError(f"{self.path}: no such file; give path relative to the scene file, or absolute")
+        P, tri, notes = read_triangles(self.path, quads="triangulate")
+        P, tri = _merge(P, tri)
+        unit = FILE_UNITS[units] if units is not None else self.scene_length
+        if not (np.isfinite(self.rotate).all() and np.isfinite(self.translate).all()):
+            raise ValueError(f"rotate and translate must be finite, got {rotate!r} and {translate!r}")
+        with np.errstate(over="ignore", invalid="ignore"):
+            V = (P * (unit * self.scale)) @ _rotation(self.rotate).T + self.translate
+            size = float(np.linalg.norm(np.ptp(V, axis=0)))
+        if not (np.isfinite(V).all() and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
+            raise ValueError(f"scale = {scale!r} (file units {units or 'of the scene'}) makes the obstacle {size:.3g} m "
+                             f"across; give a scale (and units) that make it {SIZE_RANGE[0]:g} m to {SIZE_RANGE[1]:g} m")
+        info = check_triangles(V, tri, where=str(self.path), oriented=self.thickness is None)
+        self.closed = info["closed"]
+        if self.closed and (side is not None or self.thickness is not None):
+            raise MeshError(f"{self.path}: the surface is closed (a solid, inside by its winding); side and "
+                            "thickness are for open surfaces: remove them")
+        if not self.closed and side is None and self.thickness is None:
+            open_edges = int(np.sum(info["count"] == 1))
+            raise MeshError(f'{self.path}: the surface is open ({open_edges} boundary edges): say which side is solid '
+                            '(side = "front" or "back") or make it a two-sided shell (thickness = ...)')
+        if self.closed:
+            a, b, c = V[tri[:, 0]], V[tri[:, 1]], V[tri[:, 2]]
+            volume = float(np.einsum("ti,ti->", a, np.cross(b, c))) / 6.0
+            if volume < 0:
+                tri = tri[:, [0, 2, 1]]
+                notes.append("the surface was wound inward (negative volume): turned round")
+                info = check_triangles(V, tri, where=str(self.path), oriented=True)
+        elif side == "back":
+            tri = tri[:, [0, 2, 1]]
+            info = check_triangles(V, tri, where=str(self.path), oriented=True)
+        self.notes = notes
+        self.V, self.T = V, tri
+        self.edges, self.edge_of, count = info["edges"], info["edge_of"], info["count"]
+        self.nf, self.ne, self.nv = pseudo_normals(V, tri, self.edge_of, len(self.edges))
+        boundary_edge = count == 1
+        self.boundary_edge = boundary_edge
+        self.boundary_vertex = np.zeros(len(V), bool)
+        self.boundary_vertex[self.edges[boundary_edge].ravel()] = True
+        self._build_search()
+        self._features()
+
+    # --- geometry ---------------------------------------------------------------------------------
+    def _build_search(self):
+        from scipy.spatial import cKDTree
+
+        V, T = self.V, self.T
+        self.centroid = V[T].mean(axis=1)
+        self.radius = float(np.max(np.linalg.norm(V[T] - self.centroid[:, None, :], axis=2)))
+        self.lo, self.hi = V.min(axis=0), V.max(axis=0)
+        self.band = BAND * float(np.linalg.norm(self.hi - self.lo))
+        self._ctree = cKDTree(self.centroid)
+        self._vtree = cKDTree(V)
+
+    def _closest(self, x, dk, ik):
+        """Closest features of the points ``x (n, 3)``, given their ``K`` nearest triangle centroids
+        (distances ``dk (n, K)`` [m], triangles ``ik (n, K)``): ``(q (n, 3), kind (n,), gid (n,))``, ``gid`` the
+        global face, edge or vertex index. The nearest of the ``K`` triangles is the nearest of all when the
+        ``K``-th centroid is farther than its distance plus ``R`` (no other triangle can be nearer); the
+        points it is not proven for search every triangle within ``d_v + R`` (``d_v`` their nearest vertex)."""
+        n, K = ik.shape
+        q, kind, local, tri = self._nearest_of(np.repeat(x, K, axis=0), ik.ravel(), np.full(n, K))
+        r = np.linalg.norm(x - q, axis=1)
+        open_ = (dk[:, -1] - self.radius < r) & (len(self.T) > K)
+        if open_.any():
+            xo = x[open_]
+            dv, _ = self._vtree.query(xo)
+            lists = self._ctree.query_ball_point(xo, dv + self.radius * (1 + 1e-12) + 1e-300)
+            counts = np.fromiter(map(len, lists), np.int64, len(lists))
+            tris = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
+            qo, ko, lo, to = self._nearest_of(np.repeat(xo, counts, axis=0), tris, counts)
+            q[open_], kind[open_], local[open_], tri[open_] = qo, ko, lo, to
+        gid = np.where(kind == FACE, tri, np.where(kind == EDGE, self.edge_of[tri, local], self.T[tri, local]))
+        return q, kind, gid
+
+    def _nearest_of(self, xp, tri, counts):
+        """Per point, the nearest of its ``counts`` consecutive candidate pairs ``(xp (P, 3), tri (P,))``."""
+        T = self.T[tri]
+        q, kind, local = closest_on_triangles(xp, self.V[T[:, 0]], self.V[T[:, 1]], self.V[T[:, 2]])
+        d2 = np.einsum("pi,pi->p", xp - q, xp - q)
+        if np.all(counts == counts[0]):  # K each: the nearest along the rows
+            best = np.argmin(d2.reshape(len(counts), -1), axis=1) + counts[0] * np.arange(len(counts))
+        else:
+            pt = np.repeat(np.arange(len(counts)), counts)
+            best = np.lexsort((d2, pt))[np.r_[0, np.cumsum(counts)[:-1]]]  # per point, the nearest pair first
+        return q[best], kind[best], local[best], tri[best]
+
+    def _near_far(self, x):
+        """``(near (n,) bool, lower (n,) [m], dk (n, K), ik (n, K))``: the points that need the exact distance,
+        a lower bound of every point's distance and the ``K`` nearest triangle centroids."""
+        K = min(NEAREST, len(self.T))
+        dk, ik = self._ctree.query(x, k=K)
+        dk, ik = dk.reshape(len(x), K), ik.reshape(len(x), K)
+        lower = np.maximum(dk[:, 0] - self.radius, 0.0)
+        near = lower < self.band
+        if self.closed:
+            box = ~near & np.all((x >= self.lo) & (x <= self.hi), axis=1)
+            if box.any():  # a point deep inside (none in a sound run) gets its exact distance too
+                near[box] = winding_number(x[box], self.V, self.T) > 0.5
+        return near, lower, dk, ik
+
+    def _evaluate(self, x, hessian):
+        x = _as_points(x)
+        n = len(x)
+        near, lower, dk, ik = self._near_far(x)
+        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        phi = lower - half
+        away = x - self.centroid[ik[:, 0]]
+        normal = away / np.maximum(np.linalg.norm(away, axis=1, keepdims=True), 1e-300)
+        H = np.zeros((n, 3, 3)) if hessian else None
+        idx = np.flatnonzero(near)
+        if idx.size:
+            xn = x[idx]
+            q, kind, gid = self._closest(xn, dk[idx], ik[idx])
+            d = xn - q
+            r = np.linalg.norm(d, axis=1)
+            pn = np.where((kind == FACE)[:, None], self.nf[np.where(kind == FACE, gid, 0)],
+                          np.where((kind == EDGE)[:, None], self.ne[np.where(kind == EDGE, gid, 0)],
+                                   self.nv[np.where(kind == VERTEX, gid, 0)]))
+            if self.thickness is not None:
+                s = np.ones(len(idx))
+            else:
+                s = np.where(np.einsum("pi,pi->p", d, pn) < 0.0, -1.0, 1.0)
+                if not self.closed:  # closest point on the open boundary: outside
+                    on_rim = ((kind == EDGE) & self.boundary_edge[np.where(kind == EDGE, gid, 0)]) | (
+                        (kind == VERTEX) & self.boundary_vertex[np.where(kind == VERTEX, gid, 0)])
+                    s = np.where(on_rim, 1.0, s)
+            tiny = r <= 1e-12 * self.band
+            u = np.where(tiny[:, None], pn, d / np.where(tiny, 1.0, r)[:, None])
+            phi[idx] = s * r - half
+            normal[idx] = s[:, None] * u
+            if hessian:
+                P = np.eye(3) - np.einsum("pi,pj->pij", u, u)
+                e = self.edges[np.where(kind == EDGE, gid, 0)]
+                t = self.V[e[:, 1]] - self.V[e[:, 0]]
+                t /= np.linalg.norm(t, axis=1, keepdims=True)
+                P = P - (kind == EDGE)[:, None, None] * np.einsum("pi,pj->pij", t, t)
+                # inside (s < 0) the closest point is on a face except at a reflex edge or exactly on the surface
+                # (r ~ 0, where 1 / r would be round-off): 0 there (module docstring)
+                scale = np.where((kind == FACE) | tiny | (s < 0), 0.0, s / np.where(tiny, 1.0, r))
+                H[idx] = scale[:, None, None] * P
+        return phi, normal, H
+
+    # --- the Obstacle interface -------------------------------------------------------------------
+    def signed_distance(self, x):
+        phi, normal, _ = self._evaluate(x, False)
+        return phi, normal
+
+    def normal_gradient(self, x):
+        return self._evaluate(x, True)[2]
+
+    psd_tangent = True  # the distance's curvature is unbounded at sharp edges: the penalty clamps it (PSD)
+
+    def bounding_box(self):
+        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        return self.lo - half, self.hi + half
+
+    def params(self):
+        out = {"path": str(self.path), "scale": self.scale, "rotate": self.rotate.tolist(),
+               "translate": self.translate.tolist(), "feature_angle": self.feature_angle}
+        if self.units is not None:
+            out["units"] = self.units
+        if self.side is not None:
+            out["side"] = self.side
+        if self.thickness is not None:
+            out["thickness"] = self.thickness
+        return out
+
+    def as_dict(self):
+        out = super().as_dict()
+        out["units"] = "m"  # as_dict is in metres: the file's coordinates scaled to them
+        out["scale"] = self.scale * (FILE_UNITS[self.units] if self.units else self.scene_length)
+        return out
+
+    def describe(self):
+        return (f"mesh({self.path.name}: {len(self.V)} nodes, {len(self.T)} triangles, "
+                f"{'closed' if self.closed else 'open'}, box {np.round(self.lo, 6).tolist()}.."
+                f"{np.round(self.hi, 6).tolist()}) [m]")
+
+    def surface(self):
+        """The triangles ``(V (n, 3) [m], T (t, 3))`` bounding the solid."""
+        return self.V, self.T
+
+    def footprint(self):
+        """Area [m^2] and centre of the convex hull of the surface seen from above."""
+        from scipy.spatial import ConvexHull
+
+        hull = ConvexHull(self.V[:, :2])
+        xy = self.V[hull.vertices, :2]
+        x, y = xy[:, 0], xy[:, 1]
+        cross = x * np.roll(y, -1) - np.roll(x, -1) * y
+        area = 0.5 * cross.sum()
+        centre = np.array([np.sum((x + np.roll(x, -1)) * cross), np.sum((y + np.roll(y, -1)) * cross)]) / (6 * area)
+        return float(area), centre
+
+    def plan_outline(self, n: int = 128):
+        """The convex hull of the surface seen from above and the mean height of its corners [m]."""
+        from scipy.spatial import ConvexHull
+
+        hull = ConvexHull(self.V[:, :2])
+        return self.V[hull.vertices, :2].copy(), float(self.V[hull.vertices, 2].mean())
+
+    # --- sharp features ---------------------------------------------------------------------------
+    def _features(self):
+        e_tris = np.full((len(self.edges), 2), -1, np.int64)
+        flat = self.edge_of.ravel()
+        order = np.argsort(flat, kind="stable")
+        start = np.searchsorted(flat[order], np.arange(len(self.edges)))
+        e_tris[:, 0] = order[start] // 3
+        two = self.boundary_edge == False  # noqa: E712 (numpy)
+        e_tris[two, 1] = order[start[two] + 1] // 3
+        n0, n1 = self.nf[e_tris[:, 0]], self.nf[np.maximum(e_tris[:, 1], 0)]
+        bend = np.degrees(np.arccos(np.clip(np.einsum("ei,ei->e", n0, n1), -1.0, 1.0)))
+        # convex: the far corner of the second face lies behind the first face's plane
+        t1 = self.T[np.maximum(e_tris[:, 1], 0)]
+        far = self.V[t1].sum(axis=1) - self.V[self.edges].sum(axis=1)  # the corner not on the edge
+        convex = np.einsum("ei,ei->e", far - self.V[self.edges[:, 0]], n0) < 0
+        sharp = (two & convex & (bend > self.feature_angle)) | self.boundary_edge
+        # an open rim's outward direction: in the plane of its face, away from it (and along the face's normal
+        # for a one-sided surface)
+        rim = self.boundary_edge
+        e0, e1 = self.V[self.edges[rim, 0]], self.V[self.edges[rim, 1]]
+        nf = self.nf[e_tris[rim, 0]]
+        out = np.cross(nf, e1 - e0)
+        third = self.V[self.T[e_tris[rim, 0]]].sum(axis=1) - e0 - e1
+        out *= np.where(np.einsum("ei,ei->e", out, 0.5 * (e0 + e1) - third) < 0, -1.0, 1.0)[:, None]
+        out /= np.linalg.norm(out, axis=1, keepdims=True)
+        if self.thickness is None:
+            out = out + nf
+            out /= np.linalg.norm(out, axis=1, keepdims=True)
+        normals = self.ne.copy()
+        normals[rim] = out
+        self.feature_edges = self.edges[sharp]
+        self.feature_normals = normals[sharp]
+        deg = np.bincount(self.feature_edges.ravel(), minlength=len(self.V))
+        self.feature_corners = np.flatnonzero((deg > 0) & (deg != 2))
+
+    def sharp_features(self):
+        """The sharp edges and their end or junction corners, with their pseudo-normals."""
+        if not len(self.feature_edges):
+            return None
+        return SharpFeatures(self.V, self.feature_edges, self.feature_corners, self.feature_normals,
+                             self.nv[self.feature_corners])

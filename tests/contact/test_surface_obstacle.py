@@ -1,0 +1,237 @@
+"""Triangle-surface obstacles (scene type ``mesh``): exact signed distance, derivatives, the PSD penalty and
+sharp-feature pairs checked by finite differences, and the bad-input messages."""
+
+import meshio
+import numpy as np
+import pytest
+
+from rftstatic.contact.obstacles import Sphere, SurfaceObstacle, from_spec
+from rftstatic.contact.obstacles.surface_geometry import closest_on_triangles, winding_number
+from rftstatic.contact.penalty import PenaltyContact
+from rftstatic.errors import MeshError
+from rftstatic.mesh.trimesh import rectangle
+from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
+
+# a box [-1, 1]^2 x [-2, 0] (file units) as 12 outward triangles
+BOX_V = np.array([[x, y, z] for z in (-2, 0) for y in (-1, 1) for x in (-1, 1)], float)
+BOX_F = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4], [2, 6, 3], [3, 6, 7],
+                  [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+
+
+def _icosphere(level):
+    t = (1.0 + 5.0 ** 0.5) / 2.0
+    V = [np.array(v, float) / np.linalg.norm(v) for v in
+         [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
+          (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]]
+    F = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+         (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
+         (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(level):
+        mid = {}
+
+        def middle(a, b):
+            if (min(a, b), max(a, b)) not in mid:
+                m = V[a] + V[b]
+                V.append(m / np.linalg.norm(m))
+                mid[min(a, b), max(a, b)] = len(V) - 1
+            return mid[min(a, b), max(a, b)]
+
+        F = [f for a, b, c in F for f in ((a, middle(a, b), middle(c, a)), (b, middle(b, c), middle(a, b)),
+                                          (c, middle(c, a), middle(b, c)), (middle(a, b), middle(b, c), middle(c, a)))]
+    return np.array(V), np.array(F)
+
+
+def _write(path, V, F, kind="triangle"):
+    meshio.write(path, meshio.Mesh(V, [(kind, np.asarray(F))]))
+    return path
+
+
+@pytest.fixture
+def ico(tmp_path):
+    return SurfaceObstacle(_write(tmp_path / "ico.obj", *_icosphere(2)), scale=5.0, translate=[0, 0, -0.05],
+                           scene_length=0.01)
+
+
+def _brute(x, ob):
+    V, T = ob.V, ob.T
+    pt, tt = np.repeat(np.arange(len(x)), len(T)), np.tile(np.arange(len(T)), len(x))
+    q, _, _ = closest_on_triangles(x[pt], V[T[tt, 0]], V[T[tt, 1]], V[T[tt, 2]])
+    d = np.linalg.norm(x[pt] - q, axis=1).reshape(len(x), -1).min(axis=1)
+    return np.where(winding_number(x, V, T) > 0.5, -d, d)
+
+
+def test_signed_distance_is_exact_near_and_a_lower_bound_far(ico):
+    x = np.random.default_rng(1).uniform(-0.12, 0.12, (400, 3)) - [0, 0, 0.05]
+    phi, _ = ico.signed_distance(x)
+    true = _brute(x, ico)
+    near = ico._near_far(x)[0]
+    assert near.sum() > 50 and (~near).sum() > 50
+    assert np.abs(phi - true)[near].max() <= 1e-15
+    assert np.all(phi[~near] <= true[~near]) and np.all(phi[~near] > ico.band - 1e-15)
+    # the facets lie inside the sphere through the vertices, within the sagitta (1 - cos(half the edge angle)) R
+    sph = Sphere([0, 0, -0.05], 0.05)
+    assert np.all(phi[near] >= sph.signed_distance(x[near])[0] - 1e-15)
+    assert np.abs(phi - sph.signed_distance(x)[0])[near].max() < 0.05 * 0.02
+
+
+def test_gradient_and_hessian_match_finite_differences(ico):
+    rng = np.random.default_rng(2)
+    d = rng.normal(size=(60, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    x = np.array([0, 0, -0.05]) + d * (0.05 + rng.uniform(-2e-3, 4e-3, (60, 1)))
+    phi, n = ico.signed_distance(x)
+    H = ico.normal_gradient(x)
+    h = 1e-7
+    for i in range(3):
+        e = np.zeros(3)
+        e[i] = h
+        (pp, np_), (pm, nm) = ico.signed_distance(x + e), ico.signed_distance(x - e)
+        assert np.abs((pp - pm) / (2 * h) - n[:, i]).max() < 1e-7
+        assert np.abs((np_ - nm) / (2 * h) - H[:, :, i]).max() < 1e-5 * max(1.0, np.abs(H).max())
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0)
+
+
+def _bent_sheet():
+    """A 9 x 9 sheet laid over the box's top edge x = 1 cm, bent down beyond it, 0.3 um above the top."""
+    m = rectangle(0.04, 0.04, 9, 9, origin=(-0.02, -0.02))
+    x = m.X3.copy()
+    x[:, 0] += 0.003
+    over = x[:, 0] > 0.01
+    x[over, 2] -= (x[over, 0] - 0.01) * 0.8
+    x[:, 2] += 3e-7
+    return m, x + np.random.default_rng(0).normal(scale=2e-5, size=x.shape)
+
+
+def test_penalty_and_feature_pairs_force_is_the_energy_gradient_and_tangent_psd(tmp_path):
+    box = SurfaceObstacle(_write(tmp_path / "box.obj", BOX_V, BOX_F), scene_length=0.01)
+    assert box.closed and len(box.feature_edges) == 12 and len(box.feature_corners) == 8
+    f = box.sharp_features()
+    mid = f.points[f.edges].mean(axis=1) - f.points.mean(axis=0)  # from the box's centre
+    assert np.allclose(np.linalg.norm(f.edge_normals, axis=1), 1.0) and np.all(np.einsum("ei,ei->e", mid, f.edge_normals) > 0)
+    m, x = _bent_sheet()
+    pc = PenaltyContact([box], m.node_area, 1e7, smoothing=1e-4, sheet=m)
+    cs = pc.evaluate(x)
+    assert cs.pair_blocks is not None and cs.energy > 0
+    h = 1e-8
+    nodes = np.argsort(-np.linalg.norm(cs.force, axis=1))[:8]
+    for n in nodes:
+        for i in range(3):
+            e = np.zeros_like(x)
+            e[n, i] = h
+            fd = (pc.evaluate(x + e, tangent=False).energy - pc.evaluate(x - e, tangent=False).energy) / (2 * h)
+            assert fd == pytest.approx(cs.force[n, i], rel=1e-5, abs=1e-9 * np.abs(cs.force).max())
+    rows, cols, blocks = cs.pair_blocks
+    assert np.linalg.eigvalsh(0.5 * (cs.tangent_blocks + cs.tangent_blocks.transpose(0, 2, 1))).min() >= -1e-9
+    # assembled feature tangent of the sheet's dofs: symmetric PSD
+    N = m.n_nodes
+    K = np.zeros((3 * N, 3 * N))
+    for a in range(3):
+        for b in range(3):
+            np.add.at(K, (3 * rows + a, 3 * cols + b), blocks[:, a, b])
+    assert np.abs(K - K.T).max() <= 1e-9 * np.abs(K).max()
+    assert np.linalg.eigvalsh(K).min() >= -1e-8 * np.abs(K).max()
+
+
+def test_tangent_is_the_force_gradient_on_faces(ico):
+    # points pressed 0.2 mm into the middle of the icosphere's upper faces, or 0.05 mm above them (within the
+    # onset): face regions, where the PSD tangent is the exact one
+    up = np.flatnonzero(ico.nf[:, 2] > 0.5)[:12]
+    depth = np.where(np.arange(len(up)) % 2, -2e-4, 5e-5)
+    x = ico.centroid[up] + depth[:, None] * ico.nf[up]
+    pc = PenaltyContact([ico], np.full(len(x), 1e-4), 1e7, smoothing=1e-4)
+    cs = pc.evaluate(x)
+    assert np.all(cs.energy > 0) and np.abs(cs.tangent_blocks).max() > 0
+    h = 1e-9
+    for n in range(len(x)):
+        for i in range(3):
+            e = np.zeros_like(x)
+            e[n, i] = h
+            fd = (pc.evaluate(x + e).force[n] - pc.evaluate(x - e).force[n]) / (2 * h)
+            assert np.allclose(fd, cs.tangent_blocks[n, :, i], rtol=1e-5, atol=1e-6 * np.abs(cs.tangent_blocks).max())
+
+
+def test_independent_crossing_check(tmp_path):
+    box = SurfaceObstacle(_write(tmp_path / "box.obj", BOX_V, BOX_F), scene_length=0.01)
+    m = rectangle(0.04, 0.04, 9, 9, origin=(-0.02, -0.02))
+    V, T = box.surface()
+    assert obstacle_crossings(m.X3, m.tri, V, T)["pairs"] == 0  # touching the top is not crossing
+    r = obstacle_crossings(m.X3 + [0.0013, 0.0007, -0.001], m.tri, V, T)  # off the side planes
+    assert r["pairs"] > 0 and r["smallest_distance"] == 0.0
+    r = obstacle_crossings(m.X3 + [0, 0, 0.001], m.tri, V, T)
+    assert r["pairs"] == 0 and r["smallest_distance"] == pytest.approx(0.001)
+
+
+def test_scene_keys_transform_units_and_relative_path(tmp_path):
+    _write(tmp_path / "box.stl", BOX_V, BOX_F)
+    ob = from_spec({"type": "mesh", "path": "box.stl", "units": "mm", "scale": 2.0, "rotate": [0, 0, 90],
+                    "translate": [1.0, 0.0, 0.0]}, 0.01, base_dir=tmp_path)
+    lo, hi = ob.bounding_box()
+    assert np.allclose(lo, [0.01 - 0.002, -0.002, -0.004]) and np.allclose(hi, [0.01 + 0.002, 0.002, 0.0])
+    again = from_spec(ob.as_dict(), 1.0)
+    assert np.allclose(again.V, ob.V)
+
+
+def _refused(tmp_path, name, V, cells, fragment, **keys):
+    path = tmp_path / name
+    if cells is not None:
+        meshio.write(path, meshio.Mesh(np.asarray(V, float), cells))
+    with pytest.raises(MeshError, match=fragment):
+        SurfaceObstacle(path, **keys)
+
+
+def test_bad_mesh_files_are_refused_with_the_file_and_the_problem(tmp_path):
+    (tmp_path / "empty.obj").write_text("")
+    with pytest.raises(MeshError, match="empty.obj"):
+        SurfaceObstacle(tmp_path / "empty.obj")
+    (tmp_path / "junk.stl").write_text("not a mesh")
+    with pytest.raises(MeshError, match="junk.stl: meshio could not read it"):
+        SurfaceObstacle(tmp_path / "junk.stl")
+    with pytest.raises(MeshError, match="no such file"):
+        SurfaceObstacle(tmp_path / "missing.obj")
+    P = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1]]
+    _refused(tmp_path, "lines.vtu", P, [("line", np.array([[0, 1]]))], "no triangle cells")
+    _refused(tmp_path, "degenerate.vtu", P + [[2, 0, 0]], [("triangle", np.array([[0, 1, 2], [0, 1, 5]]))],
+             "degenerate", side="front")
+    _refused(tmp_path, "dup.vtu", P, [("triangle", np.array([[0, 1, 2], [2, 1, 0]]))], "duplicate", thickness=0.1)
+    _refused(tmp_path, "fan.vtu", P + [[0, -1, 0]], [("triangle", np.array([[0, 1, 2], [0, 1, 4], [1, 0, 5]]))],
+             "shared by 3 triangles", thickness=0.1)
+    _refused(tmp_path, "flip.vtu", P, [("triangle", np.array([[0, 1, 2], [0, 2, 3], [0, 1, 4]]))],
+             "inconsistent orientation", side="front")
+    _refused(tmp_path, "open.vtu", P, [("triangle", np.array([[0, 1, 2], [0, 2, 3]]))], "open")
+    # quads are split (and said), not refused
+    ob = SurfaceObstacle(_write(tmp_path / "quad.vtu", P[:4], [[0, 1, 2, 3]], "quad"), side="front")
+    assert len(ob.T) == 2 and "quad" in ob.notes[0]
+
+
+def test_a_sheet_edge_pushed_under_a_rim_is_pushed_back_out(tmp_path):
+    """A sheet edge bent 45 deg over the box's top rim x = 1 cm, its ends on either side: 0.1 d outside the rim,
+    the feature pair pushes it outward; moved 0.2 d through the rim it is pushed outward again, harder (the signed
+    distance: an unsigned one would push it on through)."""
+    from rftstatic.contact.features import FeatureContact
+
+    box = SurfaceObstacle(_write(tmp_path / "box.obj", BOX_V, BOX_F), scene_length=0.01)
+    X = np.array([[0.009, 0.0, 0.001], [0.011, 0.0, -0.001], [0.009, 0.001, 0.001]])  # through the rim
+    tri, edges = np.array([[0, 1, 2]]), np.array([[0, 1], [1, 2], [0, 2]])
+    fc = FeatureContact([box], tri, edges, X, gap=1e-4, stiffness=10.0, margin=1e-3)
+    pushes = []
+    out = np.array([1.0, 0.0, 1.0]) / np.sqrt(2.0)  # the rim's outward normal
+    for shift in (1e-5, -2e-5):
+        fs = fc.evaluate(X + shift * out)
+        pushes.append(-fs.force[:2].sum(axis=0) @ out)  # what the pair does to the edge's two nodes, outward
+    assert 0 < pushes[0] < pushes[1]
+
+
+def test_open_surfaces_with_a_side_or_a_thickness(tmp_path):
+    """A 2 x 2 cm plate (two counter-clockwise triangles, normals +z) at z = 0: two-sided with a thickness, or
+    solid behind its front (the side its normals face) or its back; beyond the rim every point is outside."""
+    path = _write(tmp_path / "plate.obj", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], [[0, 1, 2], [0, 2, 3]])
+    x = np.array([[0.0, 0.0, 0.001], [0.0, 0.0, -0.001], [0.02, 0.0, -0.005]])
+    beside = np.hypot(0.01, 0.005)
+    shell = SurfaceObstacle(path, thickness=0.0004, scene_length=0.01)
+    assert np.allclose(shell.signed_distance(x)[0], [0.0008, 0.0008, beside - 0.0002])
+    front = SurfaceObstacle(path, side="front", scene_length=0.01)
+    phi, n = front.signed_distance(x)
+    assert np.allclose(phi, [0.001, -0.001, beside]) and np.allclose(n[:2], [[0, 0, 1], [0, 0, 1]])
+    back = SurfaceObstacle(path, side="back", scene_length=0.01)
+    assert np.allclose(back.signed_distance(x)[0], [-0.001, 0.001, beside])
+    assert len(shell.feature_edges) == 4 and len(front.feature_edges) == 4  # the rim is a sharp feature
