@@ -127,13 +127,17 @@ class PhaseClock:
 
     ``seconds[phase]``: time with ``phase`` innermost; ``calls[phase]``: entries into ``phase`` from another
     phase (a nested call of the same phase is not counted again); ``events[name]``: calls of the targets
-    that count one (numeric factorisations, back-substitutions, ...), inside opaque phases too.
+    that count one (numeric factorisations, back-substitutions, ...), inside opaque phases too;
+    ``imports[package]``: wall time of importing the package's modules, each without the modules it imports
+    (what the two import phases are made of; ``rftstatic`` by subpackage).
     """
 
     def __init__(self):
         self.seconds = defaultdict(float)
         self.calls = Counter()
         self.events = Counter()
+        self.imports = defaultdict(float)  # package -> seconds importing its modules (their own code)
+        self._nested_imports = []
         self.running = False
         self.entries = 0  # phase entries (wrapped calls that took the clock), for the cost estimate
         self._stack = []
@@ -148,6 +152,7 @@ class PhaseClock:
         self.seconds.clear()
         self.calls.clear()
         self.events.clear()
+        self.imports.clear()
         self._stack = [OTHER]
         self.entries = 0
         self._opaque = 0
@@ -268,11 +273,18 @@ class PhaseClock:
             phase = NUMBA if name.split(".")[0] in NUMBA_MODULES or name.endswith("._kernels_numba") else IMPORTS
             if not clock._claims(phase):
                 return original(name, import_)
+            nested = clock._nested_imports
+            nested.append(0.0)
+            t0 = time.perf_counter()
             clock.enter(phase)
             try:
                 module = original(name, import_)
             finally:
                 clock.leave()
+                spent = time.perf_counter() - t0
+                clock.imports[_package(name)] += spent - nested.pop()
+                if nested:
+                    nested[-1] += spent
             if clock._pending:
                 clock._install_loaded()
             return module
@@ -336,6 +348,12 @@ class PhaseClock:
         names = list(PHASES) + [p for p in self.seconds if p not in PHASES]
         return [{"phase": p, "seconds": float(self.seconds.get(p, 0.0)), "calls": int(self.calls.get(p, 0))}
                 for p in names]
+
+
+def _package(name: str) -> str:
+    """The package an import is counted under: the top-level one, ``rftstatic``'s by subpackage."""
+    parts = name.split(".")
+    return ".".join(parts[:2]) if parts[0] == "rftstatic" and len(parts) > 1 else parts[0]
 
 
 def _loaded(module) -> bool:

@@ -27,6 +27,7 @@ import tempfile
 import time
 
 TIMEOUT_S = 3600.0
+IMPORTS_SHOWN = 8  # the packages slowest to import, listed under the table
 
 
 def _maxrss_mb() -> float:
@@ -71,6 +72,7 @@ def run_scene(name: str, overrides: list, figures: bool = False, profiled: bool 
     if profiled:
         out["phases"] = clock.table()
         out["events"] = dict(clock.events)
+        out["imports"] = dict(sorted(clock.imports.items(), key=lambda kv: -kv[1])[:IMPORTS_SHOWN])
         out["timer_entries"] = clock.entries
         out["timer_cost_s"] = clock.entries * clock.entry_cost()
     return out
@@ -129,9 +131,16 @@ def _heading(r: dict) -> str:
     sets = "".join(f" --set {o}" for o in r["overrides"])
     state = "converged" if r.get("converged") else f"NOT converged ({r.get('error') or r.get('message')})"
     load = " / ".join(" ".join(f"{x:.2f}" for x in la) for la in r["load"])
+    route = f", route {r['route']}" if r.get("route") else ""
     return (f"profile of `{r['scene']}{sets}`{' with figures' if r['figures'] else ' --no-figures'}: "
-            f"{r.get('nodes')} nodes, {r.get('analysis')} analysis, route {r.get('route')}, {state}; {r['date']}, "
+            f"{r.get('nodes')} nodes, {r.get('analysis')} analysis{route}, {state}; {r['date']}, "
             f"{os.cpu_count()} cores, load average before / after {load}")
+
+
+def _imports(r: dict) -> str:
+    top = r.get("imports") or {}
+    return "import time by package (each module without what it imports): " + (", ".join(f"{m} {t:.2f} s" for m, t in top.items())
+                                                            or "none")
 
 
 def _overhead(r: dict) -> str:
@@ -161,13 +170,13 @@ def format_record(r: dict, fmt: str = "text") -> str:
                   f"| interpreter start-up (outside the total) | {startup:.3f} | | |", "",
                   "| count | value |", "|---|---:|"]
         lines += [f"| {k} | {v} |" for k, v in _count_lines(r)]
-        lines += ["", memory + "; " + _overhead(r)]
+        lines += ["", memory + "; " + _imports(r) + "; " + _overhead(r)]
         return "\n".join(lines)
     lines = [_heading(r).replace("`", ""), f"{'phase':48s} {'wall [s]':>9s} {'share':>7s} {'entries':>8s}"]
     lines += [f"{p:48s} {s:9.3f} {f:6.1f}% {c:8d}" for p, s, f, c in rows]
     lines += [f"{'total (the run in the child)':48s} {total:9.3f} {100.0:6.1f}%",
               f"{'interpreter start-up (outside the total)':48s} {startup:9.3f}",
-              "counts: " + ", ".join(f"{k} {v}" for k, v in _count_lines(r)), memory, _overhead(r)]
+              "counts: " + ", ".join(f"{k} {v}" for k, v in _count_lines(r)), memory, _imports(r), _overhead(r)]
     return "\n".join(lines)
 
 
