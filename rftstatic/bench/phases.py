@@ -53,6 +53,7 @@ BOUND = "self-contact: step bound"
 PAIR_FORCES = "self-contact: pair forces"
 STABILITY = "stability check"
 BUILD = "scene, mesh and model build"
+REMESH = "remeshing (size field, mesher, transfer)"
 POST = "summary measures"
 OUTPUT = "output writing"
 CHECKPOINT = "checkpoint writes"
@@ -61,7 +62,7 @@ IMPORTS = "imports (other modules)"
 OTHER = "other"
 
 PHASES = (FORCE, STEP, ESTIMATE, TANGENT, RESIDUAL, FACTOR, ANALYSIS, BACKSUB, BROAD, OBSTACLE, PAIRS, BOUND,
-          PAIR_FORCES, STABILITY, BUILD, POST, OUTPUT, CHECKPOINT, NUMBA, IMPORTS, OTHER)
+          PAIR_FORCES, STABILITY, BUILD, REMESH, POST, OUTPUT, CHECKPOINT, NUMBA, IMPORTS, OTHER)
 """Every phase, in the order of the tables."""
 
 OPAQUE = frozenset({STABILITY, POST, OUTPUT, CHECKPOINT})
@@ -73,6 +74,7 @@ TARGETS = (
     ("rftstatic.solvers.explicit", "explicit_steps", STEP, None),
     ("rftstatic.solvers.explicit", "_Loop.begin", STEP, None),
     ("rftstatic.solvers.explicit", "_Loop.advance", STEP, None),
+    ("rftstatic.solvers.relaxation", "relax_steps", STEP, None),  # its rest test between steps
     ("rftstatic.solvers.step_plan", "plan_steps", ESTIMATE, None),
     ("rftstatic.solvers.timestep", "stable_time_step", ESTIMATE, None),
     ("rftstatic.model.model", "Model.tangent", TANGENT, "tangent assemblies"),
@@ -110,6 +112,8 @@ TARGETS = (
     ("rftstatic.scenes.schema", "load_scene", BUILD, None),
     ("rftstatic.scenes.build", "build_model", BUILD, None),
     ("rftstatic.model.model", "Model.__init__", BUILD, "models built"),
+    ("rftstatic.remesh.adapt", "adapt_mesh", REMESH, "remeshes"),
+    ("rftstatic.remesh.adapt", "transfer_state", REMESH, None),
     ("rftstatic.app.static", "static_summary", POST, None),
     ("rftstatic.app.dynamic", "_summary", POST, None),
     ("rftstatic.io.results", "write_outputs", OUTPUT, None),

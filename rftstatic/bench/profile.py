@@ -25,8 +25,11 @@ import resource
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 TIMEOUT_S = 3600.0
+INPUT_ERRORS = ("SceneError", "ParameterError", "MeshError", "MeshingError", "PatchError")
+"""Exceptions of the child that are the scene's fault (found only when it is built): exit status 2."""
 IMPORTS_SHOWN = 8  # the packages slowest to import, listed under the table
 
 
@@ -61,7 +64,7 @@ def run_scene(name: str, overrides: list, figures: bool = False, profiled: bool 
             except (ConvergenceError, InstabilityError) as exc:  # the run ended short of its goal: still profiled
                 error = f"{type(exc).__name__}: {exc}"
                 path = f"{tmp}/out/summary.json"
-                summary = json.load(open(path)) if os.path.exists(path) else {}
+                summary = json.loads(Path(path).read_text()) if os.path.exists(path) else {}
     finally:
         total = time.perf_counter() - t0
         if profiled:
@@ -211,7 +214,7 @@ def main(argv=None) -> int:
         record = profile(args.scene, args.set, figures=args.figures, compare=not args.no_compare, timeout=args.timeout)
     except ChildError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 1
+        return 2 if exc.exception in INPUT_ERRORS else 1
     print(format_record(record, args.format), flush=True)
     return 0 if record.get("error") is None else 3
 
