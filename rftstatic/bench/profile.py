@@ -115,10 +115,14 @@ def profile(name: str, overrides=(), *, figures: bool = False, compare: bool = T
     record.update(process_s=run.wall_s, cpu_s=run.cpu_s, peak_rss_mb=run.peak_rss_mb,
                   load=[list(load0), list(os.getloadavg())], date=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()))
     if plain is not None:
+        same = all(plain.result.get(k) == record.get(k) for k in SAME)
         record["unprofiled"] = {"total_s": plain.result["total_s"], "process_s": plain.wall_s,
-                                "peak_rss_mb": plain.peak_rss_mb}
+                                "peak_rss_mb": plain.peak_rss_mb, "same_counts": same}
     return record
 
+
+SAME = ("converged", "newton_iterations", "factorisations", "load_steps", "explicit_steps")
+"""Counts the unprofiled run must repeat: the timers change no result."""
 
 COUNTS = (("Newton iterations", "newton_iterations"), ("factorisations (the solver's count)", "factorisations"),
           ("load steps", "load_steps"), ("explicit steps", "explicit_steps"))
@@ -155,7 +159,8 @@ def _overhead(r: dict) -> str:
         return cost + "; no unprofiled run (--no-compare)"
     return (f"{cost}; run {p['total_s']:.2f} s without the timers, {r['total_s']:.2f} s with them "
             f"({100 * (r['total_s'] / p['total_s'] - 1):+.1f} %); whole process {p['process_s']:.2f} s / "
-            f"{r['process_s']:.2f} s (two fresh interpreters one after the other, the unprofiled first)")
+            f"{r['process_s']:.2f} s (two fresh interpreters one after the other, the unprofiled first); same "
+            f"iterations, factorisations and steps: {'yes' if p.get('same_counts') else 'NO'}")
 
 
 def format_record(r: dict, fmt: str = "text") -> str:

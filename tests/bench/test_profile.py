@@ -127,6 +127,7 @@ def test_bench_profile_of_a_tiny_scene_in_a_fresh_process_prints_every_phase(cap
         assert f"| {phase} |" in out
     assert "| **total** (the run in the child) |" in out and "| Newton iterations | 32 |" in out
     assert "without the timers" in out and "peak memory" in out
+    assert "same iterations, factorisations and steps: yes" in out  # the timers change no result
 
 
 def test_the_record_adds_up_and_formats(capsys):
