@@ -124,6 +124,8 @@ def profile(name: str, overrides=(), *, figures: bool = False, compare: bool = T
 SAME = ("converged", "newton_iterations", "factorisations", "load_steps", "explicit_steps")
 """Counts the unprofiled run must repeat: the timers change no result."""
 
+SAME_WORDS = {True: "yes", False: "NO", None: "not compared"}
+
 COUNTS = (("Newton iterations", "newton_iterations"), ("factorisations (the solver's count)", "factorisations"),
           ("load steps", "load_steps"), ("explicit steps", "explicit_steps"))
 
@@ -160,7 +162,7 @@ def _overhead(r: dict) -> str:
     return (f"{cost}; run {p['total_s']:.2f} s without the timers, {r['total_s']:.2f} s with them "
             f"({100 * (r['total_s'] / p['total_s'] - 1):+.1f} %); whole process {p['process_s']:.2f} s / "
             f"{r['process_s']:.2f} s (two fresh interpreters one after the other, the unprofiled first); same "
-            f"iterations, factorisations and steps: {'yes' if p.get('same_counts') else 'NO'}")
+            f"iterations, factorisations and steps: {SAME_WORDS[p.get('same_counts')]}")
 
 
 def format_record(r: dict, fmt: str = "text") -> str:
