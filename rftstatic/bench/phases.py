@@ -386,7 +386,12 @@ class _TimedFactor:
             clock.leave()
 
     def cholesky_inplace(self, *args, **kwargs):
-        return self._timed(FACTOR, "numeric factorisations", self._factor.cholesky_inplace, *args, **kwargs)
+        try:
+            return self._timed(FACTOR, "numeric factorisations", self._factor.cholesky_inplace, *args, **kwargs)
+        except Exception as exc:
+            if "NotPositiveDefinite" in type(exc).__name__ and self._clock.running:
+                self._clock.events["numeric factorisations: not positive definite"] += 1
+            raise
 
     def __call__(self, *args, **kwargs):
         return self._timed(BACKSUB, "back-substitutions", self._factor, *args, **kwargs)

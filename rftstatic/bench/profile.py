@@ -83,13 +83,15 @@ def run_scene(name: str, overrides: list, figures: bool = False, profiled: bool 
 
 def summary_counts(summary: dict) -> dict:
     """The counts of a run's summary: nodes, analysis, route, converged, message, newton_iterations,
-    factorisations, load_steps, explicit_steps (a dynamic run's steps, or the relaxation route's)."""
+    factorisations, load_steps, explicit_steps (a dynamic run's steps, or the relaxation route's), tangent_modes
+    (Newton steps by the tangent that gave them: exact, modified, psd, shift)."""
     relax = summary.get("relax") if isinstance(summary.get("relax"), dict) else {}
     steps = summary.get("steps") if summary.get("analysis") in ("dynamic", "relax") else relax.get("steps")
     return {"nodes": summary.get("nodes"), "analysis": summary.get("analysis"), "route": summary.get("route"),
             "converged": summary.get("converged"), "message": summary.get("message"),
             "newton_iterations": summary.get("newton_iterations"), "factorisations": summary.get("factorisations"),
-            "load_steps": summary.get("load_steps"), "explicit_steps": steps}
+            "load_steps": summary.get("load_steps"), "explicit_steps": steps,
+            "tangent_modes": summary.get("tangent_modes")}
 
 
 def profile(name: str, overrides=(), *, figures: bool = False, compare: bool = True,
@@ -127,11 +129,15 @@ SAME = ("converged", "newton_iterations", "factorisations", "load_steps", "expli
 SAME_WORDS = {True: "yes", False: "NO", None: "not compared"}
 
 COUNTS = (("Newton iterations", "newton_iterations"), ("factorisations (the solver's count)", "factorisations"),
-          ("load steps", "load_steps"), ("explicit steps", "explicit_steps"))
+          ("load steps", "load_steps"), ("explicit steps", "explicit_steps"),
+          ("Newton steps by tangent mode", "tangent_modes"))
 
 
 def _count_lines(r: dict) -> list[tuple[str, object]]:
-    rows = [(label, r.get(key)) for label, key in COUNTS if r.get(key) is not None]
+    def shown(v):
+        return ", ".join(f"{k} {n}" for k, n in v.items() if n) if isinstance(v, dict) else v
+
+    rows = [(label, shown(r.get(key))) for label, key in COUNTS if r.get(key) is not None]
     rows += sorted(r.get("events", {}).items())
     return rows
 
