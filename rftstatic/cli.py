@@ -67,7 +67,8 @@ def main(argv=None) -> int:
     _study_parsers(sub, common)
 
     b = sub.add_parser("bench", parents=[common], help="print wall time and peak memory of the benchmarks")
-    b.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
+    b.add_argument("names", nargs=argparse.REMAINDER, help="benchmarks to run (default: all); or profile SCENE "
+                   "[--set KEY=VALUE ...] [--format markdown], or scenes [--quick] (each with its own --help)")
 
     v = sub.add_parser("validate", parents=[common], help="regenerate the validation reports in validation/")
     v.add_argument("names", nargs="*")

@@ -9,6 +9,8 @@ Benchmarks (each a function of its size, so tests can run them tiny):
 - ``iteration``: one Newton iteration on an 81 x 81-node 20 x 20 cm wool sheet under its weight,
   pinned at two corners, from a small random out-of-plane state: tangent assembly, CHOLMOD (or
   scipy) factorisation and solve, timed separately (target < 0.5 s);
+- ``profile SCENE [--set ...]``: :mod:`rftstatic.bench.profile` (wall time by phase of one scene's run);
+- ``scenes [--quick]``: :mod:`rftstatic.bench.paper_scenes` (every paper scene, each in a fresh process);
 - ``construction``: patches with image nodes and the constant bending stiffness of a 708 x 708-node
   rectangle, ~1.0e6 triangles (target < 30 s).
 
@@ -173,9 +175,27 @@ BENCHES = {
 }
 
 
+COMMANDS = {
+    "profile": "bench.profile",  # profile SCENE [--set KEY=VALUE ...]: wall time by phase of one scene's run
+    "scenes": "bench.paper_scenes",  # the paper scenes' wall time, iterations, factorisations, steps, memory
+}
+"""Benchmarks with arguments of their own: ``bench NAME ARGS...`` calls the module's ``main(ARGS)``."""
+
+
 def main(names=None) -> int:
-    """Run the named benchmarks (all when empty) and print their figures."""
-    names = list(names or []) or list(BENCHES)
+    """Run the named benchmarks (all when empty) and print their figures; ``profile ...`` and ``scenes ...``
+    take their own arguments (:data:`COMMANDS`)."""
+    names = list(names or [])
+    if names and names[0] in COMMANDS:
+        import importlib
+
+        return importlib.import_module(f"rftstatic.{COMMANDS[names[0]]}").main(names[1:])
+    options = [n for n in names if n.startswith("-")]
+    if options:
+        print(f'error: bench {" ".join(options)}: options belong to a command ({", ".join(COMMANDS)}), '
+              f"e.g. bench profile SCENE --set KEY=VALUE")
+        return 2
+    names = names or list(BENCHES)
     unknown = [n for n in names if n not in BENCHES]
     if unknown:
         print(f'error: unknown bench {", ".join(unknown)}; use {", ".join(BENCHES)}')

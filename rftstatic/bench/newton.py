@@ -5,7 +5,9 @@ Prints, for each problem, the Newton iterations, load increments, factorisations
 strips also a second, warm solve in the same process with the compiled kernels, as a study's later
 runs) and the whole process (interpreter start, imports, build, solve, outputs without figures), every run
 in a fresh interpreter (:func:`rftstatic.bench.harness.run_child`) one after the other, so that the
-figures of one table come from one run on one machine state:
+figures of one table come from one run on one machine state, every child on one thread (:data:`ONE_THREAD`:
+``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS``, ``MKL_NUM_THREADS``, ``NUMBA_NUM_THREADS`` = 1; Kratos also
+``ParallelUtilities.SetNumThreads(1)``), so that the ratio to the peer is stable on a shared machine:
 
 - the §4.1 wool strip (5 x 1 cm, RFT6) at 51 x 11 and 101 x 21 nodes, and at 101 x 5 nodes, the
   mesh whose tip-drop error (0.015 %) equals Kratos's on 51 x 11 (the error depends on the nodes
@@ -80,12 +82,17 @@ def case_process(name: str, overrides: list[str]) -> dict:
             "build_s": summary.get("build_time_s"), "route": summary.get("route")}
 
 
+ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
+"""Environment of every child of this bench, rftstatic's and Kratos's alike: one thread each (OpenMP, BLAS,
+numba), so that the ratio of the two does not depend on what else the machine is running."""
+
+
 def _child(target: str, kwargs: dict, name: str):
     from rftstatic.bench.harness import ChildError, run_child
 
     try:
         return run_child(f"rftstatic.bench.newton:{target}" if ":" not in target else target, kwargs, name=name,
-                         timeout=TIMEOUT_S)
+                         timeout=TIMEOUT_S, env=ONE_THREAD)
     except ChildError as exc:
         print(f"{name:34s} FAILED: {exc}", flush=True)
         return None
