@@ -52,6 +52,11 @@ TOOL_REPORTS = {
     "fabric_rules": "a fabric from KES-F B, W, T alone: the fill rules, the Cusick DC's sensitivity to each, the "
                     "Cusick mesh (pattern, rings, sectors, element) and RFT6 locking numbers (tools/"
                     "fabric_rule_sensitivity.py, tools/cusick_mesh_study.py)",
+    "mesh_obstacles": "obstacles from triangle-mesh files: sphere-30 on icospheres against the analytic sphere "
+                      "(convergence with the facet size, wall time), the crossing check, the box under the sheet, "
+                      "ipctk against the project's distance kernels (tools/icosphere.py, tools/ipctk_compare.py)",
+    "bench_profile": "where the paper scenes' time goes: bench profile by phase and the bench scenes table, the "
+                     "three biggest cost centres (python -m rftstatic bench profile / bench scenes)",
 }
 """Hand-made reports in ``validation/`` that the index lists below its table."""
 
