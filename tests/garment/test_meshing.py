@@ -1,0 +1,112 @@
+"""Panel meshing: seam node counts match, sewn nodes meet when the seams are closed, quality, placement."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rftstatic.garment import PatternError, check_placement, mesh_pattern, place, read_pattern
+from rftstatic.garment.meshing import edge_segments
+
+PATTERNS = Path(__file__).resolve().parents[2] / "cases" / "patterns"
+H = 0.03
+
+
+@pytest.fixture(scope="module")
+def a_line():
+    return mesh_pattern(read_pattern(PATTERNS / "skirt-a-line.toml"), H)
+
+
+@pytest.fixture(scope="module")
+def circle():
+    return mesh_pattern(read_pattern(PATTERNS / "skirt-circle.json"), H)
+
+
+def _closed(pmesh):
+    """Synthetic closing placement: both panels at the pattern's rotations, translated to one plane."""
+    t = np.array([p.translation for p in pmesh.pattern.panels])
+    t[:, 2] = 0.0
+    return place(pmesh, translations=t)
+
+
+@pytest.mark.parametrize("which", ["a_line", "circle"])
+def test_seam_nodes_pair_and_meet_when_closed(which, request):
+    pm = request.getfixturevalue(which)
+    counts = edge_segments(pm.pattern, H)
+    x = _closed(pm)
+    for seam, pairs in zip(pm.pattern.seams, pm.seam_pairs):
+        n = counts[seam.a_panel, seam.a_edge]
+        assert n == counts[seam.b_panel, seam.b_edge]
+        assert pairs.shape == (n + 1, 2)
+        assert len(np.unique(pairs)) == 2 * (n + 1)                # one to one, two distinct sides
+        np.testing.assert_allclose(x[pairs[:, 0]], x[pairs[:, 1]], rtol=0, atol=1e-12)
+        # at the pattern's own placement the sides are apart, by the panels' z offset
+        start = place(pm)
+        gap = np.linalg.norm(start[pairs[:, 0]] - start[pairs[:, 1]], axis=1)
+        dz = abs(np.diff([p.translation[2] for p in pm.pattern.panels])[0])
+        np.testing.assert_allclose(gap, dz, rtol=1e-12)
+
+
+@pytest.mark.parametrize("which", ["a_line", "circle"])
+def test_mesh_quality_and_area(which, request):
+    pm = request.getfixturevalue(which)
+    for panel, mesh, q, nodes in zip(pm.pattern.panels, pm.meshes, pm.quality, pm.edge_nodes):
+        assert q.min_angle > 28.0 and q.mean_min_angle > 50.0
+        assert 0.5 * H < mesh.element_size.mean() < 1.2 * H
+        # the outline's edge nodes lie on their edges, in order, and are the mesh's boundary
+        for k, idx in enumerate(nodes):
+            np.testing.assert_allclose(mesh.X[idx], panel.edge_points(k, len(idx) - 1), atol=1e-15)
+        outline = np.concatenate([e[:-1] for e in nodes])
+        assert set(outline) == set(mesh.boundary_nodes.tolist())
+        # area: the mesh is the outline's inscribed polygon (chords of the arcs), area within 1 %
+        poly = mesh.X[outline]
+        area = 0.5 * abs(np.dot(poly[:, 0], np.roll(poly[:, 1], -1)) - np.dot(np.roll(poly[:, 0], -1), poly[:, 1]))
+        assert mesh.area.sum() == pytest.approx(area, rel=1e-12)
+
+
+def test_circle_skirt_area():
+    pm = mesh_pattern(read_pattern(PATTERNS / "skirt-circle.json"), 0.02)
+    exact = 0.5 * np.pi * (0.6114 ** 2 - 0.1114 ** 2)              # half annulus [m²]
+    for mesh in pm.meshes:
+        assert mesh.area.sum() == pytest.approx(exact, rel=2e-3)   # chords of h = 2 cm on r = 11 cm
+
+
+def test_combined_mesh(a_line):
+    mesh, panel_of_node, panel_of_element, warp, pairs = a_line.combined()
+    assert mesh.n_nodes == a_line.n_nodes == sum(m.n_nodes for m in a_line.meshes)
+    assert np.bincount(panel_of_element).tolist() == [m.n_elements for m in a_line.meshes]
+    assert np.bincount(panel_of_node).tolist() == [m.n_nodes for m in a_line.meshes]
+    np.testing.assert_allclose(warp, np.pi / 2)                   # grain = 90 deg in the skirt's file
+    np.testing.assert_array_equal(pairs, np.concatenate(a_line.seam_pairs))
+    np.testing.assert_allclose(mesh.area.sum(), sum(m.area.sum() for m in a_line.meshes), rtol=1e-12)
+    # the panels laid side by side do not overlap in the flat combined mesh
+    xmax = [mesh.X[panel_of_node == p, 0].max() for p in range(2)]
+    xmin = [mesh.X[panel_of_node == p, 0].min() for p in range(2)]
+    assert xmax[0] < xmin[1]
+
+
+def test_placement_checks(a_line):
+    check_placement(a_line)                                         # the file's placement: apart
+    with pytest.raises(PatternError, match=r"skirt-a-line.toml: panels 'front' and 'back' lie in one plane"):
+        check_placement(a_line, _closed(a_line))
+    # back turned to cross the front (shifted up 1.3 cm: the two meshes are the same, so a symmetric
+    # crossing would meet node on node and edge on edge, which the crossing test counts as touching)
+    x = place(a_line, translations=[[0, 0.4, 0.15], [0.05, 0.413, 0.2]], rotations=[[0, 0, 0], [0, 70, 0]])
+    with pytest.raises(PatternError, match=r"panels 'front' and 'back' intersect in their placement"):
+        check_placement(a_line, x)
+    # touching along a seam line is allowed: the back, in the front's plane, turned about z so that its
+    # edge 3 lies on the front's edge 1 (the side seam sewn flat, the panels side by side)
+    gamma = 2 * np.degrees(np.arctan2(0.12, 0.60))
+    c, s = np.cos(np.radians(gamma)), np.sin(np.radians(gamma))
+    t = np.array([0.3, 0.0]) - np.array([[c, -s], [s, c]]) @ [-0.3, 0.0]
+    x = place(a_line, translations=[[0, 0, 0], [*t, 0]], rotations=[[0, 0, 0], [0, 0, gamma]])
+    pairs = a_line.seam_pairs[0]
+    np.testing.assert_allclose(x[pairs[:, 0]], x[pairs[:, 1]], atol=1e-12)
+    check_placement(a_line, x)
+
+
+def test_bad_element_size(a_line):
+    with pytest.raises(PatternError, match="element size h = 0.5 m"):
+        mesh_pattern(a_line.pattern, 0.5)
+    with pytest.raises(PatternError, match="element size h = -1"):
+        mesh_pattern(a_line.pattern, -1)
