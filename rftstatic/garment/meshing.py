@@ -37,6 +37,7 @@ __all__ = ["PatternMesh", "mesh_pattern", "edge_segments", "place", "check_place
 _TURN_PER_SEGMENT = math.radians(15.0)
 _LAYOUT_GAP = 0.1       # gap between panels laid side by side in the combined flat mesh, in panel sizes
 _PLANE_TOL = 1e-6       # coplanarity, relative to the panels' size
+_GRID_CELLS_MIN, _GRID_CELLS_MAX = 200, 1000    # size-field grid: cells across a panel, at least / at most
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,11 +124,19 @@ def _mesh_panel(panel, counts, h, where):
     ccw = np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0
     bedges = np.column_stack([idx, np.roll(idx, -1)] if ccw else [np.roll(idx, -1), idx])
     lo, hi = bpoints.min(axis=0), bpoints.max(axis=0)
-    size = BackgroundGrid.uniform(h, np.r_[lo - h, hi + h])
+    seg = np.hypot(*(np.roll(bpoints, -1, axis=0) - bpoints).T)
+    local = np.minimum(seg, np.roll(seg, 1))       # the shorter boundary segment at each boundary node
+    extent = float((hi - lo).max()) + 2 * h
+    spacing = min(max(float(local.min()), extent / _GRID_CELLS_MAX), extent / _GRID_CELLS_MIN)
+    size = BackgroundGrid.from_samples(bpoints, np.minimum(local, h), np.r_[lo - h, hi + h], h_upper=h,
+                                       spacing=spacing)
     try:
         points, tri = advance_front(bpoints, bedges.astype(np.int64), size)
     except MeshingError as err:
-        raise PatternError(f"{where}: the mesher failed ({err}); try a smaller element size h") from None
+        lengths = [panel.edge_length(k) for k in range(len(panel.edges))]
+        k = int(np.argmin(lengths))
+        raise PatternError(f"{where}: the mesher failed ({err}); its shortest edge, edge {k}, is {lengths[k]:.3g} m "
+                           f"long against h = {h:g} m: try a smaller h, or merge that edge into a neighbour") from None
     movable = np.ones(len(points), bool)
     movable[:b] = False
     improve(points, tri, movable)
