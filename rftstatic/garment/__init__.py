@@ -19,9 +19,9 @@ Issue 37, item 1 (pattern input). What is supported now:
 Not yet: the body, sewing forces, seam merging, draping (issue 37, items 2-6).
 """
 
-from rftstatic.garment.meshing import PatternMesh, check_placement, mesh_pattern, place
+from rftstatic.garment.meshing import CombinedMesh, PatternMesh, check_placement, mesh_pattern, place
 from rftstatic.garment.pattern import Edge, Panel, Pattern, PatternError, Seam
 from rftstatic.garment.readers import read_garmentcode, read_pattern, read_toml
 
-__all__ = ["Edge", "Panel", "Pattern", "PatternError", "Seam", "PatternMesh", "mesh_pattern", "place",
+__all__ = ["Edge", "Panel", "Pattern", "PatternError", "Seam", "PatternMesh", "CombinedMesh", "mesh_pattern", "place",
            "check_placement", "read_pattern", "read_garmentcode", "read_toml"]

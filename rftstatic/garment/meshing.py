@@ -32,7 +32,7 @@ from rftstatic.garment.curves import points_in_polygon, segments_cross
 from rftstatic.garment.pattern import PatternError, rotation_matrix
 from rftstatic.mesh.trimesh import TriMesh
 
-__all__ = ["PatternMesh", "mesh_pattern", "edge_segments", "place", "check_placement"]
+__all__ = ["PatternMesh", "CombinedMesh", "mesh_pattern", "edge_segments", "place", "check_placement"]
 
 _TURN_PER_SEGMENT = math.radians(15.0)
 _LAYOUT_GAP = 0.1       # gap between panels laid side by side in the combined flat mesh, in panel sizes
@@ -69,17 +69,7 @@ class PatternMesh:
         return int(self.offsets[-1])
 
     def combined(self):
-        """One flat mesh of all panels, for the sewing and draping steps.
-
-        Returns
-        -------
-        mesh : :class:`TriMesh` of all panels, laid side by side along x (each shifted so they do not
-            overlap; the reference geometry of each element is its panel's), global node ids
-        panel_of_node : (N,) int panel index of each node
-        panel_of_element : (E,) int panel index of each element
-        warp_angle : (E,) grain line of each element's panel from the mesh's x axis [rad]
-        seam_pairs : (S, 2) global node ids of all seams' pairs, stacked in seam order
-        """
+        """One flat mesh of all panels, for the sewing and draping steps: :class:`CombinedMesh`."""
         shift, xs, tris = 0.0, [], []
         for p, m in enumerate(self.meshes):
             lo, hi = m.X.min(axis=0), m.X.max(axis=0)
@@ -88,10 +78,36 @@ class PatternMesh:
             tris.append(m.tri + self.offsets[p])
         n_el = [len(m.tri) for m in self.meshes]
         grain = np.radians([pn.grain for pn in self.pattern.panels])
-        mesh = TriMesh(X=np.concatenate(xs), tri=np.concatenate(tris), name="garment")
         pairs = np.concatenate(self.seam_pairs) if self.seam_pairs else np.zeros((0, 2), np.int64)
-        return (mesh, np.repeat(np.arange(len(self.meshes)), np.diff(self.offsets)),
-                np.repeat(np.arange(len(self.meshes)), n_el), np.repeat(grain, n_el), pairs)
+        return CombinedMesh(
+            mesh=TriMesh(X=np.concatenate(xs), tri=np.concatenate(tris), name="garment"),
+            panel_of_node=np.repeat(np.arange(len(self.meshes)), np.diff(self.offsets)),
+            panel_of_element=np.repeat(np.arange(len(self.meshes)), n_el),
+            warp_angle=np.repeat(grain, n_el), seam_pairs=pairs,
+            seam_of_pair=np.repeat(np.arange(len(self.seam_pairs)), [len(q) for q in self.seam_pairs]))
+
+
+@dataclass(frozen=True, eq=False)
+class CombinedMesh:
+    """All panels in one flat mesh (global node ids, as :meth:`PatternMesh.combined` gives it).
+
+    Attributes
+    ----------
+    mesh : :class:`TriMesh` of all panels laid side by side along x (each shifted so they do not
+        overlap; each element keeps its panel's flat reference geometry) [m]
+    panel_of_node : (N,) int panel index of each node
+    panel_of_element : (E,) int panel index of each element
+    warp_angle : (E,) grain line of each element's panel from the mesh's x axis [rad]
+    seam_pairs : (S, 2) int global node ids of all seams' pairs, seam after seam
+    seam_of_pair : (S,) int the seam of each pair (index into ``pattern.seams``)
+    """
+
+    mesh: TriMesh
+    panel_of_node: np.ndarray
+    panel_of_element: np.ndarray
+    warp_angle: np.ndarray
+    seam_pairs: np.ndarray
+    seam_of_pair: np.ndarray
 
 
 def edge_segments(pattern, h):

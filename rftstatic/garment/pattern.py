@@ -18,7 +18,9 @@ A panel not placed (overlapping another at the start) needs the meshes:
 Placement (GarmentCode's convention, that of its simulator ``pygarment.meshgen``): a panel point
 (x, y) is at R (x, y, 0) + t in space, t the translation [m] and R = Rz(gamma) Ry(beta) Rx(alpha)
 for ``rotation = (alpha, beta, gamma)`` [deg] (Maya's "xyz" order: about x first, then y, then z,
-fixed axes).
+fixed axes). GarmentCode's pattern writer (``Panel.assembly``) stores scipy's intrinsic "XYZ" angles
+(R = Rx Ry Rz); the two agree when at most one angle is nonzero, as in GarmentCode's sample patterns,
+and differ otherwise: such a file places its panels as GarmentCode's simulator does.
 """
 
 from __future__ import annotations

@@ -72,16 +72,21 @@ def test_circle_skirt_area():
 
 
 def test_combined_mesh(a_line):
-    mesh, panel_of_node, panel_of_element, warp, pairs = a_line.combined()
+    c = a_line.combined()
+    mesh = c.mesh
     assert mesh.n_nodes == a_line.n_nodes == sum(m.n_nodes for m in a_line.meshes)
-    assert np.bincount(panel_of_element).tolist() == [m.n_elements for m in a_line.meshes]
-    assert np.bincount(panel_of_node).tolist() == [m.n_nodes for m in a_line.meshes]
-    np.testing.assert_allclose(warp, np.pi / 2)                   # grain = 90 deg in the skirt's file
-    np.testing.assert_array_equal(pairs, np.concatenate(a_line.seam_pairs))
+    assert np.bincount(c.panel_of_element).tolist() == [m.n_elements for m in a_line.meshes]
+    assert np.bincount(c.panel_of_node).tolist() == [m.n_nodes for m in a_line.meshes]
+    np.testing.assert_allclose(c.warp_angle, np.pi / 2)           # grain = 90 deg in the skirt's file
+    np.testing.assert_array_equal(c.seam_pairs, np.concatenate(a_line.seam_pairs))
+    assert np.bincount(c.seam_of_pair).tolist() == [len(q) for q in a_line.seam_pairs]
     np.testing.assert_allclose(mesh.area.sum(), sum(m.area.sum() for m in a_line.meshes), rtol=1e-12)
-    # the panels laid side by side do not overlap in the flat combined mesh
-    xmax = [mesh.X[panel_of_node == p, 0].max() for p in range(2)]
-    xmin = [mesh.X[panel_of_node == p, 0].min() for p in range(2)]
+    # each panel keeps its flat geometry (shifted), and the panels laid side by side do not overlap
+    for p, m in enumerate(a_line.meshes):
+        shifted = mesh.X[c.panel_of_node == p] - m.X
+        np.testing.assert_allclose(shifted - shifted[0], 0, atol=1e-15)
+    xmax = [mesh.X[c.panel_of_node == p, 0].max() for p in range(2)]
+    xmin = [mesh.X[c.panel_of_node == p, 0].min() for p in range(2)]
     assert xmax[0] < xmin[1]
 
 
