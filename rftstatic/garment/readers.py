@@ -104,6 +104,21 @@ def _number(value, where, key):
     return out
 
 
+def _vector(value, where, key):
+    """A placement 3-vector (translation, rotation) read as floats."""
+    out = _number(value, where, key)
+    if out.shape != (3,):
+        raise PatternError(f"{where}: {key} = {value!r}; give three numbers [x, y, z]")
+    return out
+
+
+def _grain(spec, where):
+    grain = spec.get("grain", GRAIN_DEFAULT)
+    if isinstance(grain, bool) or not isinstance(grain, (int, float)):
+        raise PatternError(f"{where}: grain = {grain!r}; give the warp direction's angle from the panel's x axis [deg]")
+    return float(grain)
+
+
 def parse_garmentcode(data, *, source="<json>"):
     """GarmentCode specification ``data`` (the parsed JSON) -> :class:`Pattern` [SI]."""
     if not isinstance(data, dict) or not isinstance(data.get("pattern"), dict) \
@@ -134,11 +149,12 @@ def _gc_panel(name, spec, scale, where):
     if v.ndim != 2 or v.shape[1] != 2:
         raise PatternError(f"{where}: vertices must be a list of [x, y] pairs, got shape {v.shape}")
     v = v * scale
+    if not isinstance(spec["edges"], list):
+        raise PatternError(f"{where}: edges must be a list of {{\"endpoints\": [i, j]}} tables")
     edges = [_gc_edge(e, v, scale, f"{where}, edge {k}") for k, e in enumerate(spec["edges"])]
-    return Panel(name=name, vertices=v, edges=edges,
-                 grain=float(spec.get("grain", GRAIN_DEFAULT)),
-                 translation=_number(spec.get("translation", [0, 0, 0]), where, "translation").reshape(-1) * scale,
-                 rotation=_number(spec.get("rotation", [0, 0, 0]), where, "rotation").reshape(-1))
+    return Panel(name=name, vertices=v, edges=edges, grain=_grain(spec, where),
+                 translation=_vector(spec.get("translation", [0, 0, 0]), where, "translation") * scale,
+                 rotation=_vector(spec.get("rotation", [0, 0, 0]), where, "rotation"))
 
 
 def _gc_edge(spec, v, scale, where):
@@ -197,6 +213,8 @@ def read_toml(path):
 
 
 def _unknown(table, known, where):
+    if not isinstance(table, dict):
+        raise PatternError(f"{where}: expected a table with keys {', '.join(sorted(known))}, got {table!r}")
     extra = sorted(set(table) - known)
     if extra:
         raise PatternError(f"{where}: unknown key {extra[0]!r}; known keys: {', '.join(sorted(known))}")
@@ -215,6 +233,8 @@ def parse_toml(data, *, source="<toml>"):
 
 
 def _toml_panel(spec, k, scale, source):
+    if not isinstance(spec, dict):
+        raise PatternError(f"{source}: panels[{k}] = {spec!r}; each panel is a [[panels]] table")
     name = spec.get("name")
     where = f"{source}: panel {name!r}" if name else f"{source}: panels[{k}]"
     if not isinstance(name, str) or not name or ":" in name:
@@ -241,9 +261,9 @@ def _toml_panel(spec, k, scale, source):
             raise PatternError(f"{where}, edge {j}: arc radius = {radius!r}; give a positive length in {source}'s units")
         edges[j] = Edge(j, (j + 1) % n, "arc", radius=float(radius) * scale, large=bool(arc.get("large", False)),
                         right=side == "right")
-    return Panel(name=name, vertices=v, edges=edges, grain=float(spec.get("grain", GRAIN_DEFAULT)),
-                 translation=_number(spec.get("translate", [0, 0, 0]), where, "translate").reshape(-1) * scale,
-                 rotation=_number(spec.get("rotate", [0, 0, 0]), where, "rotate").reshape(-1))
+    return Panel(name=name, vertices=v, edges=edges, grain=_grain(spec, where),
+                 translation=_vector(spec.get("translate", [0, 0, 0]), where, "translate") * scale,
+                 rotation=_vector(spec.get("rotate", [0, 0, 0]), where, "rotate"))
 
 
 def _toml_seam(spec, where):

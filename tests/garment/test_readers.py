@@ -129,3 +129,13 @@ def test_toml_unknown_key_and_bad_seam_reference(tmp_path):
         read_pattern(tmp_path / "p.dxf")
     with pytest.raises(PatternError, match="no such pattern file"):
         read_pattern(tmp_path / "missing.toml")
+
+
+@pytest.mark.parametrize("key, value, match", [("translate", [0, 1], "translate = \\[0, 1\\]; give three numbers"),
+                                               ("rotate", "x", "rotate = 'x' is not numeric"),
+                                               ("grain", "warp", "grain = 'warp'"),
+                                               ("arcs", [5], "expected a table")])
+def test_toml_bad_values_are_named(key, value, match):
+    data = {"units": "cm", "panels": [{"name": "a", "vertices": [[0, 0], [1, 0], [1, 1]], key: value}]}
+    with pytest.raises(PatternError, match="p.toml: panel 'a'.*" + match):
+        parse_toml(data, source="p.toml")
