@@ -52,7 +52,8 @@ class PatternMesh:
     edge_nodes : per panel, per edge, the node indices (n_k + 1,) of the panel's mesh along the edge,
         start to end
     offsets : (P + 1,) first global node id of each panel (panel p owns ``offsets[p]:offsets[p+1]``)
-    seam_pairs : per seam, (n + 1, 2) global node ids, side A then side B
+    seam_pairs : per seam, (n + 1, 2) global node ids, side A then side B (the tip of a dart, where a
+        seam's two edges meet, pairs with itself)
     quality : per panel the mesher's :class:`~rftstatic.mesh.mesher.MeshQuality`
     """
 

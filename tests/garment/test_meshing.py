@@ -115,3 +115,22 @@ def test_bad_element_size(a_line):
         mesh_pattern(a_line.pattern, 0.5)
     with pytest.raises(PatternError, match="element size h = -1"):
         mesh_pattern(a_line.pattern, -1)
+
+
+def test_dart_in_one_panel():
+    """A dart: two edges of one panel sewn to each other; the tip node pairs with itself and the two
+    sides mirror each other about the dart's axis x = 20 cm."""
+    from rftstatic.garment.readers import parse_toml
+
+    pattern = parse_toml({"units": "cm",
+                          "panels": [{"name": "skirt",
+                                      "vertices": [[0, 0], [40, 0], [40, 50], [24, 50], [20, 35], [16, 50], [0, 50]]}],
+                          "seams": [{"a": "skirt:3", "b": "skirt:4"}]})
+    pm = mesh_pattern(pattern, 0.02)
+    pairs = pm.seam_pairs[0]
+    assert pairs[-1, 0] == pairs[-1, 1]                       # the tip
+    assert len(np.unique(pairs)) == 2 * len(pairs) - 1
+    x = pm.meshes[0].X
+    np.testing.assert_allclose(x[pairs[:, 0], 0] - 0.2, 0.2 - x[pairs[:, 1], 0], atol=1e-15)
+    np.testing.assert_allclose(x[pairs[:, 0], 1], x[pairs[:, 1], 1], atol=1e-15)
+    assert pm.quality[0].min_angle > 28.0
