@@ -60,7 +60,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rftstatic.garment.pattern import GRAIN_DEFAULT, Edge, Panel, Pattern, PatternError, Seam
+from rftstatic.garment.pattern import GRAIN_DEFAULT, SEAM_LENGTH_TOLERANCE, Edge, Panel, Pattern, PatternError, Seam
 
 __all__ = ["LENGTH_UNITS", "read_pattern", "read_garmentcode", "parse_garmentcode", "read_toml", "parse_toml"]
 
@@ -70,14 +70,18 @@ LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 _UNITS_IN_METER_DEFAULT = 100.0     # GarmentCode's default (cm)
 
 
-def read_pattern(path):
-    """Read a ``.json`` (GarmentCode) or ``.toml`` pattern file into a checked :class:`Pattern` [SI]."""
+def read_pattern(path, *, seam_tolerance=SEAM_LENGTH_TOLERANCE):
+    """Read a ``.json`` (GarmentCode) or ``.toml`` pattern file into a checked :class:`Pattern` [SI].
+
+    ``seam_tolerance``: largest relative length difference of a seam's edges [-]
+    (:class:`~rftstatic.garment.pattern.Pattern`).
+    """
     path = Path(path)
     readers = {".json": read_garmentcode, ".toml": read_toml}
     if path.suffix.lower() not in readers:
         raise PatternError(f"{path}: unknown pattern format {path.suffix!r}; give a .json (GarmentCode) "
                            "or a .toml pattern file")
-    return readers[path.suffix.lower()](path)
+    return readers[path.suffix.lower()](path, seam_tolerance=seam_tolerance)
 
 
 def _load(path, loader, what):
@@ -91,9 +95,9 @@ def _load(path, loader, what):
 
 
 # ------------------------------------------------------------------------------------- GarmentCode
-def read_garmentcode(path):
+def read_garmentcode(path, *, seam_tolerance=SEAM_LENGTH_TOLERANCE):
     """Read a GarmentCode JSON specification (module docstring) into a :class:`Pattern` [SI]."""
-    return parse_garmentcode(_load(path, json.load, "JSON"), source=str(path))
+    return parse_garmentcode(_load(path, json.load, "JSON"), source=str(path), seam_tolerance=seam_tolerance)
 
 
 def _number(value, where, key):
@@ -119,7 +123,7 @@ def _grain(spec, where):
     return float(grain)
 
 
-def parse_garmentcode(data, *, source="<json>"):
+def parse_garmentcode(data, *, source="<json>", seam_tolerance=SEAM_LENGTH_TOLERANCE):
     """GarmentCode specification ``data`` (the parsed JSON) -> :class:`Pattern` [SI]."""
     if not isinstance(data, dict) or not isinstance(data.get("pattern"), dict) \
             or not isinstance(data["pattern"].get("panels"), dict):
@@ -139,7 +143,7 @@ def parse_garmentcode(data, *, source="<json>"):
               for name, spec in data["pattern"]["panels"].items()]
     seams = [_gc_stitch(s, k, f"{source}: stitch {k}") for k, s in enumerate(data["pattern"].get("stitches", []))]
     units = {1.0: "m", 100.0: "cm", 1000.0: "mm"}.get(float(uim), f"1/{uim:g} m")
-    return Pattern(panels=panels, seams=seams, units=units, source=source)
+    return Pattern(panels=panels, seams=seams, units=units, source=source, seam_tolerance=seam_tolerance)
 
 
 def _gc_panel(name, spec, scale, where):
@@ -207,9 +211,9 @@ _ARC = {"edge", "radius", "side", "large"}
 _SEAM = {"a", "b", "orientation", "kind"}
 
 
-def read_toml(path):
+def read_toml(path, *, seam_tolerance=SEAM_LENGTH_TOLERANCE):
     """Read a TOML pattern (module docstring) into a :class:`Pattern` [SI]."""
-    return parse_toml(_load(path, tomllib.load, "TOML"), source=str(path))
+    return parse_toml(_load(path, tomllib.load, "TOML"), source=str(path), seam_tolerance=seam_tolerance)
 
 
 def _unknown(table, known, where):
@@ -220,7 +224,7 @@ def _unknown(table, known, where):
         raise PatternError(f"{where}: unknown key {extra[0]!r}; known keys: {', '.join(sorted(known))}")
 
 
-def parse_toml(data, *, source="<toml>"):
+def parse_toml(data, *, source="<toml>", seam_tolerance=SEAM_LENGTH_TOLERANCE):
     """A parsed TOML pattern ``data`` -> :class:`Pattern` [SI]."""
     _unknown(data, _TOP, source)
     units = data.get("units")
@@ -229,7 +233,7 @@ def parse_toml(data, *, source="<toml>"):
     scale = LENGTH_UNITS[units]
     panels = [_toml_panel(p, k, scale, source) for k, p in enumerate(data.get("panels", []))]
     seams = [_toml_seam(s, f"{source}: seams[{k}]") for k, s in enumerate(data.get("seams", []))]
-    return Pattern(panels=panels, seams=seams, units=units, source=source)
+    return Pattern(panels=panels, seams=seams, units=units, source=source, seam_tolerance=seam_tolerance)
 
 
 def _toml_panel(spec, k, scale, source):

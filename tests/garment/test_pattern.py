@@ -72,6 +72,10 @@ def test_seam_length_tolerance():
     bad["panels"][1]["vertices"][2][1] = bad["panels"][1]["vertices"][3][1] = 9.0
     _raises(bad, "seam 0 (front:1 -- back:3)", "panel 'front' edge 1 is 0.1 m", "panel 'back' edge 3 0.09 m",
             "differ by 10.0 % > 5 %")
+    gathered = parse_toml(bad, seam_tolerance=0.15)              # a gathered seam, stated
+    assert gathered.seam_tolerance == 0.15
+    with pytest.raises(PatternError, match="seam_tolerance = 1.5"):
+        parse_toml(bad, seam_tolerance=1.5)
 
 
 def test_missing_panel_or_edge():
