@@ -6,9 +6,13 @@ n = max(round(L / h), ceil(turning / 15 deg), 1), so a curved edge keeps at leas
 segments thus has n + 1 nodes on each side, equally spaced along each edge (the lengths may differ
 by the ease, up to 5 %), and node k of side A pairs with node k of side B (``aligned``) or node
 n - k (``reversed``). These boundary nodes go to the advancing-front mesher
-(:func:`rftstatic.mesh.mesher.front.advance_front` with a uniform size field h) unchanged: the
-mesher fills the outline and its smoothing (:func:`rftstatic.mesh.mesher.improve.improve`) never
-moves a boundary node.
+(:func:`rftstatic.mesh.mesher.front.advance_front`) unchanged: the mesher fills the outline and its
+smoothing (:func:`rftstatic.mesh.mesher.improve.improve`) never moves a boundary node. The size
+field is h inside and, near the boundary, the shorter boundary segment at each node, graded
+(:meth:`rftstatic.mesh.mesher.BackgroundGrid.from_samples`), so that a short edge beside long ones
+(a notch, a waistband step) gets small triangles around it rather than slivers. An edge far below h
+next to a corner can still stop the front (GarmentCode's jumpsuit: a 0.9 mm edge at h = 15 mm);
+the error names the panel's shortest edge.
 
 Grain. Each panel's mesh stays in panel coordinates; its grain angle [deg] is kept with it, and
 :meth:`PatternMesh.combined` gives every element's warp angle [rad] from the combined mesh's x axis,
