@@ -2,15 +2,15 @@
 
 Issue 37, item 1 (pattern input). What is supported now:
 
-- the pattern model (:mod:`.pattern`): panels with outlines of straight edges, circular arcs and
-  quadratic/cubic Bézier curves (:mod:`.curves`), a grain line (warp direction) and a placement
+- the pattern model (:mod:`.pattern`): panels with outlines (and holes) of straight edges, circular
+  arcs and quadratic/cubic Bézier curves (:mod:`.curves`), a grain line (warp direction) and a placement
   (translation, Euler rotation); seams joining two panel edges (``sew``, ``fold``, ``open``;
   ``reversed`` or ``aligned``); SI inside, checked on construction (zero-length edges,
   self-intersecting outlines, missing panels or edges, an edge in two seams, seam edges differing
   by more than 5 % in length), each error a :class:`~.pattern.PatternError` naming file, panel and edge;
 - readers (:mod:`.readers`): GarmentCode's JSON specification (circle arcs and relative quadratic
   and cubic Bézier curvature, ``units_in_meter``, ``right_wrong`` stitches) and a small TOML form
-  (polygons with arcs, grain, placement, ``panel:edge`` seams, ``units`` m/cm/mm);
+  (polygons with arcs and holes, grain, placement, ``panel:edge`` seams, ``units`` m/cm/mm);
 - meshing (:mod:`.meshing`): each panel by the advancing-front mesher with the same number of nodes
   along both sides of every seam (uniform by arc length), node pairs per seam, one combined mesh
   with panel ids and per-element grain angles, the panels placed in space, and the check that no

@@ -139,9 +139,13 @@ def segments_cross(p1, p2, q1, q2, *, tol=0.0):
     return hit
 
 
-def points_in_polygon(p, v):
-    """(M,) bool: points p (M, 2) inside the closed polygon v (K, 2) (even-odd rule) [m]."""
-    a, b = v[None], np.roll(v, -1, axis=0)[None]
+def points_in_polygon(p, v, w=None):
+    """(M,) bool: points p (M, 2) inside the closed polygon v (K, 2) (even-odd rule) [m].
+
+    ``w`` (K, 2): the other end of each side (default: the next vertex), so that several loops (an
+    outline and its holes) count together.
+    """
+    a, b = v[None], (np.roll(v, -1, axis=0) if w is None else w)[None]
     y = p[:, None, 1]
     cond = (a[..., 1] > y) != (b[..., 1] > y)
     with np.errstate(divide="ignore", invalid="ignore"):

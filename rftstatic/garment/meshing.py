@@ -134,19 +134,28 @@ def _mesh_panel(panel, counts, h, where):
     from rftstatic.mesh.mesher.quality import measure_quality
     from rftstatic.mesh.mesher.sizefield import BackgroundGrid
 
-    pts, starts = [], []
-    for k in range(len(panel.edges)):
-        starts.append(sum(len(q) for q in pts))
-        pts.append(panel.edge_points(k, counts[panel.name, k])[:-1])
-    bpoints = np.concatenate(pts)
-    b = len(bpoints)
-    idx = np.arange(b)
-    x, y = bpoints.T
-    ccw = np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0
-    bedges = np.column_stack([idx, np.roll(idx, -1)] if ccw else [np.roll(idx, -1), idx])
+    pts, bedges, edge_nodes = [], [], []
+    b = 0
+    for j, loop in enumerate(panel.loop_edges()):
+        first = b
+        for k in loop:
+            n = counts[panel.name, k]
+            pts.append(panel.edge_points(k, n)[:-1])
+            edge_nodes.append(b + np.arange(n + 1))
+            b += n
+        idx = np.arange(first, b)
+        edge_nodes[-1][-1] = first                              # the loop closes
+        x, y = np.concatenate(pts)[first:].T
+        ccw = np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0
+        keep = ccw == (j == 0)                                  # domain on the left: outline CCW, holes CW
+        bedges.append(np.column_stack([idx, np.roll(idx, -1)] if keep else [np.roll(idx, -1), idx]))
+    bpoints, bedges = np.concatenate(pts), np.concatenate(bedges)
     lo, hi = bpoints.min(axis=0), bpoints.max(axis=0)
-    seg = np.hypot(*(np.roll(bpoints, -1, axis=0) - bpoints).T)
-    local = np.minimum(seg, np.roll(seg, 1))       # the shorter boundary segment at each boundary node
+    a_, b_ = bedges.T
+    seg_len = np.hypot(*(bpoints[b_] - bpoints[a_]).T)
+    local = np.full(b, np.inf)
+    np.minimum.at(local, a_, seg_len)                            # the shorter boundary segment at each node
+    np.minimum.at(local, b_, seg_len)
     extent = float((hi - lo).max()) + 2 * h
     spacing = min(max(float(local.min()), extent / _GRID_CELLS_MAX), extent / _GRID_CELLS_MIN)
     size = BackgroundGrid.from_samples(bpoints, np.minimum(local, h), np.r_[lo - h, hi + h], h_upper=h,
@@ -161,8 +170,7 @@ def _mesh_panel(panel, counts, h, where):
     movable = np.ones(len(points), bool)
     movable[:b] = False
     improve(points, tri, movable)
-    edge_nodes = tuple((starts[k] + np.arange(counts[panel.name, k] + 1)) % b for k in range(len(panel.edges)))
-    return TriMesh(X=points, tri=tri, name=panel.name), edge_nodes, measure_quality(points, tri, size)
+    return TriMesh(X=points, tri=tri, name=panel.name), tuple(edge_nodes), measure_quality(points, tri, size)
 
 
 def mesh_pattern(pattern, h):
@@ -255,12 +263,13 @@ def _coplanar_overlap(pmesh, i, j, xi, xj, scale):
     if abs(abs(vi[2] @ vj[2]) - 1.0) > _PLANE_TOL or np.abs((xj - ci) @ vi[2]).max() > tol:
         return False
     to2 = lambda x: (x - ci) @ vi[:2].T                      # noqa: E731 -- the common plane's coordinates
-    outline = []
+    sides = []                                               # every loop's sides, as segment ends
     for p, x in ((i, xi), (j, xj)):
-        nodes = np.concatenate([e[:-1] for e in pmesh.edge_nodes[p]])
-        outline.append(to2(x[nodes]))
+        a = np.concatenate([e[:-1] for e in pmesh.edge_nodes[p]])
+        b = np.concatenate([e[1:] for e in pmesh.edge_nodes[p]])
+        sides.append((to2(x[a]), to2(x[b])))
     cent = [to2(x[m.tri].mean(axis=1)) for x, m in ((xi, pmesh.meshes[i]), (xj, pmesh.meshes[j]))]
-    if points_in_polygon(cent[0], outline[1]).any() or points_in_polygon(cent[1], outline[0]).any():
+    if points_in_polygon(cent[0], *sides[1]).any() or points_in_polygon(cent[1], *sides[0]).any():
         return True
-    a, b = outline
-    return bool(segments_cross(a, np.roll(a, -1, axis=0), b, np.roll(b, -1, axis=0), tol=tol).any())
+    (a0, a1), (b0, b1) = sides
+    return bool(segments_cross(a0, a1, b0, b1, tol=tol).any())

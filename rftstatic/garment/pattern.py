@@ -7,7 +7,7 @@ pattern's file, the panel and the edge, and says what to change:
 - an edge of (nearly) zero length (below 1e-6 of its panel's size);
 - an arc whose radius is below half its chord; an outline that is not a closed chain of edges;
 - a self-intersecting outline (its curved edges sampled at 32 segments each, every pair of
-  non-adjacent segments tested);
+  non-adjacent segments tested), holes crossing it or each other, a hole outside the outline;
 - a seam naming a missing panel or edge; an edge in two seams (or sewn to itself);
 - a seam whose two edges differ in length by more than the pattern's ``seam_tolerance``, by default
   :data:`SEAM_LENGTH_TOLERANCE` (5 % of the longer: sewers ease a little fullness into a seam, more
@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.errors import SceneError
-from rftstatic.garment.curves import EDGE_KINDS, edge_length, edge_points, edge_turning, segments_cross
+from rftstatic.garment.curves import (EDGE_KINDS, edge_length, edge_points, edge_turning, points_in_polygon,
+                                     segments_cross)
 
 __all__ = ["PatternError", "Edge", "Panel", "Seam", "Pattern", "check_pattern", "rotation_matrix",
            "SEAM_KINDS", "ORIENTATIONS", "SEAM_LENGTH_TOLERANCE", "GRAIN_DEFAULT"]
@@ -96,7 +97,10 @@ class Panel:
     ----------
     name : unique within the pattern
     vertices : (M, 2) outline vertices in panel coordinates [m]
-    edges : the closed outline, edge k ending where edge k+1 starts; any orientation
+    edges : the closed loops' edges, loop after loop, edge k ending where the next edge of its loop
+        starts; any orientation
+    loops : number of edges of each closed loop, the outline first, then the holes (a ring panel's
+        waist); default one loop of all edges
     grain : grain line = warp direction, counter-clockwise from the panel's x axis [deg]
     translation : (3,) placement t [m]
     rotation : (3,) placement Euler angles (alpha, beta, gamma) [deg] (module docstring)
@@ -108,10 +112,12 @@ class Panel:
     grain: float = GRAIN_DEFAULT
     translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
     rotation: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    loops: tuple = ()
 
     def __post_init__(self):
         object.__setattr__(self, "vertices", np.asarray(self.vertices, dtype=float).reshape(-1, 2))
         object.__setattr__(self, "edges", tuple(self.edges))
+        object.__setattr__(self, "loops", tuple(int(n) for n in self.loops) or (len(self.edges),))
         object.__setattr__(self, "translation", np.asarray(self.translation, dtype=float).reshape(3))
         object.__setattr__(self, "rotation", np.asarray(self.rotation, dtype=float).reshape(3))
 
@@ -132,14 +138,31 @@ class Panel:
         """(n+1, 2) points along edge k, equally spaced by arc length, start to end [m]."""
         return edge_points(*self.ends(k), n, self.edges[k].kind, **self.edges[k].shape())
 
+    def loop_edges(self):
+        """Edge indices of each loop: a tuple of ranges, the outline first."""
+        ends = np.cumsum((0,) + self.loops)
+        return tuple(range(int(a), int(b)) for a, b in zip(ends[:-1], ends[1:]))
+
+    def next_edge(self, k):
+        """The edge that follows edge k in its loop."""
+        loop = next(r for r in self.loop_edges() if k in r)
+        return loop.start + (k + 1 - loop.start) % len(loop)
+
     def outline(self, per_curve=_CHECK_SEGMENTS):
-        """Closed polyline (S, 2) of the outline [m] and the edge (S,) each segment belongs to."""
-        pts, owner = [], []
-        for k, e in enumerate(self.edges):
-            n = 1 if e.kind == "line" else per_curve
-            pts.append(self.edge_points(k, n)[:-1])
-            owner.append(np.full(n, k))
-        return np.concatenate(pts), np.concatenate(owner)
+        """The loops as polylines: points (S, 2) [m], the segment from point s to the next point of its
+        loop, the edge (S,) and the loop (S,) each segment belongs to, and the next point's index (S,)."""
+        pts, owner, loop, nxt = [], [], [], []
+        start = 0
+        for j, edges in enumerate(self.loop_edges()):
+            first = start
+            for k in edges:
+                n = 1 if self.edges[k].kind == "line" else per_curve
+                pts.append(self.edge_points(k, n)[:-1])
+                owner.append(np.full(n, k))
+                loop.append(np.full(n, j))
+                start += n
+            nxt.append(np.r_[np.arange(first + 1, start), first])
+        return np.concatenate(pts), np.concatenate(owner), np.concatenate(loop), np.concatenate(nxt)
 
     @property
     def size(self):
@@ -233,16 +256,18 @@ def _check_panel(p, src):
     if not np.isfinite(p.vertices).all() or not np.isfinite(p.translation).all() \
             or not np.isfinite(p.rotation).all() or not np.isfinite(p.grain):
         raise PatternError(f"{where}: non-finite vertex, grain or placement value; give finite numbers")
-    m, n = len(p.vertices), len(p.edges)
-    if n < 2:
-        raise PatternError(f"{where}: the outline has {n} edge(s); a closed outline needs at least 2")
+    m = len(p.vertices)
+    if sum(p.loops) != len(p.edges) or min(p.loops) < 2:
+        raise PatternError(f"{where}: loops {p.loops} of {len(p.edges)} edges; every closed loop needs at least "
+                           "2 edges and the loops must list all edges")
     for k, e in enumerate(p.edges):
         if not (0 <= e.start < m and 0 <= e.end < m):
             raise PatternError(f"{where}, edge {k}: endpoints ({e.start}, {e.end}) outside the "
                                f"{m} vertices (0..{m - 1}); fix the edge's endpoints")
-        if e.end != p.edges[(k + 1) % n].start:
-            raise PatternError(f"{where}, edge {k}: ends at vertex {e.end} but edge {(k + 1) % n} starts at "
-                               f"vertex {p.edges[(k + 1) % n].start}; list the edges as one closed chain")
+        nxt = p.next_edge(k)
+        if e.end != p.edges[nxt].start:
+            raise PatternError(f"{where}, edge {k}: ends at vertex {e.end} but edge {nxt} starts at "
+                               f"vertex {p.edges[nxt].start}; list each loop's edges as one closed chain")
         if e.kind not in EDGE_KINDS:
             raise PatternError(f"{where}, edge {k}: kind {e.kind!r}; use one of {EDGE_KINDS}")
         if e.kind == "bezier" and np.asarray(e.controls, float).size not in (2, 4):
@@ -260,13 +285,12 @@ def _check_panel(p, src):
 
 
 def _check_outline(p, where):
-    """Self-intersection of the outline: non-adjacent segments of its sampled polyline that touch."""
-    v, owner = p.outline()
-    s = len(v)
-    w = np.roll(v, -1, axis=0)
-    i = np.arange(s)
-    d = (i[:, None] - i[None, :]) % s
-    skip = (d == 0) | (d == 1) | (d == s - 1)
+    """Self-intersection of the loops (touching non-adjacent segments), and every hole inside the
+    outline and outside the other holes."""
+    v, owner, loop, nxt = p.outline()
+    w = v[nxt]
+    i = np.arange(len(v))
+    skip = (i[:, None] == i[None, :]) | (nxt[:, None] == i[None, :]) | (i[:, None] == nxt[None, :])
     hit = segments_cross(v, w, v, w) & ~skip
     if hit.any():
         a, b = np.argwhere(hit)[0]
@@ -275,8 +299,17 @@ def _check_outline(p, where):
         raise PatternError(f"{where}: the outline intersects itself ({what} near "
                            f"({v[a][0]:.6g}, {v[a][1]:.6g}) m); fix the vertices or the edges' curvature "
                            "so that the outline is a simple closed curve")
-
-
+    for j in range(len(p.loops)):
+        x, y = v[loop == j].T
+        if abs(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)) <= 1e-12 * p.size ** 2:
+            raise PatternError(f"{where}: the loop of edges {list(p.loop_edges()[j])} encloses no area; "
+                               "give it at least 3 vertices not on one line, or curve an edge")
+    for j in range(1, len(p.loops)):
+        first = v[loop == j][:1]
+        inside = [q for q in range(len(p.loops)) if q != j and points_in_polygon(first, v[loop == q])[0]]
+        if inside != [0]:
+            raise PatternError(f"{where}: the hole of edges {list(p.loop_edges()[j])} is not inside the outline "
+                               "(or lies inside another hole); fix its vertices")
 def _check_seams(pattern, src):
     index = pattern.index
     used = {}

@@ -37,6 +37,7 @@ TOML form
     [[panels]]
     name = "front"
     vertices = [[-30, 0], [30, 0], [18, 60], [-18, 60]]   # edge k runs from vertex k to k+1 (closing)
+    holes = []                        # optional: loops of vertices inside, their edges numbered on
     arcs = [{edge = 2, radius = 91.8, side = "left", large = false}]  # optional; side of the chord
     grain = 90                        # warp direction from the panel's x axis [deg] (default 90)
     translate = [0, 0.4, 0.15]        # placement, in `units` (default 0)
@@ -49,7 +50,10 @@ TOML form
     kind = "sew"                      # "sew", "fold" or "open" (default "sew")
 
 An arc's ``side`` says on which side of its chord (vertex k -> k+1) the arc's midpoint lies;
-``large = true`` takes the arc longer than half the circle. Unknown keys are errors.
+``large = true`` takes the arc longer than half the circle. A loop of two vertices whose two edges
+are arcs is a circle (a ring panel: ``vertices = [[R, 0], [-R, 0]]``, ``holes = [[[r, 0], [-r, 0]]]``,
+four arcs). Hole edges are numbered after the outline's (and after earlier holes'), each hole closing
+on itself; ``arcs`` and ``seams`` use these numbers. Unknown keys are errors.
 """
 
 from __future__ import annotations
@@ -206,7 +210,7 @@ def _gc_stitch(spec, k, where):
 
 # -------------------------------------------------------------------------------------------- TOML
 _TOP = {"units", "name", "panels", "seams"}
-_PANEL = {"name", "vertices", "arcs", "grain", "translate", "rotate"}
+_PANEL = {"name", "vertices", "holes", "arcs", "grain", "translate", "rotate"}
 _ARC = {"edge", "radius", "side", "large"}
 _SEAM = {"a", "b", "orientation", "kind"}
 
@@ -244,18 +248,24 @@ def _toml_panel(spec, k, scale, source):
     if not isinstance(name, str) or not name or ":" in name:
         raise PatternError(f"{where}: needs a name (a string without ':')")
     _unknown(spec, _PANEL, where)
-    v = _number(spec.get("vertices"), where, "vertices")
-    if v.ndim != 2 or v.shape[1] != 2 or len(v) < 3:
-        raise PatternError(f"{where}: vertices must be 3 or more [x, y] pairs, got {spec.get('vertices')!r}")
-    v = v * scale
-    n = len(v)
-    edges = [Edge(j, (j + 1) % n) for j in range(n)]
+    loops = [spec.get("vertices")] + list(spec.get("holes", []))
+    verts, edges = [], []
+    for j, raw in enumerate(loops):
+        v = _number(raw, where, "vertices" if j == 0 else f"holes[{j - 1}]")
+        if v.ndim != 2 or v.shape[1] != 2 or len(v) < 2:
+            raise PatternError(f"{where}: {'vertices' if j == 0 else f'holes[{j - 1}]'} must be 2 or more [x, y] "
+                               f"pairs (2 when both edges are arcs), got {raw!r}")
+        first = sum(len(q) for q in verts)
+        edges += [Edge(first + q, first + (q + 1) % len(v)) for q in range(len(v))]
+        verts.append(v * scale)
+    v = np.concatenate(verts)
+    n = len(edges)
     for arc in spec.get("arcs", []):
         _unknown(arc, _ARC, f"{where}, arcs")
         j = arc.get("edge")
         if not (isinstance(j, int) and 0 <= j < n):
             raise PatternError(f"{where}, arcs: edge = {j!r}; give an edge index 0..{n - 1} "
-                               "(edge k runs from vertex k to vertex k+1)")
+                               "(edge k runs from vertex k to vertex k+1 of its loop)")
         side = arc.get("side")
         if side not in ("left", "right"):
             raise PatternError(f"{where}, edge {j}: arc side = {side!r}; give 'left' or 'right' "
@@ -263,9 +273,9 @@ def _toml_panel(spec, k, scale, source):
         radius = arc.get("radius")
         if not (isinstance(radius, (int, float)) and radius > 0):
             raise PatternError(f"{where}, edge {j}: arc radius = {radius!r}; give a positive length in {source}'s units")
-        edges[j] = Edge(j, (j + 1) % n, "arc", radius=float(radius) * scale, large=bool(arc.get("large", False)),
-                        right=side == "right")
-    return Panel(name=name, vertices=v, edges=edges, grain=_grain(spec, where),
+        edges[j] = Edge(edges[j].start, edges[j].end, "arc", radius=float(radius) * scale,
+                        large=bool(arc.get("large", False)), right=side == "right")
+    return Panel(name=name, vertices=v, edges=edges, loops=[len(q) for q in verts], grain=_grain(spec, where),
                  translation=_vector(spec.get("translate", [0, 0, 0]), where, "translate") * scale,
                  rotation=_vector(spec.get("rotate", [0, 0, 0]), where, "rotate"))
 

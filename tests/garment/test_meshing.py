@@ -134,3 +134,34 @@ def test_dart_in_one_panel():
     np.testing.assert_allclose(x[pairs[:, 0], 0] - 0.2, 0.2 - x[pairs[:, 1], 0], atol=1e-15)
     np.testing.assert_allclose(x[pairs[:, 0], 1], x[pairs[:, 1], 1], atol=1e-15)
     assert pm.quality[0].min_angle > 28.0
+
+
+def test_ring_panel_with_a_hole():
+    """One ring panel (the circle skirt of cases/patterns): the waist is a hole; the mesh fills the
+    ring only, the hole's edges keep their own nodes, and a disc placed in the hole's plane inside the
+    hole does not overlap the ring."""
+    from rftstatic.garment.readers import parse_toml
+
+    pm = mesh_pattern(read_pattern(PATTERNS / "skirt-circle-ring.toml"), 0.02)
+    mesh, nodes = pm.meshes[0], pm.edge_nodes[0]
+    assert mesh.area.sum() == pytest.approx(np.pi * (0.6114 ** 2 - 0.1114 ** 2), rel=2e-3)
+    assert pm.quality[0].min_angle > 28.0
+    waist = np.concatenate([nodes[2], nodes[3]])
+    np.testing.assert_allclose(np.hypot(*mesh.X[waist].T), 0.1114, rtol=1e-12)
+    assert nodes[2][0] == nodes[3][-1] and nodes[2][-1] == nodes[3][0]          # the hole closes on itself
+    assert set(np.concatenate(nodes).tolist()) == set(mesh.boundary_nodes.tolist())
+    # a disc (two arcs) of radius 9 cm in the waist hole, in the ring's plane: no overlap
+    ring = read_pattern(PATTERNS / "skirt-circle-ring.toml").panels[0]
+    disc = {"name": "disc", "vertices": [[9, 0], [-9, 0]], "translate": [0, 100, 0], "rotate": [-90, 0, 0],
+            "arcs": [{"edge": 0, "radius": 9, "side": "right"}, {"edge": 1, "radius": 9, "side": "right"}]}
+    toml = {"units": "cm", "panels": [
+        {"name": "ring", "vertices": [[61.14, 0], [-61.14, 0]], "holes": [[[11.14, 0], [-11.14, 0]]],
+         "arcs": [{"edge": k, "radius": 61.14 if k < 2 else 11.14, "side": "right"} for k in range(4)],
+         "translate": [0, 100, 0], "rotate": [-90, 0, 0]}, disc]}
+    both = mesh_pattern(parse_toml(toml), 0.03)
+    assert both.pattern.panels[0].loops == ring.loops == (2, 2)
+    check_placement(both)
+    disc["vertices"] = [[15, 0], [-15, 0]]                     # larger than the hole: overlaps the ring
+    disc["arcs"] = [{"edge": 0, "radius": 15, "side": "right"}, {"edge": 1, "radius": 15, "side": "right"}]
+    with pytest.raises(PatternError, match="panels 'ring' and 'disc' lie in one plane and overlap"):
+        check_placement(mesh_pattern(parse_toml(toml), 0.03))

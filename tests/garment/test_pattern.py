@@ -122,3 +122,15 @@ def test_bad_seam_kind_and_duplicate_panel():
     d = _two_squares()
     d["panels"][1]["name"] = "front"
     _raises(d, "panel name 'front' is used twice")
+
+
+def test_bad_holes():
+    d = _two_squares()
+    d["panels"][0]["holes"] = [[[20, 20], [30, 20], [30, 30]]]
+    _raises(d, "panel 'front'", "hole of edges [4, 5, 6] is not inside the outline")
+    d["panels"][0]["holes"] = [[[5, 5], [15, 5], [15, 8]]]
+    _raises(d, "panel 'front'", "intersects itself", "edge 1 crosses edge 4")
+    d["panels"][0]["holes"] = [[[2, 2], [4, 2], [4, 4]], [[3, 2.5], [3.5, 2.5], [3.5, 3]]]
+    _raises(d, "panel 'front'", "hole of edges [7, 8, 9] is not inside the outline (or lies inside another hole)")
+    d["panels"][0]["holes"] = [[[2, 2], [4, 2]]]                     # two straight edges: no area
+    _raises(d, "panel 'front'", "loop of edges [4, 5] encloses no area")
