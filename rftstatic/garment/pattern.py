@@ -276,7 +276,8 @@ def _check_panel(p, src):
         a, b = p.ends(k)
         if np.hypot(*(b - a)) <= _ZERO_EDGE * max(p.size, 1e-300):
             raise PatternError(f"{where}, edge {k}: zero length (vertices {e.start} and {e.end} coincide at "
-                               f"{tuple(np.round(a, 9))} m); remove the edge or move a vertex (a full circle is two half arcs)")
+                               f"{tuple(np.round(a, 9))} m); remove the edge or move a vertex "
+                               "(a full circle is two half arcs)")
         try:
             p.edge_length(k)
         except ValueError as err:

@@ -272,7 +272,8 @@ def _toml_panel(spec, k, scale, source):
                                "(the side of the chord vertex k -> k+1 the arc bulges to)")
         radius = arc.get("radius")
         if not (isinstance(radius, (int, float)) and radius > 0):
-            raise PatternError(f"{where}, edge {j}: arc radius = {radius!r}; give a positive length in {source}'s units")
+            raise PatternError(f"{where}, edge {j}: arc radius = {radius!r}; give a positive length "
+                               "in the file's units")
         edges[j] = Edge(edges[j].start, edges[j].end, "arc", radius=float(radius) * scale,
                         large=bool(arc.get("large", False)), right=side == "right")
     return Panel(name=name, vertices=v, edges=edges, loops=[len(q) for q in verts], grain=_grain(spec, where),
