@@ -165,3 +165,23 @@ def test_ring_panel_with_a_hole():
     disc["arcs"] = [{"edge": 0, "radius": 15, "side": "right"}, {"edge": 1, "radius": 15, "side": "right"}]
     with pytest.raises(PatternError, match="panels 'ring' and 'disc' lie in one plane and overlap"):
         check_placement(mesh_pattern(parse_toml(toml), 0.03))
+
+
+@pytest.mark.parametrize("which", ["a_line", "circle"])
+def test_sewn_surface_is_consistently_oriented(which, request):
+    """Merging each seam's pairs gives a manifold whose triangles (counter-clockwise in their panels)
+    cross every seam edge in opposite directions: the "reversed" pairing of two panels drawn
+    counter-clockwise sews them right side to right side, as GarmentCode's default does."""
+    pm = request.getfixturevalue(which)
+    c = pm.combined()
+    merge = np.arange(pm.n_nodes)
+    merge[c.seam_pairs[:, 1]] = c.seam_pairs[:, 0]
+    tri = merge[c.mesh.tri]
+    directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    assert len(np.unique(directed, axis=0)) == len(directed)             # no edge twice the same way
+    undirected, count = np.unique(np.sort(directed, axis=1), axis=0, return_counts=True)
+    assert count.max() == 2
+    seam_edges = np.sort(merge[np.c_[c.seam_pairs[:-1, 0], c.seam_pairs[1:, 0]]], axis=1)
+    same_seam = c.seam_of_pair[:-1] == c.seam_of_pair[1:]
+    inner = {tuple(e) for e, two in zip(undirected, count == 2) if two}
+    assert all(tuple(e) in inner for e in seam_edges[same_seam])         # every seam edge now interior
