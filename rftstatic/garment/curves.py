@@ -13,8 +13,8 @@ An edge runs from point ``a`` to point ``b`` (2,) [m]:
   (absolute panel coordinates); its arc length is integrated on a fine polyline.
 
 :func:`edge_points` samples an edge uniformly by arc length: the nodes of a seam edge, so the two
-sides of a seam with the same number of segments pair one to one. :func:`segments_cross` is the
-vectorised crossing test of the outline check and of the placement check.
+sides of a seam with the same number of segments pair one to one. The outline and placement checks use the
+mesher's vectorised crossing test, :func:`~rftstatic.mesh.mesher.domain.segments_cross`.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 __all__ = ["EDGE_KINDS", "arc_geometry", "edge_length", "edge_points", "edge_turning",
-           "segments_cross", "points_in_polygon"]
+           "points_in_polygon"]
 
 EDGE_KINDS = ("line", "arc", "bezier")
 
@@ -110,33 +110,6 @@ def edge_points(a, b, n, kind, *, radius=0.0, large=False, right=False, controls
         pts = _bernstein(poly, np.interp(s * cum[-1], cum, t))
     pts[0], pts[-1] = a, b
     return pts
-
-
-def segments_cross(p1, p2, q1, q2, *, tol=0.0):
-    """(n, m) bool: segment p1p2 (n, 2) touches or crosses segment q1q2 (m, 2) [m].
-
-    ``tol`` > 0 [m] asks for a proper crossing: each segment's ends on opposite sides of the other's
-    line and farther than ``tol`` from it (touching and collinear overlap excluded). With ``tol`` = 0,
-    touching counts, collinear segments only when they overlap.
-    """
-    def orient(a, b, c):
-        return (b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (b[..., 1] - a[..., 1]) * (c[..., 0] - a[..., 0])
-
-    P1, P2, Q1, Q2 = p1[:, None], p2[:, None], q1[None], q2[None]
-    o1, o2 = orient(P1, P2, Q1), orient(P1, P2, Q2)
-    o3, o4 = orient(Q1, Q2, P1), orient(Q1, Q2, P2)
-    if tol > 0:
-        lp = tol * np.hypot(*(p2 - p1).T)[:, None]
-        lq = tol * np.hypot(*(q2 - q1).T)[None, :]
-        return ((o1 * o2 < 0) & (np.minimum(abs(o1), abs(o2)) > lp)
-                & (o3 * o4 < 0) & (np.minimum(abs(o3), abs(o4)) > lq))
-    hit = (o1 * o2 <= 0) & (o3 * o4 <= 0)
-    collinear = (o1 == 0) & (o2 == 0)
-    if collinear.any():
-        lo = np.minimum(P1, P2) <= np.maximum(Q1, Q2)
-        hi = np.minimum(Q1, Q2) <= np.maximum(P1, P2)
-        hit &= ~collinear | (lo & hi).all(axis=-1)
-    return hit
 
 
 def points_in_polygon(p, v, w=None):

@@ -32,8 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rftstatic.garment.curves import points_in_polygon, segments_cross
+from rftstatic.garment.curves import points_in_polygon
 from rftstatic.garment.pattern import PatternError, rotation_matrix
+from rftstatic.mesh.mesher.domain import segments_cross
 from rftstatic.mesh.trimesh import TriMesh
 
 __all__ = ["PatternMesh", "CombinedMesh", "mesh_pattern", "edge_segments", "place", "check_placement"]

@@ -32,8 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.errors import SceneError
-from rftstatic.garment.curves import (EDGE_KINDS, edge_length, edge_points, edge_turning, points_in_polygon,
-                                     segments_cross)
+from rftstatic.garment.curves import EDGE_KINDS, edge_length, edge_points, edge_turning, points_in_polygon
+from rftstatic.mesh.mesher.domain import segments_cross
 
 __all__ = ["PatternError", "Edge", "Panel", "Seam", "Pattern", "check_pattern", "rotation_matrix",
            "SEAM_KINDS", "ORIENTATIONS", "SEAM_LENGTH_TOLERANCE", "GRAIN_DEFAULT"]

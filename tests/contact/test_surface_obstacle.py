@@ -1,6 +1,9 @@
 """Triangle-surface obstacles (scene type ``mesh``): exact signed distance, derivatives, the PSD penalty and
 sharp-feature pairs checked by finite differences, and the bad-input messages."""
 
+import importlib.util
+from pathlib import Path
+
 import meshio
 import numpy as np
 import pytest
@@ -18,27 +21,16 @@ BOX_F = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 
                   [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
 
 
-def _icosphere(level):
-    t = (1.0 + 5.0 ** 0.5) / 2.0
-    V = [np.array(v, float) / np.linalg.norm(v) for v in
-         [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
-          (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]]
-    F = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
-         (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
-         (6, 2, 10), (8, 6, 7), (9, 8, 1)]
-    for _ in range(level):
-        mid = {}
+def _tool(name):
+    """A script of tools/ as a module (the icosphere the scenes' obstacle files are made with)."""
+    path = Path(__file__).resolve().parents[2] / "tools" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"tools_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
-        def middle(a, b):
-            if (min(a, b), max(a, b)) not in mid:
-                m = V[a] + V[b]
-                V.append(m / np.linalg.norm(m))
-                mid[min(a, b), max(a, b)] = len(V) - 1
-            return mid[min(a, b), max(a, b)]
 
-        F = [f for a, b, c in F for f in ((a, middle(a, b), middle(c, a)), (b, middle(b, c), middle(a, b)),
-                                          (c, middle(c, a), middle(b, c)), (middle(a, b), middle(b, c), middle(c, a)))]
-    return np.array(V), np.array(F)
+_icosphere = _tool("icosphere").icosphere
 
 
 def _write(path, V, F, kind="triangle"):

@@ -131,23 +131,31 @@ def _as_vertices(name, pts):
     return pts
 
 
-def _segments_cross(p1, p2, q1, q2, skip):
-    """(n, m) mask of segments p (n,2)-(n,2) touching/crossing segments q, excluding ``skip``."""
-    def orient(a, b, c):
-        return ((b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1])
-                - (b[..., 1] - a[..., 1]) * (c[..., 0] - a[..., 0]))
+def segments_cross(p1, p2, q1, q2, *, tol=0.0):
+    """(n, m) bool: segment p1p2 (n, 2) touches or crosses segment q1q2 (m, 2) [m].
 
-    P1, P2 = p1[:, None, :], p2[:, None, :]
-    Q1, Q2 = q1[None, :, :], q2[None, :, :]
+    ``tol`` > 0 [m] asks for a proper crossing: each segment's ends on opposite sides of the other's
+    line and farther than ``tol`` from it (touching and collinear overlap excluded). With ``tol`` = 0,
+    touching counts, collinear segments only when they overlap.
+    """
+    def orient(a, b, c):
+        return (b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (b[..., 1] - a[..., 1]) * (c[..., 0] - a[..., 0])
+
+    P1, P2, Q1, Q2 = p1[:, None], p2[:, None], q1[None], q2[None]
     o1, o2 = orient(P1, P2, Q1), orient(P1, P2, Q2)
     o3, o4 = orient(Q1, Q2, P1), orient(Q1, Q2, P2)
+    if tol > 0:
+        lp = tol * np.hypot(*(p2 - p1).T)[:, None]
+        lq = tol * np.hypot(*(q2 - q1).T)[None, :]
+        return ((o1 * o2 < 0) & (np.minimum(abs(o1), abs(o2)) > lp)
+                & (o3 * o4 < 0) & (np.minimum(abs(o3), abs(o4)) > lq))
     hit = (o1 * o2 <= 0) & (o3 * o4 <= 0)
     collinear = (o1 == 0) & (o2 == 0)
     if collinear.any():
         lo = np.minimum(P1, P2) <= np.maximum(Q1, Q2)
         hi = np.minimum(Q1, Q2) <= np.maximum(P1, P2)
         hit &= ~collinear | (lo & hi).all(axis=-1)
-    return hit & ~skip
+    return hit
 
 
 def _point_in_polygon(p, v):
@@ -320,7 +328,7 @@ class Domain:
             same = loop_id[sl, None] == loop_id[None, :]
             d = (local[sl, None] - local[None, :]) % size[None, :]
             skip = same & ((d == 0) | (d == 1) | (d == size[None, :] - 1))
-            hit = _segments_cross(p1[sl], p2[sl], p1, p2, skip)
+            hit = segments_cross(p1[sl], p2[sl], p1, p2) & ~skip
             if hit.any():
                 i, j = np.argwhere(hit)[0]
                 i += s
