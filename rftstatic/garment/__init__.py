@@ -1,6 +1,6 @@
-"""Garments: sewing patterns read, checked, meshed with matching seam nodes and placed in space.
+"""Garments: sewing patterns read, checked, meshed with matching seam nodes and placed in space; a dress form.
 
-Issue 37, item 1 (pattern input). What is supported now:
+What is supported now:
 
 - the pattern model (:mod:`.pattern`): panels with outlines (and holes) of straight edges, circular
   arcs and quadratic/cubic Bézier curves (:mod:`.curves`), a grain line (warp direction) and a placement
@@ -15,8 +15,11 @@ Issue 37, item 1 (pattern input). What is supported now:
   along both sides of every seam (uniform by arc length), node pairs per seam, one combined mesh
   with panel ids and per-element grain angles, the panels placed in space, and the check that no
   two placed panels intersect or overlap.
+- the dress form (:mod:`.body`): a closed torso surface of elliptical sections from body measurements
+  (bust, waist, hip and neck girths at their heights, shoulder breadth), written as an OBJ file a
+  ``type = "mesh"`` obstacle reads.
 
-Not yet: the body, sewing forces, seam merging, draping (issue 37, items 2-6).
+Not yet: size charts and the scene's ``[body]`` table, sewing forces, seam merging, draping.
 """
 
 from rftstatic.garment.meshing import CombinedMesh, PatternMesh, check_placement, mesh_pattern, place
