@@ -1,8 +1,8 @@
-"""Command line: ``python -m rftstatic {case, view, list, fabrics, options, sweep, fit, bench, validate}``, on the
-Python API (:mod:`rftstatic.api`), the run viewer (:mod:`rftstatic.io.viewer`) and the studies on Dask
-(:mod:`rftstatic.study`). ``fabrics --explain [SCENE --set ...]`` prints the lab keys, their ranges and the rules
-that fill a lab fabric's missing values, and where each value of a scene's fabric comes from
-(:mod:`rftstatic.scenes.fabric_explain`).
+"""Command line: ``python -m rftstatic {case, view, pattern, list, fabrics, options, sweep, fit, bench,
+validate}``, on the Python API (:mod:`rftstatic.api`), the run viewer (:mod:`rftstatic.io.viewer`), the
+sewing patterns (:mod:`rftstatic.garment`) and the studies on Dask (:mod:`rftstatic.study`). ``fabrics
+--explain [SCENE --set ...]`` prints the lab keys, their ranges and the rules that fill a lab fabric's missing
+values, and where each value of a scene's fabric comes from (:mod:`rftstatic.scenes.fabric_explain`).
 
 Exit statuses (:data:`EXIT`): 0 done; 2 invalid input (scene, options, mesh or checkpoint file); 3 goal
 not reached (no convergence, instability, no rest by t_end; the last state is written); 4 the outputs
@@ -54,6 +54,15 @@ def main(argv=None) -> int:
                    "displacement (|u|), membrane_strain (largest principal), height (z) or gap (to the "
                    "nearest obstacle), as the run has them")
     w.add_argument("--out", default=None, help="the HTML file to write (default RUN_DIR/view.html)")
+    pt = sub.add_parser("pattern", parents=[common], help="read a sewing pattern (GarmentCode JSON or TOML), mesh "
+                        "its panels with matching seam nodes, check it and write the placed panels as VTU",
+                        description="Read a sewing pattern (GarmentCode's JSON specification or the TOML form of "
+                        "rftstatic.garment.readers), check it (seam lengths, missing panels or edges, outlines, "
+                        "placement), mesh every panel with the same node count along both sides of each seam, "
+                        "print its panels and seams, and write the panels as placed, OUT/pattern.vtu.")
+    pt.add_argument("file", help="a pattern file (.json or .toml), e.g. cases/patterns/skirt-a-line.toml")
+    pt.add_argument("--h", type=float, default=2.0, help="target element size [cm] (default 2)")
+    pt.add_argument("--out", default=None, help="output folder (default out/pattern-NAME)")
     sub.add_parser("list", parents=[common], help="list the scenes in cases/")
     fb = sub.add_parser("fabrics", parents=[common], help="list the fabric library with bending lengths and sources")
     fb.add_argument("--explain", action="store_true", help="the lab keys, their ranges and the rules that fill what a "
@@ -187,6 +196,8 @@ def _command(args) -> int:
                 print(f"not from the source: {rule}")
             print("sources in full: rftstatic.fabrics.library.FABRICS[name].source")
             return 0
+        if args.command == "pattern":
+            return _pattern(args)
         if args.command == "view":
             from rftstatic.io.viewer import ViewError, write_view
 
@@ -263,3 +274,28 @@ def _command(args) -> int:
         print(f"error: the outputs cannot be written: {exc}", file=sys.stderr)
         return EXIT["output"]
     return EXIT["internal"]
+
+
+def _pattern(args) -> int:
+    """``pattern FILE``: read, mesh, check and describe a sewing pattern; write its placed panels as VTU."""
+    import numpy as np
+
+    from rftstatic.garment.meshing import check_placement, mesh_pattern, place
+    from rftstatic.garment.readers import read_pattern
+    from rftstatic.garment.report import describe
+    from rftstatic.io.files import write_vtu
+
+    path = Path(args.file)
+    pmesh = mesh_pattern(read_pattern(path), args.h / 100.0)
+    check_placement(pmesh)
+    print(describe(pmesh))
+    out = Path(args.out) if args.out else Path("out") / f"pattern-{path.stem}"
+    out.mkdir(parents=True, exist_ok=True)
+    combined = pmesh.combined()
+    X3 = place(pmesh)
+    vtu = write_vtu(out / "pattern.vtu", X3, np.zeros_like(X3), combined.mesh.tri, length_unit_scale=0.01,
+                    point_data={"panel": combined.panel_of_node.astype(float)},
+                    cell_data={"panel": combined.panel_of_element.astype(float),
+                               "warp_angle_deg": np.degrees(combined.warp_angle)})
+    print(f"placed panels written to {vtu} (cm)")
+    return EXIT["done"]
