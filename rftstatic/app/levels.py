@@ -122,17 +122,16 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             continue
         if prev is None:  # the route finds the branch with the scene's own fabric
             m = carry if scale == 1.0 else build_model(sc, mesh, quiet=True)[0]
-            start = {"options": replace(opts, progress=opts.progress and last)}
+            level_opts, U0 = replace(opts, progress=opts.progress and last), None
             what = f"the scene's route ({opts.route.start})"
         else:
             m = carry
-            start = {"U0": transfer_start(prev[0], prev[1], m),
-                     "options": _newton_options(opts, opts.progress and last)}
+            level_opts, U0 = _newton_options(opts, opts.progress and last), transfer_start(prev[0], prev[1], m)
             what = f"Newton at full load from level {k - 1}" + (f", membrane x {scale:.4g}" if scale != 1.0 else "")
         log.info("mesh sequencing: level %d of %d, %s nodes, by %s", k, len(scenes), m.mesh.n_nodes, what)
         try:
-            state = start_state(m, start["options"].newton.linear_solver)
-            route = static_route(m, state, start["options"], U0=start.get("U0"), callback=callback if last else None)
+            state = start_state(m, level_opts.newton.linear_solver)
+            route = static_route(m, state, level_opts, U0=U0, callback=callback if last else None)
             res = drive(route, saver.on(state) if last and saver is not None else None)
         except ConvergenceError as exc:
             failed = exc.result if last else None

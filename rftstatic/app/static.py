@@ -59,7 +59,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     remove_stale(path)
     resumed = None
     single = run_options(scene).levels == 1  # mesh sequencing resumes from its own saved levels (level-K.npz)
-    state = start_state(model, opts.newton.linear_solver)
+    state = None  # the single mesh's solve State (mesh sequencing makes one per level)
     if resume and single and path.exists():
         state = load_static_state(path, model, opts, scene=scene.name)
         resumed = where(state)
@@ -74,6 +74,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
                 result = solve_levels(scene, model, opts, folder=out, resume=resume, callback=callback,
                                       saver=saver)
             else:
+                state = state or start_state(model, opts.newton.linear_solver)
                 result = drive(static_route(model, state, opts, callback=callback), saver.on(state))
     except ConvergenceError as exc:
         error, result = exc, exc.result

@@ -304,15 +304,17 @@ class CheckpointSaver:
     def pause(self, state, pause) -> None:
         """``state`` at a route's ``pause``: written when final or due (kept back, if ``pause.keep``, when not);
         after a first Ctrl-C, written and the run stopped."""
-        what = pause.what or f"t = {state.t:.6g} s, step {state.step}"
-        if self.interrupted:
-            self._write(state_arrays(state, self.header), what)
-            raise KeyboardInterrupt(f"interrupted at {what}; checkpoint saved")
         by_step = self.every_steps is not None and pause.step is not None and pause.step % self.every_steps == 0
-        if pause.final or by_step or self.due():
+        write = self.interrupted or pause.final or by_step or self.due()
+        if not (write or pause.keep):
+            return  # the explicit runs' many pauses: no message formatted, nothing encoded
+        what = pause.what or f"t = {state.t:.6g} s, step {state.step}"
+        if write:
             self._write(state_arrays(state, self.header), what)
-        elif pause.keep:
+        else:
             self._pending = (state_arrays(state, self.header), what)
+        if self.interrupted:
+            raise KeyboardInterrupt(f"interrupted at {what}; checkpoint saved")
 
     def on(self, state):
         """The ``on_pause`` of :func:`~rftstatic.solvers.drive.drive` for a route stepping ``state``."""
