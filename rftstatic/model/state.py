@@ -45,6 +45,10 @@ class State:
         solve at the state where damping is first needed (None before)
     modified_shift : the last diagonal shift [N/m] that made an indefinite exact tangent positive definite
         (:func:`~rftstatic.solvers.iteration.direction`, mode ``"modified"``): the next try starts below it
+    fallback : the last tangent beyond the exact and modified ones that gave a Newton direction, and how many
+        directions in a row it has given: ``{"mode": "psd" | "shift", "rung": index into SHIFT_LADDER, "run": int}``; the next
+        direction starts from it (:func:`~rftstatic.solvers.iteration.direction`); None after an exact or
+        modified step
     route : the position of every route under way, keyed by route (:mod:`rftstatic.solvers.drive`): what a
         checkpoint of this State lets the route go on from (e.g. the load steps' next increment, the
         relaxation route's phase, an explicit run's records)
@@ -64,6 +68,7 @@ class State:
     factorisations: int = 0
     lm_scale: float | None = None
     modified_shift: float = 0.0
+    fallback: dict | None = None
     route: dict = field(default_factory=dict)
 
     @classmethod
