@@ -22,7 +22,20 @@ from rftstatic.solvers.checkpoint import explicit_header, save_atomic, state_arr
 from rftstatic.solvers.static_checkpoint import load_static_state, where
 
 STRIP = ["mesh.nodes=[21,5]"]  # 7 load increments in about 0.2 s
-DRAPE = ["mesh.nodes=[7,7]"]  # start = "relax": two handovers (the first Newton fails), about 3 s
+DRAPE = ["mesh.nodes=[7,7]"]  # start = "relax": two handovers (the first Newton fails, below), about 3 s
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _first_handover_fails():
+    """Newton from the first relaxed state gets 4 iterations and no continuation, so that the coarse drape's
+    first handover fails (with the route's own budget it converges in 43) and its relaxation goes on: the
+    route's second segment, PD check and second handover are what these tests interrupt and resume."""
+    from rftstatic.solvers import static
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(static, "RELAX_NEWTON_ITERATIONS", 2)
+        mp.setattr(static, "FIRST_HANDOVER_CONTINUATIONS", 0)
+        yield
 
 
 def _solve(scene, out, **kw):
