@@ -41,7 +41,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError
+from rftstatic.errors import ConvergenceError, ParameterError
 from rftstatic.progress import Progress
 from rftstatic.solvers.branches import switch_branch
 from rftstatic.solvers.inertia import InertiaSolver
@@ -145,7 +145,7 @@ class _Path:
         self.eps = float(getattr(model.contact, "smoothing", 0.0) or 0.0) if model.contact is not None else 0.0
 
     def point(self, U, lam) -> _Point:
-        _, K = self.model.tangent(U, lam=lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
+        _, K = self.model.tangent(U, lam=lam, candidates=self.state.candidates, pairs=self.state.self_pairs, slip=self.state.bending_slip)
         return _Point(U, lam, K, self.inertia.factor(K))
 
     def tangent(self, pt: _Point, prev: _Point | None) -> None:
@@ -208,7 +208,7 @@ class _Path:
     def _converged(self, x: Iterate) -> bool:
         """The corrector's test: the residual at ``x`` within :meth:`tolerance`; evaluates and factorises the
         tangent there (the converged point keeps both: its inertia and the next predictor)."""
-        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
+        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.state.candidates, pairs=self.state.self_pairs, slip=self.state.bending_slip)
         x.r = (f - x.lam * self.model.load).ravel()[self.free]
         x.rnorm = float(np.linalg.norm(x.r))
         if not np.isfinite(x.rnorm):
@@ -247,6 +247,10 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
     step cannot converge even with the smallest arc length, or the path runs out of steps; ``.result``
     holds the last equilibrium (``converged=False``).
     """
+    if getattr(model, "friction", None) is not None:
+        raise ParameterError("solver.continuation", '"arc-length" does not commit the bending friction\'s slip along '
+                             'the path (bending hysteresis, material kes_2HB_*): use continuation = "load" or '
+                             'start = "relax"')
     opts = options or StaticOptions()
     if model.load_terms or not np.any(model.load):
         raise ValueError('solver.continuation = "arc-length" needs a fixed load vector (no end moments, not '
@@ -304,7 +308,7 @@ def _start(path, U, result) -> _Point:
     start, its = path.corrector(pt, 0.0, target=LAM_START, iterations=START_ITERATIONS)
     result.iterations += its
     if start is None:
-        r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs).ravel()[path.free]
+        r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs, slip=path.state.bending_slip).ravel()[path.free]
         raise ConvergenceError(f"arc-length start, load factor {LAM_START:g}: Newton did not converge in "
                                f"{START_ITERATIONS} iterations; |r| = {np.linalg.norm(r):.3e} N at the lifted start; "
                                "try solver.continuation = \"load\" (load steps) or solver.start = \"relax\"", None)
@@ -369,7 +373,7 @@ def _follow(path, pt, result, record, bar, callback):
                     lam_max = max(lam_max, pt.lam)
                     continue
             if ds < MIN_ARC:
-                r = path.model.residual(pt.U, pt.lam, candidates=path.state.candidates, pairs=path.state.self_pairs)
+                r = path.model.residual(pt.U, pt.lam, candidates=path.state.candidates, pairs=path.state.self_pairs, slip=path.state.bending_slip)
                 raise ConvergenceError(
                     f"arc-length step {len(record['steps']) + 1}, load factor {pt.lam:.6g}: the corrector did not "
                     f"converge even with arc length {ds:.3g}; |r| = {np.linalg.norm(r.ravel()[path.free]):.3e} N at "

@@ -158,7 +158,8 @@ def _check_stability(model, result, state):
     tangent positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver
     cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
     solver = state.solver
-    stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs)
+    stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs,
+                                  slip=state.bending_slip)
               if solver.detects_indefinite else None)
     return replace(result, stable=stable)
 
@@ -346,7 +347,7 @@ def _relax_route(model, opts, callback, state, first):
             if final:
                 result = exc.result
                 if result is not None:  # write the relaxed shape at full load, labelled not converged
-                    r = model.residual(route.U, 1.0).ravel()[model.free.ravel()]
+                    r = model.residual(route.U, 1.0, slip=state.bending_slip).ravel()[model.free.ravel()]
                     result = replace(result, U=route.U, lam=1.0, residual=float(np.linalg.norm(r)))
                 raise fail(f"{exc} (after dynamic relaxation to t = {route.t_used:.3g} s, {info['steps']} steps; "
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
@@ -375,6 +376,7 @@ def _segment_state(model, state, route) -> State:
     seg = as_state(model, state.route.get(SEGMENT))
     if seg is None:
         seg = State.initial(model, route.U, route.V)
+        seg.bending_slip, seg.dissipated = state.bending_slip, state.dissipated  # the friction's history goes on
     state.route[SEGMENT] = seg
     return seg
 
@@ -412,6 +414,7 @@ def _relax_segment(model, opts, plan, route, fail, state, t0):
     except StepLimitError as exc:  # the stable step at this state collapsed (a stretched start)
         raise fail(f"dynamic relaxation cannot go on from t = {route.t_used:.3g} s: {exc}") from None
     del state.route[SEGMENT]
+    state.bending_slip, state.dissipated = seg.bending_slip, seg.dissipated
     route.U, route.V, route.peak, route.at_rest = rel.U, rel.V, rel.peak_kinetic, rel.converged
     route.t_used += rel.t
     route.info.update(time_s=route.t_used, steps=route.info["steps"] + rel.steps, at_rest=rel.converged,
@@ -444,6 +447,7 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     except StepLimitError as exc:
         raise fail(f"the guided dynamic relaxation cannot run: {exc}") from None
     del state.route[SEGMENT]
+    state.bending_slip, state.dissipated = seg.bending_slip, seg.dissipated
     route.U, route.V, route.peak, route.t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
     route.seed = guide.seed
     route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": guide.guide_folds, "weight": guide.guide_weight,
@@ -452,12 +456,12 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     yield _route_pause(route)
 
 
-def _positive_definite(model, U, solver, lam=1.0, pairs=None) -> bool:
+def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None) -> bool:
     """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation);
-    ``pairs``: a self-contact pair cache (:meth:`~rftstatic.model.model.Model.tangent`)."""
+    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip (:meth:`~rftstatic.model.model.Model.tangent`)."""
     if not solver.detects_indefinite:
         return True
-    _, K = model.tangent(U, lam=lam, pairs=pairs)
+    _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip)
     try:
         solver.solve(K, np.zeros(K.shape[0]))
     except (NotPositiveDefinite, LinearSolveError):
