@@ -63,7 +63,8 @@ prints these) and the bias k1 (it is a value of the repository's interpolation, 
 theory: turning it into a twisting rigidity would need the plate's compliance rotation, which the
 repository's law does not follow).
 
-What the linear model drops: the bending and shear hysteresis (KES 2HB, 2HG, 2HG5), the nonlinear
+What the model drops (bending hysteresis 2HB is an option, ``kes_2HB_*`` above): the shear hysteresis (KES 2HG,
+2HG5), the nonlinear
 shear curve beyond the small angles where G is measured (0.5-5 deg), the tensile curve's nonlinearity
 (the secant at Fm replaces it: crimp interchange makes the initial modulus far lower, so a drape that
 stretches little is too stiff in tension; drape is insensitive to it while C >> B / h^2), the

@@ -41,7 +41,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError, ParameterError
+from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
 from rftstatic.solvers.branches import switch_branch
 from rftstatic.solvers.inertia import InertiaSolver
@@ -247,10 +247,6 @@ def solve_arc_length(model, *, U0=None, options: StaticOptions | None = None, ca
     step cannot converge even with the smallest arc length, or the path runs out of steps; ``.result``
     holds the last equilibrium (``converged=False``).
     """
-    if getattr(model, "friction", None) is not None:
-        raise ParameterError("solver.continuation", '"arc-length" does not commit the bending friction\'s slip along '
-                             'the path (bending hysteresis, material kes_2HB_*): use continuation = "load" or '
-                             'start = "relax"')
     opts = options or StaticOptions()
     if model.load_terms or not np.any(model.load):
         raise ValueError('solver.continuation = "arc-length" needs a fixed load vector (no end moments, not '

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
+from rftstatic.errors import ConvergenceError, InstabilityError, ParameterError, StepLimitError
 from rftstatic.model.state import State
 from rftstatic.solvers.checkpoint import as_state
 from rftstatic.solvers.continuation import solve_arc_length
@@ -91,6 +91,9 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
     else:
         try:
             if opts.increments.continuation == "arc-length":
+                if model.friction is not None:  # the path's points are not committed steps
+                    raise ParameterError("solver.continuation", '"arc-length" does not commit the bending friction\'s '
+                                         'slip (material kes_2HB_*): use continuation = "load" or start = "relax"')
                 result = solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state)
             else:
                 result = yield from load_steps(model, state, opts, U0=U0, callback=callback)
