@@ -194,8 +194,8 @@ def _with_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Material:
                              "for a direction without measurable hysteresis)")
     ratio = m.get("hysteresis_ratio", 10.0)
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 1.0 <= ratio <= 1e4:
-        raise ParameterError("hysteresis_ratio", f"{ratio!r} must be a number in [1, 1e4] (the friction element's stick "
-                             "stiffness over B; default 10)")
+        raise ParameterError("hysteresis_ratio", f"{ratio!r} must be a number in [1, 1e4] (the friction element's "
+                             "stick stiffness over B; default 10)")
     from dataclasses import replace
 
     return replace(material, hysteresis=mat.BendingHysteresis(si["M0_warp"], si["M0_weft"], float(ratio)))

@@ -25,13 +25,13 @@ constant acceleration (free fall gives ``z = z0 + V0 t - g t^2 / 2`` to round-of
 Energy bookkeeping (history): kinetic energy at step n from the mean of the two half-step
 velocities, potential = stored (bending + membrane + penalty) energy - P.D_n, dissipated = the work
 of the damping force ``sum alpha dt v_(n-1/2) M v_(n+1/2)`` plus, with bending hysteresis, the friction's
-(:mod:`rftstatic.element.hysteresis`, H4: its slip is committed after every step, each step a converged one). ``total`` = kinetic + potential +
-dissipated is conserved up to the scheme's O(dt^2) error without obstacles. The kinematic contact
-is not conservative: it removes the inward normal velocity (``contact_loss``, the kinetic energy
-removed, reported apart) and its position projection does work that is not tracked; on balance
-it lowers ``total``, by about ``contact_loss``. Growth of ``total`` beyond ``energy_tol`` times the
-energy scale of the run (or a non-finite
-value) raises :class:`InstabilityError` naming the time, the step and the step size to use.
+(:mod:`rftstatic.element.hysteresis`, H4: its slip is committed after every step, each step a converged one).
+``total`` = kinetic + potential + dissipated is conserved up to the scheme's O(dt^2) error without
+obstacles. The kinematic contact is not conservative: it removes the inward normal velocity
+(``contact_loss``, the kinetic energy removed, reported apart) and its position projection does work that is
+not tracked; on balance it lowers ``total``, by about ``contact_loss``. Growth of ``total`` beyond
+``energy_tol`` times the energy scale of the run (or a non-finite value) raises :class:`InstabilityError`
+naming the time, the step and the step size to use.
 """
 
 from __future__ import annotations
@@ -248,7 +248,8 @@ class _Loop:
             sample = step % sample_every == 0
             checked = sample or step % check_every == 0
             if checked:
-                f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
+                f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs,
+                                   slip=state.bending_slip)
             else:
                 f = self.kernel(U, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
             self._frames_due(t, U)

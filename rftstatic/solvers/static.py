@@ -461,7 +461,8 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
 
 def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None) -> bool:
     """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation);
-    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip (:meth:`~rftstatic.model.model.Model.tangent`)."""
+    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip
+    (:meth:`~rftstatic.model.model.Model.tangent`)."""
     if not solver.detects_indefinite:
         return True
     _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip)

@@ -138,8 +138,9 @@ def _stats(s: dict) -> dict:
         folds = [r["fold_count"] for r in good]
     else:
         dc, folds = [s["drape"]["drape_coefficient_percent"]], [s["drape"]["fold_count"]]
-    return {"dc": float(np.mean(dc)), "dc_min": float(min(dc)), "dc_max": float(max(dc)), "folds": float(np.mean(folds)),
-            "folds_min": min(folds), "folds_max": max(folds), "pairs": list(zip(dc, folds)), "n": len(dc)}
+    return {"dc": float(np.mean(dc)), "dc_min": float(min(dc)), "dc_max": float(max(dc)),
+            "folds": float(np.mean(folds)), "folds_min": min(folds), "folds_max": max(folds),
+            "pairs": list(zip(dc, folds)), "n": len(dc)}
 
 
 def _c(s: dict) -> float:
@@ -215,8 +216,9 @@ def _filled(s: dict) -> str:
 
 def _hysteresis(result, runs):
     """Part 3: the lab fabric without and with 2HB on three sizes, the 2HB sweep and the stick ratio."""
-    head = ("| fabric | specimen | 2HB warp / weft [gf cm/cm] | stick ratio | DC [%] mean (range) | nodes mean (range) | "
-            "dissipated [gf cm] | yielded share warp / weft | time [s] |\n|---|---|---|---|---|---|---|---|---|")
+    head = ("| fabric | specimen | 2HB warp / weft [gf cm/cm] | stick ratio | DC [%] mean (range) | "
+            "nodes mean (range) | dissipated [gf cm] | yielded share warp / weft | time [s] |\n"
+            "|---|---|---|---|---|---|---|---|---|")
     lines, filled = [head], None
     base = {}
     for label, s in runs.items():
@@ -268,6 +270,12 @@ def _literature() -> str:
             + f"\n\nMeasured rows in rftstatic.references.drape_literature.MEASURED_ROWS: {len(MEASURED_ROWS)}.")
 
 
+SCOPE = ("Measured with the current Cusick route (cases/cusick-*.toml: dynamic relaxation at full load, then Newton; "
+         "specimen = seeded start); the route is being reworked in another branch, so these numbers belong to this "
+         "commit's route. Not built, so not measured: nonlinear bending (the moment's fall-off with curvature, e.g. "
+         "the k2 of Feng et al.'s data set) and shear hysteresis (KES 2HG, 2HG5).")
+
+
 def run(quick: bool = False, *, out=None) -> BenchmarkResult:
     result = BenchmarkResult(
         name="measured_drape", title="Cusick drape: measured fabrics (none readable), trends, bending hysteresis",
@@ -282,11 +290,7 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
     failed = _trends(result, runs, quick)
     if not quick:
         _hysteresis(result, runs)
-    result.sections.append(("Route and scope", "Measured with the current Cusick route (cases/cusick-*.toml: "
-                            "dynamic relaxation at full load, then Newton; specimen = seeded start); the route is being "
-                            "reworked in another branch, so these numbers belong to this commit's route. Not built, "
-                            "so not measured: nonlinear bending (the moment's fall-off with curvature, e.g. the k2 of "
-                            "Feng et al.'s data set) and shear hysteresis (KES 2HG, 2HG5)."))
+    result.sections.append(("Route and scope", SCOPE))
     result.passed = not failed
     result.notes.append("trend checks failed: " + ", ".join(failed) if failed else "every trend check holds")
     return result
