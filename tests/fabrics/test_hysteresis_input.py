@@ -56,3 +56,13 @@ def test_checkpoint_keeps_the_slip_and_the_dissipation(tmp_path):
     back = restore_state(mod, saved)
     np.testing.assert_array_equal(back.bending_slip, state.bending_slip)
     assert back.dissipated == 1.25e-6
+
+
+def test_arc_length_route_is_refused_with_hysteresis():
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.schema import load_scene
+
+    table = "material={" + ", ".join(f"{k}={v}" for k, v in {**LAB, "kes_2HB_warp": 0.05,
+                                                             "kes_2HB_weft": 0.04}.items()) + "}"
+    with pytest.raises(SceneError, match=r"solver\.continuation: \"arc-length\" does not commit"):
+        build_model(load_scene("strip", [table, "solver.continuation=arc-length"]))
