@@ -38,6 +38,34 @@ def _orthotropic(d11, d22, d12, d33) -> np.ndarray:
 
 
 @dataclass(frozen=True)
+class BendingHysteresis:
+    """Bending hysteresis of a fabric: a friction moment per unit width in parallel with its bending rigidity
+    (:mod:`rftstatic.element.hysteresis`, Grosberg's model of the KES-FB2 loop).
+
+    Attributes
+    ----------
+    M0_warp, M0_weft : yield (friction) moment per unit width [N m/m]: half the KES loop width, ``2HB / 2``
+    ratio : stick stiffness over bending rigidity, ``K_k / B_k`` [-]; after a reversal the friction element
+        sticks over a curvature change ``2 M0 / K`` before it slips
+    """
+
+    M0_warp: float
+    M0_weft: float
+    ratio: float = 10.0
+
+    def __post_init__(self):
+        for key in ("M0_warp", "M0_weft"):
+            v = getattr(self, key)
+            if not (np.isfinite(v) and v >= 0):
+                raise ValueError(f"bending hysteresis {key} must be a finite number >= 0 [N m/m], got {v!r}")
+        if not (np.isfinite(self.ratio) and self.ratio > 0):
+            raise ValueError(f"bending hysteresis ratio must be a finite number > 0, got {self.ratio!r}")
+
+    def as_dict(self) -> dict:
+        return {"M0_warp_N": self.M0_warp, "M0_weft_N": self.M0_weft, "stick_ratio": self.ratio}
+
+
+@dataclass(frozen=True)
 class Material:
     """Membrane and bending rigidities in global axes, and the areal weight.
 
@@ -47,6 +75,7 @@ class Material:
     Db : (3, 3) bending rigidity in global axes [N m]
     weight : areal weight under standard gravity [N/m^2]
     name : label for summaries
+    hysteresis : bending hysteresis (:class:`BendingHysteresis`), or None (elastic bending)
     """
 
     Dm: np.ndarray
@@ -54,6 +83,7 @@ class Material:
     weight: float
     name: str = "material"
     info: dict = field(default_factory=dict)
+    hysteresis: BendingHysteresis | None = None
 
     def __post_init__(self):
         for key in ("Dm", "Db"):
@@ -100,6 +130,7 @@ class Material:
             "Dm_N_per_m": self.Dm.tolist(),
             "Db_N_m": self.Db.tolist(),
             "weight_N_per_m2": self.weight,
+            **({"bending_hysteresis": self.hysteresis.as_dict()} if self.hysteresis is not None else {}),
             **self.info,
         }
 

@@ -18,6 +18,8 @@ import logging
 import time
 from pathlib import Path
 
+import numpy as np
+
 from rftstatic.app.levels import remove_levels, solve_levels
 from rftstatic.app.result import RunResult
 from rftstatic.errors import ConvergenceError
@@ -81,6 +83,8 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         if result is None:
             raise
     summary = static_summary(scene, model, extras, result, build_time)
+    if model.friction is not None and state is not None:  # bending hysteresis: what the route dissipated
+        summary["bending_hysteresis"] = hysteresis_summary(scene, model, state, result.U)
     if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
         summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds)
     summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or resumed else None, "writes": saver.writes,
@@ -90,6 +94,16 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         raise error
     remove_levels(out)
     return RunResult(to_jsonable(summary), model, result.U, extras, out)
+
+
+def hysteresis_summary(scene, model, state, U) -> dict:
+    """The bending friction at the end of a solve (scene units): energy dissipated along the route, and the
+    share of element-directions (warp, weft) whose friction moment is at its yield M0 (slipping) [-]."""
+    fr = model.friction
+    moment = fr.moment(U, model.positions(U), state.bending_slip)
+    at_yield = np.abs(moment) >= fr.M0 * (1 - 1e-9)
+    return {"dissipated": scene.units.from_si(state.dissipated, "energy"),
+            "yielded_share_warp": float(at_yield[:, 0].mean()), "yielded_share_weft": float(at_yield[:, 1].mean())}
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:

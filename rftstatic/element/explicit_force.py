@@ -71,6 +71,9 @@ class ForceKernel:
         self.nodes = np.ascontiguousarray(mem.nodes, dtype=np.int64)
         self.G = np.ascontiguousarray(mem.G, dtype=float)
         self.threads = 1
+        self.friction = getattr(model, "friction", None)
+        if self.friction is not None:  # the bending friction's scatter
+            self._patch_dofs = (3 * self.friction.nodes[..., None] + np.arange(3)).ravel()
         if backend == "numpy":
             self._G_last = element_last(self.G)
             self._dofs = (3 * self.nodes.T[:, None, :] + np.arange(3)[:, None]).ravel()  # scatter of fe (A, 3, E)
@@ -95,12 +98,13 @@ class ForceKernel:
             self._tuner = ThreadTuner(self._run_threads) if tune else None
             self._nb_parallel = internal_force_parallel
 
-    def __call__(self, U: np.ndarray, *, energy: bool = False, candidates=None, pairs=None):
+    def __call__(self, U: np.ndarray, *, energy: bool = False, candidates=None, pairs=None, slip=None):
         """Internal force ``(N, 3)`` [N]; with ``energy=True`` also the stored energy [J].
 
         The stored energy is bending + membrane + penalty contact + self-contact (:meth:`Model.energies`);
         ``candidates`` is the solve's contact candidate list (a cache; None: every node), ``pairs`` its
-        self-contact pair cache (``State.self_pairs``; None: a fresh broad phase).
+        self-contact pair cache (``State.self_pairs``; None: a fresh broad phase), ``slip`` the committed
+        slip of the bending friction (``State.bending_slip``, :mod:`rftstatic.element.hysteresis`; numpy).
         """
         U = np.ascontiguousarray(U, dtype=float)
         if self.backend == "numba":
@@ -127,6 +131,11 @@ class ForceKernel:
                 fe, We = forces_numpy(self._G_last, self.nodes, self.area, self.Dm, U)
                 f += np.bincount(self._dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
                 W += float(We.sum()) if energy else 0.0
+        if self.friction is not None:
+            held = self.friction.initial_slip() if slip is None else slip
+            Wf, fe, _ = self.friction.evaluate(U, self.X3 + U, held)
+            f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
+            W += Wf if energy else 0.0
         if self.contact is not None:
             x = self.X3 + U
             f += self.contact.force(x, candidates=candidates)

@@ -18,6 +18,9 @@ kes_EMT_warp/weft  %                   C [gf/cm] = Fm / (EMT/100): the secant at
 kes_LT, kes_WT     -, gf cm/cm^2       without EMT: EMT/100 = 2 WT / (LT Fm)  (WT = LT Fm eps_m / 2), then as EMT
 kes_W              mg/cm^2             weight [gf/cm^2] = W / 1000  (mass per area under standard gravity)
 kes_T              mm                  thickness (self-contact default): T / 10 cm
+kes_2HB_warp/weft  gf cm/cm            bending hysteresis: the friction moment per width M0 = 2HB / 2 [gf cm/cm = gf]
+                                       of :mod:`rftstatic.element.hysteresis` (the KES-FB2 loop's width is 2HB);
+                                       the stick stiffness is ``hysteresis_ratio`` (default 10) times B
 =================  ==================  ===================================================================
 
 FAST (SiroFAST: De Boos & Tester 1994, CSIRO report WT92.02), key ``fast_*``:
@@ -60,7 +63,8 @@ prints these) and the bias k1 (it is a value of the repository's interpolation, 
 theory: turning it into a twisting rigidity would need the plate's compliance rotation, which the
 repository's law does not follow).
 
-What the linear model drops: the bending and shear hysteresis (KES 2HB, 2HG, 2HG5), the nonlinear
+What the model drops (bending hysteresis 2HB is an option, ``kes_2HB_*`` above): the shear hysteresis (KES 2HG,
+2HG5), the nonlinear
 shear curve beyond the small angles where G is measured (0.5-5 deg), the tensile curve's nonlinearity
 (the secant at Fm replaces it: crimp interchange makes the initial modulus far lower, so a drape that
 stretches little is too stiff in tension; drape is insensitive to it while C >> B / h^2), the
@@ -124,6 +128,8 @@ LAB_KEYS = {
     "kes_Fm": ("gf/cm", "KES-FB1 maximum tensile load (default 500)"),
     "kes_W": ("mg/cm^2", "KES mass per area"),
     "kes_T": ("mm", "KES-FB3 thickness at 0.5 gf/cm^2"),
+    "kes_2HB_warp": ("gf cm/cm", "KES-FB2 bending hysteresis (loop width at +-1 /cm), warp"),
+    "kes_2HB_weft": ("gf cm/cm", "KES-FB2 bending hysteresis, weft"),
     "fast_B_warp": ("uN m", "FAST-2 bending rigidity, warp"),
     "fast_B_weft": ("uN m", "FAST-2 bending rigidity, weft"),
     "fast_E100_warp": ("%", "FAST-3 extensibility at 100 gf/cm, warp"),
@@ -141,7 +147,7 @@ RANGES = {
     "kes_B_warp": (0.0005, 20.0), "kes_B_weft": (0.0005, 20.0), "kes_G": (0.02, 20.0),
     "kes_EMT_warp": (0.2, 60.0), "kes_EMT_weft": (0.2, 60.0), "kes_LT_warp": (0.2, 1.5), "kes_LT_weft": (0.2, 1.5),
     "kes_WT_warp": (0.5, 100.0), "kes_WT_weft": (0.5, 100.0), "kes_Fm": (5.0, 1000.0),
-    "kes_W": (0.3, 500.0), "kes_T": (0.05, 10.0),
+    "kes_W": (0.3, 500.0), "kes_T": (0.05, 10.0), "kes_2HB_warp": (0.0005, 20.0), "kes_2HB_weft": (0.0005, 20.0),
     "fast_B_warp": (0.05, 2000.0), "fast_B_weft": (0.05, 2000.0), "fast_E100_warp": (0.1, 60.0),
     "fast_E100_weft": (0.1, 60.0), "fast_G": (2.0, 2000.0), "fast_W": (3.0, 5000.0), "fast_T": (0.05, 10.0),
 }
@@ -166,6 +172,8 @@ QUANTITY_KEYS = {
     "C_weft": ("kes_EMT_weft", "kes_WT_weft", "fast_E100_weft"),
     "weight": ("kes_W", "fast_W", "ctd_density"),
     "thickness": ("kes_T", "fast_T"),
+    "M0_warp": ("kes_2HB_warp",),
+    "M0_weft": ("kes_2HB_weft",),
 }
 """Model quantity -> the lab keys that give it (one source per quantity)."""
 
@@ -249,7 +257,7 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
     -------
     si : dict
         ``{quantity: value}`` for the quantities given: ``B_warp, B_weft`` [N m], ``C_shear, C_warp,
-        C_weft`` [N/m], ``weight`` [N/m^2], ``thickness`` [m].
+        C_weft`` [N/m], ``weight`` [N/m^2], ``thickness`` [m], ``M0_warp, M0_weft`` [N m/m = N].
     record : dict
         ``{quantity: {"from": key, "value": lab value, "unit": lab unit, "rule": ...}}``.
 
@@ -291,4 +299,8 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
     for key in ("kes_T", "fast_T"):
         if key in lab:
             put("thickness", key, lab[key] * 1e-3, "mm")
+    for d in ("warp", "weft"):
+        if f"kes_2HB_{d}" in lab:
+            put(f"M0_{d}", f"kes_2HB_{d}", 0.5 * lab[f"kes_2HB_{d}"] * GF,
+                "friction moment per width M0 = 2HB / 2; gf cm/cm = gf = 9.80665e-3 N")
     return si, record

@@ -25,6 +25,7 @@ import numpy as np
 
 from rftstatic.compiled import choose_kernels
 from rftstatic.element.curvature import curvature_norm
+from rftstatic.element.hysteresis import bending_friction
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
 from rftstatic.material import Material
@@ -149,6 +150,10 @@ class Model(Frozen):
         self.patches = build_patches(mesh, clamped_nodes=self.supports.clamped)
         self.Kb = bending_stiffness(mesh, self.patches, material.Db)
         self.membrane = membrane_operator(element, mesh, self.patches)
+        h = material.hysteresis
+        self.friction = (None if h is None or h.M0_warp == h.M0_weft == 0.0 else bending_friction(
+            self.patches, mesh.area, material.Db, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
+            M0=(h.M0_warp, h.M0_weft), ratio=h.ratio))
         warnings = []
         if element == "RFT6" and self.with_membrane:
             lock = locking_number(mesh, material)
@@ -180,6 +185,10 @@ class Model(Frozen):
         # contiguous: scatter_matrices ravels it at every tangent (a strided copy took 3 x the scatter)
         return np.ascontiguousarray(self.plan.element_map(self.membrane.nodes))
 
+    @cached_property
+    def _patch_map(self) -> np.ndarray:
+        return np.ascontiguousarray(self.plan.element_map(self.patches.nodes))
+
     @property
     def X3(self) -> np.ndarray:
         """(N, 3) reference positions [m]."""
@@ -199,9 +208,13 @@ class Model(Frozen):
     # self-contact pair cache (State.self_pairs), or None to find the pairs afresh; it also carries the
     # solve's factor on the self-contact stiffness (State.self_contact_scale; 1 without a cache), which
     # results do depend on; ``branches``: the potential loads' committed branches (State.load_branches).
-    def energies(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None) -> dict:
-        """Parts of the total potential [J]: bending, membrane, contact, self-contact, external work, total."""
+    def energies(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None, slip=None) -> dict:
+        """Parts of the total potential [J]: bending, membrane, contact, self-contact, external work, total.
+        ``bending`` holds the bending friction's incremental potential (:mod:`rftstatic.element.hysteresis`, H3)
+        at the committed ``slip (E, 2)`` [1/m] (None: the virgin state), when the material has one."""
         Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
+        if self.friction is not None:
+            Eb += self._friction(U, slip)[0]
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
         Es = (self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).energy
@@ -214,9 +227,20 @@ class Model(Frozen):
         return {"bending": Eb, "membrane": Em, "contact": Ec, "self_contact": Es, "external_work": W,
                 "total": Eb + Em + Ec + Es - W}
 
-    def potential(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None) -> float:
+    def potential(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None, slip=None) -> float:
         """Total potential energy Pi(U) [J]."""
-        return self.energies(U, lam, candidates=candidates, pairs=pairs, branches=branches)["total"]
+        return self.energies(U, lam, candidates=candidates, pairs=pairs, branches=branches, slip=slip)["total"]
+
+    def _friction(self, U, slip, tangent=False, psd=False):
+        """The bending friction's energy [J], element forces (E, 6, 3) [N] and tangents (E, 6, 3, 6, 3) [N/m]."""
+        slip = self.friction.initial_slip() if slip is None else slip
+        return self.friction.evaluate(U, self.positions(U), slip, tangent=tangent, psd=psd)
+
+    def commit_slip(self, U, slip) -> tuple[np.ndarray, float]:
+        """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] from the committed ``slip (E, 2)``
+        [1/m]: the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
+        <rftstatic.element.hysteresis.BendingFriction.commit>`, H4)."""
+        return self.friction.commit(U, self.positions(U), slip)
 
     def load_branches(self, U, previous=None) -> tuple:
         """The branch of each potential load at the converged ``U (N, 3)`` [m], continuous from ``previous``
@@ -226,10 +250,12 @@ class Model(Frozen):
         x = self.positions(U)
         return tuple(t.branch(x, b) for t, b in zip(self.load_terms, previous or (None,) * len(self.load_terms)))
 
-    def internal_force(self, U, *, candidates=None, pairs=None) -> np.ndarray:
+    def internal_force(self, U, *, candidates=None, pairs=None, slip=None) -> np.ndarray:
         """Internal (bending + membrane + contact + self-contact) force ``(N, 3)`` [N], the gradient of
-        the stored energy."""
+        the stored energy (with the bending friction at the committed ``slip``, :meth:`energies`)."""
         f = self.Kb @ U
+        if self.friction is not None:
+            f += scatter_forces(self.patches.nodes, self._friction(U, slip)[1], self.mesh.n_nodes)
         if self.with_membrane:
             fe = self.membrane.element_forces(U, self.material.Dm, backend=self.membrane_backend)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
@@ -239,14 +265,14 @@ class Model(Frozen):
             f += self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).force
         return f
 
-    def residual(self, U, lam=1.0, *, candidates=None, pairs=None) -> np.ndarray:
+    def residual(self, U, lam=1.0, *, candidates=None, pairs=None, slip=None) -> np.ndarray:
         """Out-of-balance force ``dPi/dU (N, 3)`` [N]; zero at equilibrium on the free dofs."""
-        r = self.internal_force(U, candidates=candidates, pairs=pairs) - lam * self.load
+        r = self.internal_force(U, candidates=candidates, pairs=pairs, slip=slip) - lam * self.load
         for term in self.load_terms:
             r += lam * term.force(self.positions(U))
         return r
 
-    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None, stress=None, pairs=None):
+    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None, stress=None, pairs=None, slip=None):
         """Internal force ``(N, 3)`` [N] and tangent of the free dofs (CSR) [N/m] at load factor ``lam``.
 
         ``psd=True`` drops compressive stress from the geometric stiffness (positive semi-definite
@@ -256,12 +282,17 @@ class Model(Frozen):
 
         Self-contact couples nodes outside the patch pattern: its PSD pair blocks are added as a second
         sparse matrix (:meth:`_pair_matrix`), so the pattern of the result changes with the pairs in
-        contact (a sparse factorisation must redo its symbolic analysis then).
+        contact (a sparse factorisation must redo its symbolic analysis then). The bending friction (at the
+        committed ``slip``, :meth:`energies`) adds its consistent tangent on the patch pattern.
         """
         plan = self.plan
         data = self._bending_data.copy()
         f = self.Kb @ U
         x = self.positions(U)
+        if self.friction is not None:
+            _, fe, ke = self._friction(U, slip, tangent=True, psd=psd)
+            f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
+            data += scatter_matrices(self._patch_map, ke, plan.nnz)
         if self.with_membrane:
             fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress,
                                              backend=self.membrane_backend)

@@ -49,6 +49,11 @@ class State:
         directions in a row it has given: ``{"mode": "psd" | "shift", "rung": index into SHIFT_LADDER, "run": int}``; the next
         direction starts from it (:func:`~rftstatic.solvers.iteration.direction`); None after an exact or
         modified step
+    bending_slip : the committed slip curvature of the bending friction (E, 2) [1/m], warp and weft in material
+        axes (:mod:`rftstatic.element.hysteresis`, internal variable of the return mapping (H4)), set at every
+        converged step (:meth:`commit_slip`); None for a model without bending hysteresis
+    dissipated : energy dissipated by the bending friction since the flat start [J] (sum of (H4) over the
+        committed steps)
     route : the position of every route under way, keyed by route (:mod:`rftstatic.solvers.drive`): what a
         checkpoint of this State lets the route go on from (e.g. the load steps' next increment, the
         relaxation route's phase, an explicit run's records)
@@ -70,6 +75,8 @@ class State:
     modified_shift: float = 0.0
     fallback: dict | None = None
     route: dict = field(default_factory=dict)
+    bending_slip: np.ndarray | None = None
+    dissipated: float = 0.0
 
     @classmethod
     def initial(cls, model, U=None, V=None, *, t: float = 0.0, step: int = 0, lam: float = 1.0) -> State:
@@ -83,7 +90,20 @@ class State:
         candidates = model.contact.new_candidates() if model.contact is not None else None
         sc = getattr(model, "self_contact", None)
         pairs = sc.new_pairs() if sc is not None else None
-        return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates, self_pairs=pairs)
+        friction = getattr(model, "friction", None)
+        slip = friction.initial_slip() if friction is not None else None
+        return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates, self_pairs=pairs,
+                   bending_slip=slip)
+
+    def commit_slip(self, model, U=None) -> float:
+        """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] (default ``self.U``): the new
+        :attr:`bending_slip` and :attr:`dissipated` (:meth:`rftstatic.model.model.Model.commit_slip`); returns the
+        energy dissipated in the step [J] (0 without bending hysteresis)."""
+        if self.bending_slip is None:
+            return 0.0
+        self.bending_slip, d = model.commit_slip(self.U if U is None else U, self.bending_slip)
+        self.dissipated += d
+        return d
 
     @property
     def self_contact_scale(self) -> float:

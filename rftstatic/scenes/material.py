@@ -31,7 +31,7 @@ from rftstatic.units import UnitSystem, unit_system
 
 __all__ = ["build_material", "material_summary", "FABRIC_KEYS"]
 
-FABRIC_KEYS = set(mat._FABRIC_KINDS) | {"thickness"} | set(LAB_KEYS)
+FABRIC_KEYS = set(mat._FABRIC_KINDS) | {"thickness", "hysteresis_ratio"} | set(LAB_KEYS)
 """Keys of a fabric ``[material]`` table besides ``preset``, ``kind`` and ``warp_angle``."""
 
 _REQUIRED = ("C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "weight")
@@ -162,6 +162,7 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
         raise
     if "thickness" in si:
         material.info["thickness"] = si["thickness"]
+    material = _with_hysteresis(material, m, si)
     for q, rec in record.items():
         rec["si"] = si[q]
     if record:
@@ -171,6 +172,33 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
         material.info["preset"] = name
         material.info["changed"] = sorted(m)
     return material
+
+
+_SUMMARY_KINDS = {**mat._FABRIC_KINDS, "thickness": "length", "M0_warp": "force", "M0_weft": "force"}
+"""Unit kind of every quantity a lab record may convert (for the summary in scene units)."""
+
+
+def _with_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Material:
+    """``material`` with the bending hysteresis of ``kes_2HB_warp`` and ``kes_2HB_weft`` (both or neither; M0 =
+    2HB / 2 in ``si``) and ``hysteresis_ratio`` (:class:`rftstatic.material.BendingHysteresis`)."""
+    given = [d for d in ("warp", "weft") if f"M0_{d}" in si]
+    if not given:
+        if "hysteresis_ratio" in m:
+            raise ParameterError("hysteresis_ratio", f"{m['hysteresis_ratio']!r} is given without the hysteresis "
+                                 "itself: give kes_2HB_warp and kes_2HB_weft [gf cm/cm], or remove hysteresis_ratio")
+        return material
+    if len(given) == 1:
+        other = "weft" if given[0] == "warp" else "warp"
+        raise ParameterError(f"kes_2HB_{other}", f"missing: kes_2HB_{given[0]} = {m[f'kes_2HB_{given[0]}']!r} is given "
+                             f"without kes_2HB_{other} [gf cm/cm]; bending hysteresis needs both directions (0.0005 "
+                             "for a direction without measurable hysteresis)")
+    ratio = m.get("hysteresis_ratio", 10.0)
+    if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 1.0 <= ratio <= 1e4:
+        raise ParameterError("hysteresis_ratio", f"{ratio!r} must be a number in [1, 1e4] (the friction element's "
+                             "stick stiffness over B; default 10)")
+    from dataclasses import replace
+
+    return replace(material, hysteresis=mat.BendingHysteresis(si["M0_warp"], si["M0_weft"], float(ratio)))
 
 
 def build_material(scene) -> mat.Material:
@@ -234,14 +262,18 @@ def material_summary(scene, material: mat.Material) -> dict:
     out["Dm_global"] = (np.asarray(material.Dm) / u.line_force).tolist()
     out["Db_global"] = (np.asarray(material.Db) / u.moment).tolist()
     if "lab" in material.info:
-        kinds = {**mat._FABRIC_KINDS, "thickness": "length"}
         out["lab"] = {q: {**{k: v for k, v in rec.items() if k != "si"},
-                          "converted": u.from_si(rec["si"], kinds[q]), "converted_units": u.name}
+                          "converted": u.from_si(rec["si"], _SUMMARY_KINDS[q]), "converted_units": u.name}
                       for q, rec in material.info["lab"].items()}
     if "filled" in material.info:
         out["filled"] = {q: {"value": u.from_si(rec["si"], rec["kind"]), "unit": unit_label(u, rec["kind"]),
                              "rule": rec["rule"], "source": rec["source"]}
                          for q, rec in material.info["filled"].items()}
+    h = material.hysteresis
+    if h is not None:
+        out["bending_hysteresis"] = {"M0_warp": u.from_si(h.M0_warp, "force"), "M0_weft": u.from_si(h.M0_weft, "force"),
+                                     "unit": "force per width x length / length (gf in cm-gf-s: gf cm/cm)",
+                                     "stick_ratio": h.ratio, "model": "rftstatic.element.hysteresis"}
     for key in ("preset", "changed"):
         if key in material.info:
             out[key] = material.info[key]

@@ -137,6 +137,7 @@ SCHEMA = {
         "E": (NUM, "Young's modulus [force/area]"),
         "nu": (NUM, "Poisson ratio"),
         "thickness": (NUM, "shell thickness, or a fabric's (self-contact default) [length]"),
+        "hysteresis_ratio": (NUM, "bending hysteresis: stick stiffness / B (default 10; with kes_2HB_*)"),
         **{k: (NUM, f"{meaning} [{unit}], lab units whatever the scene's (rftstatic.fabrics.lab)")
            for k, (unit, meaning) in LAB_KEYS.items()},
     }, "fabric or shell rigidities; fabric lab data (KES-F kes_*, FAST fast_*)"),

@@ -87,7 +87,7 @@ CHECKPOINT_FORMAT = 2
 """Version of the one checkpoint layout (key ``checkpoint_format``): a State and a header."""
 
 SAVED = ("U", "V", "t", "step", "lam", "load_branches", "contact_history", "modes", "factorisations", "lm_scale",
-         "modified_shift", "fallback", "route")
+         "modified_shift", "fallback", "route", "bending_slip", "dissipated")
 """The :class:`~rftstatic.model.state.State` fields a checkpoint keeps (with ``self_contact_scale``); the
 contact candidate list, the self-contact pair cache and the linear solver are caches, made again."""
 

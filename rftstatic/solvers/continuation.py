@@ -145,7 +145,8 @@ class _Path:
         self.eps = float(getattr(model.contact, "smoothing", 0.0) or 0.0) if model.contact is not None else 0.0
 
     def point(self, U, lam) -> _Point:
-        _, K = self.model.tangent(U, lam=lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
+        _, K = self.model.tangent(U, lam=lam, candidates=self.state.candidates, pairs=self.state.self_pairs,
+                                  slip=self.state.bending_slip)
         return _Point(U, lam, K, self.inertia.factor(K))
 
     def tangent(self, pt: _Point, prev: _Point | None) -> None:
@@ -208,7 +209,8 @@ class _Path:
     def _converged(self, x: Iterate) -> bool:
         """The corrector's test: the residual at ``x`` within :meth:`tolerance`; evaluates and factorises the
         tangent there (the converged point keeps both: its inertia and the next predictor)."""
-        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
+        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.state.candidates, pairs=self.state.self_pairs,
+                                          slip=self.state.bending_slip)
         x.r = (f - x.lam * self.model.load).ravel()[self.free]
         x.rnorm = float(np.linalg.norm(x.r))
         if not np.isfinite(x.rnorm):
@@ -304,7 +306,8 @@ def _start(path, U, result) -> _Point:
     start, its = path.corrector(pt, 0.0, target=LAM_START, iterations=START_ITERATIONS)
     result.iterations += its
     if start is None:
-        r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs).ravel()[path.free]
+        r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs,
+                           slip=path.state.bending_slip).ravel()[path.free]
         raise ConvergenceError(f"arc-length start, load factor {LAM_START:g}: Newton did not converge in "
                                f"{START_ITERATIONS} iterations; |r| = {np.linalg.norm(r):.3e} N at the lifted start; "
                                "try solver.continuation = \"load\" (load steps) or solver.start = \"relax\"", None)
@@ -369,7 +372,8 @@ def _follow(path, pt, result, record, bar, callback):
                     lam_max = max(lam_max, pt.lam)
                     continue
             if ds < MIN_ARC:
-                r = path.model.residual(pt.U, pt.lam, candidates=path.state.candidates, pairs=path.state.self_pairs)
+                r = path.model.residual(pt.U, pt.lam, candidates=path.state.candidates, pairs=path.state.self_pairs,
+                                        slip=path.state.bending_slip)
                 raise ConvergenceError(
                     f"arc-length step {len(record['steps']) + 1}, load factor {pt.lam:.6g}: the corrector did not "
                     f"converge even with arc length {ds:.3g}; |r| = {np.linalg.norm(r.ravel()[path.free]):.3e} N at "

@@ -102,7 +102,8 @@ class LineSearch:
         record = {"alpha": alpha, "cap": cap, "mu": mu, "fresh": dn.fresh, "mode": dn.mode}
         if dn.fresh:
             self._trust_region(x.energy, Pi, alpha, slope, cap, dn.curvature)
-        r = model.residual(U, x.lam, candidates=state.candidates, pairs=state.self_pairs).ravel()[free]
+        r = model.residual(U, x.lam, candidates=state.candidates, pairs=state.self_pairs,
+                           slip=state.bending_slip).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r))
         if self.work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
@@ -153,8 +154,10 @@ def displacement_iterations(model, U, lam, opts, state, max_step) -> Iteration:
     # the final increment converges to the tight tolerance and may need longer
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
     U = U.copy()
-    parts = model.energies(U, lam, candidates=state.candidates, pairs=state.self_pairs, branches=state.load_branches)
-    r = model.residual(U, lam, candidates=state.candidates, pairs=state.self_pairs).ravel()[model.free.ravel()]
+    parts = model.energies(U, lam, candidates=state.candidates, pairs=state.self_pairs,
+                           slip=state.bending_slip, branches=state.load_branches)
+    r = model.residual(U, lam, candidates=state.candidates, pairs=state.self_pairs,
+                       slip=state.bending_slip).ravel()[model.free.ravel()]
     x = Iterate(U, lam, r, float(np.linalg.norm(r)), energy=parts["total"], energy_scale=energy_scale(parts))
     if not np.isfinite(x.rnorm):
         return Iteration(False, U, 0, x.rnorm, "non-finite residual")
@@ -178,13 +181,13 @@ def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_tr
     of the energies at ``U`` (computed when None)."""
     def parts_at(alpha):
         return model.energies(U + alpha * step, lam, candidates=state.candidates, pairs=state.self_pairs,
-                              branches=state.load_branches)
+                              slip=state.bending_slip, branches=state.load_branches)
 
     if not opts.line_search:
         return 1.0, parts_at(1.0)
     if scale is None:
         scale = energy_scale(model.energies(U, lam, candidates=state.candidates, pairs=state.self_pairs,
-                                            branches=state.load_branches))
+                                            slip=state.bending_slip, branches=state.load_branches))
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence

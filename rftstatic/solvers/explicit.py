@@ -24,13 +24,14 @@ constant acceleration (free fall gives ``z = z0 + V0 t - g t^2 / 2`` to round-of
 
 Energy bookkeeping (history): kinetic energy at step n from the mean of the two half-step
 velocities, potential = stored (bending + membrane + penalty) energy - P.D_n, dissipated = the work
-of the damping force ``sum alpha dt v_(n-1/2) M v_(n+1/2)``. ``total`` = kinetic + potential +
-dissipated is conserved up to the scheme's O(dt^2) error without obstacles. The kinematic contact
-is not conservative: it removes the inward normal velocity (``contact_loss``, the kinetic energy
-removed, reported apart) and its position projection does work that is not tracked; on balance
-it lowers ``total``, by about ``contact_loss``. Growth of ``total`` beyond ``energy_tol`` times the
-energy scale of the run (or a non-finite
-value) raises :class:`InstabilityError` naming the time, the step and the step size to use.
+of the damping force ``sum alpha dt v_(n-1/2) M v_(n+1/2)`` plus, with bending hysteresis, the friction's
+(:mod:`rftstatic.element.hysteresis`, H4: its slip is committed after every step, each step a converged one).
+``total`` = kinetic + potential + dissipated is conserved up to the scheme's O(dt^2) error without
+obstacles. The kinematic contact is not conservative: it removes the inward normal velocity
+(``contact_loss``, the kinetic energy removed, reported apart) and its position projection does work that is
+not tracked; on balance it lowers ``total``, by about ``contact_loss``. Growth of ``total`` beyond
+``energy_tol`` times the energy scale of the run (or a non-finite value) raises :class:`InstabilityError`
+naming the time, the step and the step size to use.
 """
 
 from __future__ import annotations
@@ -202,12 +203,12 @@ class _Loop:
     def begin(self, dt, *, start_consistent, state):
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
         self.dt = dt
-        self.acc = {"damping": 0.0, "contact": 0.0, "total0": None, "scale": 0.0, "peak_kinetic": 0.0,
+        self.acc = {"damping": 0.0, "friction": 0.0, "contact": 0.0, "total0": None, "scale": 0.0, "peak_kinetic": 0.0,
                     "frame_index": 0}
         self.hist = {k: [] for k in HISTORY_KEYS}
         self.probe_hist, self.frames = [], []
         if start_consistent:
-            f = self.kernel(state.U, candidates=state.candidates, pairs=state.self_pairs)
+            f = self.kernel(state.U, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
             a0 = (self.P - f) / self.mass[:, None] - self.alpha * state.V
             state.V = state.V - 0.5 * dt * a0 * self.free
 
@@ -247,9 +248,10 @@ class _Loop:
             sample = step % sample_every == 0
             checked = sample or step % check_every == 0
             if checked:
-                f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs)
+                f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs,
+                                   slip=state.bending_slip)
             else:
-                f = self.kernel(U, candidates=state.candidates, pairs=state.self_pairs)
+                f = self.kernel(U, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
             self._frames_due(t, U)
             # Eq. 20-21, with the damping force lagged half a step
             np.subtract(P, f, out=f)
@@ -279,6 +281,8 @@ class _Loop:
                     np.copyto(U, Ufix, where=~free)
             step += 1
             state.U, state.V, state.t, state.step = U, V, step * dt, step
+            if state.bending_slip is not None:
+                acc["friction"] = acc.get("friction", 0.0) + state.commit_slip(self.model, U)
             if stopped:
                 break
             if step < n_steps:
@@ -293,7 +297,7 @@ class _Loop:
     def final_sample(self, state, check):
         """The history sample (and any frame due) at the end state."""
         t, U, V, dt = state.t, state.U, state.V, self.dt
-        f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs)
+        f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
         self._frames_due(t, U)
         g = (self.P - f) * self.minv * dt
         Vend = V * (1.0 - self.alpha * dt) + g
@@ -308,7 +312,7 @@ def _sample(t, U, V, Vnew, W, P, g, dt, mass, minv, free, acc) -> dict:
     vbar = 0.5 * (V + Vnew)
     kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, vbar, vbar))
     ext = float(np.einsum("ni,ni->", P, U))
-    dissipated = acc["damping"]
+    dissipated = acc["damping"] + acc.get("friction", 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(free, g / (dt * np.where(minv > 0, minv, 1.0)), 0.0)
     return {"time": t, "kinetic": kinetic, "potential": W - ext, "strain": W, "external_work": ext,

@@ -160,6 +160,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                 U_prev, lam_prev = U, lam
                 lam, U = lam_next, nt.U
                 state.load_branches = model.load_branches(U, state.load_branches)  # angle-type potentials
+                state.commit_slip(model, U)  # bending hysteresis: the return mapping of the converged step
                 result.load_steps.append({"lam": lam, "iterations": nt.iterations, "residual": nt.residual,
                                           "increment": dlam, "scheme": nt.scheme})
                 result.U, result.lam, result.residual, result.stable = U, lam, nt.residual, nt.stable
@@ -266,7 +267,7 @@ def _first_increment(model, U, opts, state, target) -> float:
     if not np.any(P) or model.load_terms:
         return opts.increments.initial_increment
     try:
-        _, K = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs)
+        _, K = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
         du = np.zeros(3 * model.mesh.n_nodes)
         state.factorisations += 1
         du[free] = state.solver.solve(K, P)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError, InstabilityError, StepLimitError
+from rftstatic.errors import ConvergenceError, InstabilityError, ParameterError, StepLimitError
 from rftstatic.model.state import State
 from rftstatic.solvers.checkpoint import as_state
 from rftstatic.solvers.continuation import solve_arc_length
@@ -91,6 +91,9 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
     else:
         try:
             if opts.increments.continuation == "arc-length":
+                if model.friction is not None:  # the path's points are not committed steps
+                    raise ParameterError("solver.continuation", '"arc-length" does not commit the bending friction\'s '
+                                         'slip (material kes_2HB_*): use continuation = "load" or start = "relax"')
                 result = solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state)
             else:
                 result = yield from load_steps(model, state, opts, U0=U0, callback=callback)
@@ -158,7 +161,8 @@ def _check_stability(model, result, state):
     tangent positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver
     cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
     solver = state.solver
-    stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs)
+    stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs,
+                                  slip=state.bending_slip)
               if solver.detects_indefinite else None)
     return replace(result, stable=stable)
 
@@ -339,7 +343,8 @@ def _relax_route(model, opts, callback, state, first):
         if route.phase == "relax":
             yield from _relax_segment(model, opts, plan, route, fail, state, t0)
         final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
-        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, state.solver):
+        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, state.solver,
+                                                                           slip=state.bending_slip):
             route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
         handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest,
@@ -354,9 +359,12 @@ def _relax_route(model, opts, callback, state, first):
             handover["basin"] = route.tol_force < 1.0
             options = (polish if final else short.replace(max_continuations=FIRST_HANDOVER_CONTINUATIONS)
                        if first_try else basin if long_try else short)
+            history = state.bending_slip, state.dissipated  # committed by a converged Newton
             res = solve_load_steps(model, U0=route.U, options=options, callback=callback, state=state,
                                    iteration_fallback=final or long_try or first_try)
-            if first_try and not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs):
+            if first_try and not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
+                                                       slip=state.bending_slip):
+                state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
                 raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not a "
                                        "stable minimum", res)
         except ConvergenceError as exc:
@@ -364,7 +372,7 @@ def _relax_route(model, opts, callback, state, first):
             if final:
                 result = exc.result
                 if result is not None:  # write the relaxed shape at full load, labelled not converged
-                    r = model.residual(route.U, 1.0).ravel()[model.free.ravel()]
+                    r = model.residual(route.U, 1.0, slip=state.bending_slip).ravel()[model.free.ravel()]
                     result = replace(result, U=route.U, lam=1.0, residual=float(np.linalg.norm(r)))
                 raise fail(f"{exc} (after dynamic relaxation to t = {route.t_used:.3g} s, {info['steps']} steps; "
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
@@ -393,6 +401,7 @@ def _segment_state(model, state, route) -> State:
     seg = as_state(model, state.route.get(SEGMENT))
     if seg is None:
         seg = State.initial(model, route.U, route.V)
+        seg.bending_slip, seg.dissipated = state.bending_slip, state.dissipated  # the friction's history goes on
     state.route[SEGMENT] = seg
     return seg
 
@@ -430,6 +439,7 @@ def _relax_segment(model, opts, plan, route, fail, state, t0):
     except StepLimitError as exc:  # the stable step at this state collapsed (a stretched start)
         raise fail(f"dynamic relaxation cannot go on from t = {route.t_used:.3g} s: {exc}") from None
     del state.route[SEGMENT]
+    state.bending_slip, state.dissipated = seg.bending_slip, seg.dissipated
     route.U, route.V, route.peak, route.at_rest = rel.U, rel.V, rel.peak_kinetic, rel.converged
     route.t_used += rel.t
     route.info.update(time_s=route.t_used, steps=route.info["steps"] + rel.steps, at_rest=rel.converged,
@@ -462,6 +472,7 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     except StepLimitError as exc:
         raise fail(f"the guided dynamic relaxation cannot run: {exc}") from None
     del state.route[SEGMENT]
+    state.bending_slip, state.dissipated = seg.bending_slip, seg.dissipated
     route.U, route.V, route.peak, route.t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
     route.seed = guide.seed
     route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": guide.guide_folds, "weight": guide.guide_weight,
@@ -470,12 +481,13 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     yield _route_pause(route)
 
 
-def _positive_definite(model, U, solver, lam=1.0, pairs=None) -> bool:
+def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None) -> bool:
     """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation);
-    ``pairs``: a self-contact pair cache (:meth:`~rftstatic.model.model.Model.tangent`)."""
+    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip
+    (:meth:`~rftstatic.model.model.Model.tangent`)."""
     if not solver.detects_indefinite:
         return True
-    _, K = model.tangent(U, lam=lam, pairs=pairs)
+    _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip)
     try:
         solver.solve(K, np.zeros(K.shape[0]))
     except (NotPositiveDefinite, LinearSolveError):

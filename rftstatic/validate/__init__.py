@@ -9,6 +9,9 @@ Every benchmark is a module here with ``run(quick, *, out=None) -> BenchmarkResu
 - ``hang20``: the explicit dynamics of §4.6 against fine-mesh and small-step runs;
 - ``textile_tests``: the cantilever tester recovers the given bending rigidity; the Cusick tester's DC and folds
   against the mesh, the seed and the disc radius / bending length;
+- ``measured_drape``: Cusick DC and node count of published measured fabrics (none readable: the sources
+  searched are listed), the trends of the readable abstracts instead, and what bending hysteresis (KES 2HB)
+  changes;
 - ``peers``: the plates with scikit-fem's Morley and Argyris triangles (optional extra ``peers``) and
   the published ABAQUS S4R meshes of Sze et al. (2004), error and time side by side.
 
@@ -44,6 +47,7 @@ BENCHMARKS = {
     "path_following": "the load-scaled route alone (arc-length, levels) from the flat sheet on the §4 drapes",
     "self_contact": "self-contact: crossing pairs and smallest distance with and without it",
     "textile_tests": "cantilever bending tester and Cusick drape tester (ASTM D1388, BS 3356, BS 5058)",
+    "measured_drape": "Cusick DC: published measured fabrics (none readable), trends, bending hysteresis 2HB",
     "peers": "a general FE code (scikit-fem Morley/Argyris plates; cited ABAQUS S4R) next to RF triangles",
 }
 

@@ -126,7 +126,7 @@ class _VonMisesTruss:
     def positions(self, U):
         return self.X3 + U
 
-    def energies(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None):
+    def energies(self, U, lam=1.0, *, candidates=None, pairs=None, branches=None, slip=None):
         L = np.hypot(self.a, self.h + U[2, 2])
         E = self.EA / self.L0 * (L - self.L0) ** 2
         W = lam * float(np.sum(self.load * U))
@@ -144,7 +144,7 @@ class _VonMisesTruss:
     def residual(self, U, lam=1.0, **kw):
         return self.internal_force(U) - lam * self.load
 
-    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None, stress=None, pairs=None):
+    def tangent(self, U, *, psd=False, shift=0.0, lam=1.0, candidates=None, stress=None, pairs=None, slip=None):
         k = self.stiffness(U[2, 2])
         if psd:
             k = max(k, 0.0)
