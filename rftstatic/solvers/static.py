@@ -91,9 +91,8 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
     else:
         try:
             if opts.increments.continuation == "arc-length":
-                if model.friction is not None:  # the path's points are not committed steps
-                    raise ParameterError("solver.continuation", '"arc-length" does not commit the bending friction\'s '
-                                         'slip (material kes_2HB_*): use continuation = "load" or start = "relax"')
+                if model.friction is not None:  # the path's points are not committed steps (the scene says more)
+                    raise ParameterError("solver.continuation", '"arc-length" cannot carry bending hysteresis')
                 result = solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state)
             else:
                 result = yield from load_steps(model, state, opts, U0=U0, callback=callback)
@@ -184,14 +183,11 @@ RELAX_NEWTON_ITERATIONS = 10
 relaxation resumes; the final handover uses the solver's own budget."""
 
 FIRST_HANDOVER_CONTINUATIONS = 8
-"""Continuations of Newton from the first relaxed state (each a further ``2 x`` :data:`RELAX_NEWTON_ITERATIONS`
-displacement iterations, granted only while the energy still falls,
-:data:`~rftstatic.solvers.load_steps.FROM_STATE_PROGRESS`), after the mixed iteration's short try: on a flat
-energy the line-searched descent reaches the minimum the longer relaxation would have led it to, in a fraction
-of the time. Measured from the first relaxed state, each to the route's own equilibrium (total energy equal to
-1e-13): sphere-30 67 iterations (the relaxation took 13,285 explicit steps more before Newton converged),
-pedestal-round-50 116 (11,076 steps more), pedestal-square-80 165 (19,521 steps more). A result that is not a
-stable minimum (the exact tangent indefinite) is not taken: the relaxation goes on from the relaxed state."""
+"""Continuations of Newton from the first relaxed state (each ``2 x`` :data:`RELAX_NEWTON_ITERATIONS` more
+displacement iterations while the energy falls, :data:`~rftstatic.solvers.load_steps.FROM_STATE_PROGRESS`),
+after the mixed iteration's short try; the result counts only if it is a stable minimum. Measured to the route's
+own equilibrium (energy to 1e-13) in 67 iterations on sphere-30 (instead of 13,285 more explicit steps),
+116 on pedestal-round-50 (11,076 steps), 165 on pedestal-square-80 (19,521 steps)."""
 
 RELAX_BASIN_NEWTON_ITERATIONS = 40
 """Newton's ``max_iterations`` (80 at full load) from the first relaxed state whose exact tangent is
@@ -288,15 +284,13 @@ def _relax_then_newton(model, opts, callback, state, *, first=None):
     The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while
     the out-of-balance force is still of the order of the weight (``|r| < |P|``): Newton usually
     converges from there in a few iterations, and the slow tail of the relaxation (half of its steps
-    on a 33 x 33 drape) is skipped. Newton gets a short budget (:data:`RELAX_NEWTON_ITERATIONS`) and, at this
-    first handover, the line-searched displacement iteration after it, continued while the energy still falls
-    (:data:`FIRST_HANDOVER_CONTINUATIONS`); its result counts only if it is a stable minimum. When
-    it fails, the relaxation resumes (same displacements and velocities) in chunks of a few damping
-    times; after each chunk the tangent is factorised, and Newton tries again, with a longer budget
-    (:data:`RELAX_BASIN_NEWTON_ITERATIONS`), only when it is positive definite (the state is in the basin of a stable minimum: from an indefinite tangent, Newton walks
-    downhill for hundreds of iterations on the PSD tangent, to a point that need not be a minimum —
-    the 80 cm sheet did). The relaxation ends at rest at half the solver's ``rtol`` or at its time
-    limit; Newton then finishes with the solver's own budget.
+    on a 33 x 33 drape) is skipped. Newton gets a short budget (:data:`RELAX_NEWTON_ITERATIONS`), here continued
+    while the energy falls (:data:`FIRST_HANDOVER_CONTINUATIONS`; taken if a stable minimum). When it fails, the
+    relaxation resumes (same displacements and velocities) in chunks of a few damping times; after each chunk the
+    tangent is factorised, and Newton tries again (:data:`RELAX_BASIN_NEWTON_ITERATIONS`) only when it is positive
+    definite (in the basin of a stable minimum: from an indefinite tangent a short-budget Newton may walk to a
+    point that is no minimum). The relaxation ends at rest at half the solver's ``rtol`` or at its time limit;
+    Newton then finishes with the solver's own budget.
 
     A route (:mod:`rftstatic.solvers.drive`): its :class:`RelaxRoute` is ``state.route[RELAX_ROUTE]``, the
     explicit State of a segment under way ``state.route[SEGMENT]``. It pauses (final) after the failed load
@@ -496,10 +490,8 @@ def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None) -> bool
 
 
 def compare_with_static(model, U_relaxed, U_static=None) -> dict:
-    """Difference between a relaxed state and the static Newton solution (``solve_static`` if not given).
-
-    Returns ``{"max_difference": [m], "max_displacement": [m], "relative": [-]}``.
-    """
+    """Difference between a relaxed state and the static Newton solution (``solve_static`` if not given):
+    ``{"max_difference": [m], "max_displacement": [m], "relative": [-]}``."""
     if U_static is None:
         U_static = solve_static(model, options=StaticOptions(progress=False)).U
     d = float(np.linalg.norm(U_relaxed - U_static, axis=1).max())
