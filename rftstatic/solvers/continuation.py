@@ -145,8 +145,7 @@ class _Path:
         self.eps = float(getattr(model.contact, "smoothing", 0.0) or 0.0) if model.contact is not None else 0.0
 
     def point(self, U, lam) -> _Point:
-        _, K = self.model.tangent(U, lam=lam, candidates=self.state.candidates, pairs=self.state.self_pairs,
-                                  slip=self.state.bending_slip)
+        _, K = self.model.tangent(U, lam=lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
         return _Point(U, lam, K, self.inertia.factor(K))
 
     def tangent(self, pt: _Point, prev: _Point | None) -> None:
@@ -209,8 +208,7 @@ class _Path:
     def _converged(self, x: Iterate) -> bool:
         """The corrector's test: the residual at ``x`` within :meth:`tolerance`; evaluates and factorises the
         tangent there (the converged point keeps both: its inertia and the next predictor)."""
-        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.state.candidates, pairs=self.state.self_pairs,
-                                          slip=self.state.bending_slip)
+        f, x.tangent = self.model.tangent(x.U, lam=x.lam, candidates=self.state.candidates, pairs=self.state.self_pairs)
         x.r = (f - x.lam * self.model.load).ravel()[self.free]
         x.rnorm = float(np.linalg.norm(x.r))
         if not np.isfinite(x.rnorm):
@@ -306,8 +304,7 @@ def _start(path, U, result) -> _Point:
     start, its = path.corrector(pt, 0.0, target=LAM_START, iterations=START_ITERATIONS)
     result.iterations += its
     if start is None:
-        r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs,
-                           slip=path.state.bending_slip).ravel()[path.free]
+        r = model.residual(U, LAM_START, candidates=path.state.candidates, pairs=path.state.self_pairs).ravel()[path.free]
         raise ConvergenceError(f"arc-length start, load factor {LAM_START:g}: Newton did not converge in "
                                f"{START_ITERATIONS} iterations; |r| = {np.linalg.norm(r):.3e} N at the lifted start; "
                                "try solver.continuation = \"load\" (load steps) or solver.start = \"relax\"", None)
@@ -372,8 +369,7 @@ def _follow(path, pt, result, record, bar, callback):
                     lam_max = max(lam_max, pt.lam)
                     continue
             if ds < MIN_ARC:
-                r = path.model.residual(pt.U, pt.lam, candidates=path.state.candidates, pairs=path.state.self_pairs,
-                                        slip=path.state.bending_slip)
+                r = path.model.residual(pt.U, pt.lam, candidates=path.state.candidates, pairs=path.state.self_pairs)
                 raise ConvergenceError(
                     f"arc-length step {len(record['steps']) + 1}, load factor {pt.lam:.6g}: the corrector did not "
                     f"converge even with arc length {ds:.3g}; |r| = {np.linalg.norm(r.ravel()[path.free]):.3e} N at "
