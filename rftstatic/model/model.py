@@ -7,11 +7,13 @@ contact term. Its methods evaluate, for a displacement field ``U (N, 3)`` [m] an
 
     Pi(U) = E_b + E_m + E_c + E_s - lam P . U,
 
-``E_s`` the self-contact energy (:class:`rftstatic.contact.self_contact.law.SelfContact`, optional),
+``E_s`` the self-contact energy (:class:`rftstatic.contact.self_contact.law.SelfContact`, optional); with bending
+hysteresis (``material.hysteresis``, attribute ``friction``: :class:`rftstatic.element.hysteresis.BendingFriction`)
+E_b also holds the friction's incremental potential at the committed slip (``State.bending_slip``, keyword ``slip``),
 
 its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
 A Model is read-only once built (:class:`~rftstatic.model.frozen.Frozen`): what a solve advances or
-caches (``U``, the contact caches, the self-contact stiffness scale, the potential loads' branches)
+caches (``U``, the contact caches, the self-contact stiffness scale, the potential loads' branches, the slip)
 lives in its :class:`~rftstatic.model.state.State` and reaches these methods as keywords.
 """
 
