@@ -83,7 +83,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         if result is None:
             raise
     summary = static_summary(scene, model, extras, result, build_time)
-    if model.friction is not None and state is not None:  # bending hysteresis: what the route dissipated
+    if model.bending_friction is not None and state is not None:  # bending hysteresis: what the route dissipated
         summary["bending_hysteresis"] = hysteresis_summary(scene, model, state, result.U)
     if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
         summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds)
@@ -99,7 +99,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
 def hysteresis_summary(scene, model, state, U) -> dict:
     """The bending friction at the end of a solve (scene units): energy dissipated along the route, and the
     share of element-directions (warp, weft) whose friction moment is at its yield M0 (slipping) [-]."""
-    fr = model.friction
+    fr = model.bending_friction
     moment = fr.moment(U, model.positions(U), state.bending_slip)
     at_yield = np.abs(moment) >= fr.M0 * (1 - 1e-9)
     return {"dissipated": scene.units.from_si(state.dissipated, "energy"),

@@ -71,9 +71,9 @@ class ForceKernel:
         self.nodes = np.ascontiguousarray(mem.nodes, dtype=np.int64)
         self.G = np.ascontiguousarray(mem.G, dtype=float)
         self.threads = 1
-        self.friction = getattr(model, "friction", None)
-        if self.friction is not None:  # the bending friction's scatter
-            self._patch_dofs = (3 * self.friction.nodes[..., None] + np.arange(3)).ravel()
+        self.bending_friction = getattr(model, "bending_friction", None)
+        if self.bending_friction is not None:  # the bending friction's scatter
+            self._patch_dofs = (3 * self.bending_friction.nodes[..., None] + np.arange(3)).ravel()
         if backend == "numpy":
             self._G_last = element_last(self.G)
             self._dofs = (3 * self.nodes.T[:, None, :] + np.arange(3)[:, None]).ravel()  # scatter of fe (A, 3, E)
@@ -131,9 +131,9 @@ class ForceKernel:
                 fe, We = forces_numpy(self._G_last, self.nodes, self.area, self.Dm, U)
                 f += np.bincount(self._dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
                 W += float(We.sum()) if energy else 0.0
-        if self.friction is not None:
-            held = self.friction.initial_slip() if slip is None else slip
-            Wf, fe, _ = self.friction.evaluate(U, self.X3 + U, held)
+        if self.bending_friction is not None:
+            held = self.bending_friction.initial_slip() if slip is None else slip
+            Wf, fe, _ = self.bending_friction.evaluate(U, self.X3 + U, held)
             f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
             W += Wf if energy else 0.0
         if self.contact is not None:

@@ -153,7 +153,7 @@ class Model(Frozen):
         self.Kb = bending_stiffness(mesh, self.patches, material.Db)
         self.membrane = membrane_operator(element, mesh, self.patches)
         h = material.hysteresis
-        self.friction = (None if h is None or h.M0_warp == h.M0_weft == 0.0 else bending_friction(
+        self.bending_friction = (None if h is None or h.M0_warp == h.M0_weft == 0.0 else bending_friction(
             self.patches, mesh.area, material.Db, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
             M0=(h.M0_warp, h.M0_weft), ratio=h.ratio))
         warnings = []
@@ -215,7 +215,7 @@ class Model(Frozen):
         ``bending`` holds the bending friction's incremental potential (:mod:`rftstatic.element.hysteresis`, H3)
         at the committed ``slip (E, 2)`` [1/m] (None: the virgin state), when the material has one."""
         Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
-        if self.friction is not None:
+        if self.bending_friction is not None:
             Eb += self._friction(U, slip)[0]
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
@@ -235,14 +235,14 @@ class Model(Frozen):
 
     def _friction(self, U, slip, tangent=False, psd=False):
         """The bending friction's energy [J], element forces (E, 6, 3) [N] and tangents (E, 6, 3, 6, 3) [N/m]."""
-        slip = self.friction.initial_slip() if slip is None else slip
-        return self.friction.evaluate(U, self.positions(U), slip, tangent=tangent, psd=psd)
+        slip = self.bending_friction.initial_slip() if slip is None else slip
+        return self.bending_friction.evaluate(U, self.positions(U), slip, tangent=tangent, psd=psd)
 
     def commit_slip(self, U, slip) -> tuple[np.ndarray, float]:
         """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] from the committed ``slip (E, 2)``
         [1/m]: the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
         <rftstatic.element.hysteresis.BendingFriction.commit>`, H4)."""
-        return self.friction.commit(U, self.positions(U), slip)
+        return self.bending_friction.commit(U, self.positions(U), slip)
 
     def load_branches(self, U, previous=None) -> tuple:
         """The branch of each potential load at the converged ``U (N, 3)`` [m], continuous from ``previous``
@@ -256,7 +256,7 @@ class Model(Frozen):
         """Internal (bending + membrane + contact + self-contact) force ``(N, 3)`` [N], the gradient of
         the stored energy (with the bending friction at the committed ``slip``, :meth:`energies`)."""
         f = self.Kb @ U
-        if self.friction is not None:
+        if self.bending_friction is not None:
             f += scatter_forces(self.patches.nodes, self._friction(U, slip)[1], self.mesh.n_nodes)
         if self.with_membrane:
             fe = self.membrane.element_forces(U, self.material.Dm, backend=self.membrane_backend)
@@ -291,7 +291,7 @@ class Model(Frozen):
         data = self._bending_data.copy()
         f = self.Kb @ U
         x = self.positions(U)
-        if self.friction is not None:
+        if self.bending_friction is not None:
             _, fe, ke = self._friction(U, slip, tangent=True, psd=psd)
             f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
             data += scatter_matrices(self._patch_map, ke, plan.nnz)

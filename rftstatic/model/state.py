@@ -90,7 +90,7 @@ class State:
         candidates = model.contact.new_candidates() if model.contact is not None else None
         sc = getattr(model, "self_contact", None)
         pairs = sc.new_pairs() if sc is not None else None
-        friction = getattr(model, "friction", None)
+        friction = getattr(model, "bending_friction", None)
         slip = friction.initial_slip() if friction is not None else None
         return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates, self_pairs=pairs,
                    bending_slip=slip)

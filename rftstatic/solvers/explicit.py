@@ -203,8 +203,8 @@ class _Loop:
     def begin(self, dt, *, start_consistent, state):
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
         self.dt = dt
-        self.acc = {"damping": 0.0, "friction": 0.0, "contact": 0.0, "total0": None, "scale": 0.0, "peak_kinetic": 0.0,
-                    "frame_index": 0}
+        self.acc = {"damping": 0.0, "bending_friction": 0.0, "contact": 0.0, "total0": None, "scale": 0.0,
+                    "peak_kinetic": 0.0, "frame_index": 0}
         self.hist = {k: [] for k in HISTORY_KEYS}
         self.probe_hist, self.frames = [], []
         if start_consistent:
@@ -282,7 +282,7 @@ class _Loop:
             step += 1
             state.U, state.V, state.t, state.step = U, V, step * dt, step
             if state.bending_slip is not None:
-                acc["friction"] = acc.get("friction", 0.0) + state.commit_slip(self.model, U)
+                acc["bending_friction"] = acc.get("bending_friction", 0.0) + state.commit_slip(self.model, U)
             if stopped:
                 break
             if step < n_steps:
@@ -312,7 +312,7 @@ def _sample(t, U, V, Vnew, W, P, g, dt, mass, minv, free, acc) -> dict:
     vbar = 0.5 * (V + Vnew)
     kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, vbar, vbar))
     ext = float(np.einsum("ni,ni->", P, U))
-    dissipated = acc["damping"] + acc.get("friction", 0.0)
+    dissipated = acc["damping"] + acc.get("bending_friction", 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(free, g / (dt * np.where(minv > 0, minv, 1.0)), 0.0)
     return {"time": t, "kinetic": kinetic, "potential": W - ext, "strain": W, "external_work": ext,

@@ -91,7 +91,7 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
     else:
         try:
             if opts.increments.continuation == "arc-length":
-                if model.friction is not None:  # the path's points are not committed steps (the scene says more)
+                if model.bending_friction is not None:  # the path's points are not committed steps
                     raise ParameterError("solver.continuation", '"arc-length" cannot carry bending hysteresis')
                 result = solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state)
             else:

@@ -33,7 +33,7 @@ def _bent(mod, rng):
 
 def _mixed_slip(mod, U, rng):
     """A committed slip that leaves about half the element-directions sticking at ``U``."""
-    fr = mod.friction
+    fr = mod.bending_friction
     km = fr.curvature(U, mod.positions(U))[:, :2]
     return km + (fr.M0 / fr.K) * rng.uniform(-2.0, 2.0, size=km.shape)
 
@@ -45,8 +45,8 @@ def test_friction_force_and_tangent_are_derivatives_of_the_incremental_potential
     rng = np.random.default_rng(4)
     U = _bent(mod, rng)
     slip = _mixed_slip(mod, U, rng)
-    km = mod.friction.curvature(U, mod.positions(U))[:, :2]
-    stick = np.abs(km - slip) <= mod.friction.M0 / mod.friction.K
+    km = mod.bending_friction.curvature(U, mod.positions(U))[:, :2]
+    stick = np.abs(km - slip) <= mod.bending_friction.M0 / mod.bending_friction.K
     assert 0.2 < stick.mean() < 0.8  # both branches of (H2) are exercised
     h = 1e-7
     r = mod.residual(U, 0.6, slip=slip)
@@ -73,7 +73,7 @@ def test_psd_tangent_keeps_only_the_positive_part():
     rng = np.random.default_rng(6)
     U = _bent(mod, rng)
     slip = _mixed_slip(mod, U, rng)
-    _, fe, ke = mod.friction.evaluate(U, mod.positions(U), slip, tangent=True, psd=True)
+    _, fe, ke = mod.bending_friction.evaluate(U, mod.positions(U), slip, tangent=True, psd=True)
     k = ke.reshape(len(ke), 18, 18)
     assert np.linalg.eigvalsh(0.5 * (k + k.transpose(0, 2, 1))).min() > -1e-12 * np.abs(k).max()
 
@@ -85,7 +85,7 @@ def test_friction_curvature_is_invariant_and_its_force_turns_with_a_rigid_motion
     U = _bent(mod, rng)
     slip = _mixed_slip(mod, U, rng)
     x = mod.positions(U)
-    fr = mod.friction
+    fr = mod.bending_friction
     R = Rotation.from_rotvec([0.7, -1.1, 0.4]).as_matrix()
     x2 = x @ R.T + np.array([0.3, -2.0, 5.0])
     U2 = x2 - mod.X3
@@ -127,8 +127,8 @@ def _kes_loop(step_per_cm=0.01):
     for kappa in path:
         state.U = _cylinder(mod.X3, kappa) - mod.X3
         x = mod.positions(state.U)
-        K.append(mod.friction.curvature(state.U, x)[:, 0])
-        MF.append(mod.friction.moment(state.U, x, state.bending_slip)[:, 0])
+        K.append(mod.bending_friction.curvature(state.U, x)[:, 0])
+        MF.append(mod.bending_friction.moment(state.U, x, state.bending_slip)[:, 0])
         D.append(state.commit_slip(mod))
     return path, np.array(K), np.array(MF), np.array(D), mod, starts
 
@@ -152,7 +152,7 @@ def test_kes_pure_bending_loop_has_the_width_2hb_and_the_slope_b():
     slope = (M[i15] - M[i05]) / (path[i15] - path[i05])
     assert slope == pytest.approx(B_WARP, rel=5e-3)
     # on the first loading the friction element sticks over M0 / K, then slips: M_f = M0 from there on
-    fr = mod.friction
+    fr = mod.bending_friction
     first = np.arange(starts[0], starts[1])
     assert np.allclose(MF[first][path[first] > 2 * fr.M0[0] / fr.K[0], :][:, interior], fr.M0[0])
 
@@ -165,7 +165,7 @@ def test_dissipation_per_cycle_is_the_loop_area():
     dissipated = D[cycle][1:].sum()
     assert dissipated == pytest.approx(loop, rel=1e-3)
     # a parallelogram in (kappa, M_f): height 2 M0, base the swing less the stick span 2 M0 / K
-    fr = mod.friction
+    fr = mod.bending_friction
     interior = mod.patches.has_opposite.all(axis=1)
     per_area = np.trapezoid(MF[cycle][:, interior], K[cycle][:, interior], axis=0)
     span = np.ptp(K[cycle][:, interior], axis=0)
