@@ -84,17 +84,28 @@ def solve(sets: list) -> dict:
     return row
 
 
+LOG = None
+"""Where each row is appended as it is solved (JSON lines), so an interrupted study keeps its rows."""
+
+
+def _keep(row: dict):
+    if LOG is not None:
+        with open(LOG, "a") as f:
+            f.write(json.dumps(row, default=str) + "\n")
+
+
 def _runs(label: str, sets: list, seeds: list, rows: list, study: str):
     for seed in seeds:
         for route, rsets in ROUTES.items():
             r = solve([*sets, *rsets, f"solver.seed={seed}"])
             r.update(study=study, case=label, route_name=route, seed=seed)
             rows.append(r)
+            _keep(r)
             print(json.dumps({k: r.get(k) for k in ("study", "case", "route_name", "seed", "dc", "folds",
                                                      "energy_mJ", "explicit_steps", "time_s")}), flush=True)
 
 
-def study_rows(studies, seeds: int) -> list:
+def study_rows(studies, seeds: int, fabrics=None) -> list:
     rows = []
     if "routes" in studies:
         for a in AMPLITUDES:
@@ -102,12 +113,14 @@ def study_rows(studies, seeds: int) -> list:
                   "routes")
     if "fabrics" in studies:
         for label, sets in FABRICS:
-            _runs(label, sets, [1, 2], rows, "fabrics")
+            if fabrics is None or label in fabrics:
+                _runs(label, sets, list(range(1, min(seeds, 2) + 1)), rows, "fabrics")
     if "branches" in studies:
         for n in range(3, 13):
             r = solve(["solver.start=load-steps", "solver.perturbation=1.0", f"solver.perturbation_folds={n}"])
             r.update(study="branches", case=f"wool, {n}-fold lift", route_name="load steps", seed=1)
             rows.append(r)
+            _keep(r)
             print(json.dumps({k: r.get(k) for k in ("case", "dc", "folds", "energy_mJ", "time_s")}), flush=True)
     if "causes" in studies:
         for label, sets in CAUSES:
@@ -147,13 +160,16 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default=str(Path(__file__).resolve().parent.parent / "validation"))
     p.add_argument("--study", action="append", choices=["routes", "fabrics", "branches", "causes"])
-    p.add_argument("--seeds", type=int, default=5)
+    p.add_argument("--seeds", type=int, default=5, help="seeds of the routes study (the fabrics study: at most 2)")
+    p.add_argument("--fabric", action="append", help="only these rows of the fabrics study (their labels)")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     studies = args.study or ["routes", "fabrics", "branches", "causes"]
     t0 = time.perf_counter()
-    rows = study_rows(studies, args.seeds)
     out = Path(args.out)
+    global LOG
+    LOG = out / "cusick_route.jsonl"
+    rows = study_rows(studies, args.seeds, args.fabric)
     (out / "cusick_route.json").write_text(json.dumps({"scene": SCENE, "rows": rows}, indent=1, default=str))
     print("\n".join(table(rows)))
     print(f"\n{len(rows)} solves, {time.perf_counter() - t0:.0f} s", file=sys.stderr)
