@@ -105,7 +105,7 @@ def _runs(label: str, sets: list, seeds: list, rows: list, study: str):
                                                      "energy_mJ", "explicit_steps", "time_s")}), flush=True)
 
 
-def study_rows(studies, seeds: int, fabrics=None) -> list:
+def study_rows(studies, seeds: int, cases=None) -> list:
     rows = []
     if "routes" in studies:
         for a in AMPLITUDES:
@@ -113,7 +113,7 @@ def study_rows(studies, seeds: int, fabrics=None) -> list:
                   "routes")
     if "fabrics" in studies:
         for label, sets in FABRICS:
-            if fabrics is None or label in fabrics:
+            if cases is None or label in cases:
                 _runs(label, sets, list(range(1, min(seeds, 2) + 1)), rows, "fabrics")
     if "branches" in studies:
         for n in range(3, 13):
@@ -124,7 +124,8 @@ def study_rows(studies, seeds: int, fabrics=None) -> list:
             print(json.dumps({k: r.get(k) for k in ("case", "dc", "folds", "energy_mJ", "time_s")}), flush=True)
     if "causes" in studies:
         for label, sets in CAUSES:
-            _runs(label, sets, [1], rows, "causes")
+            if cases is None or label in cases:
+                _runs(label, sets, [1], rows, "causes")
     return rows
 
 
@@ -161,7 +162,7 @@ def main(argv=None) -> int:
     p.add_argument("--out", default=str(Path(__file__).resolve().parent.parent / "validation"))
     p.add_argument("--study", action="append", choices=["routes", "fabrics", "branches", "causes"])
     p.add_argument("--seeds", type=int, default=5, help="seeds of the routes study (the fabrics study: at most 2)")
-    p.add_argument("--fabric", action="append", help="only these rows of the fabrics study (their labels)")
+    p.add_argument("--case", action="append", help="only these cases of the fabrics and causes studies (labels)")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     studies = args.study or ["routes", "fabrics", "branches", "causes"]
@@ -169,7 +170,7 @@ def main(argv=None) -> int:
     out = Path(args.out)
     global LOG
     LOG = out / "cusick_route.jsonl"
-    rows = study_rows(studies, args.seeds, args.fabric)
+    rows = study_rows(studies, args.seeds, args.case)
     (out / "cusick_route.json").write_text(json.dumps({"scene": SCENE, "rows": rows}, indent=1, default=str))
     print("\n".join(table(rows)))
     print(f"\n{len(rows)} solves, {time.perf_counter() - t0:.0f} s", file=sys.stderr)
