@@ -59,6 +59,9 @@ TOOL_REPORTS = {
     "mesh_obstacles": "obstacles from triangle-mesh files: sphere-30 on icospheres against the analytic sphere "
                       "(convergence with the facet size, wall time), the crossing check, the box under the sheet, "
                       "ipctk against the project's distance kernels (tools/icosphere.py, tools/ipctk_compare.py)",
+    "cusick_route": "the Cusick tester's route: which drape the load steps and the dynamic relaxation find on "
+                    "cusick-30, their energies, fold counts over seeds, lift amplitudes, fabrics and model changes "
+                    "(tools/cusick_route_study.py)",
     "bench_profile": "where the paper scenes' time goes: bench profile by phase and the bench scenes table, the "
                      "three biggest cost centres (python -m rftstatic bench profile / bench scenes)",
 }
