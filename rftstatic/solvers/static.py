@@ -97,7 +97,8 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
             else:
                 result = yield from load_steps(model, state, opts, U0=U0, callback=callback)
         except ConvergenceError as exc:
-            if not opts.route.relax_fallback or model.load_terms or not np.any(model.load):
+            if (not opts.route.relax_fallback or model.load_terms or not np.any(model.load)
+                    or getattr(model.contact, "friction", None) is not None):  # relaxation is frictionless
                 raise
             log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
             result = yield from _relax_then_newton(model, opts, callback, state, first=exc)
