@@ -22,7 +22,7 @@ along ``n`` (F4). Newton's tangent and the stability check stay valid.
 
 After every converged state the lag is **committed** (:func:`commit`): the normal forces and normals are
 taken from the penalty at the new state; a node that slid (``y >= eps``) has its anchor brought along to
-``x - eps t`` (it trails the node at the slip length), a node that stuck keeps its anchor, so a sheet held by
+``x - 0.9 eps t`` (:data:`TRAIL`: it trails the node by about the slip length), a node that stuck keeps its anchor, so a sheet held by
 friction stays where it is instead of creeping by ``eps`` per solve; a node that leaves the obstacle drops out,
 one that arrives is anchored where it touched. The coefficient is the static one while a node sticks and the
 kinetic one once it has slid. The static route repeats Newton at the same load until the committed normal forces
@@ -40,7 +40,7 @@ import numpy as np
 
 __all__ = ["FrictionLaw", "friction_terms", "initial_lag", "commit"]
 
-SLIP_LENGTH = 1e-5
+SLIP_LENGTH = 1e-4
 """Default slip length ``eps`` of (F2) relative to the sheet's size: the tangential motion of a sticking node under
 the full friction force; a sheet held on an incline moves less than this share of its size."""
 
@@ -67,6 +67,12 @@ class FrictionLaw:
             object.__setattr__(self, name, v)
         if not (np.isfinite(self.eps) and self.eps > 0):
             raise ValueError(f"eps (the slip length) must be > 0 [m], got {self.eps!r}")
+
+
+TRAIL = 0.9
+"""A node that slid has its anchor brought to this share of the slip length ``eps`` behind it: the friction force
+stays at ``f1(0.9) = 0.99`` of ``mu lambda`` and the tangent along the slip keeps the curvature ``f0''(0.9 eps) =
+0.2 / eps`` (at ``eps`` itself it is 0, a singular tangent at every equilibrium a sheet slid into)."""
 
 
 def _mollifier(y, eps):
@@ -163,7 +169,7 @@ def commit(law: FrictionLaw, penalty, lag: dict, x: np.ndarray, lam: float = 1.0
         y = np.linalg.norm(ut, axis=1)
         sliding = y >= law.eps * (1 - 1e-12)
         a = lag["anchor"][j].copy()
-        a[sliding] = x[nodes[had]][sliding] - law.eps * ut[sliding] / y[sliding, None]
+        a[sliding] = x[nodes[had]][sliding] - TRAIL * law.eps * ut[sliding] / y[sliding, None]
         anchor[had] = a
         slid[had] = sliding | lag["slid"][j]
     new = _lag(law, nodes, obstacle, force, normal, anchor, slid, lam)

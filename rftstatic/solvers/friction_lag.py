@@ -22,7 +22,7 @@ KEY = "friction"
 LAG_ITERATIONS = 12
 """Most Newton solves at one load factor while the lag settles."""
 
-LAG_TOL = 1e-3
+LAG_TOL = 1e-2
 """The lag has settled when the normal forces changed by less than this share of the largest one and either no
 node changed between sticking and sliding or the last solve with the committed lag moved no node by more than the
 slip length (sliding nodes trail their anchors by it: the same state again)."""
@@ -65,6 +65,7 @@ def settle(model, state, nt, lam, solve):
     for k in range(LAG_ITERATIONS):
         lag, change = commit(law, model.contact, state.contact_history[KEY], model.positions(nt.U), lam)
         state.contact_history[KEY] = state.candidates.friction = lag
+        log.debug("friction lag %d at load factor %.6g: %s, moved %.3g m", k, lam, change, moved)
         if change["normal_force"] < LAG_TOL and (change["stick_changes"] == 0 or moved < law.eps):
             break  # a fixed point: the committed lag gives back the state it was committed at
         again = solve(nt.U)
@@ -92,3 +93,17 @@ def sliding_share(model, state) -> float:
     if lag is None or lag["nodes"].size == 0:
         return 0.0
     return float(np.mean(lag["slid"]))
+
+
+def explain(model, state, exc) -> None:
+    """Add to the message of a failed static solve ``exc`` (a ConvergenceError) what the friction did at the last
+    committed state: the share of its contact nodes that had slid and what that means."""
+    lag = state.contact_history.get(KEY) if law_of(model) is not None else None
+    if lag is None or lag["nodes"].size == 0 or "friction" in str(exc):
+        return
+    law = law_of(model)
+    exc.args = (f"{exc}. With friction (mu static {', '.join(f'{m:g}' for m in np.unique(law.mu_static))}, kinetic "
+                f"{', '.join(f'{m:g}' for m in np.unique(law.mu_kinetic))}) {sliding_share(model, state):.0%} of the "
+                f"{lag['nodes'].size} contact nodes had slid at the last equilibrium: where the tangential load exceeds "
+                "mu times the normal force (a sheet on a plane steeper than its friction angle) there is no static "
+                "equilibrium; run it as a dynamic scene, or raise contact.friction",) + exc.args[1:]

@@ -220,6 +220,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                     "solver.max_iterations")
     except ConvergenceError as exc:
         close_record(model, result, state, t0, exc)
+        friction_lag.explain(model, state, exc)
         raise
     finally:
         bar.close()

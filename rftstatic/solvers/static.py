@@ -162,7 +162,7 @@ def _check_stability(model, result, state):
     cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
     solver = state.solver
     stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs,
-                                  slip=state.bending_slip)
+                                  slip=state.bending_slip, candidates=state.candidates)
               if solver.detects_indefinite else None)
     return replace(result, stable=stable)
 
@@ -476,13 +476,13 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     yield _route_pause(route)
 
 
-def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None) -> bool:
+def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None, candidates=None) -> bool:
     """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation);
-    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip
-    (:meth:`~rftstatic.model.model.Model.tangent`)."""
+    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip, ``candidates``: the contact candidate
+    list with the lagged friction (:meth:`~rftstatic.model.model.Model.tangent`)."""
     if not solver.detects_indefinite:
         return True
-    _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip)
+    _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip, candidates=candidates)
     try:
         solver.solve(K, np.zeros(K.shape[0]))
     except (NotPositiveDefinite, LinearSolveError):

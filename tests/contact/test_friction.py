@@ -88,5 +88,94 @@ def test_a_sheet_above_its_friction_angle_has_no_equilibrium():
     mu = 0.4
     theta = 1.1 * np.degrees(np.arctan(mu))
     model = _incline(theta, mu)
-    with pytest.raises(ConvergenceError, match="friction does not hold the sheet.*no static equilibrium"):
+    with pytest.raises(ConvergenceError, match="friction.*no static equilibrium"):
         static.solve_static(model, options=static.StaticOptions(progress=False).replace(relax_fallback=False))
+
+
+# ------------------------------------------------------------------------------------------------ scenes
+def _case(tmp_path, *sets, name="incline"):
+    from rftstatic.cli import main
+
+    out = tmp_path / "run"
+    args = ["case", name, "--no-figures", "--out", str(out)]
+    for s in sets:
+        args += ["--set", s]
+    return main(args), out
+
+
+def test_the_incline_scene_stays_put_below_its_friction_angle_and_has_no_equilibrium_above(tmp_path, capsys):
+    import json
+
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.schema import load_scene
+
+    rc, out = _case(tmp_path)
+    assert rc == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["converged"] and s["stable_minimum"]
+    import meshio
+
+    m = meshio.read(out / "deformed.vtu")
+    model, _ = build_model(load_scene("incline"))
+    drift = np.abs(m.points[:, :2].mean(axis=0) - model.mesh.X[:, :2].mean(axis=0)).max()
+    assert drift < 1e-3 * 20.0  # cm: less than 1e-3 of the sheet's size
+    rc, _ = _case(tmp_path, "loads.gravity_tilt=24")  # 1.1 x the friction angle atan(0.4) = 21.8 deg
+    assert rc == 3
+    assert "no static equilibrium" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("sets, key", [
+    (["contact.friction=-0.1"], "contact.friction"),
+    (["contact.friction=nan"], "contact.friction"),
+    (["contact.friction_static=0.2", "contact.friction_kinetic=0.3"], "contact.friction_kinetic"),
+    (["solver.start=relax"], "contact.friction"),
+])
+def test_bad_friction_input_names_its_key(tmp_path, capsys, sets, key):
+    rc, _ = _case(tmp_path, *sets)
+    assert rc == 2 and key in capsys.readouterr().err
+
+
+def test_a_frictional_solve_interrupted_resumes_bit_identical(tmp_path):
+    """The lag (normal forces, anchors, sticking set) is State: a solve cut after an increment and resumed from
+    its checkpoint ends where the uninterrupted one did, to the bit."""
+    from rftstatic.app import static as app
+    from rftstatic.scenes.schema import load_scene
+
+    scene = load_scene("pedestal-square-20", ["mesh.nodes=[9,9]", "solver.start=load-steps", "contact.friction=0.3"])
+    full = app.run(scene, tmp_path / "full", progress=False, figures=False)
+    seen = []
+
+    def cut(lam, U):
+        seen.append(lam)
+        if len(seen) == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        app.run(scene, tmp_path / "cut", progress=False, figures=False, callback=cut, checkpoint_seconds=0.0)
+    resumed = app.run(scene, tmp_path / "cut", progress=False, figures=False, resume=True)
+    assert full.summary["converged"] and full.summary["stable_minimum"]
+    assert np.array_equal(resumed.U, full.U)
+
+
+@pytest.mark.parametrize("mu_s, mu_k", [(0.4, 0.4), (0.5, 0.3)])
+def test_explicit_sliding_on_an_incline_accelerates_at_g_sin_minus_mu_k_cos(mu_s, mu_k):
+    """The exact incline, explicit: at 1.2 x the static friction angle a sheet slides from rest with the
+    acceleration g (sin theta - mu_k cos theta) (within 2 %); at 0.9 x it does not move."""
+    from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit_options import ExplicitOptions
+
+    for factor in (1.2, 0.9):
+        theta = factor * np.arctan(mu_s)
+        model = _incline(np.degrees(theta), mu_s)
+        model = Model(model.mesh, model.material, supports=model.supports, load=model.load)  # kinematic contact
+        law = FrictionLaw(np.array([mu_s]), np.array([mu_k]), eps=1e-6)
+        T = 0.05
+        r = run_explicit(model, ExplicitOptions(t_end=T, alpha=0.0, progress=False, energy_check=False),
+                         obstacles=[Floor(0.0)], friction=law)
+        g = 9.80665
+        if factor > 1:  # the sheet's mean velocity grows by a dt every step (the positions lag it by a step)
+            expected = g * (np.sin(theta) - mu_k * np.cos(theta))
+            assert float(r.V[:, 0].mean()) / r.t == pytest.approx(expected, rel=0.02)
+            assert 2 * float(r.U[:, 0].mean()) / r.t**2 == pytest.approx(expected, rel=0.05)
+        else:
+            assert np.abs(r.U[:, :2]).max() < 1e-9
