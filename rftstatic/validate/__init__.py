@@ -59,6 +59,8 @@ TOOL_REPORTS = {
     "mesh_obstacles": "obstacles from triangle-mesh files: sphere-30 on icospheres against the analytic sphere "
                       "(convergence with the facet size, wall time), the crossing check, the box under the sheet, "
                       "ipctk against the project's distance kernels (tools/icosphere.py, tools/ipctk_compare.py)",
+    "friction_obstacles": "Coulomb friction against the exact incline (static lag and explicit impulses) and its "
+                          "cost on pedestal-square-20 (tools/friction_report.py)",
     "bench_profile": "where the paper scenes' time goes: bench profile by phase and the bench scenes table, the "
                      "three biggest cost centres (python -m rftstatic bench profile / bench scenes)",
 }
