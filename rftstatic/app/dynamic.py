@@ -43,8 +43,8 @@ from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
 from rftstatic.io.results import run_label, write_run_view
 from rftstatic.io.summary import self_contact_summary, self_intersection_summary, summary_header
 from rftstatic.post.probes import probe_interpolation
-from rftstatic.scenes.build import build_model
-from rftstatic.scenes.options import dynamics_options, static_options
+from rftstatic.scenes.build import build_model, contact_friction
+from rftstatic.scenes.options import contact_options, dynamics_options, static_options
 from rftstatic.model.state import State
 from rftstatic.solvers.checkpoint import CheckpointSaver, explicit_header, load_explicit_state
 from rftstatic.solvers.drive import drive
@@ -118,6 +118,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     analysis = scene.analysis
     o = dynamics_options(scene)
     obstacles = tuple(extras.get("obstacles", ()))
+    friction = contact_friction(scene, contact_options(scene), len(obstacles), model.mesh) if obstacles else None
     names, pnodes, pw = probe_interpolation(model.mesh, extras.get("probes", {}))
     t_end = o.t_end
     regular = np.linspace(0.0, t_end, o.samples + 1) if o.samples else np.zeros(0)
@@ -157,7 +158,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         every = checkpoint_steps(o.checkpoint_every, data["dt"])
         resumed_from, reason = state.t, "the step of the checkpoint's run"
         route = explicit_steps(model, state, options, obstacles=obstacles, frame_times=frame_times, probes=probe_nodes,
-                               callback=watch)
+                               callback=watch, friction=friction)
     else:
         if resume:
             log.warning("no checkpoint %s: starting the run from t = 0", ckpt_path)
@@ -173,7 +174,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
                                   max_steps_name=_limit_name(o, model.mesh.n_nodes), progress=progress)
         state = State.initial(model)
         route = explicit_steps(model, state, options, obstacles=obstacles, frame_times=save_times,
-                               probes=pnodes.ravel(), callback=watch, plan=plan)
+                               probes=pnodes.ravel(), callback=watch, plan=plan, friction=friction)
         reason = plan.reason
     saver = CheckpointSaver(ckpt_path, explicit_header(model, obstacles), every_steps=every, run=f"the {analysis} run")
     with saver.stopping():

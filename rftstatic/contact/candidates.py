@@ -28,6 +28,7 @@ class CandidateList:
         self._x = None  # (N, 3) positions at the refresh [m]
         self._gap = None  # (N,) distances at the refresh [m]
         self.pairs = None  # a law's pair list and the positions it was built at (rftstatic.contact.features)
+        self.friction = None  # the solve's lagged friction (State.contact_history["friction"], rftstatic.contact.friction)
 
     def reset(self, margin: float | None = None) -> None:
         """Forget the list (e.g. a new mesh); optionally a new ``margin`` [m]."""

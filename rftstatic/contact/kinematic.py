@@ -20,19 +20,27 @@ from rftstatic.contact.obstacles import Obstacle
 
 
 def kinematic_contact(
-    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray
+    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray, friction=None, dt: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, int]:
-    """Kinematic contact correction after an explicit step (§6.3).
+    """Kinematic contact correction after an explicit step (§6.3), with Coulomb friction impulses.
 
     Each penetrated node (``phi < 0``) is moved to its closest surface point ``x - phi n`` and the inward
-    part of its normal velocity is removed (``v <- v - min(v.n, 0) n``); tangential and outward
-    velocities are kept (frictionless, no rebound). Obstacles are treated one after the other.
+    part of its normal velocity is removed (``v <- v - min(v.n, 0) n``, no rebound): a normal impulse per unit
+    mass ``j = -min(v.n, 0)``. With friction the tangential velocity ``v_t`` then sticks (``v_t <- 0``) where
+    ``|v_t| <= mu_s j``, the impulse needed being within the static cone, and slides with the kinetic impulse
+    ``v_t <- v_t (1 - mu_k j / |v_t|)`` elsewhere; on a node resting under its weight ``j = g cos(theta) dt`` per
+    step, so a sheet on a plane steeper than its friction angle slides with ``g (sin theta - mu_k cos theta)``.
+    The step's tangential move is corrected by the friction's change of velocity times ``dt`` (the position
+    advances with the velocity friction leaves: a sticking node does not creep by ``g sin(theta) dt^2`` a step).
+    Without friction tangential and outward velocities are kept. Obstacles are treated one after the other.
 
     Parameters
     ----------
     obstacles : an obstacle or a sequence of them
     x : (N, 3) nodal positions at the end of the step [m]
     v : (N, 3) nodal velocities [m/s]
+    friction : :class:`rftstatic.contact.friction.FrictionLaw` (coefficients per obstacle), or None
+    dt : the step [s] whose tangential move friction corrects
 
     Returns
     -------
@@ -44,7 +52,7 @@ def kinematic_contact(
     x_new = _as_points(x).copy()
     v_new = _as_points(v, x_new.shape[0], name="v").copy()
     touched = np.zeros(x_new.shape[0], dtype=bool)
-    for ob in items:
+    for m, ob in enumerate(items):
         phi, normal = ob.signed_distance(x_new)
         act = phi < 0.0
         if not np.any(act):
@@ -52,7 +60,17 @@ def kinematic_contact(
         n = normal[act]
         x_new[act] -= phi[act, None] * n
         vn = np.einsum("ni,ni->n", v_new[act], n)
-        v_new[act] -= np.minimum(vn, 0.0)[:, None] * n
+        j = -np.minimum(vn, 0.0)  # normal impulse per unit mass [m/s]
+        v_new[act] += j[:, None] * n
+        if friction is not None and (friction.mu_static[m] > 0 or friction.mu_kinetic[m] > 0):
+            va = v_new[act]
+            vt = va - np.einsum("ni,ni->n", va, n)[:, None] * n
+            speed = np.linalg.norm(vt, axis=1)
+            stick = speed <= friction.mu_static[m] * j
+            scale = np.where(stick, 0.0, 1.0 - friction.mu_kinetic[m] * j / np.maximum(speed, 1e-300))
+            dv = (1.0 - np.maximum(scale, 0.0))[:, None] * vt
+            v_new[act] = va - dv
+            x_new[act] -= dt * dv
         touched |= act
     return x_new, v_new, int(np.count_nonzero(touched))
 

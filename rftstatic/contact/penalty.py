@@ -132,8 +132,9 @@ class PenaltyContact(Frozen):
     """
 
     def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float,
-                 smoothing: float = 0.0, sheet=None):
+                 smoothing: float = 0.0, sheet=None, friction=None):
         self.obstacles = _as_list(obstacles)
+        self.friction = friction  # a rftstatic.contact.friction.FrictionLaw, lagged through the candidate list
         self.smoothing = _positive("smoothing", smoothing, allow_zero=True)
         area = np.asarray(node_area, dtype=float)
         if area.ndim != 1:
@@ -227,6 +228,15 @@ class PenaltyContact(Frozen):
             energy += fs.energy
             force += fs.force
             pairs = (fs.rows, fs.cols, fs.blocks) if len(fs.rows) else None
+        lag = getattr(candidates, "friction", None)
+        if lag is not None:
+            from rftstatic.contact.friction import friction_terms
+
+            ef, ff, kf = friction_terms(lag, x, tangent=tangent)
+            energy += ef
+            force += ff
+            if tangent:
+                blocks += kf
         return ContactState(energy, force, blocks, gap, active, pairs)
 
     def _near(self, x, candidates):
@@ -291,6 +301,11 @@ class PenaltyContact(Frozen):
             force[cand] = np.einsum("n,mn,mni->ni", self.stiffness * self.node_area[cand], d1, normal)
         if self.features is not None:
             force += self.features.evaluate(x, tangent=False, cache=candidates).force
+        lag = getattr(candidates, "friction", None)
+        if lag is not None:
+            from rftstatic.contact.friction import friction_terms
+
+            force += friction_terms(lag, x, tangent=False)[1]
         return force
 
     def tangent_blocks(self, x: np.ndarray, *, candidates: CandidateList | None = None) -> np.ndarray:

@@ -246,7 +246,13 @@ def build_load(scene: Scene, mesh, material) -> np.ndarray:
     loads = scene.get("loads", {"gravity": True})
     P = np.zeros((mesh.n_nodes, 3))
     if loads.get("gravity", False):
-        P += gravity_load(mesh, material.weight)
+        w = gravity_load(mesh, material.weight)
+        tilt = float(loads.get("gravity_tilt", 0.0))
+        if not (math.isfinite(tilt) and -90.0 < tilt < 90.0):
+            raise scene.error("loads.gravity_tilt", f"must be an angle in (-90, 90) degrees, got {tilt!r}")
+        th = math.radians(tilt)
+        P[:, 0] -= w[:, 2] * math.sin(th)  # downhill along +x in the inclined plane's frame
+        P[:, 2] += w[:, 2] * math.cos(th)
     if "pressure" in loads:
         P += gravity_load(mesh, units.to_si(loads["pressure"], "pressure"))
     for i, spec in enumerate(loads.get("point", [])):
@@ -307,7 +313,8 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
         return None, []
     check_surface_obstacles(scene, mesh, obstacles, law)
     c = contact_options(scene)
-    hold = c.hold_inplane
+    friction = contact_friction(scene, c, len(obstacles), mesh)
+    hold = c.hold_inplane if c.hold_inplane is not None else friction is None
     if law == "kinematic":
         if hold and scene.analysis == "relax":
             hold_inplane_rigid_modes(mesh, supports)
@@ -321,7 +328,29 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
                          weight=max(material.weight, 1e-300), h=h, factor=c.factor)
     if hold:
         hold_inplane_rigid_modes(mesh, supports)
-    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh), obstacles
+    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh,
+                          friction=friction), obstacles
+
+
+def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
+    """The scene's Coulomb friction law (:class:`rftstatic.contact.friction.FrictionLaw`), or None when
+    frictionless: lagged on the static load-step route, impulses in a dynamic run (relaxation refuses it)."""
+    mu_s = c.friction if c.friction_static is None else c.friction_static
+    mu_k = c.friction if c.friction_kinetic is None else c.friction_kinetic
+    if mu_s == 0.0 and mu_k == 0.0:
+        return None
+    if mu_k > mu_s:
+        raise scene.error("contact.friction_kinetic", f"the kinetic coefficient {mu_k:g} exceeds the static one "
+                          f"{mu_s:g}; give friction_kinetic <= friction_static")
+    static = scene.analysis == "static" and static_options(scene, progress=False).route.start == "load-steps"
+    if not (static or scene.analysis == "dynamic"):
+        raise scene.error("contact.friction", "friction acts on the static load-step route (analysis = \"static\", "
+                          'solver.start = "load-steps") and in dynamic runs (analysis = "dynamic"); dynamic '
+                          "relaxation is frictionless in this version: set contact.friction = 0 for it")
+    from rftstatic.contact.friction import SLIP_LENGTH, FrictionLaw
+
+    size = float(np.ptp(mesh.X, axis=0).max())
+    return FrictionLaw(np.full(n_obstacles, mu_s), np.full(n_obstacles, mu_k), eps=SLIP_LENGTH * size)
 
 
 OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z", "translate": "xyz"}

@@ -31,10 +31,18 @@ class ContactOptions:
                                    "element size, times contact.factor)", kind="float",
                                    unit="stiffness_volumetric", low=0.0, open_low=True)
     factor: float = option(1.0, "multiplier of the automatic penalty", low=0.0, open_low=True)
-    hold_inplane: bool = option(True, "hold the in-plane rigid modes of a sheet on a frictionless support")
+    hold_inplane: bool | None = option(None, 'hold the in-plane rigid modes of a sheet on its support ("auto": '
+                                       "yes on a frictionless support, no with friction, which holds them)",
+                                       kind="bool")
     smoothing: float = option(0.05, "width of the C2 penalty onset (0: the plain quadratic penalty); the sheet "
                               "rests about that far above the obstacle", unit="element_sizes", low=0.0,
                               high=MAX_SMOOTHING)
+    friction: float = option(0.0, "Coulomb friction coefficient mu of the sheet on the obstacles, static and "
+                             "kinetic (0: frictionless)", low=0.0)
+    friction_static: float | None = option(None, 'static friction coefficient ("auto": contact.friction)',
+                                           kind="float", low=0.0)
+    friction_kinetic: float | None = option(None, 'kinetic friction coefficient ("auto": contact.friction), at '
+                                            "most the static one", kind="float", low=0.0)
     self: bool = option(False, "self-contact of the sheet: its layers never pass through each other")
     self_thickness: float | None = option(None, 'self-contact thickness ("auto": material.thickness, else '
                                           "0.05 cm); below half the smallest edge", kind="float", unit="length",

@@ -151,6 +151,8 @@ SCHEMA = {
     }], "prescribed (zero) displacements"),
     "loads": ({
         "gravity": (bool, "the material's weight, along -z"),
+        "gravity_tilt": (NUM, "tilt of the weight about the y axis [deg], towards +x: the sheet on a plane "
+                              "inclined by this angle, in the plane's frame (the incline scene)"),
         "pressure": (NUM, "uniform transverse load along -z [force/area]"),
         "point": ([{"at": (PointsXY(), "[x, y]"), "force": (XYZ, "[fx, fy, fz]")}], "nodal forces"),
         "edge": ([{"box": (BOX, "[xmin, xmax, ymin, ymax]"),

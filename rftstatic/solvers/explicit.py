@@ -102,15 +102,16 @@ accumulators, history, probe records, frames and options (what a resumed run con
 
 
 def run_explicit(model, options: ExplicitOptions, *, U0=None, V0=None, obstacles=(), load=None, frame_times=(),
-                 probes=None, callback=None, plan: StepPlan | None = None) -> ExplicitResult:
+                 probes=None, callback=None, plan: StepPlan | None = None, friction=None) -> ExplicitResult:
     """Integrate the motion of ``model`` from t = 0 to ``options.t_end`` (module docstring): :func:`explicit_steps`
     from ``U0``, ``V0`` (N, 3) [m, m/s] (default zero), run to its end without checkpoints."""
     return finish(explicit_steps(model, State.initial(model, U0, V0), options, obstacles=obstacles, load=load,
-                                 frame_times=frame_times, probes=probes, callback=callback, plan=plan))
+                                 frame_times=frame_times, probes=probes, callback=callback, plan=plan,
+                                 friction=friction))
 
 
 def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(), load=None, frame_times=(),
-                   probes=None, callback=None, plan: StepPlan | None = None):
+                   probes=None, callback=None, plan: StepPlan | None = None, friction=None):
     """The explicit run as a route (:mod:`rftstatic.solvers.drive`): steps ``state`` to ``options.t_end``, pausing
     after every whole step; returns the :class:`ExplicitResult`.
 
@@ -130,6 +131,7 @@ def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(
         values); returning True stops the run
     plan : the :class:`~rftstatic.solvers.step_plan.StepPlan` of this run, made by the caller with
         :func:`~rftstatic.solvers.step_plan.plan_steps` from the same options (default: planned here)
+    friction : Coulomb friction of the kinematic obstacles (:class:`rftstatic.contact.friction.FrictionLaw`), or None
     """
     o = options
     wall0 = time.perf_counter()
@@ -139,7 +141,7 @@ def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(
     if probes.size and (probes.min() < 0 or probes.max() >= N):
         raise ValueError(f"probe nodes must lie in 0..{N - 1}, got min {probes.min()}, max {probes.max()}")
     loop = _Loop(model, obstacles, mass_scale=o.mass_scale, alpha=o.alpha, load=load, backend=o.backend,
-                 probes=probes, frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()))
+                 probes=probes, frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()), friction=friction)
     saved = state.route.get(EXPLICIT)
     if saved is None:
         state.V *= model.free
@@ -183,8 +185,8 @@ class _Loop:
     """The central-difference loop of :func:`run_explicit` (Eq. 20-22) and its bookkeeping: energy
     accumulators, history samples, probe records and frames. The solve's state is a :class:`State`."""
 
-    def __init__(self, model, obstacles, *, mass_scale, alpha, load, backend, probes, frame_times):
-        self.model, self.obstacles, self.alpha = model, obstacles, alpha
+    def __init__(self, model, obstacles, *, mass_scale, alpha, load, backend, probes, frame_times, friction=None):
+        self.model, self.obstacles, self.alpha, self.friction = model, obstacles, alpha, friction
         self.free = model.free
         self.mass = lumped_mass(model, mass_scale)
         self.kernel = ForceKernel(model, backend=backend)
@@ -276,7 +278,7 @@ class _Loop:
             # Eq. 22
             U += dt * V
             if self.obstacles:
-                self.n_contact = _contact(self.model, self.obstacles, U, V, mass, acc)
+                self.n_contact = _contact(self.model, self.obstacles, U, V, mass, acc, self.friction, dt, self.P)
                 if fixed_any:
                     np.copyto(U, Ufix, where=~free)
             step += 1
@@ -312,7 +314,7 @@ def _sample(t, U, V, Vnew, W, P, g, dt, mass, minv, free, acc) -> dict:
     vbar = 0.5 * (V + Vnew)
     kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, vbar, vbar))
     ext = float(np.einsum("ni,ni->", P, U))
-    dissipated = acc["damping"] + acc.get("bending_friction", 0.0)
+    dissipated = acc["damping"] + acc.get("bending_friction", 0.0) + acc.get("projection", 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(free, g / (dt * np.where(minv > 0, minv, 1.0)), 0.0)
     return {"time": t, "kinetic": kinetic, "potential": W - ext, "strain": W, "external_work": ext,
@@ -356,11 +358,14 @@ def _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, ene
         t=rec["time"], step=step, dt=dt, suggested_dt=suggested)
 
 
-def _contact(model, obstacles, U, V, mass, acc) -> int:
+def _contact(model, obstacles, U, V, mass, acc, friction=None, dt=0.0, P=None) -> int:
     from rftstatic.contact.kinematic import kinematic_contact
 
     X3 = model.X3
-    x_new, v_new, n_active = kinematic_contact(obstacles, X3 + U, V)
+    x_new, v_new, n_active = kinematic_contact(obstacles, X3 + U, V, friction, dt)
+    if n_active and P is not None:  # the load's work on the projection's moves: a work term of the balance (a
+        # sheet resting on an obstacle at the start would otherwise gain P . dx a step against its tiny scale)
+        acc["projection"] = acc.get("projection", 0.0) + float(np.einsum("ni,ni->", P, (x_new - X3 - U) * model.free))
     if n_active:
         # the projection along the normal must not give a supported dof a velocity (a node held in
         # x, y on a sphere would otherwise keep a spurious, never damped in-plane speed)

@@ -26,6 +26,7 @@ from rftstatic.progress import Progress
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 from rftstatic.model.state import State
 from rftstatic.solvers.newton import StaticResult, close_record, newton, start_state
+from rftstatic.solvers import friction_lag
 from rftstatic.solvers.drive import Pause, finish
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import start_perturbation
@@ -114,6 +115,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
     result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
     lam = 0.0
     mixed = opts.newton.iteration == "mixed" and model.with_membrane
+    friction_lag.link(model, state, U)
     if resume is None:
         dlam = _first_increment(model, U, opts, state, target)
         U_prev, lam_prev = None, None  # previous equilibrium, for the secant predictor
@@ -142,6 +144,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
             # the mixed iteration starts from the last equilibrium itself: its first step there is the
             # tangent predictor (a secant start stretches a stiff membrane: the 21 x 5 RFT6 strip at
             # C/B = 1e9 /cm^2 took 177 iterations from it, 38 from the equilibrium)
+            friction_lag.predict(model, state, lam_next)
             nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement" if fallback else None)
             continuing = None
             result.iterations += nt.iterations
@@ -155,6 +158,10 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                          lam_next, nt.reason, nt.residual)
                 nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement")
                 result.iterations += nt.iterations
+            if nt.converged and friction_lag.law_of(model) is not None:  # the lagged friction settles here
+                nt, its = friction_lag.settle(model, state, nt, lam_next, lambda V: newton(
+                    model, V, lam_next, opts.newton, state, max_step, scheme="displacement"))
+                result.iterations += its
             if nt.converged:
                 continuations = 0
                 U_prev, lam_prev = U, lam
@@ -213,6 +220,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                     "solver.max_iterations")
     except ConvergenceError as exc:
         close_record(model, result, state, t0, exc)
+        friction_lag.explain(model, state, exc)
         raise
     finally:
         bar.close()

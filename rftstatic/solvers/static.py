@@ -97,7 +97,8 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
             else:
                 result = yield from load_steps(model, state, opts, U0=U0, callback=callback)
         except ConvergenceError as exc:
-            if not opts.route.relax_fallback or model.load_terms or not np.any(model.load):
+            if (not opts.route.relax_fallback or model.load_terms or not np.any(model.load)
+                    or getattr(model.contact, "friction", None) is not None):  # relaxation is frictionless
                 raise
             log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
             result = yield from _relax_then_newton(model, opts, callback, state, first=exc)
@@ -161,7 +162,7 @@ def _check_stability(model, result, state):
     cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
     solver = state.solver
     stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs,
-                                  slip=state.bending_slip)
+                                  slip=state.bending_slip, candidates=state.candidates)
               if solver.detects_indefinite else None)
     return replace(result, stable=stable)
 
@@ -475,13 +476,13 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     yield _route_pause(route)
 
 
-def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None) -> bool:
+def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None, candidates=None) -> bool:
     """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation);
-    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip
-    (:meth:`~rftstatic.model.model.Model.tangent`)."""
+    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip, ``candidates``: the contact candidate
+    list with the lagged friction (:meth:`~rftstatic.model.model.Model.tangent`)."""
     if not solver.detects_indefinite:
         return True
-    _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip)
+    _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip, candidates=candidates)
     try:
         solver.solve(K, np.zeros(K.shape[0]))
     except (NotPositiveDefinite, LinearSolveError):

@@ -1,0 +1,187 @@
+"""Coulomb friction of the sheet's nodes on rigid obstacles, lagged for the static route.
+
+The static route treats friction as IPC does (Li et al., *Incremental Potential Contact*, 2020, §5): the
+normal force ``lambda_c`` of every contact node ``c`` and its tangent plane (normal ``n_c``) are *lagged*,
+frozen at the last converged state, so that the friction has a potential over the next solve,
+
+    D(x) = sum_c mu_c lambda_c f0(y_c),   y_c = |T_c (x_c - a_c)|,   T_c = I - n_c n_c^T,        (F1)
+
+with ``a_c`` the node's **stick anchor** and ``f0`` the mollified norm of IPC (Eq. 12 there, written as a length):
+
+    f0(y) = y^2 / eps - y^3 / (3 eps^2) + eps / 3   (y < eps),      f0(y) = y   (y >= eps),       (F2)
+
+so ``f1 = f0' = 2 y / eps - y^2 / eps^2`` rises from 0 to 1 over the slip length ``eps`` and stays 1: a node
+sticks (a tangential spring of stiffness ``2 mu lambda / eps`` about its anchor) until the tangential force
+reaches ``mu lambda``, then slides against that force. The gradient is
+
+    grad_c D = mu_c lambda_c (f1(y) / y) T_c u_c,        u_c = x_c - a_c,                         (F3)
+
+and its Hessian ``mu lambda [g T + h t t^T]`` (``t`` the unit slip direction, ``g = f1 / y``, ``h = f0'' - g``)
+is positive semi-definite everywhere: its eigenvalues are ``f0'' >= 0`` along ``t``, ``g > 0`` across it and 0
+along ``n`` (F4). Newton's tangent and the stability check stay valid.
+
+After every converged state the lag is **committed** (:func:`commit`): the normal forces and normals are
+taken from the penalty at the new state; a node that slid (``y >= eps``) has its anchor brought along to
+``x - 0.9 eps t`` (:data:`TRAIL`: it trails the node by about the slip length), a node that stuck keeps its anchor, so a sheet held by
+friction stays where it is instead of creeping by ``eps`` per solve; a node that leaves the obstacle drops out,
+one that arrives is anchored where it touched. The coefficient is the static one while a node sticks and the
+kinetic one once it has slid. The static route repeats Newton at the same load until the committed normal forces
+and the sticking set settle (:mod:`rftstatic.solvers.friction_lag`).
+
+The lag is State (``State.contact_history["friction"]``, checkpointed); the penalty law reads it from the solve's
+candidate list (:attr:`rftstatic.contact.candidates.CandidateList.friction`), so it adds nothing to the Model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["FrictionLaw", "friction_terms", "initial_lag", "commit"]
+
+SLIP_LENGTH = 1e-4
+"""Default slip length ``eps`` of (F2) relative to the sheet's size: the tangential motion of a sticking node under
+the full friction force; a sheet held on an incline moves less than this share of its size."""
+
+
+@dataclass(frozen=True)
+class FrictionLaw:
+    """Coulomb coefficients per obstacle and the slip length.
+
+    Attributes
+    ----------
+    mu_static, mu_kinetic : (M,) coefficients [-] for the M obstacles, >= 0, finite
+    eps : slip length of (F2) [m], > 0
+    """
+
+    mu_static: np.ndarray
+    mu_kinetic: np.ndarray
+    eps: float
+
+    def __post_init__(self):
+        for name in ("mu_static", "mu_kinetic"):
+            v = np.asarray(getattr(self, name), dtype=float)
+            if v.ndim != 1 or not np.all(np.isfinite(v)) or np.any(v < 0):
+                raise ValueError(f"{name} must be finite coefficients >= 0, one per obstacle; got {v!r}")
+            object.__setattr__(self, name, v)
+        if not (np.isfinite(self.eps) and self.eps > 0):
+            raise ValueError(f"eps (the slip length) must be > 0 [m], got {self.eps!r}")
+
+
+TRAIL = 0.9
+"""A node that slid has its anchor brought to this share of the slip length ``eps`` behind it: the friction force
+stays at ``f1(0.9) = 0.99`` of ``mu lambda`` and the tangent along the slip keeps the curvature ``f0''(0.9 eps) =
+0.2 / eps`` (at ``eps`` itself it is 0, a singular tangent at every equilibrium a sheet slid into)."""
+
+
+def _mollifier(y, eps):
+    """``f0 (F2)``, ``g = f1 / y`` and ``h = f0'' - g`` for slips ``y (C,)`` [m]."""
+    stick = y < eps
+    f0 = np.where(stick, y * y / eps - y**3 / (3 * eps * eps) + eps / 3, y)
+    safe = np.maximum(y, 1e-300)
+    g = np.where(stick, 2.0 / eps - y / (eps * eps), 1.0 / safe)
+    h = np.where(stick, -y / (eps * eps), -1.0 / safe)
+    return f0, g, h
+
+
+def friction_terms(lag: dict, x: np.ndarray, *, tangent: bool = True):
+    """Energy [J], force ``(N, 3)`` [N] and node-diagonal tangent blocks ``(N, 3, 3)`` [N/m] of (F1)-(F4) at
+    positions ``x (N, 3)`` [m] for the lagged contacts ``lag`` (:func:`initial_lag`, :func:`commit`)."""
+    n = x.shape[0]
+    force = np.zeros((n, 3))
+    blocks = np.zeros((n, 3, 3)) if tangent else None
+    c = lag["nodes"]
+    if c.size == 0:
+        return 0.0, force, blocks
+    nrm = lag["normal"]
+    u = x[c] - lag["anchor"]
+    ut = u - np.einsum("ci,ci->c", u, nrm)[:, None] * nrm
+    y = np.linalg.norm(ut, axis=1)
+    f0, g, h = _mollifier(y, lag["eps"])
+    w = lag["mu"] * lag["normal_force"]  # (C,) [N]
+    energy = float(np.sum(w * f0))
+    np.add.at(force, c, (w * g)[:, None] * ut)
+    if tangent:
+        t = ut / np.maximum(y, 1e-300)[:, None]
+        T = np.eye(3)[None] - np.einsum("ci,cj->cij", nrm, nrm)
+        K = w[:, None, None] * (g[:, None, None] * T + h[:, None, None] * np.einsum("ci,cj->cij", t, t))
+        np.add.at(blocks, c, K)
+    return energy, force, blocks
+
+
+def _contacts(penalty, x):
+    """Contact nodes of the penalty law at ``x (N, 3)`` [m]: nodes ``(C,)``, their obstacle ``(C,)``, normal force
+    magnitude ``k A |d1|`` [N] and unit normal ``(C, 3)`` of the obstacle they are deepest in."""
+    phi, normal = penalty._distances(x)
+    if phi.shape[0] == 0:
+        return np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 3))
+    deepest = phi.argmin(axis=0)
+    cols = np.arange(x.shape[0])
+    d1 = penalty._slope(phi[deepest, cols])
+    lam = -penalty.stiffness * penalty.node_area * d1
+    nodes = np.flatnonzero(lam > 0.0)
+    return nodes, deepest[nodes], lam[nodes], normal[deepest[nodes], nodes]
+
+
+def initial_lag(law: FrictionLaw, penalty, x: np.ndarray, load: np.ndarray) -> dict:
+    """The lag before the first solve at positions ``x (N, 3)`` [m]: every node within the penalty's onset width
+    of an obstacle, anchored where it is, with the normal force the full ``load (N, 3)`` [N] presses it onto the
+    obstacle with (the lag from a converged state replaces it after the first increment)."""
+    phi, normal = penalty._distances(x)
+    if phi.shape[0] == 0:
+        return _lag(law, np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)),
+                    np.zeros(0, bool), 1.0)
+    deepest = phi.argmin(axis=0)
+    cols = np.arange(x.shape[0])
+    near = phi[deepest, cols] <= max(penalty.smoothing, 0.0)
+    nrm = normal[deepest, cols]
+    press = np.maximum(-np.einsum("ni,ni->n", load, nrm), 0.0)
+    nodes = np.flatnonzero(near & (press > 0.0))
+    return _lag(law, nodes, deepest[nodes], press[nodes], nrm[nodes], x[nodes], np.zeros(nodes.size, bool), 1.0)
+
+
+def _lag(law, nodes, obstacle, force, normal, anchor, slid, lam) -> dict:
+    """The lag's arrays (C = contact nodes): ``normal_force (C,)`` [N] (the committed ``committed_force`` scaled
+    to the load factor being solved for), committed at load factor ``lam``."""
+    mu = np.where(slid, law.mu_kinetic[obstacle], law.mu_static[obstacle]) if nodes.size else np.zeros(0)
+    return {"nodes": nodes.astype(np.int64), "obstacle": obstacle.astype(np.int64), "normal_force": force.copy(),
+            "committed_force": force, "lam": float(lam), "normal": normal, "anchor": anchor, "slid": slid, "mu": mu,
+            "eps": float(law.eps)}
+
+
+def commit(law: FrictionLaw, penalty, lag: dict, x: np.ndarray, lam: float = 1.0) -> tuple[dict, dict]:
+    """The lag after the converged state ``x (N, 3)`` [m] at load factor ``lam`` (module docstring), and how much
+    it changed:
+    ``{"normal_force": max |d lambda| / max lambda, "stick_changes": nodes that changed between sticking and sliding
+    or entered or left the contact}``."""
+    nodes, obstacle, force, normal = _contacts(penalty, x)
+    anchor = x[nodes].copy()
+    slid = np.zeros(nodes.size, bool)
+    old = {int(k): i for i, k in enumerate(lag["nodes"])}
+    keep = np.array([old.get(int(k), -1) for k in nodes], dtype=np.int64)
+    had = keep >= 0
+    if np.any(had):
+        j = keep[had]
+        u = x[nodes[had]] - lag["anchor"][j]
+        nj = lag["normal"][j]
+        ut = u - np.einsum("ci,ci->c", u, nj)[:, None] * nj
+        y = np.linalg.norm(ut, axis=1)
+        sliding = y >= law.eps * (1 - 1e-12)
+        a = lag["anchor"][j].copy()
+        a[sliding] = x[nodes[had]][sliding] - TRAIL * law.eps * ut[sliding] / y[sliding, None]
+        anchor[had] = a
+        slid[had] = sliding | lag["slid"][j]
+    new = _lag(law, nodes, obstacle, force, normal, anchor, slid, lam)
+    prev = np.zeros(x.shape[0])
+    prev[lag["nodes"]] = lag["normal_force"]
+    now = np.zeros(x.shape[0])
+    now[nodes] = force
+    scale = max(float(now.max(initial=0.0)), 1e-300)
+    was = np.zeros(x.shape[0], int)
+    was[lag["nodes"]] = 1 + lag["slid"].astype(int)
+    isn = np.zeros(x.shape[0], int)
+    isn[nodes] = 1 + slid.astype(int)
+    change = {"normal_force": float(np.abs(now - prev).max(initial=0.0)) / scale,
+              "stick_changes": int(np.count_nonzero(was != isn))}
+    return new, change

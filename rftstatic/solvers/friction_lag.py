@@ -1,0 +1,109 @@
+"""The lag iteration of static friction (:mod:`rftstatic.contact.friction`): Newton at one load factor, the lag
+committed at its solution, Newton again, until the normal forces and the sticking set settle.
+
+The lag is State: ``state.contact_history["friction"]`` (checkpointed with it); the penalty law reads it through
+the solve's candidate list (``state.candidates.friction``), which :func:`link` points at it.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from rftstatic.contact.friction import commit, initial_lag
+from rftstatic.errors import ConvergenceError
+
+log = logging.getLogger(__name__)
+
+KEY = "friction"
+"""The lag's key in ``State.contact_history``."""
+
+LAG_ITERATIONS = 12
+"""Most Newton solves at one load factor while the lag settles."""
+
+LAG_TOL = 1e-2
+"""The lag has settled when the normal forces changed by less than this share of the largest one and either no
+node changed between sticking and sliding or the last solve with the committed lag moved no node by more than the
+slip length (sliding nodes trail their anchors by it: the same state again)."""
+
+
+def law_of(model):
+    """The model's friction law, or None (no penalty contact, or frictionless)."""
+    return getattr(model.contact, "friction", None) if model.contact is not None else None
+
+
+def link(model, state, U) -> None:
+    """Make the lag (the initial one, :func:`~rftstatic.contact.friction.initial_lag`, if the State has none) the
+    one the solve's contact evaluations see."""
+    law = law_of(model)
+    if law is None or state.candidates is None:
+        return
+    lag = state.contact_history.get(KEY)
+    if lag is None:
+        lag = state.contact_history[KEY] = initial_lag(law, model.contact, model.positions(U), model.load)
+    state.candidates.friction = lag
+
+
+def predict(model, state, lam_to: float) -> None:
+    """Scale the normal forces committed at load factor ``lag["lam"]`` to the solve at ``lam_to`` (the forces a
+    growing load presses with: lagged unscaled, a sheet held at one load factor would slide at the next before
+    the lag caught up). The committed forces stay as they were, so a cut back scales them again."""
+    lag = state.contact_history.get(KEY) if law_of(model) is not None else None
+    if lag is None or not lag["lam"] > 0:
+        return
+    lag["normal_force"] = lag["committed_force"] * (lam_to / lag["lam"])
+
+
+def settle(model, state, nt, lam, solve):
+    """Commit the lag at the converged Newton result ``nt`` and solve again (``solve(U)`` -> a new result at the
+    same load) until it settles (:data:`LAG_TOL`): ``(result, iterations of the extra solves)``, the result's lag
+    committed. A solve that does not converge is returned as it is (the caller cuts back or fails)."""
+    law = law_of(model)
+    its = 0
+    moved = np.inf  # the largest nodal move of the last re-solve [m]
+    for k in range(LAG_ITERATIONS):
+        lag, change = commit(law, model.contact, state.contact_history[KEY], model.positions(nt.U), lam)
+        state.contact_history[KEY] = state.candidates.friction = lag
+        log.debug("friction lag %d at load factor %.6g: %s, moved %.3g m", k, lam, change, moved)
+        if change["normal_force"] < LAG_TOL and (change["stick_changes"] == 0 or moved < law.eps):
+            break  # a fixed point: the committed lag gives back the state it was committed at
+        again = solve(nt.U)
+        its += again.iterations
+        if not again.converged:
+            return again, its
+        moved = float(np.abs(again.U - nt.U).max())
+        nt = again
+    else:
+        lag = state.contact_history[KEY]
+        share = float(np.mean(lag["slid"])) if lag["nodes"].size else 0.0
+        mu = np.unique(lag["mu"]) if lag["nodes"].size else np.zeros(0)
+        raise ConvergenceError(
+            f"load factor {lam:.6g}: friction does not hold the sheet: the normal forces and the sticking set did not "
+            f"settle in {LAG_ITERATIONS} solves, {share:.0%} of the {lag['nodes'].size} contact nodes sliding "
+            f"(mu = {', '.join(f'{m:g}' for m in mu)}). Where the tangential load exceeds mu times the normal force "
+            "(a sheet on a plane steeper than its friction angle) there is no static equilibrium: run it as a dynamic "
+            "scene, or raise contact.friction", None)
+    return nt, its
+
+
+def sliding_share(model, state) -> float:
+    """Share of the lagged contact nodes that slid at the last commit (0 without friction)."""
+    lag = state.contact_history.get(KEY) if law_of(model) is not None else None
+    if lag is None or lag["nodes"].size == 0:
+        return 0.0
+    return float(np.mean(lag["slid"]))
+
+
+def explain(model, state, exc) -> None:
+    """Add to the message of a failed static solve ``exc`` (a ConvergenceError) what the friction did at the last
+    committed state: the share of its contact nodes that had slid and what that means."""
+    lag = state.contact_history.get(KEY) if law_of(model) is not None else None
+    if lag is None or lag["nodes"].size == 0 or "friction" in str(exc):
+        return
+    law = law_of(model)
+    exc.args = (f"{exc}. With friction (mu static {', '.join(f'{m:g}' for m in np.unique(law.mu_static))}, kinetic "
+                f"{', '.join(f'{m:g}' for m in np.unique(law.mu_kinetic))}) {sliding_share(model, state):.0%} of the "
+                f"{lag['nodes'].size} contact nodes had slid at the last equilibrium: where the tangential load exceeds "
+                "mu times the normal force (a sheet on a plane steeper than its friction angle) there is no static "
+                "equilibrium; run it as a dynamic scene, or raise contact.friction",) + exc.args[1:]
