@@ -274,7 +274,7 @@ class _Loop:
             # Eq. 22
             U += dt * V
             if self.obstacles:
-                self.n_contact = _contact(self.model, self.obstacles, U, V, mass, acc)
+                self.n_contact = _contact(self.model, self.obstacles, U, V, mass, acc, dt)
                 if fixed_any:
                     np.copyto(U, Ufix, where=~free)
             step += 1
@@ -352,11 +352,12 @@ def _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, ene
         t=rec["time"], step=step, dt=dt, suggested_dt=suggested)
 
 
-def _contact(model, obstacles, U, V, mass, acc) -> int:
+def _contact(model, obstacles, U, V, mass, acc, dt) -> int:
     from rftstatic.contact.kinematic import kinematic_contact
 
     X3 = model.X3
-    x_new, v_new, n_active = kinematic_contact(obstacles, X3 + U, V)
+    x = X3 + U
+    x_new, v_new, n_active = kinematic_contact(obstacles, x, V, x_old=x - dt * V)  # the step was U += dt V
     if n_active:
         # the projection along the normal must not give a supported dof a velocity (a node held in
         # x, y on a sphere would otherwise keep a spurious, never damped in-plane speed)

@@ -39,6 +39,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from rftstatic.compiled import numba_available
 from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures, _as_points
 from rftstatic.contact.obstacles.registry import register
 from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, pseudo_normals,
@@ -58,6 +59,12 @@ smaller or larger is a mistake (its triangles would be degenerate, or its coordi
 
 NEAREST = 12
 """Triangle centroids each point's nearest triangle is first sought among (then proven, or searched wider)."""
+
+HELD_SETS = 8
+"""Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
+midpoints, the feature contact's points ...): a static obstacle's triangles never move, so a point that moved
+less than its margin keeps its set (:meth:`SurfaceObstacle._candidates`) and Newton's iterations skip the
+k-d tree."""
 
 FEATURE_ANGLE = 30.0
 """Default angle [deg] between two faces' normals above which their common (convex) edge is a sharp feature: a
@@ -203,27 +210,85 @@ class SurfaceObstacle(Obstacle):
         self.band = BAND * float(np.linalg.norm(self.hi - self.lo))
         self._ctree = cKDTree(self.centroid)
         self._vtree = cKDTree(V)
+        self._sets = {}  # candidate sets of the last calls, by their number of points (_candidates)
+        self.compiled = numba_available()
 
-    def _closest(self, x, dk, ik):
-        """Closest features of the points ``x (n, 3)``, given their ``K`` nearest triangle centroids
-        (distances ``dk (n, K)`` [m], triangles ``ik (n, K)``): ``(q (n, 3), kind (n,), gid (n,))``, ``gid`` the
-        global face, edge or vertex index. The nearest of the ``K`` triangles is the nearest of all when the
-        ``K``-th centroid is farther than its distance plus ``R`` (no other triangle can be nearer); the
-        points it is not proven for search every triangle within ``d_v + R`` (``d_v`` their nearest vertex)."""
+    def _candidates(self, x, K):
+        """Each point's ``K`` candidate triangles ``ik (n, K)`` and ``beyond (n,)`` [m], a lower bound of its
+        distance to every other triangle's centroid: the previous call's sets (same number of points) kept,
+        ``beyond = d_K - |x - x_ref|`` (``d_K`` the ``K``-th centroid distance where they were found, ``x_ref``;
+        the distance is 1-Lipschitz), else the ``K`` nearest centroids now (``beyond = d_K``)."""
+        held = self._sets.get(len(x))
+        if held is None:
+            dk, ik = self._ctree.query(x, k=K)
+            dk, ik = dk.reshape(len(x), K), ik.reshape(len(x), K)
+            self._hold(x, ik, dk[:, -1])
+            return ik, dk[:, -1].copy(), np.zeros(len(x), bool)
+        x_ref, ik, dK = held
+        return ik, dK - np.linalg.norm(x - x_ref, axis=1), np.ones(len(x), bool)
+
+    def _hold(self, x, ik, dK):
+        if len(self._sets) >= HELD_SETS and len(x) not in self._sets:
+            self._sets.pop(next(iter(self._sets)))
+        self._sets[len(x)] = (x.copy(), ik, dK)
+
+    def _nearest_in(self, x, ik):
+        """Per point, the nearest of its candidate triangles ``ik (n, K)``: ``(q, kind, local, tri, r, dc)``,
+        ``dc`` the least distance to their centroids (:func:`.surface_kernels.nearest_in_sets`)."""
         n, K = ik.shape
+        if self.compiled:
+            from rftstatic.contact.obstacles._surface_numba import nearest_in_sets
+
+            q, r, dc = np.empty((n, 3)), np.empty(n), np.empty(n)
+            kind, local, tri = np.empty(n, np.int8), np.empty(n, np.int8), np.empty(n, np.int64)
+            nearest_in_sets(np.ascontiguousarray(x), self.V, self.T, self.centroid, np.ascontiguousarray(ik),
+                            q, kind, local, tri, r, dc)
+            return q, kind, local, tri, r, dc
         q, kind, local, tri = self._nearest_of(np.repeat(x, K, axis=0), ik.ravel(), np.full(n, K))
-        r = np.linalg.norm(x - q, axis=1)
-        open_ = (dk[:, -1] - self.radius < r) & (len(self.T) > K)
-        if open_.any():
-            xo = x[open_]
-            dv, _ = self._vtree.query(xo)
-            lists = self._ctree.query_ball_point(xo, dv + self.radius * (1 + 1e-12) + 1e-300)
-            counts = np.fromiter(map(len, lists), np.int64, len(lists))
-            tris = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
-            qo, ko, lo, to = self._nearest_of(np.repeat(xo, counts, axis=0), tris, counts)
-            q[open_], kind[open_], local[open_], tri[open_] = qo, ko, lo, to
-        gid = np.where(kind == FACE, tri, np.where(kind == EDGE, self.edge_of[tri, local], self.T[tri, local]))
-        return q, kind, gid
+        dc = np.sqrt(np.min(np.einsum("pki,pki->pk", x[:, None] - self.centroid[ik], x[:, None] - self.centroid[ik]),
+                            axis=1))
+        return q, kind, local, tri, np.linalg.norm(x - q, axis=1), dc
+
+    def _closest(self, x):
+        """Closest features of the points ``x (n, 3)`` [m]: ``(q (n, 3), kind (n,), gid (n,), exact (n,), lower
+        (n,))``, ``gid`` the global face, edge or vertex index, ``exact`` where it is proven (the others: the
+        nearest of their candidates) and ``lower`` a lower bound of each point's distance [m]. The nearest of a
+        point's candidates is the nearest of all when every other centroid is farther than its distance plus
+        ``R`` (``beyond - R >= r``); candidate sets that fail that are sought again at ``x``; the points still
+        unproven and within ``band`` search every triangle within ``d_v + R`` (``d_v`` their nearest vertex)."""
+        K = min(NEAREST, len(self.T))
+        ik, beyond, held = self._candidates(x, K)
+        q, kind, local, tri, r, dc = self._nearest_in(x, ik)
+        whole = len(self.T) <= K
+        proven = whole | (beyond - self.radius >= r)
+        again = np.flatnonzero(~proven & held)
+        if again.size:  # sets kept from the last call that no longer prove the nearest: the K nearest now
+            dk, ika = self._ctree.query(x[again], k=K)
+            dk, ika = dk.reshape(len(again), K), ika.reshape(len(again), K)
+            ik[again], beyond[again] = ika, dk[:, -1]
+            x_ref, _, dK = self._sets[len(x)]
+            x_ref[again], dK[again] = x[again], dk[:, -1]
+            q[again], kind[again], local[again], tri[again], r[again], dc[again] = self._nearest_in(x[again], ika)
+            proven[again] = beyond[again] - self.radius >= r[again]
+        lower = np.maximum(np.minimum(dc, beyond) - self.radius, 0.0)
+        open_ = np.flatnonzero(~proven & (lower < self.band))
+        if open_.size:
+            q[open_], kind[open_], local[open_], tri[open_] = self._ball(x[open_])
+            proven[open_] = True
+        return q, kind, self._gid(kind, local, tri), proven, lower
+
+    def _ball(self, xo):
+        """The nearest triangle of each point ``xo (m, 3)`` among all within ``d_v + R``: ``(q, kind, local,
+        tri)``."""
+        dv, _ = self._vtree.query(xo)
+        lists = self._ctree.query_ball_point(xo, dv + self.radius * (1 + 1e-12) + 1e-300)
+        counts = np.fromiter(map(len, lists), np.int64, len(lists))
+        tris = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
+        return self._nearest_of(np.repeat(xo, counts, axis=0), tris, counts)
+
+    def _gid(self, kind, local, tri):
+        """The global face, edge or vertex index of a closest feature."""
+        return np.where(kind == FACE, tri, np.where(kind == EDGE, self.edge_of[tri, local], self.T[tri, local]))
 
     def _nearest_of(self, xp, tri, counts):
         """Per point, the nearest of its ``counts`` consecutive candidate pairs ``(xp (P, 3), tri (P,))``."""
@@ -237,33 +302,28 @@ class SurfaceObstacle(Obstacle):
             best = np.lexsort((d2, pt))[np.r_[0, np.cumsum(counts)[:-1]]]  # per point, the nearest pair first
         return q[best], kind[best], local[best], tri[best]
 
-    def _near_far(self, x):
-        """``(near (n,) bool, lower (n,) [m], dk (n, K), ik (n, K))``: the points that need the exact distance,
-        a lower bound of every point's distance and the ``K`` nearest triangle centroids."""
-        K = min(NEAREST, len(self.T))
-        dk, ik = self._ctree.query(x, k=K)
-        dk, ik = dk.reshape(len(x), K), ik.reshape(len(x), K)
-        lower = np.maximum(dk[:, 0] - self.radius, 0.0)
-        near = lower < self.band
-        if self.closed:
-            box = ~near & np.all((x >= self.lo) & (x <= self.hi), axis=1)
-            if box.any():  # a point deep inside (none in a sound run) gets its exact distance too
-                near[box] = winding_number(x[box], self.V, self.T) > 0.5
-        return near, lower, dk, ik
-
     def _evaluate(self, x, hessian):
         x = _as_points(x)
         n = len(x)
-        near, lower, dk, ik = self._near_far(x)
+        q, kind, gid, exact, lower = self._closest(x)
+        near = exact & (lower < self.band)
+        if self.closed:
+            box = ~near & np.all((x >= self.lo) & (x <= self.hi), axis=1)
+            if box.any():  # a point deep inside (none in a sound run) gets its exact distance too
+                deep = np.flatnonzero(box)[winding_number(x[box], self.V, self.T) > 0.5]
+                if deep.size:
+                    qd, kd, ld, td = self._ball(x[deep])
+                    q[deep], kind[deep], gid[deep] = qd, kd, self._gid(kd, ld, td)
+                    near[deep] = True
         half = 0.0 if self.thickness is None else 0.5 * self.thickness
         phi = lower - half
-        away = x - self.centroid[ik[:, 0]]
+        away = x - q
         normal = away / np.maximum(np.linalg.norm(away, axis=1, keepdims=True), 1e-300)
         H = np.zeros((n, 3, 3)) if hessian else None
         idx = np.flatnonzero(near)
         if idx.size:
             xn = x[idx]
-            q, kind, gid = self._closest(xn, dk[idx], ik[idx])
+            q, kind, gid = q[idx], kind[idx], gid[idx]
             d = xn - q
             r = np.linalg.norm(d, axis=1)
             pn = np.where((kind == FACE)[:, None], self.nf[np.where(kind == FACE, gid, 0)],
@@ -300,6 +360,16 @@ class SurfaceObstacle(Obstacle):
 
     def normal_gradient(self, x):
         return self._evaluate(x, True)[2]
+
+    def segment_crossings(self, x0, x1):
+        """Steps ``x0 -> x1`` ``(n, 3)`` [m] through the surface (:mod:`.surface_ccd`): a point whose step is
+        longer than its end's distance to the surface (the mid-surface of a shell) is tested."""
+        from rftstatic.contact.obstacles.surface_ccd import first_crossings
+
+        x0, x1 = _as_points(x0), _as_points(x1)
+        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        r = np.abs(self.signed_distance(x1)[0] + half)
+        return first_crossings(self, x0, x1, np.flatnonzero(np.linalg.norm(x1 - x0, axis=1) >= r), half)
 
     psd_tangent = True  # the distance's curvature is unbounded at sharp edges: the penalty clamps it (PSD)
 
