@@ -59,7 +59,7 @@ def test_signed_distance_is_exact_near_and_a_lower_bound_far(ico):
     near = np.abs(true) < ico.band
     assert near.sum() > 50 and (~near).sum() > 50
     assert np.abs(phi - true)[near].max() <= 1e-15
-    assert np.all(phi[~near] <= true[~near]) and np.all(phi[~near] > ico.band - ico.radius - 1e-15)
+    assert np.all(phi[~near] <= true[~near] + 1e-15) and np.all(phi[~near] > ico.band - ico.radius - 1e-15)
     # the facets lie inside the sphere through the vertices, within the sagitta (1 - cos(half the edge angle)) R
     sph = Sphere([0, 0, -0.05], 0.05)
     assert np.all(phi[near] >= sph.signed_distance(x[near])[0] - 1e-15)

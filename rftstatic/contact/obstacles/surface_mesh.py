@@ -60,6 +60,11 @@ smaller or larger is a mistake (its triangles would be degenerate, or its coordi
 NEAREST = 12
 """Triangle centroids each point's nearest triangle is first sought among (then proven, or searched wider)."""
 
+WIDER = 64
+"""Triangle centroids a point whose nearest is not proven among its :data:`NEAREST` is sought among next (a
+point a few triangles off the surface: the sheet hanging beside a finely tessellated body), before every
+triangle within its distance plus ``R`` is."""
+
 HELD_SETS = 8
 """Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
 midpoints, the feature contact's points ...): a static obstacle's triangles never move, so a point that moved
@@ -271,17 +276,26 @@ class SurfaceObstacle(Obstacle):
             q[again], kind[again], local[again], tri[again], r[again], dc[again] = self._nearest_in(x[again], ika)
             proven[again] = beyond[again] - self.radius >= r[again]
         lower = np.maximum(np.minimum(dc, beyond) - self.radius, 0.0)
+        wide = np.flatnonzero(~proven & (lower < self.band))
+        if wide.size and len(self.T) > K:  # a point farther off than a few triangles: its WIDER nearest
+            Kw = min(WIDER, len(self.T))
+            dk, ikw = self._ctree.query(x[wide], k=Kw)
+            dk, ikw = dk.reshape(len(wide), Kw), ikw.reshape(len(wide), Kw)
+            q[wide], kind[wide], local[wide], tri[wide], r[wide], _ = self._nearest_in(x[wide], ikw)
+            proven[wide] = (len(self.T) <= Kw) | (dk[:, -1] - self.radius >= r[wide])
         open_ = np.flatnonzero(~proven & (lower < self.band))
         if open_.size:
-            q[open_], kind[open_], local[open_], tri[open_] = self._ball(x[open_])
+            q[open_], kind[open_], local[open_], tri[open_] = self._ball(x[open_], r[open_])
             proven[open_] = True
         return q, kind, self._gid(kind, local, tri), proven, lower
 
-    def _ball(self, xo):
-        """The nearest triangle of each point ``xo (m, 3)`` among all within ``d_v + R``: ``(q, kind, local,
-        tri)``."""
-        dv, _ = self._vtree.query(xo)
-        lists = self._ctree.query_ball_point(xo, dv + self.radius * (1 + 1e-12) + 1e-300)
+    def _ball(self, xo, reach=None):
+        """The nearest triangle of each point ``xo (m, 3)`` among all whose centroid lies within ``reach + R``
+        (``reach (m,)`` [m], a distance to the surface some triangle attains; default: to the nearest vertex):
+        ``(q, kind, local, tri)``."""
+        if reach is None:
+            reach, _ = self._vtree.query(xo)
+        lists = self._ctree.query_ball_point(xo, reach + self.radius * (1 + 1e-12) + 1e-300)
         counts = np.fromiter(map(len, lists), np.int64, len(lists))
         tris = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
         return self._nearest_of(np.repeat(xo, counts, axis=0), tris, counts)
