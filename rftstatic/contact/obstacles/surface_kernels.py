@@ -7,8 +7,7 @@ of the nearest one (Ericson, *Real-Time Collision Detection*, §5.1.5: the seven
 the order of :func:`.surface_geometry.closest_on_triangles`, so both pick the same feature), and the least
 distance to the candidates' centroids (a lower bound of the distance to the surface after subtracting the
 largest centroid-to-corner radius). One pass over ``n K`` triangles without the ``(n K, 3)`` temporaries of
-the numpy twin: 2 ms -> about 0.1 ms per evaluation of 300 points against 12 candidates each
-(validation/mesh_obstacles.md, "Cost").
+the numpy twin, stopping at the first candidate that cannot be nearer (validation/mesh_obstacles.md, "Cost").
 """
 
 from __future__ import annotations
@@ -56,18 +55,24 @@ def closest_one(p0, p1, p2, a, b, c):
     return 1.0 - v - w, v, w, 0, 0
 
 
-def nearest_in_sets(x, V, T, centroid, ik, q, kind, local, tri, r, dc):
+def nearest_in_sets(x, V, T, centroid, ik, dk, moved, R, q, kind, local, tri, r, dc):
     """For each point ``x[p] (n, 3)`` [m], the nearest of its candidate triangles ``ik[p] (n, K)`` of the
-    surface ``V (m, 3)`` [m], ``T (t, 3)``: fills its closest point ``q (n, 3)``, ``kind (n,)``, ``local
+    surface ``V (m, 3)`` [m], ``T (t, 3)``, sorted by their centroid distances ``dk[p] (n, K)`` [m] from where
+    the point was ``moved[p] (n,)`` [m] ago: fills its closest point ``q (n, 3)``, ``kind (n,)``, ``local
     (n,)`` (as :func:`closest_one`), triangle ``tri (n,)``, distance ``r (n,)`` [m], and the least distance
-    ``dc (n,)`` [m] from the point to the candidates' ``centroid (t, 3)``. The first of equally near
-    triangles wins (as ``argmin``)."""
+    ``dc (n,)`` [m] from the point to the ``centroid (t, 3)`` of the candidates it tested. It stops at the first
+    candidate whose centroid is surely farther than the nearest so far plus ``R`` [m] (the largest
+    centroid-to-corner radius): neither it nor any after it can be nearer. The first of equally near triangles
+    wins (as ``argmin``)."""
     n, K = ik.shape
     for p in range(n):
         p0, p1, p2 = x[p, 0], x[p, 1], x[p, 2]
         best = np.inf
         cbest = np.inf
         for k in range(K):
+            gap = dk[p, k] - moved[p] - R
+            if gap > 0 and gap * gap > best:
+                break
             t = ik[p, k]
             ia, ib, ic = T[t, 0], T[t, 1], T[t, 2]
             wa, wb, wc, kd, lc = closest_one(p0, p1, p2, V[ia], V[ib], V[ic])

@@ -58,12 +58,14 @@ SIZE_RANGE = (1e-6, 1e4)
 smaller or larger is a mistake (its triangles would be degenerate, or its coordinates overflow)."""
 
 NEAREST = 12
-"""Triangle centroids each point's nearest triangle is first sought among (then proven, or searched wider)."""
+"""Triangle centroids each point's nearest triangle is sought among by the numpy twin (then proven, or searched
+wider)."""
 
 WIDER = 64
-"""Triangle centroids a point whose nearest is not proven among its :data:`NEAREST` is sought among next (a
-point a few triangles off the surface: the sheet hanging beside a finely tessellated body), before every
-triangle within its distance plus ``R`` is."""
+"""Triangle centroids each point's nearest triangle is sought among by the compiled twin, nearest first: it
+stops at the first that cannot be nearer (a point on the surface tests a few), and a point several triangles
+off the surface (the sheet hanging beside a finely tessellated body) is still proven among them, without the
+search of every triangle within its distance plus ``R``."""
 
 HELD_SETS = 8
 """Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
@@ -219,27 +221,25 @@ class SurfaceObstacle(Obstacle):
         self.compiled = numba_available()
 
     def _candidates(self, x, K):
-        """Each point's ``K`` candidate triangles ``ik (n, K)`` and ``beyond (n,)`` [m], a lower bound of its
-        distance to every other triangle's centroid: the previous call's sets (same number of points) kept,
-        ``beyond = d_K - |x - x_ref|`` (``d_K`` the ``K``-th centroid distance where they were found, ``x_ref``;
-        the distance is 1-Lipschitz), else the ``K`` nearest centroids now (``beyond = d_K``)."""
+        """Each point's ``K`` candidate triangles ``ik (n, K)``, nearest centroid first, their centroid distances
+        ``dk (n, K)`` [m] where they were found and how far the point moved since, ``moved (n,)`` [m]: the
+        previous call's sets (same number of points) kept, else the ``K`` nearest centroids now (``moved = 0``).
+        ``dk - moved`` bounds the centroids' distances from below (the distance is 1-Lipschitz)."""
         held = self._sets.get(len(x))
-        if held is None:
+        if held is None or held[1].shape[1] != K:
             dk, ik = self._ctree.query(x, k=K)
             dk, ik = dk.reshape(len(x), K), ik.reshape(len(x), K)
-            self._hold(x, ik, dk[:, -1])
-            return ik, dk[:, -1].copy(), np.zeros(len(x), bool)
-        x_ref, ik, dK = held
-        return ik, dK - np.linalg.norm(x - x_ref, axis=1), np.ones(len(x), bool)
+            if len(self._sets) >= HELD_SETS and len(x) not in self._sets:
+                self._sets.pop(next(iter(self._sets)))
+            self._sets[len(x)] = (x.copy(), ik, dk)
+            return ik, dk, np.zeros(len(x))
+        x_ref, ik, dk = held
+        return ik, dk, np.linalg.norm(x - x_ref, axis=1)
 
-    def _hold(self, x, ik, dK):
-        if len(self._sets) >= HELD_SETS and len(x) not in self._sets:
-            self._sets.pop(next(iter(self._sets)))
-        self._sets[len(x)] = (x.copy(), ik, dK)
-
-    def _nearest_in(self, x, ik):
+    def _nearest_in(self, x, ik, dk, moved):
         """Per point, the nearest of its candidate triangles ``ik (n, K)``: ``(q, kind, local, tri, r, dc)``,
-        ``dc`` the least distance to their centroids (:func:`.surface_kernels.nearest_in_sets`)."""
+        ``dc`` the least distance to the centroids of those it tested (:func:`.surface_kernels.nearest_in_sets`:
+        the compiled twin stops at the first candidate that cannot be nearer, ``dk - moved - R > r``)."""
         n, K = ik.shape
         if self.compiled:
             from rftstatic.contact.obstacles._surface_numba import nearest_in_sets
@@ -247,7 +247,7 @@ class SurfaceObstacle(Obstacle):
             q, r, dc = np.empty((n, 3)), np.empty(n), np.empty(n)
             kind, local, tri = np.empty(n, np.int8), np.empty(n, np.int8), np.empty(n, np.int64)
             nearest_in_sets(np.ascontiguousarray(x), self.V, self.T, self.centroid, np.ascontiguousarray(ik),
-                            q, kind, local, tri, r, dc)
+                            np.ascontiguousarray(dk), moved, self.radius, q, kind, local, tri, r, dc)
             return q, kind, local, tri, r, dc
         q, kind, local, tri = self._nearest_of(np.repeat(x, K, axis=0), ik.ravel(), np.full(n, K))
         dc = np.sqrt(np.min(np.einsum("pki,pki->pk", x[:, None] - self.centroid[ik], x[:, None] - self.centroid[ik]),
@@ -259,30 +259,26 @@ class SurfaceObstacle(Obstacle):
         (n,))``, ``gid`` the global face, edge or vertex index, ``exact`` where it is proven (the others: the
         nearest of their candidates) and ``lower`` a lower bound of each point's distance [m]. The nearest of a
         point's candidates is the nearest of all when every other centroid is farther than its distance plus
-        ``R`` (``beyond - R >= r``); candidate sets that fail that are sought again at ``x``; the points still
-        unproven and within ``band`` search every triangle within ``d_v + R`` (``d_v`` their nearest vertex)."""
-        K = min(NEAREST, len(self.T))
-        ik, beyond, held = self._candidates(x, K)
-        q, kind, local, tri, r, dc = self._nearest_in(x, ik)
+        ``R`` (``d_K - moved - R >= r``); candidate sets that fail that are sought again at ``x``; the points
+        still unproven and within ``band`` search every triangle within ``r + R``."""
+        K = min(WIDER if self.compiled else NEAREST, len(self.T))
+        ik, dk, moved = self._candidates(x, K)
+        q, kind, local, tri, r, dc = self._nearest_in(x, ik, dk, moved)
         whole = len(self.T) <= K
+        beyond = dk[:, -1] - moved
         proven = whole | (beyond - self.radius >= r)
-        again = np.flatnonzero(~proven & held)
+        again = np.flatnonzero(~proven & (moved > 0))
         if again.size:  # sets kept from the last call that no longer prove the nearest: the K nearest now
-            dk, ika = self._ctree.query(x[again], k=K)
-            dk, ika = dk.reshape(len(again), K), ika.reshape(len(again), K)
-            ik[again], beyond[again] = ika, dk[:, -1]
-            x_ref, _, dK = self._sets[len(x)]
-            x_ref[again], dK[again] = x[again], dk[:, -1]
-            q[again], kind[again], local[again], tri[again], r[again], dc[again] = self._nearest_in(x[again], ika)
+            dka, ika = self._ctree.query(x[again], k=K)
+            dka, ika = dka.reshape(len(again), K), ika.reshape(len(again), K)
+            x_ref, ik_held, dk_held = self._sets[len(x)]
+            x_ref[again], ik_held[again], dk_held[again] = x[again], ika, dka
+            q[again], kind[again], local[again], tri[again], r[again], dc[again] = self._nearest_in(
+                x[again], ika, dka, np.zeros(len(again)))
+            beyond[again] = dka[:, -1]
             proven[again] = beyond[again] - self.radius >= r[again]
-        lower = np.maximum(np.minimum(dc, beyond) - self.radius, 0.0)
-        wide = np.flatnonzero(~proven & (lower < self.band))
-        if wide.size and len(self.T) > K:  # a point farther off than a few triangles: its WIDER nearest
-            Kw = min(WIDER, len(self.T))
-            dk, ikw = self._ctree.query(x[wide], k=Kw)
-            dk, ikw = dk.reshape(len(wide), Kw), ikw.reshape(len(wide), Kw)
-            q[wide], kind[wide], local[wide], tri[wide], r[wide], _ = self._nearest_in(x[wide], ikw)
-            proven[wide] = (len(self.T) <= Kw) | (dk[:, -1] - self.radius >= r[wide])
+        # every centroid not tested is farther than r + R or than beyond: the distance is at least this
+        lower = np.maximum(np.minimum(np.minimum(dc, beyond) - self.radius, r), 0.0)
         open_ = np.flatnonzero(~proven & (lower < self.band))
         if open_.size:
             q[open_], kind[open_], local[open_], tri[open_] = self._ball(x[open_], r[open_])
