@@ -55,12 +55,12 @@ def closest_one(p0, p1, p2, a, b, c):
     return 1.0 - v - w, v, w, 0, 0
 
 
-def nearest_in_sets(x, V, T, centroid, ik, dk, moved, R, q, kind, local, tri, r, dc):
+def nearest_in_sets(x, V, T, centroid, ik, dk, moved, R, q, feature, dist):
     """For each point ``x[p] (n, 3)`` [m], the nearest of its candidate triangles ``ik[p] (n, K)`` of the
     surface ``V (m, 3)`` [m], ``T (t, 3)``, sorted by their centroid distances ``dk[p] (n, K)`` [m] from where
-    the point was ``moved[p] (n,)`` [m] ago: fills its closest point ``q (n, 3)``, ``kind (n,)``, ``local
-    (n,)`` (as :func:`closest_one`), triangle ``tri (n,)``, distance ``r (n,)`` [m], and the least distance
-    ``dc (n,)`` [m] from the point to the ``centroid (t, 3)`` of the candidates it tested. It stops at the first
+    the point was ``moved[p] (n,)`` [m] ago: fills its closest point ``q (n, 3)``, ``feature (n, 3)`` its kind
+    and local index (as :func:`closest_one`) and triangle, ``dist (n, 2)`` its distance [m] and the least
+    distance [m] from the point to the ``centroid (t, 3)`` of the candidates it tested. It stops at the first
     candidate whose centroid is surely farther than the nearest so far plus ``R`` [m] (the largest
     centroid-to-corner radius): neither it nor any after it can be nearer. The first of equally near triangles
     wins (as ``argmin``)."""
@@ -83,9 +83,9 @@ def nearest_in_sets(x, V, T, centroid, ik, dk, moved, R, q, kind, local, tri, r,
             if d2 < best:
                 best = d2
                 q[p, 0], q[p, 1], q[p, 2] = s0, s1, s2
-                kind[p], local[p], tri[p] = kd, lc, t
+                feature[p, 0], feature[p, 1], feature[p, 2] = kd, lc, t
             c2 = (p0 - centroid[t, 0]) ** 2 + (p1 - centroid[t, 1]) ** 2 + (p2 - centroid[t, 2]) ** 2
             if c2 < cbest:
                 cbest = c2
-        r[p] = np.sqrt(best)
-        dc[p] = np.sqrt(cbest)
+        dist[p, 0] = np.sqrt(best)
+        dist[p, 1] = np.sqrt(cbest)

@@ -15,16 +15,23 @@ closest surface point is on the open boundary is outside) or ``thickness`` (a tw
 r - thickness / 2``).
 
 The signed distance and its derivatives are those of :mod:`.surface_geometry`, exact for the points
-within ``band`` of the surface (the closest triangle found through a ``cKDTree`` of the triangle
-centroids, built once: every triangle whose centroid lies within ``d_v + R`` of the point, ``d_v`` the
-distance to the nearest vertex and ``R`` the largest centroid-to-corner radius). A point farther than
-``band`` from every triangle gets the lower bound ``d_c - R`` (``d_c`` the nearest centroid): 1-Lipschitz
-and never above the true distance, which is all the contact candidate lists need
+within ``band`` of the surface. The closest triangle is sought among each point's nearest triangle centroids
+(a ``cKDTree`` of them, built once: :data:`WIDER` with the compiled kernel of :mod:`.surface_kernels`,
+:data:`NEAREST` with its numpy twin), kept between calls for the same number of points (a static obstacle's
+triangles never move: :data:`HELD_SETS`); the nearest of them is the nearest of all when every other centroid
+lies farther than its distance plus ``R`` (the largest centroid-to-corner radius; the centroid distances where
+the set was found minus how far the point moved since), else the set is sought again where the point is, and
+a point still unproven searches every triangle whose centroid lies within its distance plus ``R``. A point
+farther than ``band`` from every triangle gets a lower bound of its distance (the nearest centroid minus
+``R``): 1-Lipschitz and never above the true distance, which is all the contact candidate lists need
 (:mod:`rftstatic.contact.candidates`); its side comes from the winding number (a closed surface, a point
 inside its bounding box), and its Hessian is 0. The Hessian is 0 inside too: inside a convex edge or corner
 the closest point is on a face (phi linear), except for a point on the surface itself, where the edge's
 ``1 / r`` is round-off (a sheet node laid exactly on a box's edge); at a reflex (concave) edge the face value
 is a one-sided choice, a softer PSD tangent (the penalty's slope is negative there).
+
+A step of the explicit analyses' kinematic contact through the surface (a thin table top) is caught by
+:meth:`SurfaceObstacle.segment_crossings` (:mod:`.surface_ccd`).
 
 Sharp features (:meth:`SurfaceObstacle.sharp_features`): the convex edges whose faces meet at more than
 ``feature_angle`` (:data:`FEATURE_ANGLE`) from flat and the open boundary, and their end corners: the contact
@@ -244,11 +251,11 @@ class SurfaceObstacle(Obstacle):
         if self.compiled:
             from rftstatic.contact.obstacles._surface_numba import nearest_in_sets
 
-            q, r, dc = np.empty((n, 3)), np.empty(n), np.empty(n)
-            kind, local, tri = np.empty(n, np.int8), np.empty(n, np.int8), np.empty(n, np.int64)
+            q, feature, dist = np.empty((n, 3)), np.empty((n, 3), np.int64), np.empty((n, 2))
             nearest_in_sets(np.ascontiguousarray(x), self.V, self.T, self.centroid, np.ascontiguousarray(ik),
-                            np.ascontiguousarray(dk), moved, self.radius, q, kind, local, tri, r, dc)
-            return q, kind, local, tri, r, dc
+                            np.ascontiguousarray(dk), moved, self.radius, q, feature, dist)
+            return (q, feature[:, 0].astype(np.int8), feature[:, 1].astype(np.int8), feature[:, 2], dist[:, 0],
+                    dist[:, 1])
         q, kind, local, tri = self._nearest_of(np.repeat(x, K, axis=0), ik.ravel(), np.full(n, K))
         dc = np.sqrt(np.min(np.einsum("pki,pki->pk", x[:, None] - self.centroid[ik], x[:, None] - self.centroid[ik]),
                             axis=1))
