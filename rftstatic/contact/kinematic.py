@@ -51,7 +51,8 @@ def kinematic_contact(
     v_new = _as_points(v, x_new.shape[0], name="v").copy()
     touched = np.zeros(x_new.shape[0], dtype=bool)
     for ob in items:
-        crossed = None if x_old is None else ob.segment_crossings(x_old, x_new)
+        ccd = getattr(ob, "segment_crossings", None)  # any object with signed_distance may act here
+        crossed = None if x_old is None or ccd is None else ccd(x_old, x_new)
         if crossed is not None and crossed[0].any():
             hit, stop, n = crossed
             x_new[hit] = stop[hit]

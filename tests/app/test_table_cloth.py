@@ -37,12 +37,13 @@ def _check(summary):
 
 
 def test_coarse_table_cloth_rests_on_the_table_without_crossing(tmp_path):
+    """13 x 13 nodes: the corner folds' layers touch (24 self-crossing pairs without self-contact)."""
     _check(api.run("table-cloth", tmp_path, overrides=["mesh.nodes=[13, 13]"], figures=False).summary)
 
 
 @pytest.mark.slow
 def test_table_cloth_scene(tmp_path):
-    """The scene as given (25 x 25 nodes): 26 s on the loaded 2-core machine."""
+    """The scene as given (25 x 25 nodes, RFT3, self-contact on): 49 s on the loaded 2-core machine."""
     summary = api.run("table-cloth", tmp_path, figures=False).summary
     _check(summary)
-    assert summary["drape"]["drape_coefficient_percent"] == pytest.approx(41.3, abs=0.5)
+    assert summary["drape"]["drape_coefficient_percent"] == pytest.approx(19.40, abs=0.05)
