@@ -225,7 +225,9 @@ class SurfaceObstacle(Obstacle):
         self._ctree = cKDTree(self.centroid)
         self._vtree = cKDTree(V)
         self._sets = {}  # candidate sets of the last calls, by their number of points (_candidates)
-        self.compiled = numba_available()
+        # the compiled query pays off where the numpy twin searches subsets; a box's 12 triangles are all tested
+        # at once in numpy, without importing numba (0.5 s)
+        self.compiled = numba_available() and len(T) > NEAREST
 
     def _candidates(self, x, K):
         """Each point's ``K`` candidate triangles ``ik (n, K)``, nearest centroid first, their centroid distances
