@@ -100,3 +100,26 @@ def test_a_sheet_mesh_file_with_a_non_manifold_edge_exits_2(tmp_path, capsys):
     with pytest.raises(SceneError):
         build_mesh(scene_from_dict({"units": "SI", "mesh": {"kind": "file", "path": str(tmp_path / "fan.vtu")},
                                     "material": {"preset": "wool-kang-yu"}}))
+
+
+def test_a_remeshed_relaxation_on_a_mesh_box_reports_its_crossings(tmp_path):
+    """remesh-pedestal-square-20 (coarse, 3 s of relaxation with 4 remeshes) with its pedestal replaced by a
+    10 x 10 x 10 cm box file: the remesh app writes the crossing check of the last mesh's state. (That state is
+    the transfer of the last remesh, at t_end, with no step after it: 5 nodes lie inside the box, up to 3.2 mm,
+    as 5 lie inside the analytic pedestal, up to 4.0 mm, in the scene as given.)"""
+    from rftstatic.app import remeshed
+    from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
+    from rftstatic.scenes.schema import load_scene
+
+    meshio.write(tmp_path / "box.obj", meshio.Mesh(BOX_V * 5.0, [("triangle", BOX_F)]))
+    data = load_scene("remesh-pedestal-square-20", ["mesh.h=4.0", "remesh.const=2.0", "remesh.h_lower=2.5",
+                                                    "remesh.h_upper=5.0", "remesh.every=200",
+                                                    "remesh.kappa_h2_max=6.0", "dynamics.t_end=3.0"]).data
+    data["obstacles"] = [{"type": "mesh", "path": str(tmp_path / "box.obj")}]
+    res = remeshed.run(scene_from_dict(data), tmp_path / "out", progress=False, figures=False)
+    (crossing,) = res.summary["obstacle_crossings"]
+    ob = res.extras["obstacles"][0]
+    x = res.model.positions(res.U)
+    assert res.summary["remeshes"] == 4
+    assert crossing["smallest_node_distance"] == pytest.approx(ob.signed_distance(x)[0].min() / 0.01)
+    assert crossing["pairs"] == obstacle_crossings(x, res.model.mesh.tri, *ob.surface())["pairs"]
