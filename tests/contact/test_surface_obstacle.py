@@ -249,6 +249,9 @@ def test_compiled_and_numpy_queries_and_held_candidate_sets_agree_with_brute_for
             phi = ob.signed_distance(xs)[0]
             assert np.abs(phi - exact)[near].max() < 1e-15 and np.all(phi <= exact + 1e-15)
         assert len(twins[0]._sets) == 1
+    for ob in twins:  # no point asked about (a contact candidate list may be empty)
+        phi, normal = ob.signed_distance(np.zeros((0, 3)))
+        assert phi.shape == (0,) and normal.shape == (0, 3) and ob.normal_gradient(np.zeros((0, 3))).shape == (0, 3, 3)
 
 
 def test_a_step_through_a_thin_shell_stops_on_its_side(tmp_path):

@@ -314,6 +314,8 @@ class SurfaceObstacle(Obstacle):
         T = self.T[tri]
         q, kind, local = closest_on_triangles(xp, self.V[T[:, 0]], self.V[T[:, 1]], self.V[T[:, 2]])
         d2 = np.einsum("pi,pi->p", xp - q, xp - q)
+        if not len(counts):  # no point asked about
+            return q, kind, local, tri
         if np.all(counts == counts[0]):  # K each: the nearest along the rows
             best = np.argmin(d2.reshape(len(counts), -1), axis=1) + counts[0] * np.arange(len(counts))
         else:
