@@ -22,7 +22,8 @@ Outputs in the run folder, every number in the scene's units:
   ``at_rest`` of a relax run is the kinetic energy and the force, ``time_at_rest`` and a dynamic run's
   ``at_rest`` the kinetic energy alone, :class:`~rftstatic.solvers.rest.RestCriterion`), energies, flags,
   the self-intersection check of the final state and of every saved state
-  (:func:`rftstatic.io.summary.self_intersection_summary`);
+  (:func:`rftstatic.io.summary.self_intersection_summary`) and, for a triangle-surface obstacle, the final
+  state's sheet/obstacle crossing check (:func:`rftstatic.io.summary.obstacle_crossing_summary`);
 * ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
   continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.solvers.checkpoint`).
 
@@ -41,7 +42,8 @@ from rftstatic.app.result import RunResult
 from rftstatic.errors import CheckpointError, StepLimitError
 from rftstatic.io.files import to_jsonable, write_json, write_pvd, write_vtu
 from rftstatic.io.results import run_label, write_run_view
-from rftstatic.io.summary import self_contact_summary, self_intersection_summary, summary_header
+from rftstatic.io.summary import (obstacle_crossing_summary, self_contact_summary, self_intersection_summary,
+                                  summary_header)
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model, contact_friction
 from rftstatic.scenes.options import contact_options, dynamics_options, static_options
@@ -183,6 +185,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
 
     summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)
     summary["max_steps"] = limit
+    if (crossings := obstacle_crossing_summary(scene, model, extras, run.U)) is not None:
+        summary["obstacle_crossings"] = crossings
     summary["dt_reason"] = reason
     reading = RestCriterion(o.rest_tolerance).record()  # time_at_rest: the kinetic energy alone
     summary["rest_test"] = {"at_rest": rest.criterion.record() if analysis == "relax" else reading,

@@ -45,8 +45,8 @@ from rftstatic.contact.kinematic import contact_reaction_residual
 from rftstatic.errors import CheckpointError, InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_mesh_series, write_outputs
-from rftstatic.io.summary import (drape_summary, probe_summary, self_contact_summary, self_intersection_summary,
-                                   summary_header)
+from rftstatic.io.summary import (drape_summary, obstacle_crossing_summary, probe_summary, self_contact_summary,
+                                  self_intersection_summary, summary_header)
 from rftstatic.optionspec import scene_values
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.model.state import State
@@ -337,6 +337,8 @@ def summarize(scene, opts, solved) -> dict:
         summary["newton_iterations"] = int(solved["records"][-1].solve.get("iterations", 0))
     if solved["extras"].get("obstacles"):
         summary["drape"] = drape_summary(scene, model, solved["extras"], U)
+    if (crossings := obstacle_crossing_summary(scene, model, solved["extras"], U)) is not None:
+        summary["obstacle_crossings"] = crossings
     summary["probes"] = probe_summary(scene, model, solved["extras"].get("probes", {}), U)
     return summary
 

@@ -1,7 +1,9 @@
 """Kinematic contact of the explicit solver (§6.3) and the reaction it implies at rest.
 
 After an explicit time step a penetrated node is moved to its closest surface point and the inward
-normal component of its velocity is removed (:func:`kinematic_contact`). At rest, the obstacles carry
+normal component of its velocity is removed (:func:`kinematic_contact`); a node whose step passed through a
+thin part of an obstacle (a shell, a table top: :meth:`~rftstatic.contact.obstacles.Obstacle.segment_crossings`)
+is stopped where it crossed, on the side it came from. At rest, the obstacles carry
 the part of the load that presses the touching nodes onto them: :func:`contact_reaction_residual` is
 the out-of-balance force with that frictionless reaction taken off, the residual a rest test needs.
 
@@ -20,7 +22,8 @@ from rftstatic.contact.obstacles import Obstacle
 
 
 def kinematic_contact(
-    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray, friction=None, dt: float = 0.0
+    obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray, friction=None, dt: float = 0.0,
+    x_old: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Kinematic contact correction after an explicit step (§6.3), with Coulomb friction impulses.
 
@@ -32,7 +35,10 @@ def kinematic_contact(
     step, so a sheet on a plane steeper than its friction angle slides with ``g (sin theta - mu_k cos theta)``.
     The step's tangential move is corrected by the friction's change of velocity times ``dt`` (the position
     advances with the velocity friction leaves: a sticking node does not creep by ``g sin(theta) dt^2`` a step).
-    Without friction tangential and outward velocities are kept. Obstacles are treated one after the other.
+    Without friction tangential and outward velocities are kept. Given the step's start ``x_old``, a node whose
+    straight step ``x_old -> x`` crossed a thin part of an obstacle (continuous collision detection,
+    :meth:`~rftstatic.contact.obstacles.Obstacle.segment_crossings`) is first stopped where it crossed, on its
+    side, and loses its velocity into the obstacle there. Obstacles are treated one after the other.
 
     Parameters
     ----------
@@ -41,6 +47,7 @@ def kinematic_contact(
     v : (N, 3) nodal velocities [m/s]
     friction : :class:`rftstatic.contact.friction.FrictionLaw` (coefficients per obstacle), or None
     dt : the step [s] whose tangential move friction corrects
+    x_old : (N, 3) positions at the start of the step [m], or None (no continuous collision detection)
 
     Returns
     -------
@@ -53,6 +60,14 @@ def kinematic_contact(
     v_new = _as_points(v, x_new.shape[0], name="v").copy()
     touched = np.zeros(x_new.shape[0], dtype=bool)
     for m, ob in enumerate(items):
+        ccd = getattr(ob, "segment_crossings", None)  # any object with signed_distance may act here
+        crossed = None if x_old is None or ccd is None else ccd(x_old, x_new)
+        if crossed is not None and crossed[0].any():
+            hit, stop, n = crossed
+            x_new[hit] = stop[hit]
+            vn = np.einsum("ni,ni->n", v_new[hit], n[hit])
+            v_new[hit] -= np.minimum(vn, 0.0)[:, None] * n[hit]
+            touched |= hit
         phi, normal = ob.signed_distance(x_new)
         act = phi < 0.0
         if not np.any(act):

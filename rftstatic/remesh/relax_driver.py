@@ -106,6 +106,12 @@ class NearObstacle:
     def refreshes(self) -> int:
         return self.candidates.refreshes
 
+    def segment_crossings(self, x0, x1):
+        """The wrapped obstacle's continuous collision detection of the steps ``x0 -> x1`` (``(n, 3)`` [m];
+        :meth:`rftstatic.contact.obstacles.Obstacle.segment_crossings`), or None."""
+        ccd = getattr(self.obstacle, "segment_crossings", None)
+        return None if ccd is None else ccd(x0, x1)
+
     def reset(self, margin=None):
         """Forget the candidate list (a new mesh); optionally a new ``margin`` [m]."""
         self.candidates.reset(margin)

@@ -4,10 +4,9 @@
   refused, naming where (the independent crossing test of
   :func:`rftstatic.post.measures.obstacle_crossings.obstacle_crossings`); touching is allowed within
   :data:`START_TOUCH` mean sheet edge lengths (sphere-mesh starts with the sheet on the icosphere's top vertex,
-  a table top starts flush with the sheet). The explicit analyses (``dynamic``, ``relax``) are refused too:
-  their kinematic contact projects nodes after each step without continuous collision detection, and a thin
-  surface can be stepped through; the static route (its relaxation start included, which uses the penalty
-  force) runs them.
+  a table top starts flush with the sheet). The explicit analyses (``dynamic``, ``relax``) run them too: their
+  kinematic contact stops a node whose step crossed the surface (continuous collision detection,
+  :mod:`rftstatic.contact.obstacles.surface_ccd`), so nothing is stepped through a thin shell.
 """
 
 from __future__ import annotations
@@ -22,7 +21,8 @@ START_TOUCH = 1e-6
 
 
 def check_surface_obstacles(scene, mesh, obstacles, law: str) -> None:
-    """Scene error for a surface obstacle under the kinematic law or cutting the flat sheet (module docstring)."""
+    """Scene error for a surface obstacle cutting the flat sheet (module docstring); ``law`` (``"penalty"`` or
+    ``"kinematic"``) is the contact law of the run."""
     from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
 
     edge = float(np.mean(mesh.element_size))
@@ -31,11 +31,6 @@ def check_surface_obstacles(scene, mesh, obstacles, law: str) -> None:
         surface = ob.surface()
         if surface is None:
             continue
-        if law == "kinematic":
-            raise scene.error(f"obstacles.{i}", f'a triangle-surface obstacle runs on the static route only: '
-                              f'analysis = "{scene.analysis}" contacts obstacles kinematically, without continuous '
-                              'collision detection against a surface (left for later); use analysis = "static" '
-                              '(with solver.start = "relax" for a dynamic-relaxation start)')
         V, T = surface
         r = obstacle_crossings(mesh.X3, mesh.tri, V, T, tol=START_TOUCH * edge, within=edge)
         phi = ob.signed_distance(mesh.X3)[0]

@@ -362,7 +362,8 @@ def _contact(model, obstacles, U, V, mass, acc, friction=None, dt=0.0, P=None) -
     from rftstatic.contact.kinematic import kinematic_contact
 
     X3 = model.X3
-    x_new, v_new, n_active = kinematic_contact(obstacles, X3 + U, V, friction, dt)
+    x = X3 + U
+    x_new, v_new, n_active = kinematic_contact(obstacles, x, V, friction, dt, x_old=x - dt * V)  # the step: U += dt V
     if n_active and P is not None:  # the load's work on the projection's moves: a work term of the balance (a
         # sheet resting on an obstacle at the start would otherwise gain P . dx a step against its tiny scale)
         acc["projection"] = acc.get("projection", 0.0) + float(np.einsum("ni,ni->", P, (x_new - X3 - U) * model.free))

@@ -252,6 +252,14 @@ class Obstacle(abc.ABC):
         of the sheet against them; None for an analytic obstacle."""
         return None
 
+    def segment_crossings(self, x0: np.ndarray, x1: np.ndarray):
+        """Continuous collision detection of a step: the points moved along straight segments ``x0 -> x1``
+        (``(n, 3)`` [m]) that passed through a thin part of the obstacle, where a projection of the end point
+        would put them on the wrong side. None when nothing can be stepped through (an analytic solid: a node
+        inside it is projected back out the way it came); else ``(hit (n,) bool, stop (n, 3) [m], normal (n, 3))``,
+        where each hit point stops and the outward normal there (towards its start)."""
+        return None
+
     def sharp_features(self) -> SharpFeatures | None:
         """Sharp edges and corners that must not cut the sheet between its nodes (:class:`SharpFeatures`);
         None: the obstacle has none (its normal is continuous, e.g. the rounded pedestals), the node penalty

@@ -15,16 +15,23 @@ closest surface point is on the open boundary is outside) or ``thickness`` (a tw
 r - thickness / 2``).
 
 The signed distance and its derivatives are those of :mod:`.surface_geometry`, exact for the points
-within ``band`` of the surface (the closest triangle found through a ``cKDTree`` of the triangle
-centroids, built once: every triangle whose centroid lies within ``d_v + R`` of the point, ``d_v`` the
-distance to the nearest vertex and ``R`` the largest centroid-to-corner radius). A point farther than
-``band`` from every triangle gets the lower bound ``d_c - R`` (``d_c`` the nearest centroid): 1-Lipschitz
-and never above the true distance, which is all the contact candidate lists need
+within ``band`` of the surface. The closest triangle is sought among each point's nearest triangle centroids
+(a ``cKDTree`` of them, built once: :data:`WIDER` with the compiled kernel of :mod:`.surface_kernels`,
+:data:`NEAREST` with its numpy twin), kept between calls for the same number of points (a static obstacle's
+triangles never move: :data:`HELD_SETS`); the nearest of them is the nearest of all when every other centroid
+lies farther than its distance plus ``R`` (the largest centroid-to-corner radius; the centroid distances where
+the set was found minus how far the point moved since), else the set is sought again where the point is, and
+a point still unproven searches every triangle whose centroid lies within its distance plus ``R``. A point
+farther than ``band`` from every triangle gets a lower bound of its distance (the nearest centroid minus
+``R``): 1-Lipschitz and never above the true distance, which is all the contact candidate lists need
 (:mod:`rftstatic.contact.candidates`); its side comes from the winding number (a closed surface, a point
 inside its bounding box), and its Hessian is 0. The Hessian is 0 inside too: inside a convex edge or corner
 the closest point is on a face (phi linear), except for a point on the surface itself, where the edge's
 ``1 / r`` is round-off (a sheet node laid exactly on a box's edge); at a reflex (concave) edge the face value
 is a one-sided choice, a softer PSD tangent (the penalty's slope is negative there).
+
+A step of the explicit analyses' kinematic contact through the surface (a thin table top) is caught by
+:meth:`SurfaceObstacle.segment_crossings` (:mod:`.surface_ccd`).
 
 Sharp features (:meth:`SurfaceObstacle.sharp_features`): the convex edges whose faces meet at more than
 ``feature_angle`` (:data:`FEATURE_ANGLE`) from flat and the open boundary, and their end corners: the contact
@@ -39,6 +46,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from rftstatic.compiled import numba_available
 from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures, _as_points
 from rftstatic.contact.obstacles.registry import register
 from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, pseudo_normals,
@@ -57,7 +65,20 @@ SIZE_RANGE = (1e-6, 1e4)
 smaller or larger is a mistake (its triangles would be degenerate, or its coordinates overflow)."""
 
 NEAREST = 12
-"""Triangle centroids each point's nearest triangle is first sought among (then proven, or searched wider)."""
+"""Triangle centroids each point's nearest triangle is sought among by the numpy twin (then proven, or searched
+wider)."""
+
+WIDER = 64
+"""Triangle centroids each point's nearest triangle is sought among by the compiled twin, nearest first: it
+stops at the first that cannot be nearer (a point on the surface tests a few), and a point several triangles
+off the surface (the sheet hanging beside a finely tessellated body) is still proven among them, without the
+search of every triangle within its distance plus ``R``."""
+
+HELD_SETS = 8
+"""Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
+midpoints, the feature contact's points ...): a static obstacle's triangles never move, so a point that moved
+less than its margin keeps its set (:meth:`SurfaceObstacle._candidates`) and Newton's iterations skip the
+k-d tree."""
 
 FEATURE_ANGLE = 30.0
 """Default angle [deg] between two faces' normals above which their common (convex) edge is a sharp feature: a
@@ -203,33 +224,98 @@ class SurfaceObstacle(Obstacle):
         self.band = BAND * float(np.linalg.norm(self.hi - self.lo))
         self._ctree = cKDTree(self.centroid)
         self._vtree = cKDTree(V)
+        self._sets = {}  # candidate sets of the last calls, by their number of points (_candidates)
+        # the compiled query pays off where the numpy twin searches subsets; a box's 12 triangles are all tested
+        # at once in numpy, without importing numba (0.5 s)
+        self.compiled = numba_available() and len(T) > NEAREST
 
-    def _closest(self, x, dk, ik):
-        """Closest features of the points ``x (n, 3)``, given their ``K`` nearest triangle centroids
-        (distances ``dk (n, K)`` [m], triangles ``ik (n, K)``): ``(q (n, 3), kind (n,), gid (n,))``, ``gid`` the
-        global face, edge or vertex index. The nearest of the ``K`` triangles is the nearest of all when the
-        ``K``-th centroid is farther than its distance plus ``R`` (no other triangle can be nearer); the
-        points it is not proven for search every triangle within ``d_v + R`` (``d_v`` their nearest vertex)."""
+    def _candidates(self, x, K):
+        """Each point's ``K`` candidate triangles ``ik (n, K)``, nearest centroid first, their centroid distances
+        ``dk (n, K)`` [m] where they were found and how far the point moved since, ``moved (n,)`` [m]: the
+        previous call's sets (same number of points) kept, else the ``K`` nearest centroids now (``moved = 0``).
+        ``dk - moved`` bounds the centroids' distances from below (the distance is 1-Lipschitz)."""
+        held = self._sets.get(len(x))
+        if held is None or held[1].shape[1] != K:
+            dk, ik = self._ctree.query(x, k=K)
+            dk, ik = dk.reshape(len(x), K), ik.reshape(len(x), K)
+            if len(self._sets) >= HELD_SETS and len(x) not in self._sets:
+                self._sets.pop(next(iter(self._sets)))
+            self._sets[len(x)] = (x.copy(), ik, dk)
+            return ik, dk, np.zeros(len(x))
+        x_ref, ik, dk = held
+        return ik, dk, np.linalg.norm(x - x_ref, axis=1)
+
+    def _nearest_in(self, x, ik, dk, moved):
+        """Per point, the nearest of its candidate triangles ``ik (n, K)``: ``(q, kind, local, tri, r, dc)``,
+        ``dc`` the least distance to the centroids of those it tested (:func:`.surface_kernels.nearest_in_sets`:
+        the compiled twin stops at the first candidate that cannot be nearer, ``dk - moved - R > r``)."""
         n, K = ik.shape
+        if self.compiled:
+            from rftstatic.contact.obstacles._surface_numba import nearest_in_sets
+
+            q, feature, dist = np.empty((n, 3)), np.empty((n, 3), np.int64), np.empty((n, 2))
+            nearest_in_sets(np.ascontiguousarray(x), self.V, self.T, self.centroid, np.ascontiguousarray(ik),
+                            np.ascontiguousarray(dk), moved, self.radius, q, feature, dist)
+            return (q, feature[:, 0].astype(np.int8), feature[:, 1].astype(np.int8), feature[:, 2], dist[:, 0],
+                    dist[:, 1])
         q, kind, local, tri = self._nearest_of(np.repeat(x, K, axis=0), ik.ravel(), np.full(n, K))
-        r = np.linalg.norm(x - q, axis=1)
-        open_ = (dk[:, -1] - self.radius < r) & (len(self.T) > K)
-        if open_.any():
-            xo = x[open_]
-            dv, _ = self._vtree.query(xo)
-            lists = self._ctree.query_ball_point(xo, dv + self.radius * (1 + 1e-12) + 1e-300)
-            counts = np.fromiter(map(len, lists), np.int64, len(lists))
-            tris = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
-            qo, ko, lo, to = self._nearest_of(np.repeat(xo, counts, axis=0), tris, counts)
-            q[open_], kind[open_], local[open_], tri[open_] = qo, ko, lo, to
-        gid = np.where(kind == FACE, tri, np.where(kind == EDGE, self.edge_of[tri, local], self.T[tri, local]))
-        return q, kind, gid
+        dc = np.sqrt(np.min(np.einsum("pki,pki->pk", x[:, None] - self.centroid[ik], x[:, None] - self.centroid[ik]),
+                            axis=1))
+        return q, kind, local, tri, np.linalg.norm(x - q, axis=1), dc
+
+    def _closest(self, x):
+        """Closest features of the points ``x (n, 3)`` [m]: ``(q (n, 3), kind (n,), gid (n,), exact (n,), lower
+        (n,))``, ``gid`` the global face, edge or vertex index, ``exact`` where it is proven (the others: the
+        nearest of their candidates) and ``lower`` a lower bound of each point's distance [m]. The nearest of a
+        point's candidates is the nearest of all when every other centroid is farther than its distance plus
+        ``R`` (``d_K - moved - R >= r``); candidate sets that fail that are sought again at ``x``; the points
+        still unproven and within ``band`` search every triangle within ``r + R``."""
+        K = min(WIDER if self.compiled else NEAREST, len(self.T))
+        ik, dk, moved = self._candidates(x, K)
+        q, kind, local, tri, r, dc = self._nearest_in(x, ik, dk, moved)
+        whole = len(self.T) <= K
+        beyond = dk[:, -1] - moved
+        proven = whole | (beyond - self.radius >= r)
+        again = np.flatnonzero(~proven & (moved > 0))
+        if again.size:  # sets kept from the last call that no longer prove the nearest: the K nearest now
+            dka, ika = self._ctree.query(x[again], k=K)
+            dka, ika = dka.reshape(len(again), K), ika.reshape(len(again), K)
+            x_ref, ik_held, dk_held = self._sets[len(x)]
+            x_ref[again], ik_held[again], dk_held[again] = x[again], ika, dka
+            q[again], kind[again], local[again], tri[again], r[again], dc[again] = self._nearest_in(
+                x[again], ika, dka, np.zeros(len(again)))
+            beyond[again] = dka[:, -1]
+            proven[again] = beyond[again] - self.radius >= r[again]
+        # every centroid not tested is farther than r + R or than beyond: the distance is at least this
+        lower = np.maximum(np.minimum(np.minimum(dc, beyond) - self.radius, r), 0.0)
+        open_ = np.flatnonzero(~proven & (lower < self.band))
+        if open_.size:
+            q[open_], kind[open_], local[open_], tri[open_] = self._ball(x[open_], r[open_])
+            proven[open_] = True
+        return q, kind, self._gid(kind, local, tri), proven, lower
+
+    def _ball(self, xo, reach=None):
+        """The nearest triangle of each point ``xo (m, 3)`` among all whose centroid lies within ``reach + R``
+        (``reach (m,)`` [m], a distance to the surface some triangle attains; default: to the nearest vertex):
+        ``(q, kind, local, tri)``."""
+        if reach is None:
+            reach, _ = self._vtree.query(xo)
+        lists = self._ctree.query_ball_point(xo, reach + self.radius * (1 + 1e-12) + 1e-300)
+        counts = np.fromiter(map(len, lists), np.int64, len(lists))
+        tris = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
+        return self._nearest_of(np.repeat(xo, counts, axis=0), tris, counts)
+
+    def _gid(self, kind, local, tri):
+        """The global face, edge or vertex index of a closest feature."""
+        return np.where(kind == FACE, tri, np.where(kind == EDGE, self.edge_of[tri, local], self.T[tri, local]))
 
     def _nearest_of(self, xp, tri, counts):
         """Per point, the nearest of its ``counts`` consecutive candidate pairs ``(xp (P, 3), tri (P,))``."""
         T = self.T[tri]
         q, kind, local = closest_on_triangles(xp, self.V[T[:, 0]], self.V[T[:, 1]], self.V[T[:, 2]])
         d2 = np.einsum("pi,pi->p", xp - q, xp - q)
+        if not len(counts):  # no point asked about
+            return q, kind, local, tri
         if np.all(counts == counts[0]):  # K each: the nearest along the rows
             best = np.argmin(d2.reshape(len(counts), -1), axis=1) + counts[0] * np.arange(len(counts))
         else:
@@ -237,33 +323,28 @@ class SurfaceObstacle(Obstacle):
             best = np.lexsort((d2, pt))[np.r_[0, np.cumsum(counts)[:-1]]]  # per point, the nearest pair first
         return q[best], kind[best], local[best], tri[best]
 
-    def _near_far(self, x):
-        """``(near (n,) bool, lower (n,) [m], dk (n, K), ik (n, K))``: the points that need the exact distance,
-        a lower bound of every point's distance and the ``K`` nearest triangle centroids."""
-        K = min(NEAREST, len(self.T))
-        dk, ik = self._ctree.query(x, k=K)
-        dk, ik = dk.reshape(len(x), K), ik.reshape(len(x), K)
-        lower = np.maximum(dk[:, 0] - self.radius, 0.0)
-        near = lower < self.band
-        if self.closed:
-            box = ~near & np.all((x >= self.lo) & (x <= self.hi), axis=1)
-            if box.any():  # a point deep inside (none in a sound run) gets its exact distance too
-                near[box] = winding_number(x[box], self.V, self.T) > 0.5
-        return near, lower, dk, ik
-
     def _evaluate(self, x, hessian):
         x = _as_points(x)
         n = len(x)
-        near, lower, dk, ik = self._near_far(x)
+        q, kind, gid, exact, lower = self._closest(x)
+        near = exact & (lower < self.band)
+        if self.closed:
+            box = ~near & np.all((x >= self.lo) & (x <= self.hi), axis=1)
+            if box.any():  # a point deep inside (none in a sound run) gets its exact distance too
+                deep = np.flatnonzero(box)[winding_number(x[box], self.V, self.T) > 0.5]
+                if deep.size:
+                    qd, kd, ld, td = self._ball(x[deep])
+                    q[deep], kind[deep], gid[deep] = qd, kd, self._gid(kd, ld, td)
+                    near[deep] = True
         half = 0.0 if self.thickness is None else 0.5 * self.thickness
         phi = lower - half
-        away = x - self.centroid[ik[:, 0]]
+        away = x - q
         normal = away / np.maximum(np.linalg.norm(away, axis=1, keepdims=True), 1e-300)
         H = np.zeros((n, 3, 3)) if hessian else None
         idx = np.flatnonzero(near)
         if idx.size:
             xn = x[idx]
-            q, kind, gid = self._closest(xn, dk[idx], ik[idx])
+            q, kind, gid = q[idx], kind[idx], gid[idx]
             d = xn - q
             r = np.linalg.norm(d, axis=1)
             pn = np.where((kind == FACE)[:, None], self.nf[np.where(kind == FACE, gid, 0)],
@@ -300,6 +381,16 @@ class SurfaceObstacle(Obstacle):
 
     def normal_gradient(self, x):
         return self._evaluate(x, True)[2]
+
+    def segment_crossings(self, x0, x1):
+        """Steps ``x0 -> x1`` ``(n, 3)`` [m] through the surface (:mod:`.surface_ccd`): a point whose step is
+        longer than its end's distance to the surface (the mid-surface of a shell) is tested."""
+        from rftstatic.contact.obstacles.surface_ccd import first_crossings
+
+        x0, x1 = _as_points(x0), _as_points(x1)
+        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        r = np.abs(self.signed_distance(x1)[0] + half)
+        return first_crossings(self, x0, x1, np.flatnonzero(np.linalg.norm(x1 - x0, axis=1) >= r), half)
 
     psd_tangent = True  # the distance's curvature is unbounded at sharp edges: the penalty clamps it (PSD)
 
