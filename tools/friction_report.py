@@ -186,8 +186,8 @@ Crossing pairs by the independent triangle-triangle tests (cloth/table and the c
 
 - The drag test (a sheet pulled along a floor by a prescribed edge displacement: reaction = mu x weight): the
   scenes have no prescribed non-zero displacement yet.
-- Friction in dynamic relaxation (the relaxation route refuses `contact.friction`), per-obstacle coefficients
-  (`[[obstacles]] friction`) and `self_friction` between layers.
+- Friction in dynamic relaxation (the relaxation route refuses `contact.friction`) and `self_friction` between
+  layers. (Per-obstacle coefficients, `[[obstacles]] friction`, are built.)
 - Friction on the default Cusick and drape scenes (they take the relaxation route).
 """
     Path(args.out, "friction_obstacles.md").write_text(text)

@@ -45,7 +45,8 @@ from rftstatic.io.results import run_label, write_run_view
 from rftstatic.io.summary import (obstacle_crossing_summary, self_contact_summary, self_intersection_summary,
                                   summary_header)
 from rftstatic.post.probes import probe_interpolation
-from rftstatic.scenes.build import build_model, contact_friction
+from rftstatic.scenes.build import build_model
+from rftstatic.scenes.friction import contact_friction
 from rftstatic.scenes.options import contact_options, dynamics_options, static_options
 from rftstatic.model.state import State
 from rftstatic.solvers.checkpoint import CheckpointSaver, explicit_header, load_explicit_state

@@ -15,6 +15,7 @@ from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
 from rftstatic.scenes.material import build_material
+from rftstatic.scenes.friction import contact_friction
 from rftstatic.scenes.obstacle_checks import check_surface_obstacles
 from rftstatic.scenes.options import contact_options, declared_run_options, static_options
 from rftstatic.scenes.ranges import (
@@ -330,27 +331,6 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
         hold_inplane_rigid_modes(mesh, supports)
     return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh,
                           friction=friction), obstacles
-
-
-def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
-    """The scene's Coulomb friction law (:class:`rftstatic.contact.friction.FrictionLaw`), or None when
-    frictionless: lagged on the static load-step route, impulses in a dynamic run (relaxation refuses it)."""
-    mu_s = c.friction if c.friction_static is None else c.friction_static
-    mu_k = c.friction if c.friction_kinetic is None else c.friction_kinetic
-    if mu_s == 0.0 and mu_k == 0.0:
-        return None
-    if mu_k > mu_s:
-        raise scene.error("contact.friction_kinetic", f"the kinetic coefficient {mu_k:g} exceeds the static one "
-                          f"{mu_s:g}; give friction_kinetic <= friction_static")
-    static = scene.analysis == "static" and static_options(scene, progress=False).route.start == "load-steps"
-    if not (static or scene.analysis == "dynamic"):
-        raise scene.error("contact.friction", "friction acts on the static load-step route (analysis = \"static\", "
-                          'solver.start = "load-steps") and in dynamic runs (analysis = "dynamic"); dynamic '
-                          "relaxation is frictionless in this version: set contact.friction = 0 for it")
-    from rftstatic.contact.friction import SLIP_LENGTH, FrictionLaw
-
-    size = float(np.ptp(mesh.X, axis=0).max())
-    return FrictionLaw(np.full(n_obstacles, mu_s), np.full(n_obstacles, mu_k), eps=SLIP_LENGTH * size)
 
 
 OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z", "translate": "xyz"}

@@ -179,3 +179,13 @@ def test_explicit_sliding_on_an_incline_accelerates_at_g_sin_minus_mu_k_cos(mu_s
             assert 2 * float(r.U[:, 0].mean()) / r.t**2 == pytest.approx(expected, rel=0.05)
         else:
             assert np.abs(r.U[:, :2]).max() < 1e-9
+
+
+def test_an_obstacles_own_friction_overrides_the_contacts(tmp_path, capsys):
+    """[[obstacles]] friction: the incline's 19.6 deg hold with the floor's own mu = 0.4 and no contact.friction,
+    and fail with mu = 0.2 (friction angle 11.3 deg); a negative one is refused naming the obstacle's key."""
+    assert _case(tmp_path, "contact.friction=0", "obstacles.0.friction=0.4")[0] == 0
+    assert _case(tmp_path, "obstacles.0.friction=0.2")[0] == 3
+    capsys.readouterr()
+    assert _case(tmp_path, "obstacles.0.friction=-1")[0] == 2
+    assert "obstacles.0.friction" in capsys.readouterr().err

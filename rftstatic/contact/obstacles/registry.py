@@ -80,6 +80,12 @@ def obstacle_class(name: str) -> type[Obstacle]:
     return _TYPES[str(name).strip().lower().replace("_", "-")]
 
 
+CONTACT_KEYS = {"friction": ((int, float), "Coulomb friction coefficient of the sheet on this obstacle, static and "
+                                           "kinetic, instead of contact.friction")}
+"""Keys every ``[[obstacles]]`` table may have that belong to the contact with it, not to its shape (read by the
+scene's contact, :func:`rftstatic.scenes.build.contact_friction`; not passed to the obstacle)."""
+
+
 def scene_schema() -> dict[str, tuple[tuple[type, ...], str]]:
     """Keys of an ``[[obstacles]]`` table over all registered types, for the scene schema.
 
@@ -100,6 +106,7 @@ def scene_schema() -> dict[str, tuple[tuple[type, ...], str]]:
                 helps[key].append(sk.help)
     for key, types in kinds.items():
         table[key] = (tuple(types), "; ".join(helps[key]))
+    table.update(CONTACT_KEYS)
     return table
 
 
@@ -168,7 +175,7 @@ def from_spec(spec: Mapping[str, Any], length_scale: float = 1.0, base_dir=None)
     cls = _TYPES[kind]
     keys = cls.scene_keys
     where = f"obstacle {kind!r}"
-    unknown = sorted(set(spec) - set(keys) - {"type"})
+    unknown = sorted(set(spec) - set(keys) - {"type"} - set(CONTACT_KEYS))
     if unknown:
         raise ValueError(f"{where}: unknown key(s) {unknown}; allowed keys are {sorted(keys)}")
     missing = [key for key, sk in keys.items() if sk.required and key not in spec]
