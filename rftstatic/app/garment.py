@@ -29,8 +29,10 @@ vertical axis (a zero-energy mode on a frictionless body of revolution) is held 
 
 Measures added to ``summary.json`` (``garment``): the pattern's panels, seams (0 here, so the largest seam
 gap before merging is 0 by construction), hem nodes (the outer boundary loop), the hem's drape coefficient
-``(A_shadow - A_waist) / (A_flat - A_waist)`` (the shadow of the whole draped skirt against the flat
-skirt's, the waist opening's area taken out, as for a circular specimen on a disc), mean element size.
+``A_shadow / A_flat``: the area of the draped skirt's vertical projection (:func:`rftstatic.post.measures.shadow.shadow_area`,
+the waist opening not counted) over the flat skirt's area (the opening left out too). It is Cusick's
+``(A_shadow - A_disc) / (A_sheet - A_disc)`` with the waist opening as the disc, when the draped skirt does
+not overlap the projection of its own waist opening (it flares outwards from the waist); mean element size.
 Outputs: ``deformed.vtu`` (cell data ``panel``), ``garment.obj`` with UVs (each node's flat pattern
 coordinates, scene units), ``body.obj`` and ``body.vtu`` (scene units).
 """
@@ -163,14 +165,11 @@ def _garment_measures(scene, model, U, pmesh, hem) -> dict:
     u = scene.units.length
     x = model.positions(U)
     flat = float(model.mesh.area.sum())
-    outline = shadow_area(model.X3, model.mesh.tri)
-    waist = outline - flat  # the flat skirt's opening (the waist hole), inside its outline
     shadow = shadow_area(x, model.mesh.tri)
-    return {"pattern": pmesh.pattern.name if hasattr(pmesh.pattern, "name") else "",
-            "panels": len(pmesh.meshes), "seams": len(pmesh.pattern.seams), "largest_seam_gap": 0.0,
-            "hem_nodes": int(len(hem)), "mean_element_size": float(model.mesh.element_size.mean()) / u,
-            "flat_area": flat / u**2, "waist_opening_area": waist / u**2, "shadow_area": shadow / u**2,
-            "hem_drape_coefficient": (shadow - waist) / (outline - waist),
+    return {"pattern": Path(pmesh.pattern.source).name, "panels": len(pmesh.meshes),
+            "seams": len(pmesh.pattern.seams), "largest_seam_gap": 0.0, "hem_nodes": int(len(hem)),
+            "mean_element_size": float(model.mesh.element_size.mean()) / u, "flat_area": flat / u**2,
+            "shadow_area": shadow / u**2, "hem_drape_coefficient": shadow / flat,
             "hem_lowest": float(x[hem, 2].min()) / u, "hem_highest": float(x[hem, 2].max()) / u}
 
 
