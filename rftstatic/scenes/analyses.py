@@ -13,6 +13,7 @@ ANALYSES = {
     "dynamic": "rftstatic.app.dynamic",  # explicit central differences with mass damping (§2.4, §4.6)
     "relax": "rftstatic.app.dynamic",  # dynamic relaxation to rest (§6)
     "remeshed": "rftstatic.app.remeshed",
+    "garment": "rftstatic.app.garment",  # a garment pattern on a dress form (issue 37)
     "cantilever": "rftstatic.app.cantilever",  # Peirce's cantilever tester: the overhang at which the tip meets 41.5 deg  # a scene with [remesh]: global adaptive remeshing (§5-6)
 }
 """Analysis name -> module that runs it."""

@@ -168,6 +168,17 @@ SCHEMA = {
     "remesh": (schema_entries(RemeshOptions), "global adaptive remeshing (§5): python -m rftstatic options remesh"),
     "cantilever": (schema_entries(CantileverOptions), "cantilever bending tester (analysis = \"cantilever\"): the "
                    "strip's mesh.size[0] is the first overhang; python -m rftstatic options cantilever"),
+    "garment": ({"pattern": (str, "pattern file, GarmentCode JSON or TOML (relative to the scene)"),
+                 "h": (NUM, "target element size of the garment mesh [length]")},
+                "the garment of analysis = \"garment\" (rftstatic.app.garment)"),
+    "body": ({"kind": (str, "dress-form (rftstatic.garment.body.DressForm)"),
+              **{k: (NUM, "dress form measurement [length]") for k in
+                 ("bust_girth", "waist_girth", "hip_girth", "bust_height", "waist_height", "hip_height",
+                  "shoulder_breadth", "shoulder_height", "neck_girth", "neck_height", "neck_length",
+                  "bottom_height")},
+              **{k: (NUM, "depth / width ratio of the section [-]") for k in
+                 ("bust_depth", "waist_depth", "hip_depth", "shoulder_depth", "neck_depth")}},
+             "the dress form of analysis = \"garment\""),
     "probes": ([{"name": (str, "probe name"), "at": (XY, "[x, y] reference point")}], "tracked points"),
     "output": ({
         "views": (ListOf(str, choices=("side", "top", "iso")), "PNG views: side, top, iso"),
