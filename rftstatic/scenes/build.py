@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from rftstatic.compiled import choose_kernels
+from rftstatic.errors import PatchError
 from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
@@ -448,8 +449,11 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     membrane = declared_run_options(scene).membrane
     kernels = run_kernels(scene, mesh)
     self_contact = build_self_contact(scene, mesh, material, kernels=kernels)
-    model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
-                  contact=contact, membrane=membrane, quiet=quiet, self_contact=self_contact, kernels=kernels)
+    try:
+        model = Model(mesh, material, element=scene.get("element", "RFT6"), supports=supports, load=load,
+                      contact=contact, membrane=membrane, quiet=quiet, self_contact=self_contact, kernels=kernels)
+    except PatchError as exc:  # the scene's mesh: say which scene and key
+        raise scene.error("mesh", str(exc)) from None
     probes = {}
     u = scene.units.length
     for i, spec in enumerate(scene.get("probes", [])):

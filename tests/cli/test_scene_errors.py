@@ -460,3 +460,11 @@ def test_an_unconverged_solve_says_what_to_try_last(capsys, tmp_path, sets):
     assert code == 3, err
     last = err.replace(". ", "; ").split("; ")[-1]
     assert any(word in last for word in ("solver.", "mesh", "material", "dynamics.")), err
+
+
+def test_a_mesh_with_singular_patches_is_an_input_error_naming_the_scene(capsys, tmp_path):
+    """A polar mesh too coarse for its patches (4 x 4 nodes on the Cusick annulus: the six points of 16 patches on
+    one conic) is refused with the scene's file and its mesh key, not only the patch message."""
+    assert main(["case", "cusick-30", "--set", "mesh.nodes=[4,4]", "--no-figures", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "cusick-30.toml: mesh: " in err and "singular patch" in err
