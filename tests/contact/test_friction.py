@@ -189,3 +189,42 @@ def test_an_obstacles_own_friction_overrides_the_contacts(tmp_path, capsys):
     capsys.readouterr()
     assert _case(tmp_path, "obstacles.0.friction=-1")[0] == 2
     assert "obstacles.0.friction" in capsys.readouterr().err
+
+
+def drag(mu=0.3, steps=4, step=0.5e-3, n=9):
+    """A 10 cm wool square resting on the floor under its weight with friction mu, one edge (x = 0) held in x and y
+    and dragged along -x by ``step`` [m] ``steps`` times at full load: the edge's reaction along x over mu times the
+    sheet's weight after each drag step (the exact value of a sliding sheet: 1)."""
+    from rftstatic.solvers.load_steps import solve_load_steps
+    from rftstatic.solvers.newton import start_state
+
+    mesh = rectangle(0.1, 0.1, n, n)
+    mat = preset("wool-kang-yu")
+    h = float(mesh.element_size.mean())
+    k = auto_penalty(membrane_rigidity=mat.membrane_scale, bending_rigidity=mat.bending_scale, weight=mat.weight, h=h)
+    contact = PenaltyContact([Floor(0.0)], mesh.node_area, k, smoothing=0.05 * h,
+                             friction=FrictionLaw(np.array([mu]), np.array([mu]), eps=1e-5))
+    edge = np.flatnonzero(np.abs(mesh.X[:, 0]) < 1e-12)
+    fixed = np.zeros((mesh.n_nodes, 3), bool)
+    fixed[edge, :2] = True  # held in the plane, resting on the floor
+    load = gravity_load(mesh, mat.weight)
+    model = Model(mesh, mat, supports=Supports(np.zeros(0, np.int64), np.zeros(0, np.int64), fixed), load=load,
+                  contact=contact)
+    opts = static.StaticOptions(progress=False).replace(relax_fallback=False)
+    state = start_state(model, opts.newton.linear_solver)
+    U = solve_load_steps(model, options=opts, state=state).U.copy()
+    ratios = []
+    for _ in range(steps):
+        U[edge, 0] -= step
+        res = solve_load_steps(model, U0=U, options=opts.from_state(relax_fallback=False), state=state)
+        assert res.converged
+        U = res.U.copy()
+        reaction = model.residual(U, 1.0, candidates=state.candidates)[edge, 0].sum()
+        ratios.append(abs(reaction) / (mu * -load[:, 2].sum()))
+    return ratios
+
+
+def test_a_sheet_dragged_along_the_floor_pulls_back_with_mu_times_its_weight():
+    """The drag test of issue 36: once the sheet slides, the edge's reaction is mu W within 2 % (measured: 0.9994)."""
+    ratios = drag()
+    assert all(abs(r - 1.0) < 0.02 for r in ratios[1:]), ratios
