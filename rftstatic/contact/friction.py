@@ -158,9 +158,10 @@ def commit(law: FrictionLaw, penalty, lag: dict, x: np.ndarray, lam: float = 1.0
     nodes, obstacle, force, normal = _contacts(penalty, x)
     anchor = x[nodes].copy()
     slid = np.zeros(nodes.size, bool)
-    old = {int(k): i for i, k in enumerate(lag["nodes"])}
-    keep = np.array([old.get(int(k), -1) for k in nodes], dtype=np.int64)
-    had = keep >= 0
+    prev = lag["nodes"]  # sorted, as np.flatnonzero gives them
+    pos = np.minimum(np.searchsorted(prev, nodes), max(prev.size - 1, 0))
+    had = prev[pos] == nodes if prev.size else np.zeros(nodes.size, bool)
+    keep = np.where(had, pos, -1)
     if np.any(had):
         j = keep[had]
         u = x[nodes[had]] - lag["anchor"][j]

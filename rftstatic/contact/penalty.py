@@ -41,6 +41,7 @@ from rftstatic.contact.candidates import CandidateList
 from rftstatic.contact.common import as_list as _as_list
 from rftstatic.contact.common import as_points as _as_points
 from rftstatic.contact.common import positive as _positive
+from rftstatic.contact.friction import friction_terms
 from rftstatic.contact.obstacles import Obstacle
 from rftstatic.model.frozen import Frozen
 
@@ -230,8 +231,6 @@ class PenaltyContact(Frozen):
             pairs = (fs.rows, fs.cols, fs.blocks) if len(fs.rows) else None
         lag = getattr(candidates, "friction", None)
         if lag is not None:
-            from rftstatic.contact.friction import friction_terms
-
             ef, ff, kf = friction_terms(lag, x, tangent=tangent)
             energy += ef
             force += ff
@@ -303,8 +302,6 @@ class PenaltyContact(Frozen):
             force += self.features.evaluate(x, tangent=False, cache=candidates).force
         lag = getattr(candidates, "friction", None)
         if lag is not None:
-            from rftstatic.contact.friction import friction_terms
-
             force += friction_terms(lag, x, tangent=False)[1]
         return force
 
