@@ -20,7 +20,7 @@ from rftstatic.element import kernels
 
 _ELEMENT = ("strain_point_gradients", "green_strain", "averaged_strain", "stress", "membrane_state",
             "strain_energy", "_deformation", "element_force", "positive_part", "element_tangent", "_gather",
-            "strain_increment", "_force_and_tangent")
+            "strain_increment", "_force_and_tangent", "_gather_offset")
 _LOOPS = ("membrane_energies", "membrane_forces", "membrane_tangents", "membrane_tangents_into",
           "membrane_linearised_strains", "membrane_force_blocks", "internal_force")
 _THREADED = ("membrane_force_blocks", "internal_force")

@@ -61,6 +61,7 @@ class ForceKernel:
         self.Dm = np.ascontiguousarray(model.material.Dm, dtype=float)
         self.with_membrane = model.with_membrane
         self.contact = model.contact
+        self.load_terms = model.load_terms
         self.self_contact = getattr(model, "self_contact", None)
         self.X3 = model.X3
         mem = model.membrane
@@ -70,6 +71,11 @@ class ForceKernel:
         self.area = np.ascontiguousarray(mem.area, dtype=float)
         self.nodes = np.ascontiguousarray(mem.nodes, dtype=np.int64)
         self.G = np.ascontiguousarray(mem.G, dtype=float)
+        self._D, self._D_last = mem._compiled_args[3], mem.offset_last  # a sewn mesh's reference offsets
+        # a sewn mesh bends from its placed reference: K_b (X3 + U) = K_b U + b (Model.bending_displacement)
+        self._bend_offset = None if model.mesh.element_X is None else model.Kb @ self.X3
+        self._bend_energy = 0.0 if self._bend_offset is None else 0.5 * float(np.einsum("ni,ni->", self.X3,
+                                                                                          self._bend_offset))
         self.threads = 1
         self.bending_friction = getattr(model, "bending_friction", None)
         if self.bending_friction is not None:  # the bending friction's scatter
@@ -101,7 +107,8 @@ class ForceKernel:
     def __call__(self, U: np.ndarray, *, energy: bool = False, candidates=None, pairs=None, slip=None):
         """Internal force ``(N, 3)`` [N]; with ``energy=True`` also the stored energy [J].
 
-        The stored energy is bending + membrane + penalty contact + self-contact (:meth:`Model.energies`);
+        The stored energy is bending + membrane + penalty contact + self-contact (:meth:`Model.energies`), and
+        the potential of the model's potential loads (``model.load_terms``) at load factor 1;
         ``candidates`` is the solve's contact candidate list (a cache; None: every node), ``pairs`` its
         self-contact pair cache (``State.self_pairs``; None: a fresh broad phase), ``slip`` the committed
         slip of the bending friction (``State.bending_slip``, :mod:`rftstatic.element.hysteresis`; numpy).
@@ -110,7 +117,7 @@ class ForceKernel:
         if self.backend == "numba":
             f = np.empty_like(U)
             Kb = self.Kb
-            args = (Kb.indptr, Kb.indices, Kb.data, self.nodes, self.G, self.area, self.Dm, U, f, self._fe,
+            args = (Kb.indptr, Kb.indices, Kb.data, self.nodes, self.G, self.area, self._D, self.Dm, U, f, self._fe,
                     self._slot_ptr, self._slots, self.with_membrane)
             if self.threads > 1:
                 import numba
@@ -128,14 +135,22 @@ class ForceKernel:
             f = self.Kb @ U
             W = 0.5 * float(np.einsum("ni,ni->", U, f)) if energy else 0.0
             if self.with_membrane:
-                fe, We = forces_numpy(self._G_last, self.nodes, self.area, self.Dm, U)
+                fe, We = forces_numpy(self._G_last, self.nodes, self.area, self.Dm, U, self._D_last)
                 f += np.bincount(self._dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
                 W += float(We.sum()) if energy else 0.0
+        if self._bend_offset is not None:
+            f += self._bend_offset
+            W += float(np.einsum("ni,ni->", U, self._bend_offset)) + self._bend_energy if energy else 0.0
         if self.bending_friction is not None:
             held = self.bending_friction.initial_slip() if slip is None else slip
-            Wf, fe, _ = self.bending_friction.evaluate(U, self.X3 + U, held)
+            Ub = U if self._bend_offset is None else self.X3 + U
+            Wf, fe, _ = self.bending_friction.evaluate(Ub, self.X3 + U, held)
             f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
             W += Wf if energy else 0.0
+        for term in self.load_terms:  # potential loads at load factor 1 (the explicit loads act in full)
+            x = self.X3 + U
+            f += term.force(x)
+            W += term.potential(x) if energy else 0.0
         if self.contact is not None:
             x = self.X3 + U
             f += self.contact.force(x, candidates=candidates)

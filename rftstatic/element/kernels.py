@@ -222,18 +222,31 @@ def _gather(U, n, u):
     return u
 
 
-def membrane_energies(nodes, G, area, Dm, U, We):
+def _gather_offset(U, n, D, e, u):
+    """:func:`_gather` plus the element's reference offset ``D[e] (A, 3)`` [m] when ``D`` has rows (a mesh sewn
+    from panels, :attr:`rftstatic.element.membrane.MembraneOperator.offset`; ``D (0, A, 3)`` otherwise): the
+    displacements of the element's nodes from its own flat reference."""
+    _gather(U, n, u)
+    if D.shape[0] > 0:
+        for a in range(n.shape[0]):
+            for i in range(3):
+                u[a, i] = u[a, i] + D[e, a, i]
+    return u
+
+
+def membrane_energies(nodes, G, area, D, Dm, U, We):
     """Fill ``We (E,)`` [J] with the membrane energy of every element at ``U (N, 3)`` [m];
-    ``nodes (E, A)``, ``G (E, Q, A, 2)`` [1/m], ``area (E,)`` [m^2]."""
+    ``nodes (E, A)``, ``G (E, Q, A, 2)`` [1/m], ``area (E,)`` [m^2], ``D (E, A, 3)`` [m] the reference offsets
+    of a sewn mesh or ``(0, A, 3)`` (:func:`_gather_offset`; the same in every loop below)."""
     E, Q, A = G.shape[0], G.shape[1], G.shape[2]
     H = np.empty((Q, 2, 3))
     u = np.empty((A, 3))
     for e in range(E):
-        exx, eyy, gxy, sxx, syy, sxy = membrane_state(G[e], _gather(U, nodes[e], u), Dm, H)
+        exx, eyy, gxy, sxx, syy, sxy = membrane_state(G[e], _gather_offset(U, nodes[e], D, e, u), Dm, H)
         We[e] = strain_energy(area[e], exx, eyy, gxy, sxx, syy, sxy)
 
 
-def membrane_forces(nodes, G, area, Dm, U, fe, start, stop):
+def membrane_forces(nodes, G, area, D, Dm, U, fe, start, stop):
     """Fill ``fe[start:stop] (E, A, 3)`` [N] with the membrane forces of elements ``start`` to
     ``stop - 1``; return their membrane energy [J]."""
     Q, A = G.shape[1], G.shape[2]
@@ -241,19 +254,19 @@ def membrane_forces(nodes, G, area, Dm, U, fe, start, stop):
     u = np.empty((A, 3))
     W = 0.0
     for e in range(start, stop):
-        exx, eyy, gxy, sxx, syy, sxy = membrane_state(G[e], _gather(U, nodes[e], u), Dm, H)
+        exx, eyy, gxy, sxx, syy, sxy = membrane_state(G[e], _gather_offset(U, nodes[e], D, e, u), Dm, H)
         element_force(G[e], H, sxx, syy, sxy, area[e], fe[e])
         W += strain_energy(area[e], exx, eyy, gxy, sxx, syy, sxy)
     return W
 
 
-def membrane_force_blocks(nodes, G, area, Dm, U, fe, chunks):
+def membrane_force_blocks(nodes, G, area, D, Dm, U, fe, chunks):
     """:func:`membrane_forces` of all elements in ``chunks`` blocks (on threads in the parallel twin;
     any number of blocks gives the same ``fe``); return the membrane energy [J]."""
     E = G.shape[0]
     W = 0.0
     for c in prange(chunks):
-        W += membrane_forces(nodes, G, area, Dm, U, fe, c * E // chunks, (c + 1) * E // chunks)
+        W += membrane_forces(nodes, G, area, D, Dm, U, fe, c * E // chunks, (c + 1) * E // chunks)
     return W
 
 
@@ -268,7 +281,7 @@ def _force_and_tangent(g, u, area, Dm, psd, S, e, H, B, DB, SG, fe, ke):
     element_tangent(g, H, sxx, syy, sxy, area, Dm, psd, B, DB, SG, ke)
 
 
-def membrane_tangents(nodes, G, area, Dm, U, psd, S, fe, ke):
+def membrane_tangents(nodes, G, area, D, Dm, U, psd, S, fe, ke):
     """Fill ``fe (E, A, 3)`` [N] and ``ke (E, A, 3, A, 3)`` [N/m] for every element.
 
     ``S (E, 3)`` [N/m]: the stress of the geometric part (the mixed stress of
@@ -281,10 +294,11 @@ def membrane_tangents(nodes, G, area, Dm, U, psd, S, fe, ke):
     DB = np.empty((3, A, 3))
     SG = np.empty((Q, A, 2))
     for e in range(E):
-        _force_and_tangent(G[e], _gather(U, nodes[e], u), area[e], Dm, psd, S, e, H, B, DB, SG, fe[e], ke[e])
+        u = _gather_offset(U, nodes[e], D, e, u)
+        _force_and_tangent(G[e], u, area[e], Dm, psd, S, e, H, B, DB, SG, fe[e], ke[e])
 
 
-def membrane_tangents_into(nodes, G, area, Dm, U, psd, S, emap, fe, data):
+def membrane_tangents_into(nodes, G, area, D, Dm, U, psd, S, emap, fe, data):
     """:func:`membrane_tangents` with every element tangent added straight into the CSR values
     ``data (nnz,)`` [N/m] at the positions ``emap (E, A, 3, A, 3)`` (no (E, A, 3, A, 3) array, no
     separate scatter), element by element in order; ``fe (E, A, 3)`` [N] is filled as there."""
@@ -296,7 +310,8 @@ def membrane_tangents_into(nodes, G, area, Dm, U, psd, S, emap, fe, data):
     SG = np.empty((Q, A, 2))
     ke = np.empty((A, 3, A, 3))
     for e in range(E):
-        _force_and_tangent(G[e], _gather(U, nodes[e], u), area[e], Dm, psd, S, e, H, B, DB, SG, fe[e], ke)
+        u = _gather_offset(U, nodes[e], D, e, u)
+        _force_and_tangent(G[e], u, area[e], Dm, psd, S, e, H, B, DB, SG, fe[e], ke)
         m = emap[e]
         for a in range(A):
             for i in range(3):
@@ -305,7 +320,7 @@ def membrane_tangents_into(nodes, G, area, Dm, U, psd, S, emap, fe, data):
                         data[m[a, i, b, j]] += ke[a, i, b, j]
 
 
-def membrane_linearised_strains(nodes, G, U, dU, out):
+def membrane_linearised_strains(nodes, G, D, U, dU, out):
     """Fill ``out (E, 3)`` [-] with ``eps(U) + Bbar(U) dU`` of every element (:func:`strain_increment`),
     ``U, dU (N, 3)`` [m]."""
     E, Q, A = G.shape[0], G.shape[1], G.shape[2]
@@ -315,7 +330,7 @@ def membrane_linearised_strains(nodes, G, U, dU, out):
     du = np.empty((A, 3))
     for e in range(E):
         g = G[e]
-        strain_point_gradients(g, _gather(U, nodes[e], u), H)
+        strain_point_gradients(g, _gather_offset(U, nodes[e], D, e, u), H)
         strain_point_gradients(g, _gather(dU, nodes[e], du), h)
         exx, eyy, gxy = averaged_strain(H)
         dxx, dyy, dxy = strain_increment(H, h)
@@ -324,7 +339,7 @@ def membrane_linearised_strains(nodes, G, U, dU, out):
         out[e, 2] = gxy + dxy
 
 
-def internal_force(indptr, indices, data, nodes, G, area, Dm, U, f, fe, slot_ptr, slots, with_membrane, chunks):
+def internal_force(indptr, indices, data, nodes, G, area, D, Dm, U, f, fe, slot_ptr, slots, with_membrane, chunks):
     """Fill ``f (N, 3)`` [N] with the internal force at ``U (N, 3)`` [m]; return the stored energy [J].
 
     Bending ``K_b @ U`` over the CSR rows ``indptr, indices, data`` of the scalar K_b [N/m] (Eq. 13),
@@ -336,7 +351,7 @@ def internal_force(indptr, indices, data, nodes, G, area, Dm, U, f, fe, slot_ptr
     E, A = nodes.shape[0], nodes.shape[1]
     W = 0.0
     if with_membrane:
-        W = membrane_force_blocks(nodes, G, area, Dm, U, fe, chunks)
+        W = membrane_force_blocks(nodes, G, area, D, Dm, U, fe, chunks)
     flat = fe.reshape((E * A, 3))
     for n in prange(N):
         s0 = 0.0
@@ -367,10 +382,13 @@ def element_last(G):
     return np.ascontiguousarray(np.moveaxis(G, 0, -1))
 
 
-def _vectorised(G_last, nodes, U):
+def _vectorised(G_last, nodes, U, D=None):
     """Nodal displacements ``u (A, 3, E)`` [m] and their strain-point gradients ``H (Q, 2, 3, E)`` [-]
-    (Eq. 24-25, :func:`strain_point_gradients`: the same sum as one contraction over the element axis)."""
+    (Eq. 24-25, :func:`strain_point_gradients`: the same sum as one contraction over the element axis); with
+    the reference offsets ``D (A, 3, E)`` [m] of a sewn mesh added (:func:`_gather_offset`)."""
     u = np.ascontiguousarray(U.T)[:, nodes.T].transpose(1, 0, 2)
+    if D is not None:
+        u = u + D
     return u, np.einsum("qaJe,aie->qJie", G_last, u)
 
 
@@ -380,46 +398,46 @@ def _state(Dm, H):
     return (exx, eyy, gxy, *stress(Dm, exx, eyy, gxy))
 
 
-def strains_numpy(G_last, nodes, U):
+def strains_numpy(G_last, nodes, U, D=None):
     """``(E, 3)`` averaged Green strain (e_xx, e_yy, 2 e_xy) [-] of every element; and ``H (Q, 2, 3, E)``."""
-    u, H = _vectorised(G_last, nodes, U)
+    u, H = _vectorised(G_last, nodes, U, D)
     return np.stack(averaged_strain(H), axis=-1), H
 
 
-def linearised_strain_numpy(G_last, nodes, U, dU):
+def linearised_strain_numpy(G_last, nodes, U, dU, D=None):
     """``(E, 3)`` linearised membrane strain ``eps(U) + Bbar(U) dU`` [-] of every element: the strain
     that the mixed (MIP) Newton iteration carries to the next iterate (:func:`strain_increment`)."""
-    u, H = _vectorised(G_last, nodes, U)
+    u, H = _vectorised(G_last, nodes, U, D)
     du, h = _vectorised(G_last, nodes, dU)
     eps = averaged_strain(H)
     inc = strain_increment(H, h)
     return np.stack([eps[k] + inc[k] for k in range(3)], axis=-1)
 
 
-def energies_numpy(G_last, nodes, area, Dm, U):
+def energies_numpy(G_last, nodes, area, Dm, U, D=None):
     """``(E,)`` membrane energy [J] of every element (:func:`membrane_energies`)."""
-    u, H = _vectorised(G_last, nodes, U)
+    u, H = _vectorised(G_last, nodes, U, D)
     return strain_energy(area, *_state(Dm, H))
 
 
-def forces_numpy(G_last, nodes, area, Dm, U):
+def forces_numpy(G_last, nodes, area, Dm, U, D=None):
     """Element forces ``fe (A, 3, E)`` [N], element axis last, and energies ``(E,)`` [J]
     (:func:`membrane_forces`)."""
-    u, H = _vectorised(G_last, nodes, U)
+    u, H = _vectorised(G_last, nodes, U, D)
     exx, eyy, gxy, sxx, syy, sxy = _state(Dm, H)
     fe = np.empty(u.shape)
     element_force(G_last, H, sxx, syy, sxy, area, fe)
     return fe, strain_energy(area, exx, eyy, gxy, sxx, syy, sxy)
 
 
-def tangents_numpy(G_last, nodes, area, Dm, U, psd, S=None):
+def tangents_numpy(G_last, nodes, area, Dm, U, psd, S=None, D=None):
     """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m] (:func:`membrane_tangents`;
     ``S (E, 3)`` or None as there). The forces come from the kernel :func:`element_force` (through an
     element-last view); the tangent is :func:`element_tangent`'s Hessian of Eq. 15 as whole-array
     operations, ``A (Bbar^T D^m Bbar + 1/Q sum_q (g_qa . S g_qb) I)``, the material part one batched
     matrix product (the kernel's loops over node pairs cost a numpy twin ~1,700 array operations).
     The element tests run both back ends (force = gradient of energy, tangent = gradient of force)."""
-    u, H = _vectorised(G_last, nodes, U)
+    u, H = _vectorised(G_last, nodes, U, D)
     E, A = nodes.shape
     Q = G_last.shape[0]
     _, _, _, sxx, syy, sxy = _state(Dm, H)

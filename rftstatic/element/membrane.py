@@ -68,12 +68,22 @@ class MembraneOperator:
     nodes : (E, A) global node of each local node
     G : (E, Q, A, 2) reference gradients of the shape functions at the strain points [1/m]
     area : (E,) reference areas [m^2]
+    offset : (E, A, 3) reference offsets [m] of a mesh sewn from panels
+        (:attr:`rftstatic.mesh.trimesh.TriMesh.element_X`): ``X3[nodes[e, a]] - (X_e,a, 0)``, the placed
+        reference position of each local node less its position in the element's own flat reference, so
+        that ``U + offset`` is the displacement from that flat reference; None for a flat mesh (zero)
     """
 
     kind: str
     nodes: np.ndarray
     G: np.ndarray
     area: np.ndarray
+    offset: np.ndarray | None = None
+
+    @cached_property
+    def offset_last(self) -> np.ndarray | None:
+        """:attr:`offset` as ``(A, 3, E)``, the element-last layout of the vectorised kernels (None: no offset)."""
+        return None if self.offset is None else np.ascontiguousarray(np.moveaxis(self.offset, 0, -1))
 
     @cached_property
     def G_last(self) -> np.ndarray:
@@ -82,13 +92,15 @@ class MembraneOperator:
 
     @cached_property
     def _compiled_args(self):
-        """``nodes`` (int64), ``G`` and ``area``, contiguous, for the compiled kernels."""
+        """``nodes`` (int64), ``G``, ``area`` and the offsets ``D`` (``(0, A, 3)`` without), contiguous, for the
+        compiled kernels."""
+        D = np.zeros((0,) + self.nodes.shape[1:] + (3,)) if self.offset is None else self.offset
         return (np.ascontiguousarray(self.nodes, dtype=np.int64), np.ascontiguousarray(self.G, dtype=float),
-                np.ascontiguousarray(self.area, dtype=float))
+                np.ascontiguousarray(self.area, dtype=float), np.ascontiguousarray(D, dtype=float))
 
     def displacement_gradient(self, U: np.ndarray) -> np.ndarray:
         """``H = dU/dX (E, Q, 3, 2)`` [-] at every strain point for displacements ``U (N, 3)`` [m]."""
-        return strains_numpy(self.G_last, self.nodes, U)[1].transpose(3, 0, 2, 1)
+        return strains_numpy(self.G_last, self.nodes, U, self.offset_last)[1].transpose(3, 0, 2, 1)
 
     def strain(self, U: np.ndarray) -> np.ndarray:
         """Averaged Green membrane strain ``(E, 3)``: (e_xx, e_yy, 2 e_xy), Eq. 14 [-].
@@ -96,7 +108,7 @@ class MembraneOperator:
         Computed from the displacement gradient, ``E = (H + H^T + H^T H) / 2`` with F = I + H, so
         that no round-off from cancelling reference coordinates enters small strains.
         """
-        return strains_numpy(self.G_last, self.nodes, U)[0]
+        return strains_numpy(self.G_last, self.nodes, U, self.offset_last)[0]
 
     def linearised_strain(self, U: np.ndarray, dU: np.ndarray, *, backend="auto") -> np.ndarray:
         """``eps(U) + Bbar(U) dU (E, 3)`` [-]: the averaged strain of Eq. 14 linearised about ``U (N, 3)``
@@ -106,9 +118,10 @@ class MembraneOperator:
             from rftstatic.element._kernels_numba import membrane_linearised_strains
 
             out = np.empty((len(self.nodes), 3))
-            membrane_linearised_strains(self._compiled_args[0], self._compiled_args[1], U, dU, out)
+            nodes, G, _, D = self._compiled_args
+            membrane_linearised_strains(nodes, G, D, U, dU, out)
             return out
-        return linearised_strain_numpy(self.G_last, self.nodes, U, dU)
+        return linearised_strain_numpy(self.G_last, self.nodes, U, dU, self.offset_last)
 
     def force_roundoff(self, U: np.ndarray, Dm: np.ndarray) -> np.ndarray:
         """``(E, A)`` [N]: the size of the round-off in the element forces at ``U (N, 3)`` [m], per unit
@@ -136,7 +149,7 @@ class MembraneOperator:
             We = np.empty(len(self.nodes))
             membrane_energies(*self._compiled_args, Dm, U, We)
             return We
-        return energies_numpy(self.G_last, self.nodes, self.area, Dm, U)
+        return energies_numpy(self.G_last, self.nodes, self.area, Dm, U, self.offset_last)
 
     def element_forces(self, U, Dm, *, backend="auto") -> np.ndarray:
         """Internal membrane forces ``(E, A, 3)`` [N], the gradient of :meth:`energy`."""
@@ -147,7 +160,7 @@ class MembraneOperator:
             fe = np.empty(self.nodes.shape + (3,))
             membrane_forces(*self._compiled_args, Dm, U, fe, 0, len(fe))
             return fe
-        return np.moveaxis(forces_numpy(self.G_last, self.nodes, self.area, Dm, U)[0], -1, 0)
+        return np.moveaxis(forces_numpy(self.G_last, self.nodes, self.area, Dm, U, self.offset_last)[0], -1, 0)
 
     def element_tangents(self, U, Dm, *, psd=False, stress=None, backend="auto"):
         """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m].
@@ -172,7 +185,7 @@ class MembraneOperator:
             S = np.zeros((0, 3)) if stress is None else _as_float(stress)
             membrane_tangents(*self._compiled_args, Dm, U, bool(psd), S, f, K)
             return f, K
-        return tangents_numpy(self.G_last, self.nodes, self.area, Dm, U, bool(psd), stress)
+        return tangents_numpy(self.G_last, self.nodes, self.area, Dm, U, bool(psd), stress, self.offset_last)
 
 
     def tangents_into(self, U, Dm, emap, data, *, psd=False, stress=None, backend="auto") -> np.ndarray:
@@ -211,10 +224,10 @@ def membrane_operator(kind: str, mesh: TriMesh, patches: Patches | None = None) 
     """Strain-point gradients of RFT3 or RFT6 for every element of ``mesh``."""
     if kind not in ELEMENTS:
         raise ValueError(f'unknown element "{kind}"; use one of {", ".join(ELEMENTS)}')
-    Xe = mesh.X[mesh.tri]
+    Xe = mesh.corners
     cst = cst_gradients(Xe)  # (E, 3, 2)
     if kind == "RFT3":
-        return MembraneOperator(kind, mesh.tri, cst[:, None], mesh.area)
+        return MembraneOperator(kind, mesh.tri, cst[:, None], mesh.area, _offset(mesh, mesh.tri, Xe))
     if patches is None:
         raise ValueError("RFT6 needs the element patches")
     Xp = patches.X_patch  # (E, 6, 2), image nodes included (they never get a non-zero weight)
@@ -227,4 +240,14 @@ def membrane_operator(kind: str, mesh: TriMesh, patches: Patches | None = None) 
         boundary = ~patches.has_opposite[:, q]
         cst6 = np.concatenate([np.zeros((mesh.n_elements, 3, 2)), cst], axis=1)
         G[boundary, q] = cst6[boundary]
-    return MembraneOperator(kind, patches.nodes, G, mesh.area)
+    return MembraneOperator(kind, patches.nodes, G, mesh.area, _offset(mesh, patches.nodes, Xp))
+
+
+def _offset(mesh: TriMesh, nodes: np.ndarray, Xloc: np.ndarray) -> np.ndarray | None:
+    """:attr:`MembraneOperator.offset` ``(E, A, 3)`` [m] of a sewn mesh (None for a flat one): the placed reference
+    positions of the local ``nodes (E, A)`` less their flat element coordinates ``Xloc (E, A, 2)`` (at z = 0; a
+    constant shift drops out of the gradients)."""
+    if mesh.element_X is None:
+        return None
+    flat = np.concatenate([Xloc, np.zeros(Xloc.shape[:2] + (1,))], axis=2)
+    return mesh.X3[nodes] - flat

@@ -81,15 +81,16 @@ def build_patches(mesh: TriMesh, *, clamped_nodes=None, check=True) -> Patches:
         mirror image rule (zero slope), every other boundary edge the free rule
     check : raise :class:`PatchError` for singular patches, log badly conditioned ones
     """
-    tri, X = mesh.tri, mesh.X
+    tri = mesh.tri
     topo = mesh.topology
     has_opp = ~topo.is_boundary
     nb = np.maximum(topo.neighbour, 0)
     opp_real = tri[nb, np.maximum(topo.neighbour_vertex, 0)]  # (E, 3)
     # image node coordinates X_a + X_b - X_c for edge k (a, b = the other two vertices, c = vertex k)
-    Xe = X[tri]  # (E, 3, 2)
+    Xe = mesh.corners  # (E, 3, 2)
     X_img = Xe[:, [1, 2, 0]] + Xe[:, [2, 0, 1]] - Xe
-    X_opp = np.where(has_opp[..., None], X[opp_real], X_img)
+    X_nb = mesh.X[opp_real] if mesh.element_X is None else unfolded_opposites(mesh)
+    X_opp = np.where(has_opp[..., None], X_nb, X_img)
     X_patch = np.concatenate([X_opp, Xe], axis=1)  # (E, 6, 2)
 
     # scaled local coordinates: centred on the centroid, divided by the element size
@@ -122,6 +123,32 @@ def build_patches(mesh: TriMesh, *, clamped_nodes=None, check=True) -> Patches:
         L[:, :, 3 + k] += np.where(free[:, None], -coef, coef)
         L[:, :, k] = np.where(img[:, None], 0.0, L[:, :, k])
     return Patches(nodes, has_opp, clamped_edge, X_patch, L_geom, L, condition)
+
+
+def unfolded_opposites(mesh: TriMesh) -> np.ndarray:
+    """(E, 3, 2) [m]: the vertex of the neighbour across each edge k of every element, unfolded into the element's
+    own flat reference (``mesh.corners``), for a mesh whose elements each keep their own flat shape (a sewn mesh,
+    :attr:`rftstatic.mesh.trimesh.TriMesh.element_X`). The neighbour is turned flat about the shared edge a-b: its
+    opposite vertex keeps its coordinates along a-b and across it, in units of the edge's length in the neighbour
+    (so across a seam eased by a few per cent it scales with the element's own edge), on the far side of a-b from
+    the element's vertex k. In a flat mesh this is ``X[opposite]`` exactly (rigid motions of one chart); entries of
+    boundary edges are meaningless (the image nodes take them)."""
+    tri, topo, P = mesh.tri, mesh.topology, mesh.corners
+    nb, nv = np.maximum(topo.neighbour, 0), np.maximum(topo.neighbour_vertex, 0)  # (E, 3)
+    k = np.arange(3)
+    Pa, Pb = P[:, (k + 1) % 3], P[:, (k + 2) % 3]  # the element's edge k, a -> b (counter-clockwise)
+    Q = P[nb]  # (E, 3, 3, 2): the neighbour's corners; there the same edge runs b -> a
+    rows = np.arange(len(tri))[:, None]
+    Qc = Q[rows, k[None, :], nv]  # the neighbour's opposite vertex
+    Qb, Qa = Q[rows, k[None, :], (nv + 1) % 3], Q[rows, k[None, :], (nv + 2) % 3]
+    d = Qa - Qb  # in the neighbour's frame, along b -> a
+    L2 = np.maximum((d * d).sum(-1), 1e-300)
+    r = Qc - Qb
+    s = (r * d).sum(-1) / L2  # along b -> a
+    t = (d[..., 0] * r[..., 1] - d[..., 1] * r[..., 0]) / L2  # left of b -> a (> 0: counter-clockwise)
+    e = Pa - Pb  # the element's b -> a: its left side is away from the element's vertex k
+    left = np.stack([-e[..., 1], e[..., 0]], axis=-1)
+    return Pb + s[..., None] * e + t[..., None] * left
 
 
 def _report_conditioning(mesh: TriMesh, condition: np.ndarray) -> None:

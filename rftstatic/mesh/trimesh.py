@@ -97,9 +97,18 @@ class TriMesh:
     Parameters
     ----------
     X : (N, 2) reference coordinates [m]
-    tri : (E, 3) node indices; reoriented to counter-clockwise if needed
+    tri : (E, 3) node indices; reoriented to counter-clockwise if needed (a flat mesh)
     z0 : height of the reference plane [m]
     name : label for summaries
+    element_X : (E, 3, 2) flat reference coordinates of every element's corners [m], for a mesh sewn from
+        panels (:mod:`rftstatic.garment.sewing`): no single flat chart holds it, each element keeps the shape
+        it has in its panel (its x axis along the panel's grain line, the warp); counter-clockwise, as ``tri``.
+        None: ``X[tri]``, the flat mesh of §2.1. Given, ``X`` is only a chart for locating nodes (the pattern
+        layout), and areas, sizes, the RF patches (:func:`rftstatic.element.patch.build_patches`, neighbours
+        unfolded across their shared edge) and the membrane come from ``element_X``
+    placed : (N, 3) reference positions in space [m] that displacements are measured from, with
+        ``element_X``: the panels as placed around the body, or a sewn garment's state where a stage starts
+        (:attr:`X3`). None: ``(X, z0)``
     """
 
     X: np.ndarray
@@ -107,6 +116,8 @@ class TriMesh:
     z0: float = 0.0
     name: str = "mesh"
     info: dict = field(default_factory=dict)
+    element_X: np.ndarray | None = None
+    placed: np.ndarray | None = None
 
     def __post_init__(self):
         X = np.ascontiguousarray(self.X, dtype=float)
@@ -119,17 +130,24 @@ class TriMesh:
             raise MeshError(f"tri refers to nodes outside 0..{len(X) - 1} (min {tri.min()}, max {tri.max()})")
         if not np.isfinite(X).all():
             raise MeshError("X contains non-finite coordinates")
-        area2 = _signed_area2(X, tri)
+        if self.element_X is not None or self.placed is not None:
+            self._check_sewn(X, tri)
+        corners = X[tri] if self.element_X is None else self.element_X
+        area2 = _corner_area2(corners)
         flip = area2 < 0
+        if flip.any() and self.element_X is not None:
+            e = int(np.flatnonzero(flip)[0])
+            raise MeshError(f"{flip.sum()} element(s) of a sewn mesh are clockwise in element_X (first: element {e}); "
+                            "give every element's corners counter-clockwise, as in its panel")
         if flip.any():
             tri = tri.copy()
             tri[flip] = tri[flip][:, [0, 2, 1]]
             area2 = np.abs(area2)
-        scale = np.ptp(X, axis=0).max() ** 2
+        scale = float(np.max(np.ptp(corners.reshape(-1, 2), axis=0))) ** 2
         tiny = area2 <= 1e-14 * scale
         if tiny.any():
             e = int(np.flatnonzero(tiny)[0])
-            c = X[tri[e]].mean(axis=0)
+            c = corners[e].mean(axis=0)
             raise MeshError(
                 f"{tiny.sum()} degenerate (zero-area) triangle(s), first: element {e} at "
                 f"({c[0]:.6g}, {c[1]:.6g}); remove or re-mesh them"
@@ -140,6 +158,25 @@ class TriMesh:
         object.__setattr__(self, "X", X)
         object.__setattr__(self, "tri", tri)
         self.topology  # noqa: B018 -- validates the edge structure now (non-manifold edges)
+
+    def _check_sewn(self, X, tri):
+        """Shapes and values of ``element_X`` and ``placed`` (given together)."""
+        if self.element_X is None or self.placed is None:
+            raise MeshError("a sewn mesh needs both element_X (E, 3, 2) and placed (N, 3); got one of them")
+        ex = np.ascontiguousarray(self.element_X, dtype=float)
+        pl = np.ascontiguousarray(self.placed, dtype=float)
+        if ex.shape != (len(tri), 3, 2) or pl.shape != (len(X), 3):
+            raise MeshError(f"element_X must have shape ({len(tri)}, 3, 2) and placed ({len(X)}, 3); "
+                            f"got {ex.shape} and {pl.shape}")
+        if not (np.isfinite(ex).all() and np.isfinite(pl).all()):
+            raise MeshError("element_X or placed contains non-finite coordinates")
+        object.__setattr__(self, "element_X", ex)
+        object.__setattr__(self, "placed", pl)
+
+    @property
+    def corners(self) -> np.ndarray:
+        """(E, 3, 2) flat reference coordinates of every element's corners [m]: ``element_X``, or ``X[tri]``."""
+        return self.X[self.tri] if self.element_X is None else self.element_X
 
     # --- sizes ------------------------------------------------------------------------------
     @property
@@ -153,7 +190,7 @@ class TriMesh:
     @cached_property
     def area(self) -> np.ndarray:
         """(E,) reference triangle areas [m^2]."""
-        return 0.5 * _signed_area2(self.X, self.tri)
+        return 0.5 * _corner_area2(self.corners)
 
     @cached_property
     def node_area(self) -> np.ndarray:
@@ -163,13 +200,15 @@ class TriMesh:
     @cached_property
     def element_size(self) -> np.ndarray:
         """(E,) average side length h of each triangle [m] (the h of Eq. 28)."""
-        P = self.X[self.tri]
+        P = self.corners
         d = P[:, [1, 2, 0]] - P[:, [2, 0, 1]]
         return np.linalg.norm(d, axis=2).mean(axis=1)
 
     @property
     def X3(self) -> np.ndarray:
-        """(N, 3) reference positions in space [m]."""
+        """(N, 3) reference positions in space [m]: ``placed``, or the flat plane ``(X, z0)``."""
+        if self.placed is not None:
+            return self.placed
         return np.column_stack([self.X, np.full(self.n_nodes, self.z0)])
 
     @cached_property
@@ -251,7 +290,11 @@ class TriMesh:
 
 
 def _signed_area2(X, tri):
-    P = X[tri]
+    return _corner_area2(X[tri])
+
+
+def _corner_area2(P):
+    """Twice the signed areas ``(E,)`` of triangles with corners ``P (E, 3, 2)``."""
     d1, d2 = P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
     return d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
 

@@ -196,6 +196,13 @@ class Model(Frozen):
         """(N, 3) reference positions [m]."""
         return self.mesh.X3
 
+    def bending_displacement(self, U) -> np.ndarray:
+        """``(N, 3)`` [m]: what the curvature operator acts on (Eq. 7, 13). On a flat mesh ``U`` itself (L X = 0 for the
+        flat reference, so L U = L x); on a sewn mesh (:attr:`rftstatic.mesh.trimesh.TriMesh.element_X`), whose
+        placed reference is not flat across the seams, the positions ``X3 + U``: the bending energy is then
+        ``1/2 x . K_b x``, zero for a garment lying flat across every seam, as its patches' unfolded reference."""
+        return U if self.mesh.element_X is None else self.X3 + U
+
     def positions(self, U) -> np.ndarray:
         return self.X3 + U
 
@@ -214,7 +221,8 @@ class Model(Frozen):
         """Parts of the total potential [J]: bending, membrane, contact, self-contact, external work, total.
         ``bending`` holds the bending friction's incremental potential (:mod:`rftstatic.element.hysteresis`, H3)
         at the committed ``slip (E, 2)`` [1/m] (None: the virgin state), when the material has one."""
-        Eb = 0.5 * float(np.einsum("ni,ni->", U, self.Kb @ U))
+        Ub = self.bending_displacement(U)
+        Eb = 0.5 * float(np.einsum("ni,ni->", Ub, self.Kb @ Ub))
         if self.bending_friction is not None:
             Eb += self._friction(U, slip)[0]
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
@@ -236,13 +244,14 @@ class Model(Frozen):
     def _friction(self, U, slip, tangent=False, psd=False):
         """The bending friction's energy [J], element forces (E, 6, 3) [N] and tangents (E, 6, 3, 6, 3) [N/m]."""
         slip = self.bending_friction.initial_slip() if slip is None else slip
-        return self.bending_friction.evaluate(U, self.positions(U), slip, tangent=tangent, psd=psd)
+        return self.bending_friction.evaluate(self.bending_displacement(U), self.positions(U), slip, tangent=tangent,
+                                              psd=psd)
 
     def commit_slip(self, U, slip) -> tuple[np.ndarray, float]:
         """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] from the committed ``slip (E, 2)``
         [1/m]: the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
         <rftstatic.element.hysteresis.BendingFriction.commit>`, H4)."""
-        return self.bending_friction.commit(U, self.positions(U), slip)
+        return self.bending_friction.commit(self.bending_displacement(U), self.positions(U), slip)
 
     def load_branches(self, U, previous=None) -> tuple:
         """The branch of each potential load at the converged ``U (N, 3)`` [m], continuous from ``previous``
@@ -255,7 +264,7 @@ class Model(Frozen):
     def internal_force(self, U, *, candidates=None, pairs=None, slip=None) -> np.ndarray:
         """Internal (bending + membrane + contact + self-contact) force ``(N, 3)`` [N], the gradient of
         the stored energy (with the bending friction at the committed ``slip``, :meth:`energies`)."""
-        f = self.Kb @ U
+        f = self.Kb @ self.bending_displacement(U)
         if self.bending_friction is not None:
             f += scatter_forces(self.patches.nodes, self._friction(U, slip)[1], self.mesh.n_nodes)
         if self.with_membrane:
@@ -289,7 +298,7 @@ class Model(Frozen):
         """
         plan = self.plan
         data = self._bending_data.copy()
-        f = self.Kb @ U
+        f = self.Kb @ self.bending_displacement(U)
         x = self.positions(U)
         if self.bending_friction is not None:
             _, fe, ke = self._friction(U, slip, tangent=True, psd=psd)
@@ -341,7 +350,7 @@ class Model(Frozen):
     # --- post-processing ------------------------------------------------------------------------
     def curvature(self, U) -> np.ndarray:
         """(E, 3) element curvature (k_xx, k_yy, 2 k_xy) [1/m], Eq. 7."""
-        return curvature(self.patches, U, self.positions(U))
+        return curvature(self.patches, self.bending_displacement(U), self.positions(U))
 
     def membrane_strain(self, U) -> np.ndarray:
         """(E, 3) averaged Green membrane strain (e_xx, e_yy, 2 e_xy) [-]."""
