@@ -15,24 +15,32 @@ z up (heights above the floor, :mod:`rftstatic.garment.body`). A placed point ``
 is the point ``(x, -z, y)`` here (a rotation by +90 deg about x, so the pattern's height is the form's).
 
 What runs. The pattern is meshed with matching seam nodes (:func:`rftstatic.garment.meshing.mesh_pattern`,
-size ``garment.h``) and placed; the form is written as ``body-m.obj`` [m] in the run folder and acts as a
-``type = "mesh"`` obstacle (:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`) with penalty
-contact. The model's reference mesh must be flat: this version dresses patterns whose panels are placed in
-one horizontal plane and carry no seams (the one-ring circle skirt, ``cases/skirt-circle.toml``), which
-need no sewing stage; a pattern with seams, or panels out of that plane, is refused naming the pattern
-(the sewing stage, issue 37 item 3, is not built yet). The static solve is the ``static`` analysis's
-(:func:`rftstatic.app.static.run`) on this mesh, so the scene's ``[solver]``, ``[contact]``,
-``[[supports]]`` (reference coordinates are the placed plane's x, y) and ``[loads]`` apply unchanged.
-Contact is frictionless: the skirt hangs on the form's waist-to-hip flare, and its rotation about the
+size ``garment.h``), placed (and checked: no two panels may cross or overlap at the start), and sewn in the two
+stages of :mod:`rftstatic.garment.sewing`: the seams are pulled shut by seam springs in a damped explicit run on the
+form without gravity (up to :data:`CLOSING_TIME`; a pattern whose seams do not close is an error naming the gap),
+then each seam's two sides are merged into one node, so that the bending patches reach across the seams. Every
+element keeps its panel's flat shape with the warp along the panel's grain line. The form is written as
+``body-m.obj`` [m] in the run folder and acts as a ``type = "mesh"`` obstacle
+(:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`), kinematically while the seams close and by
+penalty contact in the static solve; the contact surface is the form grown by :data:`CLEARANCE` times the sag of
+the garment's longest element edge on the form's most curved section, so that the garment's flat triangles, whose
+corners rest on it, do not dip into the form between them. The static solve is the ``static`` analysis's (:func:`rftstatic.app.static.run`)
+on the sewn mesh, from the closed state, so the scene's ``[solver]``, ``[contact]``, ``[[supports]]`` and
+``[loads]`` apply unchanged; a support's ``at = [x, y]`` is a point of the plan view of the placed panels (the
+mesh's chart ``X``: its nearest node there). A pattern without seams (the one-ring circle skirt) skips the closing.
+Contact is frictionless: a skirt hangs on the form's waist-to-hip flare, and its rotation about the
 vertical axis (a zero-energy mode on a frictionless body of revolution) is held by a ``fixed``
 ``[[supports]]`` component at one waist node.
 
-Measures added to ``summary.json`` (``garment``): the pattern's panels, seams (0 here, so the largest seam
-gap before merging is 0 by construction), hem nodes (the outer boundary loop), the hem's drape coefficient
+Measures added to ``summary.json`` (``garment``): the pattern's panels and seams, the largest seam gap at the
+start of the closing and when the seams were merged, the closing's simulated time, explicit steps and wall time,
+the nodes removed by merging, hem nodes (the lowest boundary loop), the hem's drape coefficient
 ``A_shadow / A_flat``: the area of the draped skirt's vertical projection (:func:`rftstatic.post.measures.shadow.shadow_area`,
 the waist opening not counted) over the flat skirt's area (the opening left out too). It is Cusick's
 ``(A_shadow - A_disc) / (A_sheet - A_disc)`` with the waist opening as the disc, when the draped skirt does
 not overlap the projection of its own waist opening (it flares outwards from the waist); mean element size.
+The independent crossing check of the garment against the form itself (``body.obj``, not the contact surface):
+``body_crossing_pairs`` and ``body_smallest_distance``, with ``contact_clearance``.
 Outputs: ``deformed.vtu`` (cell data ``panel``), ``garment.obj`` with UVs (each node's flat pattern
 coordinates, scene units), ``body.obj`` and ``body.vtu`` (scene units).
 """
@@ -47,10 +55,11 @@ import numpy as np
 
 from rftstatic.app import static
 from rftstatic.garment.body import DressForm
-from rftstatic.garment.meshing import mesh_pattern, place
+from rftstatic.garment.meshing import check_placement, mesh_pattern, place
+from rftstatic.garment.sewing import SEAM_STIFFNESS, close_seams, panel_mesh, seam_pairs, sew
 from rftstatic.garment.readers import read_pattern
 from rftstatic.io.files import to_jsonable, write_json, write_vtu
-from rftstatic.mesh.trimesh import TriMesh
+from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
 from rftstatic.post.measures.shadow import shadow_area
 
 __all__ = ["run", "dressed_mesh", "dress_form", "write_obj", "read_obj_uv", "BODY_KEYS"]
@@ -62,7 +71,17 @@ BODY_KEYS = ("bust_girth", "waist_girth", "hip_girth", "bust_height", "waist_hei
 """Length keys of ``[body]`` (scene units), passed to :class:`~rftstatic.garment.body.DressForm` in metres;
 its depth / width ratios (``*_depth``) are passed as given."""
 DEPTH_KEYS = ("bust_depth", "waist_depth", "hip_depth", "shoulder_depth", "neck_depth")
-_PLANE_TOL = 1e-9  # [m]: panels placed in one horizontal plane
+CLOSING_TIME = 1.0
+"""Longest run of the seam-closing stage [s] of simulated time, at each spring stiffness
+(:func:`rftstatic.garment.sewing.close_seams`); a run stops as soon as the seams are closed."""
+CLEARANCE = 1.5
+"""The contact surface's distance outside the form over the sag of the garment's longest element edge on the
+form's most curved section (:meth:`rftstatic.garment.body.DressForm.chord_clearance`) [-]: the garment's nodes
+rest on that surface, so its flat triangles stay off the form itself (0 crossing pairs with ``body.obj``,
+``garment.body_crossing_pairs``)."""
+CLOSING_DAMPING = 8.0
+"""Mass damping of the seam-closing stage [1/s], about critical for a garment's swing on a body
+(2 sqrt(g / 0.5 m) = 8.9 /s)."""
 
 
 def dress_form(scene) -> DressForm:
@@ -90,32 +109,26 @@ def _pattern_path(scene) -> Path:
 
 
 def dressed_mesh(scene):
-    """``(pmesh, mesh, uv)``: the meshed pattern, the flat reference mesh of the placed garment [m] (one
-    horizontal plane, :class:`~rftstatic.mesh.trimesh.TriMesh` at its height) and the nodes' flat pattern
-    coordinates ``uv (N, 2)`` [m]."""
+    """``(pmesh, mesh, uv)``: the meshed pattern, its panels placed around the form as one mesh with the panels apart
+    (:func:`rftstatic.garment.sewing.panel_mesh`: each element flat in its panel with the warp along the grain, the
+    placed positions its reference [m], the plan view its chart ``X``) and every node's flat pattern coordinates
+    ``uv (N, 2)`` [m]."""
     path = _pattern_path(scene)
     h = scene.get("garment.h")
     if not isinstance(h, (int, float)) or not h > 0:
         raise scene.error("garment.h", f"{h!r}: give the target element size (> 0, scene units)")
     pmesh = mesh_pattern(read_pattern(path), float(h) * scene.units.length)
-    if pmesh.pattern.seams:
-        raise scene.error("garment.pattern", f"{path.name} has {len(pmesh.pattern.seams)} seams; the sewing stage "
-                          "is not built yet: this version dresses seamless one-plane patterns (a circle skirt's ring)")
     P = place(pmesh)
     world = np.stack([P[:, 0], -P[:, 2], P[:, 1]], axis=1)
-    if np.ptp(world[:, 2]) > _PLANE_TOL:
-        raise scene.error("garment.pattern", f"{path.name}: the panels are not placed in one horizontal plane "
-                          f"(heights {world[:, 2].min():.4g} to {world[:, 2].max():.4g} m); place them flat "
-                          "(e.g. rotate = [-90, 0, 0]) until the sewing stage is built")
-    tri = np.concatenate([m.tri + pmesh.offsets[p] for p, m in enumerate(pmesh.meshes)])
-    mesh = TriMesh(X=world[:, :2], tri=tri, z0=float(world[0, 2]), name=f"garment {path.stem}")
+    check_placement(pmesh, world)
     uv = np.concatenate([m.X for m in pmesh.meshes])
-    return pmesh, mesh, uv
+    return pmesh, panel_mesh(pmesh, world), uv
 
 
-def write_obj(path, x, tri, uv=None, header="") -> None:
-    """Triangles ``tri (E, 3)`` on points ``x (N, 3)`` as an OBJ file; with ``uv (N, 2)`` one texture
-    coordinate per node (``vt``, faces ``a/a``). Numbers with 9 significant digits."""
+def write_obj(path, x, tri, uv=None, header="", uv_tri=None) -> None:
+    """Triangles ``tri (E, 3)`` on points ``x (N, 3)`` as an OBJ file; with ``uv (M, 2)`` texture coordinates
+    (``vt``), one per node (faces ``a/a``) or, with ``uv_tri (E, 3)``, the texture coordinate of each face corner
+    (faces ``a/t``: a sewn node has one per panel). Numbers with 9 significant digits."""
     with open(path, "w", encoding="utf-8") as fh:
         if header:
             fh.write(f"# {header}\n")
@@ -124,12 +137,14 @@ def write_obj(path, x, tri, uv=None, header="") -> None:
             fh.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in tri)
             return
         fh.writelines(f"vt {a:.9g} {b:.9g}\n" for a, b in uv)
-        fh.writelines(f"f {a + 1}/{a + 1} {b + 1}/{b + 1} {c + 1}/{c + 1}\n" for a, b, c in tri)
+        corners = tri if uv_tri is None else uv_tri
+        fh.writelines(f"f {a + 1}/{ta + 1} {b + 1}/{tb + 1} {c + 1}/{tc + 1}\n"
+                      for (a, b, c), (ta, tb, tc) in zip(tri, corners))
 
 
-def read_obj_uv(path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(x (N, 3), uv (N, 2), tri (E, 3))`` of an OBJ written by :func:`write_obj` with UVs."""
-    v, vt, f = [], [], []
+def read_obj_uv(path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(x (N, 3), uv (M, 2), tri (E, 3), uv_tri (E, 3))`` of an OBJ written by :func:`write_obj` with UVs."""
+    v, vt, f, ft = [], [], [], []
     for line in Path(path).read_text(encoding="utf-8").splitlines():
         part = line.split()
         if part and part[0] == "v":
@@ -138,39 +153,74 @@ def read_obj_uv(path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             vt.append([float(s) for s in part[1:3]])
         elif part and part[0] == "f":
             f.append([int(s.split("/")[0]) - 1 for s in part[1:4]])
-    return np.array(v), np.array(vt), np.array(f, dtype=np.int64)
+            ft.append([int(s.split("/")[1]) - 1 for s in part[1:4]])
+    return np.array(v), np.array(vt), np.array(f, dtype=np.int64), np.array(ft, dtype=np.int64)
 
 
-def _hem(mesh) -> np.ndarray:
-    """Nodes of the longest boundary loop (the hem of a skirt) of ``mesh``."""
-    edges = np.sort(np.concatenate([mesh.tri[:, [0, 1]], mesh.tri[:, [1, 2]], mesh.tri[:, [2, 0]]]), axis=1)
-    uniq, count = np.unique(edges, axis=0, return_counts=True)
-    boundary = uniq[count == 1]
+def _hem(mesh, x) -> np.ndarray:
+    """Nodes of the hem of a skirt hanging at positions ``x (N, 3)`` [m]: the boundary loop of ``mesh`` lowest on
+    average."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    boundary = mesh.boundary_edges
     n = mesh.n_nodes
     g = coo_matrix((np.ones(len(boundary)), (boundary[:, 0], boundary[:, 1])), shape=(n, n))
     _, label = connected_components(g, directed=False)
     nodes = np.unique(boundary)
-    loops, sizes = np.unique(label[nodes], return_counts=True)
-    r = np.linalg.norm(mesh.X[nodes] - mesh.X.mean(axis=0), axis=1)
-    radius = {lab: r[label[nodes] == lab].mean() for lab in loops}
-    outer = max(loops, key=lambda lab: radius[lab])
-    return nodes[label[nodes] == outer]
+    loops = np.unique(label[nodes])
+    height = {lab: x[nodes[label[nodes] == lab], 2].mean() for lab in loops}
+    lowest = min(loops, key=lambda lab: height[lab])
+    return nodes[label[nodes] == lowest]
 
 
-def _garment_measures(scene, model, U, pmesh, hem) -> dict:
+def _garment_measures(scene, model, U, pmesh, hem, closing) -> dict:
     """The ``garment`` table of the summary (scene units; module docstring)."""
     u = scene.units.length
     x = model.positions(U)
     flat = float(model.mesh.area.sum())
     shadow = shadow_area(x, model.mesh.tri)
+    sewing = {"largest_seam_gap": 0.0, "largest_seam_gap_start": 0.0, "closing_time": 0.0, "closing_steps": 0,
+              "closing_wall_time": 0.0}
+    if closing is not None:
+        sewing = {"largest_seam_gap": closing.largest_gap / u, "largest_seam_gap_start": closing.largest_gap_start / u,
+                  "closing_time": closing.time, "closing_steps": closing.steps, "closing_wall_time": closing.wall_time}
     return {"pattern": Path(pmesh.pattern.source).name, "panels": len(pmesh.meshes),
-            "seams": len(pmesh.pattern.seams), "largest_seam_gap": 0.0, "hem_nodes": int(len(hem)),
+            "seams": len(pmesh.pattern.seams), **sewing, "hem_nodes": int(len(hem)),
+            "nodes_sewn": int(model.mesh.info.get("sewn_from_nodes", model.mesh.n_nodes) - model.mesh.n_nodes),
             "mean_element_size": float(model.mesh.element_size.mean()) / u, "flat_area": flat / u**2,
             "shadow_area": shadow / u**2, "hem_drape_coefficient": shadow / flat,
             "hem_lowest": float(x[hem, 2].min()) / u, "hem_highest": float(x[hem, 2].max()) / u}
+
+
+def _closing_scene(scene, data):
+    """The seam-closing stage's scene: a dynamic run of the same garment on the same body, no gravity."""
+    stage = copy.deepcopy(data)
+    stage["analysis"] = "dynamic"
+    stage["loads"] = {"gravity": False}
+    stage.pop("solver", None)
+    stage["dynamics"] = {"t_end": CLOSING_TIME, "alpha": CLOSING_DAMPING}
+    return type(scene)(stage, scene.path, scene.name, scene.overrides)
+
+
+def close(scene, data, mesh, pairs, *, progress=True):
+    """Close the seams ``pairs (S, 2)`` of the panel ``mesh`` on the scene's body (stage 1 of
+    :mod:`rftstatic.garment.sewing`): :class:`~rftstatic.garment.sewing.ClosingResult`."""
+    from rftstatic.model.model import Model
+    from rftstatic.scenes.build import build_model
+
+    stage = _closing_scene(scene, data)
+    base, _ = build_model(stage, mesh=mesh, contact="penalty", quiet=True)
+    Dm = base.material.Dm
+
+    def build(springs):
+        return Model(mesh, base.material, element=base.element, supports=base.supports, contact=base.contact,
+                     load_terms=(springs,), self_contact=base.self_contact, kernels=base.kernels, quiet=True)
+
+    weight = base.material.weight * float(mesh.area.sum())
+    return close_seams(build, pairs, (), weight=weight,
+                       stiffest=SEAM_STIFFNESS * min(Dm[0, 0], Dm[1, 1]), t_stage=CLOSING_TIME,
+                       alpha=CLOSING_DAMPING, progress=progress)
 
 
 def run(scene, out: Path, *, progress=True, figures=True):
@@ -180,28 +230,43 @@ def run(scene, out: Path, *, progress=True, figures=True):
     out.mkdir(parents=True, exist_ok=True)
     u = scene.units.length
     form = dress_form(scene)
-    form.write_obj(out / "body-m.obj")  # the obstacle's surface [m]; body.obj is written in scene units
     pmesh, mesh, uv = dressed_mesh(scene)
+    # the contact surface [m]: the form grown by the sag of the garment's longest chord (body.obj: the form itself)
+    clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.max()))
+    form.write_obj(out / "body-m.obj", clearance=clearance)
     data = copy.deepcopy(scene.data)
     data.pop("garment")
     data.pop("body")
     data["analysis"] = "static"
     data.setdefault("obstacles", []).append({"type": "mesh", "path": str((out / "body-m.obj").resolve()),
                                               "units": "m"})
+    pairs = seam_pairs(pmesh)
+    closing, corner_uv = None, mesh.tri
+    if len(pairs):
+        closing = close(scene, data, mesh, pairs, progress=progress)
+        if not closing.closed:
+            raise scene.error("garment.pattern", f"the seams did not close in {CLOSING_TIME:g} s: the largest gap is "
+                              f"{closing.largest_gap / u:.3g} {scene.units.name.split('-')[0]} (from "
+                              f"{closing.largest_gap_start / u:.3g}); place the panels closer to their seams "
+                              "or check that the body does not hold them apart")
+        mesh, _ = sew(mesh, pairs, closing.x, where=Path(pmesh.pattern.source).name)
     solved = type(scene)(data, scene.path, scene.name, scene.overrides)
     result = static.run(solved, out, progress=progress, figures=figures, mesh=mesh)
     model, U = result.model, result.U
-    hem = _hem(model.mesh)
-    garment = _garment_measures(scene, model, U, pmesh, hem)
+    hem = _hem(model.mesh, model.positions(U))
+    garment = _garment_measures(scene, model, U, pmesh, hem, closing)
+    P, T = form.surface()
+    body = obstacle_crossings(model.positions(U), model.mesh.tri, P, T)
+    garment.update({"contact_clearance": clearance / u, "body_crossing_pairs": body["pairs"],
+                    "body_smallest_distance": body["smallest_distance"] / u})
     summary = dict(result.summary)
     summary["analysis"] = "garment"
     summary["garment"] = to_jsonable(garment)
     panel = np.repeat(np.arange(len(pmesh.meshes)), [len(m.tri) for m in pmesh.meshes])
     write_vtu(out / "deformed.vtu", model.X3, U, model.mesh.tri, length_unit_scale=u,
               cell_data={"panel": panel.astype(float), "relative_curvature": model.relative_curvature(U)})
-    write_obj(out / "garment.obj", model.positions(U) / u, model.mesh.tri, uv / u,
+    write_obj(out / "garment.obj", model.positions(U) / u, model.mesh.tri, uv / u, uv_tri=corner_uv,
               header=f"dressed garment, {scene.units.name} lengths, vt = flat pattern coordinates")
-    P, T = form.surface()
     write_obj(out / "body.obj", P / u, T, header=f"dress form, {scene.units.name} lengths")
     write_vtu(out / "body.vtu", P, np.zeros_like(P), T, length_unit_scale=u)
     write_json(out / "summary.json", summary)

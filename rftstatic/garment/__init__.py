@@ -19,7 +19,11 @@ What is supported now:
   (bust, waist, hip and neck girths at their heights, shoulder breadth), written as an OBJ file a
   ``type = "mesh"`` obstacle reads.
 
-Not yet: size charts and the scene's ``[body]`` table, sewing forces, seam merging, draping.
+- sewing (:mod:`.sewing`): the placed panels as one mesh whose elements keep their flat panel shapes, seam springs
+  that close the seams in damped explicit runs on the form, and the merge of each seam's two sides into one node
+  (the ``garment`` analysis, :mod:`rftstatic.app.garment`, then solves the garment's static equilibrium).
+
+Not yet: size charts, ``fold`` seams, moving bodies.
 """
 
 from rftstatic.garment.meshing import CombinedMesh, PatternMesh, check_placement, mesh_pattern, place

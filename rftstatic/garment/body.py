@@ -120,15 +120,21 @@ class DressForm:
         zl, al, bl = self.levels()
         return PchipInterpolator(zl, al)(z), PchipInterpolator(zl, bl)(z)
 
-    def surface(self, *, sections: int = 80, around: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    def surface(self, *, sections: int = 80, around: int = 64, clearance: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """``(P, tri)``: the closed form as points (P, 3) [m] and outward-wound triangles (T, 3).
 
         ``sections`` rings between the bottom and the neck top (every defining level among them, so each girth
-        is met at its height), ``around`` points per ring, and a centre point for each cap.
+        is met at its height), ``around`` points per ring, and a centre point for each cap. ``clearance`` [m] > 0
+        gives the form grown by that much: every semi-axis longer by it and the caps moved out by it (a surface
+        about ``clearance`` outside the form, at least ``clearance`` times the cosine of the side's slope: the
+        contact surface that keeps a coarse garment's flat triangles off the curved form, :meth:`chord_clearance`).
         """
         zl = self.levels()[0]
         z = np.unique(np.concatenate([np.linspace(zl[0], zl[-1], sections), zl]))
         a, b = self.section(z)
+        if clearance:
+            a, b = a + clearance, b + clearance
+            z = z + clearance * (np.arange(len(z)) == len(z) - 1) - clearance * (np.arange(len(z)) == 0)
         t = 2.0 * np.pi * np.arange(around) / around
         ring = np.stack([a[:, None] * np.cos(t), b[:, None] * np.sin(t), np.broadcast_to(z[:, None], (len(z), around))],
                         axis=-1)
@@ -143,6 +149,21 @@ class DressForm:
         caps = np.concatenate([np.stack([np.full(around, nb), (k + 1) % around, k], -1),
                                np.stack([np.full(around, nt), top + k, top + (k + 1) % around], -1)])
         return P, np.concatenate([side, caps]).astype(np.int64)
+
+    def smallest_radius(self) -> float:
+        """The smallest radius of curvature [m] of the form's sections between its bottom and its bust (where
+        garments rest): ``min b^2 / a`` over the sections (semi-axes a >= b), at the ends of each ellipse's major
+        axis."""
+        zl = self.levels()[0]
+        z = np.linspace(zl[0], self.bust_height, 64)
+        a, b = self.section(z)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        return float((lo * lo / hi).min())
+
+    def chord_clearance(self, h: float) -> float:
+        """Depth [m] by which a flat triangle of size ``h`` [m] whose corners touch the form can dip into it: the
+        sag of a chord, ``h^2 / (8 R)`` with R the :meth:`smallest_radius`."""
+        return h * h / (8.0 * self.smallest_radius())
 
     def girth(self, z, *, around: int = 64) -> float:
         """Perimeter [m] of the form's sampled section at height ``z`` [m] (the polygon of ``around`` points)."""

@@ -23,13 +23,19 @@ class AssemblyPlan:
     patch_nodes : (E, 6) node of each patch slot; the structure couples every pair of them
     n_nodes : N
     free : (N, 3) bool, degrees of freedom that are unknowns (True) or prescribed (False)
+    couplings : (P, 2) further node pairs the structure couples (both ways), e.g. a garment's seam springs
+        (:class:`rftstatic.model.loads.SeamSprings`); None: the patches' pairs only
     """
 
-    def __init__(self, patch_nodes: np.ndarray, n_nodes: int, free: np.ndarray):
+    def __init__(self, patch_nodes: np.ndarray, n_nodes: int, free: np.ndarray, couplings=None):
         self.n_nodes = n = int(n_nodes)
         self.patch_nodes = patch_nodes
         rows = np.repeat(patch_nodes, patch_nodes.shape[1], axis=1).ravel()
         cols = np.tile(patch_nodes, (1, patch_nodes.shape[1])).ravel()
+        if couplings is not None and len(couplings):
+            pairs = np.asarray(couplings, dtype=np.int64).reshape(-1, 2)
+            rows = np.concatenate([rows, pairs[:, 0], pairs[:, 1]])
+            cols = np.concatenate([cols, pairs[:, 1], pairs[:, 0]])
         keys = np.unique(rows.astype(np.int64) * n + cols)
         self._pair_keys = keys  # sorted node-pair keys = CSR order of the node graph
         r, c = keys // n, keys % n

@@ -1,4 +1,5 @@
-"""Load terms with a potential beyond dead nodal forces: the end moment of a strip.
+"""Load terms with a potential beyond dead nodal forces: the end moment of a strip, and the seam springs that
+close a garment's seams (:class:`SeamSprings`).
 
 With translational degrees of freedom only, a moment has no rotation to act on. A conservative
 end moment M about the y axis is given the potential
@@ -87,3 +88,59 @@ class LeverMoment(Frozen):
         rows = np.concatenate([self.lever, self.tip, self.lever, self.tip])
         cols = np.concatenate([self.lever, self.tip, self.tip, self.lever])
         return rows, cols, np.concatenate([B, B, -B, -B])
+
+
+class SeamSprings(Frozen):
+    """Zero-length springs pulling the two sides of a garment's seams together (read-only once built).
+
+    The sewing stage's closing load (:mod:`rftstatic.garment.sewing`): for node pairs (a_k, b_k) with stiffness k_k
+
+        Pi_S = lam * 1/2 sum_k k_k |x_a,k - x_b,k|^2,
+
+    a potential load (``Model(load_terms=...)``) whose gradient pulls each pair together along the gap and whose
+    Hessian is the constant ``k_k [[I, -I], [-I, I]]``; no branches (:meth:`branch` gives None).
+
+    Parameters
+    ----------
+    pairs : (S, 2) node indices, side A and side B of each seam node pair
+    stiffness : (S,) or scalar spring stiffness [N/m]
+    """
+
+    def __init__(self, pairs, stiffness):
+        self.pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+        self.stiffness = np.broadcast_to(np.asarray(stiffness, dtype=float), (len(self.pairs),)).copy()
+        if not (np.isfinite(self.stiffness).all() and (self.stiffness >= 0).all()):
+            raise ValueError("seam spring stiffness must be finite and >= 0")
+        for a in (self.pairs, self.stiffness):
+            a.flags.writeable = False
+        self._freeze()
+
+    def gaps(self, x: np.ndarray) -> np.ndarray:
+        """(S,) distance between the two nodes of each pair [m] at positions ``x (N, 3)`` [m]."""
+        return np.linalg.norm(x[self.pairs[:, 0]] - x[self.pairs[:, 1]], axis=1)
+
+    def branch(self, x: np.ndarray, previous=None):
+        return None
+
+    def couplings(self) -> np.ndarray:
+        """(S, 2) the node pairs the springs couple (outside the RF patches: the tangent's structure takes them)."""
+        return self.pairs
+
+    def potential(self, x: np.ndarray, branch=None) -> float:
+        """``1/2 sum k |x_a - x_b|^2`` [J] per unit load factor."""
+        d = x[self.pairs[:, 0]] - x[self.pairs[:, 1]]
+        return 0.5 * float(np.einsum("s,si,si->", self.stiffness, d, d))
+
+    def force(self, x: np.ndarray) -> np.ndarray:
+        """Gradient of :meth:`potential` ``(N, 3)`` [N]."""
+        g = self.stiffness[:, None] * (x[self.pairs[:, 0]] - x[self.pairs[:, 1]])
+        f = np.zeros_like(x)
+        np.add.at(f, self.pairs[:, 0], g)
+        np.add.at(f, self.pairs[:, 1], -g)
+        return f
+
+    def tangent_blocks(self, x: np.ndarray):
+        """Hessian of :meth:`potential` as ``(rows (4S,), cols (4S,), blocks (4S, 3, 3))`` [N/m]."""
+        a, b = self.pairs[:, 0], self.pairs[:, 1]
+        B = self.stiffness[:, None, None] * np.eye(3)
+        return np.concatenate([a, b, a, b]), np.concatenate([a, b, b, a]), np.concatenate([B, B, -B, -B])

@@ -119,7 +119,8 @@ class Model(Frozen):
     membrane : include the membrane energy (``False`` gives the linear Kirchhoff plate)
     load_terms : loads with a potential scaled by the load factor, e.g.
         :class:`rftstatic.model.loads.LeverMoment` (methods ``potential(x, branch)``, ``force``,
-        ``tangent_blocks``, ``branch(x, previous)``; the branches live in the State)
+        ``tangent_blocks``, ``branch(x, previous)``; the branches live in the State; optionally ``couplings()``,
+        the node pairs (P, 2) its blocks couple beyond the patches, :class:`rftstatic.model.loads.SeamSprings`)
     quiet : log the model's warnings (``warnings``: membrane locking) at debug level, not warning
         level (a remeshed run builds one model per mesh and warns once)
     kernels : the kernel back end of every solve of the model, ``"numpy"`` or ``"compiled"``
@@ -176,7 +177,9 @@ class Model(Frozen):
     # --- constant structures, built on first use ------------------------------------------------
     @cached_property
     def plan(self) -> AssemblyPlan:
-        return AssemblyPlan(self.patches.nodes, self.mesh.n_nodes, self.free)
+        couplings = [t.couplings() for t in self.load_terms if hasattr(t, "couplings")]
+        return AssemblyPlan(self.patches.nodes, self.mesh.n_nodes, self.free,
+                            couplings=np.concatenate(couplings) if couplings else None)
 
     @cached_property
     def _bending_data(self) -> np.ndarray:

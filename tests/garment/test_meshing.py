@@ -101,9 +101,10 @@ def test_placement_checks(a_line):
         check_placement(a_line, x)
     # touching along a seam line is allowed: the back, in the front's plane, turned about z so that its
     # edge 3 lies on the front's edge 1 (the side seam sewn flat, the panels side by side)
-    gamma = 2 * np.degrees(np.arctan2(0.12, 0.60))
+    (x0, _), (x1, _), (x2, y2), _ = a_line.pattern.panels[0].vertices  # hem ends, then the waist ends
+    gamma = 2 * np.degrees(np.arctan2(x1 - x2, y2))
     c, s = np.cos(np.radians(gamma)), np.sin(np.radians(gamma))
-    t = np.array([0.3, 0.0]) - np.array([[c, -s], [s, c]]) @ [-0.3, 0.0]
+    t = np.array([x1, 0.0]) - np.array([[c, -s], [s, c]]) @ [x0, 0.0]
     x = place(a_line, translations=[[0, 0, 0], [*t, 0]], rotations=[[0, 0, 0], [0, 0, gamma]])
     pairs = a_line.seam_pairs[0]
     np.testing.assert_allclose(x[pairs[:, 0]], x[pairs[:, 1]], atol=1e-12)

@@ -15,13 +15,13 @@ def test_the_a_line_skirt_is_described_and_written(tmp_path, capsys):
                  str(tmp_path)])
     out = capsys.readouterr().out
     assert code == 0, out
-    assert "2 panels, 2 seams" in out and "front:1 - back:3" in out and "61.19 / 61.19" in out
+    assert "2 panels, 2 seams" in out and "front:1 - back:3" in out and "60.00 / 60.00" in out
     mesh = meshio.read(tmp_path / "pattern.vtu")
     panel = mesh.point_data["panel"]
     assert set(np.unique(panel)) == {0.0, 1.0}
-    # as placed: the back panel is turned about the vertical, 30 cm behind the front (z from -15 to +15 cm)
+    # as placed: the back panel is turned about the vertical, 36 cm behind the front (z from -18 to +18 cm)
     z = mesh.points[:, 2]
-    assert np.allclose(sorted({round(v, 6) for v in z}), [-15.0, 15.0])
+    assert np.allclose(sorted({round(v, 6) for v in z}), [-18.0, 18.0])
 
 
 def test_a_seam_to_a_missing_edge_exits_2_naming_panel_and_edge(tmp_path, capsys):

@@ -1,0 +1,209 @@
+"""Sewing: the placed panels as one mesh, seam springs that close the seams, and the merge of each seam's two sides.
+
+A garment is solved in two stages (:mod:`rftstatic.app.garment`):
+
+1. *Closing.* The panels, each flat and placed around the body as the pattern says, form one mesh with its
+   panels apart (:func:`panel_mesh`): every element keeps its panel's flat shape with the x axis along the
+   panel's grain line (the warp; :attr:`rftstatic.mesh.trimesh.TriMesh.element_X`), the placed positions are
+   the reference (:attr:`~rftstatic.mesh.trimesh.TriMesh.placed`). Zero-length springs on the seams' node
+   pairs (:class:`rftstatic.model.loads.SeamSprings`, stiffness :data:`SEAM_STIFFNESS` times the fabric's
+   smallest membrane rigidity) pull the seams shut in a damped explicit run with the body in contact and no
+   gravity (:func:`close_seams`), until the largest seam gap is below :data:`SEAM_CLOSED` of the mean element
+   size.
+2. *Merging.* The two sides of each seam become one node at their midpoint (:func:`sew`): the RF patches of the
+   elements along a seam now reach across it (their neighbour unfolded flat about the seam,
+   :func:`rftstatic.element.patch.unfolded_opposites`), so the sewn garment bends across its seams like
+   cloth, and the garment's static equilibrium on the body is solved from there with the real loads.
+
+Seams of kind ``sew`` are closed and merged; ``open`` seams are left open (a slit); ``fold`` seams (a hem
+turned back, which needs a rest angle of 180 deg across the seam) are refused, naming the seam.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from rftstatic.garment.pattern import PatternError
+from rftstatic.mesh.trimesh import TriMesh
+
+__all__ = ["panel_mesh", "seam_pairs", "sew", "close_seams", "ClosingResult", "SEAM_CLOSED", "SEAM_PULL",
+           "SEAM_STIFFENING", "SEAM_STIFFNESS"]
+
+log = logging.getLogger(__name__)
+
+SEAM_CLOSED = 0.05
+"""Largest seam gap at which the seams are merged, relative to the mean element size [-]: the merge then
+moves each node by at most 2.5 % of an element, a strain the following static solve relaxes."""
+
+SEAM_PULL = 1.0
+"""The seam springs' first stiffness, as the pull of all springs together on the open seams over the garment's
+weight [-]: k_0 = SEAM_PULL W / (S g_0) for S pairs of largest gap g_0, so the seams close about as fast as the
+garment would fall, with no violent snap (a stiffer first pull overshoots and tears the membrane)."""
+
+SEAM_STIFFENING = 10.0
+"""Factor on the spring stiffness from one closing run to the next [-] (:func:`close_seams`)."""
+
+CLOSING_ENERGY_TOL = 10.0
+"""The closing runs' bound on energy growth (:class:`~rftstatic.solvers.explicit_options.ExplicitOptions` ``energy_tol``)
+[-]: the body acts kinematically, and its projections of the panels' nodes out of the form do work the balance does
+not track while a loose garment is pulled onto the form; a non-finite state still stops the run."""
+
+SEAM_STIFFNESS = 0.5
+"""Largest seam spring stiffness over the fabric's smallest membrane rigidity min(C_warp, C_weft) [-]: a spring on
+a seam node then stays below the membrane's own stiffness there, so it does not shorten the explicit step, and
+pulls the last millimetres shut against the cloth's bending."""
+
+
+def panel_mesh(pmesh, placed: np.ndarray, chart: np.ndarray | None = None) -> TriMesh:
+    """The garment's panels as one mesh, apart, in their placed positions (stage 1 of the module docstring).
+
+    Parameters
+    ----------
+    pmesh : :class:`rftstatic.garment.meshing.PatternMesh`
+    placed : (N, 3) placed positions of all nodes [m] (global ids of ``pmesh``)
+    chart : (N, 2) the mesh's ``X`` [m] (a chart to locate nodes, e.g. the plan view); default ``placed[:, :2]``
+
+    Returns a :class:`TriMesh` whose ``element_X`` gives every element in its panel's coordinates turned so that
+    the grain line is the x axis (the material's warp).
+    """
+    tri = np.concatenate([m.tri + pmesh.offsets[p] for p, m in enumerate(pmesh.meshes)])
+    corners = []
+    for p, m in enumerate(pmesh.meshes):
+        g = np.radians(pmesh.pattern.panels[p].grain)
+        R = np.array([[np.cos(g), np.sin(g)], [-np.sin(g), np.cos(g)]])  # turns the grain direction onto +x
+        corners.append(m.X[m.tri] @ R.T)
+    X = placed[:, :2] if chart is None else chart
+    return TriMesh(X=np.array(X, float), tri=tri, name=f"garment {_stem(pmesh.pattern.source)}", element_X=np.concatenate(corners),
+                   placed=np.array(placed, float))
+
+
+def _stem(source) -> str:
+    from pathlib import Path
+
+    return Path(str(source)).stem
+
+
+def seam_pairs(pmesh) -> np.ndarray:
+    """(S, 2) global node pairs of the seams to sew (kind ``sew``; ``open`` left out); :class:`PatternError` for a
+    ``fold`` seam (module docstring). A dart tip pairing a node with itself is left out."""
+    pat = pmesh.pattern
+    out = []
+    for s, pairs in zip(pat.seams, pmesh.seam_pairs):
+        if s.kind == "fold":
+            raise PatternError(f"{pat.source}: the seam {s.a_panel}:{s.a_edge} - {s.b_panel}:{s.b_edge} is a fold "
+                               "(a hem turned back); folds are not sewn yet: give the hem as a panel edge (kind "
+                               "'open') or leave the seam out")
+        if s.kind == "sew":
+            out.append(pairs[pairs[:, 0] != pairs[:, 1]])
+    return np.concatenate(out).astype(np.int64) if out else np.zeros((0, 2), np.int64)
+
+
+def sew(mesh: TriMesh, pairs: np.ndarray, x: np.ndarray, *, where: str = "pattern") -> tuple[TriMesh, np.ndarray]:
+    """Merge the two sides of every seam into one node (stage 2 of the module docstring).
+
+    Parameters
+    ----------
+    mesh : the panel mesh (:func:`panel_mesh`)
+    pairs : (S, 2) node pairs to merge (chains merge into one node: a corner where two seams meet)
+    x : (N, 3) positions [m] at the end of the closing; each merged node takes its group's mean
+    where : names the pattern in errors
+
+    Returns
+    -------
+    (sewn, node_of) : the sewn :class:`TriMesh` (reference ``placed`` = the merged positions, ``element_X`` kept)
+        and ``node_of (N,)``, the sewn node of every panel node.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = mesh.n_nodes
+    g = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(g, directed=False)
+    first = np.full(label.max() + 1, n)
+    np.minimum.at(first, label, np.arange(n))
+    order = np.argsort(first, kind="stable")  # sewn nodes numbered in the order of their first panel node
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    node_of = rank[label]
+    tri = node_of[mesh.tri]
+    bad = (tri[:, 0] == tri[:, 1]) | (tri[:, 1] == tri[:, 2]) | (tri[:, 0] == tri[:, 2])
+    if bad.any():
+        e = int(np.flatnonzero(bad)[0])
+        raise PatternError(f"{where}: sewing collapses {bad.sum()} triangle(s) (first: element {e}, nodes "
+                           f"{mesh.tri[e].tolist()}): two of its nodes lie on seams sewn to each other (a dart tip or a "
+                           "corner sewn to itself); mesh finer (garment.h) or cut the dart wider")
+    m = len(order)
+    count = np.bincount(node_of, minlength=m).astype(float)
+    merged = np.stack([np.bincount(node_of, x[:, i], minlength=m) for i in range(3)], axis=1) / count[:, None]
+    chart = mesh.X[first[order]]  # each sewn node's first panel node
+    sewn = TriMesh(X=chart, tri=tri, name=mesh.name, element_X=mesh.element_X, placed=merged,
+                   info={**mesh.info, "sewn_from_nodes": n})
+    return sewn, node_of
+
+
+@dataclass
+class ClosingResult:
+    """The closing stage (:func:`close_seams`): positions, gaps and what it took.
+
+    Attributes
+    ----------
+    x : (N, 3) positions at the end [m]
+    largest_gap_start, largest_gap : the largest seam gap at the start and at the end [m]
+    time, steps, wall_time : simulated time [s], explicit steps, wall time [s]
+    closed : the gap reached :data:`SEAM_CLOSED` of the mean element size
+    """
+
+    x: np.ndarray
+    largest_gap_start: float
+    largest_gap: float
+    time: float
+    steps: int
+    wall_time: float
+    closed: bool
+
+
+def close_seams(build, pairs, obstacles, *, weight: float, stiffest: float, t_stage: float, alpha: float,
+                progress=False, friction=None) -> ClosingResult:
+    """Pull the seams ``pairs (S, 2)`` shut (stage 1 of the module docstring) by damped explicit runs
+    (:func:`rftstatic.solvers.explicit.run_explicit`, mass damping ``alpha`` [1/s], the ``obstacles`` acting
+    kinematically), each of at most ``t_stage`` [s] and stopped as soon as the largest gap is below
+    :data:`SEAM_CLOSED` of the mean element size. The first run's springs pull with :data:`SEAM_PULL` times the
+    garment's ``weight`` [N]; each further run goes on from where the last stopped (positions and velocities)
+    with springs :data:`SEAM_STIFFENING` times stiffer, up to ``stiffest`` [N/m]. ``build(springs)`` gives the
+    model of the panel mesh whose only load is the :class:`~rftstatic.model.loads.SeamSprings` ``springs``."""
+    import time
+
+    from rftstatic.model.loads import SeamSprings
+    from rftstatic.solvers.explicit import run_explicit
+    from rftstatic.solvers.explicit_options import ExplicitOptions
+
+    t0 = time.perf_counter()
+    probe = SeamSprings(pairs, 0.0)
+    model = build(probe)
+    X3 = model.X3
+    tol = SEAM_CLOSED * float(model.mesh.element_size.mean())
+    start = float(probe.gaps(X3).max(initial=0.0))
+    k = min(SEAM_PULL * weight / (max(len(pairs), 1) * max(start, tol)), stiffest)
+    U, V, t, steps = np.zeros_like(X3), np.zeros_like(X3), 0.0, 0
+    gap = start
+    while gap > tol:
+        springs = SeamSprings(pairs, k)
+        model = build(springs)
+
+        def closed(state, sample, springs=springs):
+            return bool(springs.gaps(X3 + state.U).max(initial=0.0) <= tol)
+
+        opts = ExplicitOptions(t_end=t_stage, alpha=alpha, progress=progress, energy_tol=CLOSING_ENERGY_TOL)
+        run = run_explicit(model, opts, U0=U, V0=V, obstacles=obstacles, callback=closed, friction=friction)
+        U, V, t, steps = run.U, run.V, t + float(run.t), steps + int(run.steps)
+        gap = float(springs.gaps(X3 + U).max(initial=0.0))
+        log.info("seam springs %.3g N/m: largest gap %.4g m after %.3g s", k, gap, float(run.t))
+        if k >= stiffest:
+            break
+        k = min(k * SEAM_STIFFENING, stiffest)
+    log.info("seams closed from %.4g m to %.4g m in %.3g s (%d explicit steps)", start, gap, t, steps)
+    return ClosingResult(x=X3 + U, largest_gap_start=start, largest_gap=gap, time=t, steps=steps,
+                         wall_time=time.perf_counter() - t0, closed=gap <= tol)

@@ -1,0 +1,134 @@
+"""Sewing (rftstatic.garment.sewing): seam springs, the closing stage and the merge of the seams' two sides."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rftstatic.garment.meshing import mesh_pattern, place
+from rftstatic.garment.pattern import PatternError
+from rftstatic.garment.readers import read_pattern
+from rftstatic.garment.sewing import SEAM_CLOSED, close_seams, panel_mesh, seam_pairs, sew
+from rftstatic.material import preset
+from rftstatic.model.loads import SeamSprings
+from rftstatic.model.model import Model
+
+PATTERNS = Path(__file__).resolve().parents[2] / "cases" / "patterns"
+
+# a tube of two 20 x 30 cm panels facing each other 16 cm apart, sewn along both long sides
+TUBE = """
+units = "cm"
+[[panels]]
+name = "front"
+vertices = [[-10, 0], [10, 0], [10, 30], [-10, 30]]
+grain = 90
+translate = [0, 0, 8]
+[[panels]]
+name = "back"
+vertices = [[-10, 0], [10, 0], [10, 30], [-10, 30]]
+grain = 90
+translate = [0, 0, -8]
+rotate = [0, 180, 0]
+[[seams]]
+a = "front:1"
+b = "back:3"
+[[seams]]
+a = "front:3"
+b = "back:1"
+"""
+
+
+@pytest.fixture(scope="module")
+def tube(tmp_path_factory):
+    path = tmp_path_factory.mktemp("tube") / "tube.toml"
+    path.write_text(TUBE)
+    pmesh = mesh_pattern(read_pattern(path), 0.04)
+    return pmesh, panel_mesh(pmesh, place(pmesh))
+
+
+def test_seam_springs_force_is_the_gradient_and_tangent_the_hessian():
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(7, 3))
+    springs = SeamSprings([[0, 3], [2, 5], [6, 1]], [1.5, 0.3, 2.0])
+    f = springs.force(x)
+    rows, cols, blocks = springs.tangent_blocks(x)
+    K = np.zeros((21, 21))
+    for r, c, b in zip(rows, cols, blocks):
+        K[3 * r:3 * r + 3, 3 * c:3 * c + 3] += b
+    h = 1e-6
+    for d in range(21):
+        e = np.zeros(21)
+        e[d] = h
+        e = e.reshape(7, 3)
+        assert (springs.potential(x + e) - springs.potential(x - e)) / (2 * h) == pytest.approx(f.ravel()[d], abs=1e-8)
+        np.testing.assert_allclose((springs.force(x + e) - springs.force(x - e)).ravel() / (2 * h), K[:, d], atol=1e-8)
+    np.testing.assert_allclose(springs.force(x + [1.0, -2.0, 0.5]), f)  # a rigid shift changes nothing
+    assert np.allclose(springs.gaps(x), np.linalg.norm(x[[0, 2, 6]] - x[[3, 5, 1]], axis=1))
+
+
+def test_the_placed_panels_are_stress_free_and_the_springs_pull_the_seams(tube):
+    pmesh, mesh = tube
+    pairs = seam_pairs(pmesh)
+    assert len(pairs) == sum(len(p) for p in pmesh.seam_pairs)
+    np.testing.assert_allclose(np.linalg.norm(mesh.X3[pairs[:, 0]] - mesh.X3[pairs[:, 1]], axis=1), 0.16, atol=1e-12)
+    model = Model(mesh, preset("wool-kang-yu"), element="RFT6", load_terms=(SeamSprings(pairs, 1.0),), quiet=True)
+    zero = np.zeros((mesh.n_nodes, 3))
+    assert model.energies(zero)["bending"] == pytest.approx(0, abs=1e-14)
+    assert model.energies(zero)["membrane"] == pytest.approx(0, abs=1e-14)
+    r = model.residual(zero)
+    assert np.abs(r[pairs[:, 0], 2]).min() > 0.1 and (r[pairs[:, 0], 2] > 0).all()  # front pulled back (-z)
+
+
+def test_seams_close_and_merge_into_a_tube(tube):
+    pmesh, mesh = tube
+    pairs = seam_pairs(pmesh)
+    mat = preset("wool-kang-yu")
+    Dm = mat.Dm
+
+    def build(springs):
+        return Model(mesh, mat, element="RFT6", load_terms=(springs,), quiet=True)
+
+    c = close_seams(build, pairs, (), weight=mat.weight * float(mesh.area.sum()),
+                    stiffest=0.5 * min(Dm[0, 0], Dm[1, 1]), t_stage=1.0, alpha=8.0)
+    assert c.closed and c.largest_gap <= SEAM_CLOSED * mesh.element_size.mean()
+    assert c.largest_gap_start == pytest.approx(0.16)
+    sewn, node_of = sew(mesh, pairs, c.x)
+    assert sewn.n_nodes == mesh.n_nodes - len(pairs)
+    assert np.array_equal(node_of[pairs[:, 0]], node_of[pairs[:, 1]])
+    # one closed tube: no boundary along the seams, two boundary loops (the ends)
+    assert len(sewn.boundary_edges) == len(mesh.boundary_edges) - 2 * (len(pairs) - len(pmesh.seam_pairs))
+    # every patch along a seam now reaches across it: the sewn model has real opposite nodes there
+    model = Model(sewn, mat, element="RFT6", quiet=True)
+    assert model.patches.has_opposite.sum() > Model(mesh, mat, element="RFT6", quiet=True).patches.has_opposite.sum()
+    # merging moves the nodes by half the last gap: the CST strains (RFT3: each element on its own) barely change
+    # (RFT6's mid-side strains see the patch, folded sharply at a closed seam, and are no measure of the merge)
+    before = Model(mesh, mat, element="RFT3", quiet=True).membrane_strain(c.x - mesh.X3)
+    after = Model(sewn, mat, element="RFT3", quiet=True).membrane_strain(np.zeros((sewn.n_nodes, 3)))
+    assert np.abs(after - before).max() < 2 * SEAM_CLOSED
+    # the chart keeps each sewn node's first panel node's coordinates
+    first = np.full(sewn.n_nodes, mesh.n_nodes)
+    np.minimum.at(first, node_of, np.arange(mesh.n_nodes))
+    np.testing.assert_array_equal(sewn.X, mesh.X[first])
+
+
+def test_sewing_a_triangle_onto_itself_is_an_error(tube):
+    pmesh, mesh = tube
+    t = mesh.tri[0]
+    with pytest.raises(PatternError, match="collapses 1 triangle"):
+        sew(mesh, np.array([[t[0], t[1]]]), mesh.X3, where="tube.toml")
+
+
+def test_fold_seams_are_refused_naming_the_seam(tmp_path):
+    path = tmp_path / "fold.toml"
+    path.write_text(TUBE.replace('a = "front:3"', 'kind = "fold"\na = "front:3"'))
+    pmesh = mesh_pattern(read_pattern(path), 0.05)
+    with pytest.raises(PatternError, match="front:3 - back:1 is a fold"):
+        seam_pairs(pmesh)
+
+
+def test_the_a_line_skirt_pairs_its_side_seams():
+    pmesh = mesh_pattern(read_pattern(PATTERNS / "skirt-a-line.toml"), 0.05)
+    pairs = seam_pairs(pmesh)
+    x = place(pmesh)
+    # reversed seams: front's edge 1 (hem -> waist) pairs with back's edge 3 (waist -> hem), height by height
+    np.testing.assert_allclose(x[pairs[:, 0], 1], x[pairs[:, 1], 1], atol=1e-9)
