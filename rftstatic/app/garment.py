@@ -14,33 +14,37 @@ Frames. Patterns are placed in GarmentCode's frame (y up, z to the front); the f
 z up (heights above the floor, :mod:`rftstatic.garment.body`). A placed point ``(x, y, z)`` of the pattern
 is the point ``(x, -z, y)`` here (a rotation by +90 deg about x, so the pattern's height is the form's).
 
-What runs. The pattern is meshed with matching seam nodes (:func:`rftstatic.garment.meshing.mesh_pattern`,
-size ``garment.h``), placed (and checked: no two panels may cross or overlap at the start), and sewn in the two
-stages of :mod:`rftstatic.garment.sewing`: the seams are pulled shut by seam springs in a damped explicit run on the
-form without gravity (up to :data:`CLOSING_TIME`; a pattern whose seams do not close is an error naming the gap),
-then each seam's two sides are merged into one node, so that the bending patches reach across the seams. Every
+What runs. The pattern is meshed with matching seam nodes (:func:`rftstatic.garment.meshing.mesh_pattern`, size
+``garment.h``), placed (and checked: no two panels may cross or overlap at the start), and sewn in the two stages of
+:mod:`rftstatic.garment.sewing`: the seams are pulled shut by seam springs in damped explicit runs on the form
+without gravity (each run up to :data:`CLOSING_TIME`; a pattern whose seams do not close is an error naming the
+gap), then each seam's two sides are merged into one node, so that the bending patches reach across the seams. Every
 element keeps its panel's flat shape with the warp along the panel's grain line. The form is written as
 ``body-m.obj`` [m] in the run folder and acts as a ``type = "mesh"`` obstacle
-(:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`), kinematically while the seams close and by
-penalty contact in the static solve; the contact surface is the form grown by :data:`CLEARANCE` times the sag of
-the garment's longest element edge on the form's most curved section, so that the garment's flat triangles, whose
-corners rest on it, do not dip into the form between them. The static solve is the ``static`` analysis's (:func:`rftstatic.app.static.run`)
-on the sewn mesh, from the closed state, so the scene's ``[solver]``, ``[contact]``, ``[[supports]]`` and
-``[loads]`` apply unchanged; a support's ``at = [x, y]`` is a point of the plan view of the placed panels (the
-mesh's chart ``X``: its nearest node there). A pattern without seams (the one-ring circle skirt) skips the closing.
-Contact is frictionless: a skirt hangs on the form's waist-to-hip flare, and its rotation about the
-vertical axis (a zero-energy mode on a frictionless body of revolution) is held by a ``fixed``
+(:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`) by penalty contact (softer by
+:data:`CLOSING_PENALTY` while the seams close); the contact surface is the form grown by :data:`CLEARANCE` times the
+sag of the garment's mean element edge on the form's most curved section, so that the garment's flat triangles,
+whose corners rest on it, do not dip into the form between them. The static solve is the ``static`` analysis's
+(:func:`rftstatic.app.static.run`) on the sewn mesh, from the closed state, so the scene's ``[solver]``,
+``[contact]``, ``[[supports]]`` and ``[loads]`` apply unchanged; a support's ``at = [x, y]`` is a point of the plan
+view of the placed panels (the mesh's chart ``X``: its nearest node there). A pattern without seams (the one-ring
+circle skirt) skips the closing. Contact is frictionless: a skirt hangs on the form's waist-to-hip flare, and its
+rotation about the vertical axis (a zero-energy mode on a frictionless body of revolution) is held by a ``fixed``
 ``[[supports]]`` component at one waist node.
 
 Measures added to ``summary.json`` (``garment``): the pattern's panels and seams, the largest seam gap at the
 start of the closing and when the seams were merged, the closing's simulated time, explicit steps and wall time,
-the nodes removed by merging, hem nodes (the lowest boundary loop), the hem's drape coefficient
+the nodes removed by merging, hem nodes (the lowest boundary loop), the hem's folds (the node count of
+:func:`rftstatic.post.measures.boundary.fold_count` on the outline seen from above, about the form's axis, as for a
+Cusick specimen), the hem's drape coefficient
 ``A_shadow / A_flat``: the area of the draped skirt's vertical projection (:func:`rftstatic.post.measures.shadow.shadow_area`,
 the waist opening not counted) over the flat skirt's area (the opening left out too). It is Cusick's
 ``(A_shadow - A_disc) / (A_sheet - A_disc)`` with the waist opening as the disc, when the draped skirt does
 not overlap the projection of its own waist opening (it flares outwards from the waist); mean element size.
 The independent crossing check of the garment against the form itself (``body.obj``, not the contact surface):
-``body_crossing_pairs`` and ``body_smallest_distance``, with ``contact_clearance``.
+at the start of the static solve (an error if any pair crosses) and at its end, ``body_crossing_pairs`` and
+``body_smallest_distance``, with ``contact_clearance`` (the summary's ``obstacle_crossings`` are against the
+contact surface, whose triangles the garment's cut by their sag).
 Outputs: ``deformed.vtu`` (cell data ``panel``), ``garment.obj`` with UVs (each node's flat pattern
 coordinates, scene units), ``body.obj`` and ``body.vtu`` (scene units).
 """
@@ -59,6 +63,7 @@ from rftstatic.garment.meshing import check_placement, mesh_pattern, place
 from rftstatic.garment.sewing import SEAM_STIFFNESS, close_seams, panel_mesh, seam_pairs, sew
 from rftstatic.garment.readers import read_pattern
 from rftstatic.io.files import to_jsonable, write_json, write_vtu
+from rftstatic.post.measures.boundary import boundary_loop, fold_count
 from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
 from rftstatic.post.measures.shadow import shadow_area
 
@@ -75,10 +80,14 @@ CLOSING_TIME = 1.0
 """Longest run of the seam-closing stage [s] of simulated time, at each spring stiffness
 (:func:`rftstatic.garment.sewing.close_seams`); a run stops as soon as the seams are closed."""
 CLEARANCE = 1.5
-"""The contact surface's distance outside the form over the sag of the garment's longest element edge on the
+"""The contact surface's distance outside the form over the sag of the garment's mean element edge on the
 form's most curved section (:meth:`rftstatic.garment.body.DressForm.chord_clearance`) [-]: the garment's nodes
 rest on that surface, so its flat triangles stay off the form itself (0 crossing pairs with ``body.obj``,
 ``garment.body_crossing_pairs``)."""
+CLOSING_PENALTY = 0.25
+"""Factor on the form's penalty stiffness while the seams close: a softer contact allows a 2 x longer explicit step
+(the contact frequency is sqrt(k / rho)), and the closing needs no precise contact, only the garment kept outside the
+form (its depth in the contact surface stays below the clearance: the start check against the form tests it)."""
 CLOSING_DAMPING = 8.0
 """Mass damping of the seam-closing stage [1/s], about critical for a garment's swing on a body
 (2 sqrt(g / 0.5 m) = 8.9 /s)."""
@@ -185,7 +194,11 @@ def _garment_measures(scene, model, U, pmesh, hem, closing) -> dict:
     if closing is not None:
         sewing = {"largest_seam_gap": closing.largest_gap / u, "largest_seam_gap_start": closing.largest_gap_start / u,
                   "closing_time": closing.time, "closing_steps": closing.steps, "closing_wall_time": closing.wall_time}
-    return {"pattern": Path(pmesh.pattern.source).name, "panels": len(pmesh.meshes),
+    try:  # the hem's folds: the outer boundary seen from above, about the form's axis (as a Cusick specimen's)
+        folds = fold_count(x, boundary_loop(model.mesh.tri, x), (0.0, 0.0)).count
+    except ValueError:  # the hem does not surround the axis in plan view
+        folds = None
+    return {"pattern": Path(pmesh.pattern.source).name, "panels": len(pmesh.meshes), "hem_folds": folds,
             "seams": len(pmesh.pattern.seams), **sewing, "hem_nodes": int(len(hem)),
             "nodes_sewn": int(model.mesh.info.get("sewn_from_nodes", model.mesh.n_nodes) - model.mesh.n_nodes),
             "mean_element_size": float(model.mesh.element_size.mean()) / u, "flat_area": flat / u**2,
@@ -200,6 +213,8 @@ def _closing_scene(scene, data):
     stage["loads"] = {"gravity": False}
     stage.pop("solver", None)
     stage["dynamics"] = {"t_end": CLOSING_TIME, "alpha": CLOSING_DAMPING}
+    contact = stage.setdefault("contact", {})
+    contact["factor"] = CLOSING_PENALTY * float(contact.get("factor", 1.0))
     return type(scene)(stage, scene.path, scene.name, scene.overrides)
 
 
@@ -231,8 +246,8 @@ def run(scene, out: Path, *, progress=True, figures=True):
     u = scene.units.length
     form = dress_form(scene)
     pmesh, mesh, uv = dressed_mesh(scene)
-    # the contact surface [m]: the form grown by the sag of the garment's longest chord (body.obj: the form itself)
-    clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.max()))
+    # the contact surface [m]: the form grown by the sag of the garment's mean edge (body.obj: the form itself)
+    clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.mean()))
     form.write_obj(out / "body-m.obj", clearance=clearance)
     data = copy.deepcopy(scene.data)
     data.pop("garment")
@@ -245,17 +260,26 @@ def run(scene, out: Path, *, progress=True, figures=True):
     if len(pairs):
         closing = close(scene, data, mesh, pairs, progress=progress)
         if not closing.closed:
-            raise scene.error("garment.pattern", f"the seams did not close in {CLOSING_TIME:g} s: the largest gap is "
+            raise scene.error("garment.pattern", f"the seams did not close in {closing.time:.3g} s: the largest gap is "
                               f"{closing.largest_gap / u:.3g} {scene.units.name.split('-')[0]} (from "
                               f"{closing.largest_gap_start / u:.3g}); place the panels closer to their seams "
-                              "or check that the body does not hold them apart")
+                              "or check that the body does not hold them apart (the contact surface lies "
+                              f"{clearance / u:.3g} {scene.units.name.split('-')[0]} outside the form at this mesh "
+                              "size: a finer garment.h brings it closer)")
         mesh, _ = sew(mesh, pairs, closing.x, where=Path(pmesh.pattern.source).name)
+    P, T = form.surface()
+    start = obstacle_crossings(mesh.X3, mesh.tri, P, T)
+    if start["pairs"]:
+        raise scene.error("garment.pattern", f"the placed or sewn garment crosses the form at the start "
+                          f"({start['pairs']} triangle pairs, the first at "
+                          f"{np.round(np.asarray(start['first_at']) / u, 3).tolist()}): place the panels off the form")
     solved = type(scene)(data, scene.path, scene.name, scene.overrides)
-    result = static.run(solved, out, progress=progress, figures=figures, mesh=mesh)
+    # the start is checked against the form itself above: the contact surface, grown by the clearance, is cut by
+    # the garment's flat triangles between their nodes by up to their sag (which the clearance is for)
+    result = static.run(solved, out, progress=progress, figures=figures, mesh=mesh, start_check=False)
     model, U = result.model, result.U
     hem = _hem(model.mesh, model.positions(U))
     garment = _garment_measures(scene, model, U, pmesh, hem, closing)
-    P, T = form.surface()
     body = obstacle_crossings(model.positions(U), model.mesh.tri, P, T)
     garment.update({"contact_clearance": clearance / u, "body_crossing_pairs": body["pairs"],
                     "body_smallest_distance": body["smallest_distance"] / u})

@@ -41,7 +41,7 @@ CHECKPOINT = "checkpoint.npz"
 
 
 def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback=None,
-        checkpoint_seconds: float = CHECKPOINT_SECONDS, mesh=None) -> RunResult:
+        checkpoint_seconds: float = CHECKPOINT_SECONDS, mesh=None, start_check: bool = True) -> RunResult:
     """Build and solve ``scene``; write the outputs into ``out``; return the result.
 
     ``resume``: continue from ``out/checkpoint.npz`` (a fresh solve, logged, when there is none; a
@@ -49,12 +49,13 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     ``solver.levels`` > 1 (mesh sequencing, :mod:`rftstatic.app.levels`), from the levels saved in ``out``.
     ``callback``: ``callback(lam, U)`` after every converged increment. ``checkpoint_seconds``: least wall
     time between two checkpoint writes [s]. ``mesh``: the sheet's reference mesh in place of the scene's
-    ``[mesh]`` (a garment's, :mod:`rftstatic.app.garment`).
+    ``[mesh]`` (a garment's, :mod:`rftstatic.app.garment`); ``start_check``: refuse surface obstacles cutting the
+    sheet at the start (:func:`rftstatic.scenes.build.build_contact`; a sewn garment's stage checks its own).
     """
     t0 = time.perf_counter()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    model, extras = build_model(scene, mesh=mesh)
+    model, extras = build_model(scene, mesh=mesh, start_check=start_check)
     build_time = time.perf_counter() - t0
     opts = static_options(scene, progress=progress)
     seeds = seed_count(scene)

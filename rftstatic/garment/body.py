@@ -124,7 +124,9 @@ class DressForm:
         """``(P, tri)``: the closed form as points (P, 3) [m] and outward-wound triangles (T, 3).
 
         ``sections`` rings between the bottom and the neck top (every defining level among them, so each girth
-        is met at its height), ``around`` points per ring, and a centre point for each cap. ``clearance`` [m] > 0
+        is met at its height), ``around`` points per ring; each flat cap is a centre point and ``around / 2 pi``
+        rings shrinking to it (its triangles about the size of the side's, not a fan of long slivers: a mesh
+        obstacle's nearest-triangle proof works with its largest triangle). ``clearance`` [m] > 0
         gives the form grown by that much: every semi-axis longer by it and the caps moved out by it (a surface
         about ``clearance`` outside the form, at least ``clearance`` times the cosine of the side's slope: the
         contact surface that keeps a coarse garment's flat triangles off the curved form, :meth:`chord_clearance`).
@@ -136,16 +138,23 @@ class DressForm:
             a, b = a + clearance, b + clearance
             z = z + clearance * (np.arange(len(z)) == len(z) - 1) - clearance * (np.arange(len(z)) == 0)
         t = 2.0 * np.pi * np.arange(around) / around
-        ring = np.stack([a[:, None] * np.cos(t), b[:, None] * np.sin(t), np.broadcast_to(z[:, None], (len(z), around))],
+        m = max(1, int(round(around / (2.0 * np.pi))))  # cap rings: cap triangles about as small as the side's
+        shrink = np.arange(m, 0, -1) / m  # 1 (the end section) down to 1/m
+        zs = np.concatenate([np.full(m - 1, z[0]), z, np.full(m - 1, z[-1])])
+        f = np.concatenate([shrink[:0:-1], np.ones(len(z)), shrink[1:]])  # bottom cap rings, sides, top cap rings
+        aa = np.concatenate([np.full(m - 1, a[0]), a, np.full(m - 1, a[-1])]) * f
+        bb = np.concatenate([np.full(m - 1, b[0]), b, np.full(m - 1, b[-1])]) * f
+        ring = np.stack([aa[:, None] * np.cos(t), bb[:, None] * np.sin(t), np.broadcast_to(zs[:, None], (len(zs), around))],
                         axis=-1)
-        P = np.concatenate([ring.reshape(-1, 3), [[0.0, 0.0, z[0]], [0.0, 0.0, z[-1]]]])
+        P = np.concatenate([ring.reshape(-1, 3), [[0.0, 0.0, zs[0]], [0.0, 0.0, zs[-1]]]])
         k = np.arange(around)
-        r = np.arange(len(z) - 1)[:, None] * around
+        rings = len(zs)
+        r = np.arange(rings - 1)[:, None] * around
         i0, i1 = r + k, r + (k + 1) % around  # this ring
-        j0, j1 = i0 + around, i1 + around  # the ring above
+        j0, j1 = i0 + around, i1 + around  # the next ring (up the side; outwards then inwards on the caps)
         side = np.concatenate([np.stack([i0, i1, j1], -1), np.stack([i0, j1, j0], -1)], axis=0).reshape(-1, 3)
         nb, nt = len(P) - 2, len(P) - 1
-        top = (len(z) - 1) * around
+        top = (rings - 1) * around
         caps = np.concatenate([np.stack([np.full(around, nb), (k + 1) % around, k], -1),
                                np.stack([np.full(around, nt), top + k, top + (k + 1) % around], -1)])
         return P, np.concatenate([side, caps]).astype(np.int64)

@@ -65,7 +65,10 @@ def drape_summary(scene, model, extras, U) -> dict:
     if disc is not None:  # a tester's clamping disc: the specimen includes the part the mesh leaves open
         disc_area, centre, sheet_area = disc.area, disc.centre, sheet_area + disc.open_area
     reason = None
-    if disc_area is not None and not sheet_area > disc_area:
+    if not model.mesh.chart_is_flat:
+        reason = ("a garment sewn from panels has no flat sheet to project: its hem's drape coefficient is the "
+                  "summary's garment table")
+    elif disc_area is not None and not sheet_area > disc_area:
         reason = (f"the sheet ({sheet_area / u**2:.4g} square units) is not larger than the obstacle's footprint "
                   f"({disc_area / u**2:.4g}): no drape coefficient")
     elif disc is None and model.mesh.locate(np.asarray(centre, float)[None, :2])[0][0] < 0:

@@ -114,6 +114,16 @@ class TriMesh:
         object.__setattr__(self, "element_X", ex)
         object.__setattr__(self, "placed", pl)
 
+    @cached_property
+    def chart_is_flat(self) -> bool:
+        """Whether ``X`` is a flat layout of the mesh (every triangle as large there as its reference, to 1e-9), so
+        that points can be located in it (:meth:`locate`): always for a flat mesh; for a sewn one only when its
+        chart happens to be one (a single panel placed flat, the circle skirt's ring seen from above)."""
+        if self.element_X is None:
+            return True
+        return bool(np.allclose(np.abs(_signed_area2(self.X, self.tri)), 2.0 * self.area, rtol=1e-9,
+                                atol=1e-9 * float(self.area.max())))
+
     @property
     def corners(self) -> np.ndarray:
         """(E, 3, 2) flat reference coordinates of every element's corners [m]: ``element_X``, or ``X[tri]``."""
@@ -188,6 +198,9 @@ class TriMesh:
 
         Returns ``(elem (P,), bary (P, 3))``; elem is -1 for points outside the mesh.
         """
+        if not self.chart_is_flat:
+            raise MeshError(f"{self.name}: a mesh sewn from panels has no flat chart to locate reference points in "
+                            "(its X is the plan view of the placed panels, which overlap); pick nodes by position")
         pts = np.atleast_2d(np.asarray(points, float))
         brute = len(pts) <= BRUTE_LOCATE_POINTS and len(pts) * self.n_elements <= BRUTE_LOCATE_PAIRS
         if brute:

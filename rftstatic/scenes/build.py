@@ -208,6 +208,9 @@ def check_on_sheet(scene: Scene, mesh, pts: np.ndarray, key: str) -> None:
     beyond = np.any((pts < lo - margin) | (pts > hi + margin), axis=1)  # before locate: 1e300 overflows there
     if beyond.any():
         far_points = pts[beyond]
+    elif not mesh.chart_is_flat:  # a sewn garment: its chart is the panels' plan view; near a node there
+        d = np.linalg.norm(mesh.X[mesh.nearest_node(pts)] - pts, axis=1)
+        far_points = pts[d > margin]
     else:
         elem, _ = mesh.locate(pts)
         off = elem < 0
@@ -300,9 +303,11 @@ def build_obstacles(scene: Scene) -> list:
     return obstacles
 
 
-def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str = "penalty"):
+def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str = "penalty", start_check: bool = True):
     """The obstacles and, for ``law = "penalty"``, the penalty contact (None without obstacles, or for the
-    kinematic law). May add the in-plane holds of a sheet on a frictionless support to ``supports``:
+    kinematic law); ``start_check``: refuse a surface obstacle that cuts the sheet at the start
+    (:func:`~rftstatic.scenes.obstacle_checks.check_surface_obstacles`; off for a stage that starts where an
+    earlier one of the same run ended, a sewn garment's). May add the in-plane holds of a sheet on a frictionless support to ``supports``:
     the static drape (penalty) and dynamic relaxation (a kinematic run of a ``relax`` scene) seek a rest
     state and keep them (unless ``contact.hold_inplane = false``), or a slightly asymmetric sheet creeps
     and spins on the support; a true dynamic run does not."""
@@ -313,7 +318,8 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     obstacles = build_obstacles(scene)
     if not obstacles:
         return None, []
-    check_surface_obstacles(scene, mesh, obstacles, law)
+    if start_check:
+        check_surface_obstacles(scene, mesh, obstacles, law)
     c = contact_options(scene)
     friction = contact_friction(scene, c, len(obstacles), mesh)
     hold = c.hold_inplane if c.hold_inplane is not None else friction is None
@@ -415,7 +421,7 @@ def run_kernels(scene: Scene, mesh) -> str:
 
 
 def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: bool = False,
-                membrane_scale: float = 1.0) -> tuple[Model, dict]:
+                membrane_scale: float = 1.0, start_check: bool = True) -> tuple[Model, dict]:
     """The model of a scene (optionally on another ``mesh`` of the same sheet) and its extras.
 
     ``contact``: how the obstacles act, ``"penalty"`` (in the model's energy) or ``"kinematic"`` (by the
@@ -424,6 +430,7 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
     ``membrane_scale``: the fabric's membrane rigidity multiplied by this factor, before the contact and
     self-contact stiffnesses are derived from it (a coarse level of mesh sequencing matched to the finest
     mesh's locking number, :mod:`rftstatic.app.levels`); 1: the scene's fabric.
+    ``start_check``: :func:`build_contact`'s.
     ``extras``: ``{"obstacles": [...], "probes": {name: (2,) reference point [m]}, "disc": a tester's clamping
     disc (:func:`clamping_disc`) or None}``.
     """
@@ -443,7 +450,8 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
                           "(the mass); got 0")
     supports = build_supports(scene, mesh)
     load = build_load(scene, mesh, material)
-    contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene))
+    contact, obstacles = build_contact(scene, mesh, material, supports, law=contact or contact_law(scene),
+                                       start_check=start_check)
     if scene.analysis == "static":
         check_static_scene(scene, material, supports, load, obstacles)
     membrane = declared_run_options(scene).membrane

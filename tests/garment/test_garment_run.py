@@ -1,0 +1,82 @@
+"""The garment analysis end to end (rftstatic.app.garment): panels placed, seams closed and merged, draped on the
+dress form, checked by tests independent of the solve (crossings against the form itself, seam pairs merged)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from rftstatic.app.garment import read_obj_uv
+from rftstatic.cli import main
+from rftstatic.garment.meshing import mesh_pattern
+from rftstatic.garment.readers import read_pattern
+from rftstatic.garment.sewing import SEAM_CLOSED, seam_pairs
+from rftstatic.scenes.schema import load_scene
+
+# a collar: two 22 x 8 cm panels around the form's neck, sewn at both sides; it comes to rest on the shoulders
+COLLAR = """
+units = "cm"
+[[panels]]
+name = "front"
+vertices = [[-11, 0], [11, 0], [11, 8], [-11, 8]]
+grain = 90
+translate = [0, 140, 9]
+[[panels]]
+name = "back"
+vertices = [[-11, 0], [11, 0], [11, 8], [-11, 8]]
+grain = 90
+translate = [0, 140, -9]
+rotate = [0, 180, 0]
+[[seams]]
+a = "front:1"
+b = "back:3"
+[[seams]]
+a = "front:3"
+b = "back:1"
+"""
+
+
+def _scene(tmp_path, pattern_text, h):
+    (tmp_path / "patterns").mkdir()
+    (tmp_path / "patterns" / "p.toml").write_text(pattern_text)
+    text = load_scene("skirt-a-line").path.read_text()
+    text = text.replace('pattern = "patterns/skirt-a-line.toml"', 'pattern = "patterns/p.toml"')
+    text = text.replace("h = 5.0 ", f"h = {h} ")
+    (tmp_path / "s.toml").write_text(text)
+    return tmp_path / "s.toml"
+
+
+def _check_dressed(out, pattern_path, h):
+    summary = json.loads((out / "summary.json").read_text())
+    g = summary["garment"]
+    assert summary["converged"] and summary["stable_minimum"]
+    assert g["body_crossing_pairs"] == 0 and summary["self_intersections"]["pairs"] == 0
+    assert g["largest_seam_gap"] <= SEAM_CLOSED * g["mean_element_size"]
+    pmesh = mesh_pattern(read_pattern(pattern_path), h)
+    pairs = seam_pairs(pmesh)
+    assert g["nodes_sewn"] == len(pairs)
+    # garment.obj: one texture coordinate per panel corner; each face's flat edge lengths are its panel's
+    x, vt, tri, vt_tri = read_obj_uv(out / "garment.obj")
+    assert len(vt) == pmesh.n_nodes and len(x) == pmesh.n_nodes - len(pairs)
+    flat = np.linalg.norm(vt[vt_tri[:, 1]] - vt[vt_tri[:, 0]], axis=1)
+    uv = np.concatenate([m.X for m in pmesh.meshes]) * 100
+    np.testing.assert_allclose(flat, np.linalg.norm(uv[vt_tri[:, 1]] - uv[vt_tri[:, 0]], axis=1), rtol=1e-7)
+    return summary
+
+
+@pytest.mark.slow
+def test_a_collar_is_sewn_round_the_neck_and_rests_on_the_shoulders(tmp_path):
+    scene = _scene(tmp_path, COLLAR, 4.0)
+    out = tmp_path / "out"
+    assert main(["case", str(scene), "--out", str(out), "--no-figures"]) == 0
+    summary = _check_dressed(out, tmp_path / "patterns" / "p.toml", 0.04)
+    x, *_ = read_obj_uv(out / "garment.obj")
+    assert x[:, 2].min() > 130.0  # on the shoulders (136 cm), not slid down the form
+
+
+@pytest.mark.slow
+def test_the_a_line_skirt_sews_and_drapes(tmp_path):
+    out = tmp_path / "out"
+    assert main(["case", "skirt-a-line", "--out", str(out), "--no-figures"]) == 0
+    summary = _check_dressed(out, load_scene("skirt-a-line").path.parent / "patterns" / "skirt-a-line.toml", 0.05)
+    assert summary["garment"]["hem_folds"] >= 2
