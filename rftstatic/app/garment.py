@@ -84,6 +84,11 @@ CLEARANCE = 1.5
 form's most curved section (:meth:`rftstatic.garment.body.DressForm.chord_clearance`) [-]: the garment's nodes
 rest on that surface, so its flat triangles stay off the form itself (0 crossing pairs with ``body.obj``,
 ``garment.body_crossing_pairs``)."""
+BODY_FEATURE_ANGLE = 100.0
+"""The form's ``feature_angle`` [deg] as a mesh obstacle: above the 90 deg rims of its flat caps, so the form has no
+sharp features (a body has none; the caps only close the surface). With the rims as features, the feature contact
+(obstacle edges against garment edges, :mod:`rftstatic.contact.features`) pumps energy into the closing runs: on a
+collar round the neck, total energy 0.130 -> 1.12 J in 0.3 s undamped, against 0.130 -> 0.128 J without it."""
 CLOSING_PENALTY = 0.25
 """Factor on the form's penalty stiffness while the seams close: a softer contact allows a 2 x longer explicit step
 (the contact frequency is sqrt(k / rho)), and the closing needs no precise contact, only the garment kept outside the
@@ -254,7 +259,7 @@ def run(scene, out: Path, *, progress=True, figures=True):
     data.pop("body")
     data["analysis"] = "static"
     data.setdefault("obstacles", []).append({"type": "mesh", "path": str((out / "body-m.obj").resolve()),
-                                              "units": "m"})
+                                              "units": "m", "feature_angle": BODY_FEATURE_ANGLE})
     pairs = seam_pairs(pmesh)
     closing, corner_uv = None, mesh.tri
     if len(pairs):

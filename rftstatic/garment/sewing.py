@@ -50,17 +50,6 @@ by one with stiffer springs, a run stopped on a closed gap that springs open aga
 SEAM_STIFFENING = 10.0
 """Factor on the spring stiffness from one closing run to the next [-] (:func:`close_seams`)."""
 
-CLOSING_ENERGY_TOL = 10.0
-"""Bound on the closing runs' energy growth [-] (``energy_tol`` of
-:class:`~rftstatic.solvers.explicit_options.ExplicitOptions`; a non-finite state still stops a run). The closing
-is a numerical device, not a motion to be tracked, and its balance drifts once the garment meets the form:
-on skirt-a-line the total grew by 26 % of the energy scale within 0.12 s at the soft penalty (and with the form
-acting kinematically); not explained yet, so the default 0.25 would stop every closing on a body."""
-
-CLOSING_SAFETY = 0.5
-"""Factor on the closing runs' critical explicit step [-] (the solver's default is 0.9): the step is estimated at
-the start of each run, and the panels stiffen as their seams fold them round the form (stress and contact)."""
-
 SEAM_STIFFNESS = 0.5
 """Largest seam spring stiffness over the fabric's smallest membrane rigidity min(C_warp, C_weft) [-]: a spring on
 a seam node then stays below the membrane's own stiffness there, so it does not shorten the explicit step, and
@@ -180,13 +169,13 @@ def _closing_step(model, U, alpha) -> float:
     (:func:`rftstatic.solvers.timestep.stable_time_step`) with the penalty contact's frequency added,
     omega^2 = omega_cloth^2 + k / rho (k the penalty stiffness [N/m^3], rho the mass per area [kg/m^2]): the
     estimate at the start sees no contact, and the body is met later in the run."""
-    from rftstatic.solvers.timestep import critical_step, stable_time_step
+    from rftstatic.solvers.timestep import SAFETY, critical_step, stable_time_step
 
     est = stable_time_step(model, U, alpha=alpha)
     omega = est.omega_max
     if model.contact is not None:
         omega = float(np.hypot(omega, np.sqrt(model.contact.stiffness / model.material.mass_per_area)))
-    return CLOSING_SAFETY * critical_step(omega, alpha)
+    return SAFETY * critical_step(omega, alpha)
 
 
 def close_seams(build, pairs, obstacles, *, weight: float, stiffest: float, t_stage: float, alpha: float,
@@ -194,7 +183,8 @@ def close_seams(build, pairs, obstacles, *, weight: float, stiffest: float, t_st
     """Pull the seams ``pairs (S, 2)`` shut (stage 1 of the module docstring) by damped explicit runs
     (:func:`rftstatic.solvers.explicit.run_explicit`, mass damping ``alpha`` [1/s], the model's penalty contact
     and any ``obstacles`` acting kinematically), each of at most ``t_stage`` [s] and stopped as soon as the
-    largest gap is below half of :data:`SEAM_CLOSED` of the mean element size (the run takes one more step). The
+    largest gap is below half of :data:`SEAM_CLOSED` of the mean element size (the run takes one more step; the
+    run at the stiffest springs goes to its end). The
     first run's springs pull with :data:`SEAM_PULL` times the garment's ``weight`` [N]; a run that comes to rest
     short of closing is followed by one with springs :data:`SEAM_STIFFENING` times stiffer, up to ``stiffest``
     [N/m], at most :data:`CLOSING_RUNS` runs, each going on from where the last stopped (positions and
@@ -219,10 +209,12 @@ def close_seams(build, pairs, obstacles, *, weight: float, stiffest: float, t_st
         springs = SeamSprings(pairs, k)
         model = build(springs)
 
-        def closed(state, sample, springs=springs):  # half the tolerance: the run takes one more step
-            return bool(springs.gaps(X3 + state.U).max(initial=0.0) <= 0.5 * tol)
+        def closed(state, sample, springs=springs, last=k >= stiffest):
+            # half the tolerance: the run takes one more step; the stiffest springs ring about the closed seam, and
+            # their run goes to its end (damped) rather than stop on a passing small gap
+            return not last and bool(springs.gaps(X3 + state.U).max(initial=0.0) <= 0.5 * tol)
 
-        opts = ExplicitOptions(t_end=t_stage, alpha=alpha, progress=progress, energy_tol=CLOSING_ENERGY_TOL,
+        opts = ExplicitOptions(t_end=t_stage, alpha=alpha, progress=progress,
                                dt=_closing_step(model, U, alpha))
         run = run_explicit(model, opts, U0=U, V0=V, obstacles=obstacles, callback=closed, friction=friction)
         U, V, t, steps = run.U, run.V, t + float(run.t), steps + int(run.steps)

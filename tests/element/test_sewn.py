@@ -181,3 +181,15 @@ def test_the_explicit_force_of_a_sewn_mesh_is_the_models(kernel):
     f, W = ForceKernel(mod, backend=kernel, threads=1)(U, energy=True)
     np.testing.assert_allclose(f, mod.internal_force(U), rtol=1e-9, atol=1e-12 * np.abs(f).max())
     np.testing.assert_allclose(W, mod.potential(U), rtol=1e-12)
+
+
+def test_a_sewn_mesh_locates_points_only_in_a_flat_chart():
+    tube, _ = _tube(8, 3)
+    assert not tube.chart_is_flat
+    with pytest.raises(MeshError, match="no flat chart"):
+        tube.locate([[0.1, 0.1]])
+    flat = trimesh.rectangle(1.0, 0.6, 5, 4)
+    cut = _cut(flat, angle=0.3)
+    assert flat.chart_is_flat and cut.chart_is_flat  # a sewn mesh whose chart is a flat layout of it
+    elem, _ = cut.locate([[0.3, 0.2]])
+    assert elem[0] >= 0

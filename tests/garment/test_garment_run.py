@@ -80,3 +80,20 @@ def test_the_a_line_skirt_sews_and_drapes(tmp_path):
     assert main(["case", "skirt-a-line", "--out", str(out), "--no-figures"]) == 0
     summary = _check_dressed(out, load_scene("skirt-a-line").path.parent / "patterns" / "skirt-a-line.toml", 0.05)
     assert summary["garment"]["hem_folds"] >= 2
+
+
+def test_the_garmentcode_json_skirt_is_the_toml_skirt(tmp_path):
+    # the same A-line skirt written to GarmentCode's published schema: the same panels, placement and seam pairs, so
+    # the sewing and the drape (test_the_a_line_skirt_sews_and_drapes) are the same run
+    from rftstatic.app.garment import dressed_mesh
+
+    toml = load_scene("skirt-a-line")
+    text = toml.path.read_text().replace("patterns/skirt-a-line.toml", "patterns/skirt-a-line.json")
+    (tmp_path / "patterns").symlink_to(toml.path.parent / "patterns")
+    (tmp_path / "s.toml").write_text(text)
+    js = load_scene(str(tmp_path / "s.toml"))
+    (pa, ma, uva), (pb, mb, uvb) = dressed_mesh(toml), dressed_mesh(js)
+    np.testing.assert_allclose(ma.X3, mb.X3, atol=1e-12)
+    np.testing.assert_allclose(ma.element_X, mb.element_X, atol=1e-12)
+    np.testing.assert_array_equal(ma.tri, mb.tri)
+    np.testing.assert_array_equal(seam_pairs(pa), seam_pairs(pb))
