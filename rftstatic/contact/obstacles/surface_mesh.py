@@ -225,6 +225,12 @@ class SurfaceObstacle(Obstacle):
         self._ctree = cKDTree(self.centroid)
         self._vtree = cKDTree(V)
         self._sets = {}  # candidate sets of the last calls, by their number of points (_candidates)
+        self._surface = tuple(np.ascontiguousarray(a) for a in (
+            V, T.astype(np.int64), self.centroid, self.nf, self.ne, self.nv, self.edge_of.astype(np.int64),
+            self.edges.astype(np.int64), self.boundary_edge, self.boundary_vertex))
+        mode = 0 if self.closed else (2 if self.thickness is not None else 1)
+        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        self._consts = np.array([self.radius, self.band, half, mode, *self.lo, *self.hi], float)
         # the compiled query pays off where the numpy twin searches subsets; a box's 12 triangles are all tested
         # at once in numpy, without importing numba (0.5 s)
         self.compiled = numba_available() and len(T) > NEAREST
@@ -325,9 +331,60 @@ class SurfaceObstacle(Obstacle):
 
     def _evaluate(self, x, hessian):
         x = _as_points(x)
-        n = len(x)
+        if self.compiled:
+            return self._evaluate_compiled(x, hessian)
         q, kind, gid, exact, lower = self._closest(x)
-        near = exact & (lower < self.band)
+        return self._signed(x, q, kind, gid, exact & (lower < self.band), lower, hessian)
+
+    def _kernel_call(self, x, ik, dk, moved, hessian):
+        from rftstatic.contact.obstacles._surface_numba import signed_in_sets
+
+        n = len(x)
+        phi, normal, out = np.empty(n), np.empty((n, 3)), np.empty((n, 6))
+        H = np.empty((n, 3, 3) if hessian else (1, 3, 3))
+        signed_in_sets(np.ascontiguousarray(x), self._surface, np.ascontiguousarray(ik), np.ascontiguousarray(dk),
+                       moved, self._consts, hessian, phi, normal, H, out)
+        return phi, normal, H, out
+
+    def _evaluate_compiled(self, x, hessian):
+        """:meth:`_evaluate` by the compiled :func:`.surface_kernels.signed_in_sets` over the held candidate sets;
+        the points it leaves (status 1: a held set that no longer proves the nearest triangle is sought again
+        where the point is, then every triangle within ``r + R``; status 2: beyond the band inside the box) go
+        through the numpy path (:meth:`_signed`)."""
+        K = min(WIDER, len(self.T))
+        ik, dk, moved = self._candidates(x, K)
+        phi, normal, H, out = self._kernel_call(x, ik, dk, moved, hessian)
+        again = np.flatnonzero((out[:, 5] == 1.0) & (moved > 0))
+        if again.size:  # sets kept from the last call that no longer prove the nearest: the K nearest now
+            dka, ika = self._ctree.query(x[again], k=K)
+            dka, ika = dka.reshape(len(again), K), ika.reshape(len(again), K)
+            x_ref, ik_held, dk_held = self._sets[len(x)]
+            x_ref[again], ik_held[again], dk_held[again] = x[again], ika, dka
+            phi[again], normal[again], Ha, out[again] = self._kernel_call(x[again], ika, dka, np.zeros(len(again)),
+                                                                          hessian)
+            if hessian:
+                H[again] = Ha
+        rest = np.flatnonzero(out[:, 5] != 0.0)
+        if rest.size:
+            xr, o = x[rest], out[rest]
+            q, lower = o[:, :3].copy(), o[:, 4]
+            kind, gid = np.zeros(len(rest), np.int8), np.zeros(len(rest), np.int64)
+            ball = np.flatnonzero(o[:, 5] == 1.0)
+            near = o[:, 5] == 1.0
+            if ball.size:
+                qb, kb, lb, tb = self._ball(xr[ball], o[ball, 3])
+                q[ball], kind[ball], gid[ball] = qb, kb, self._gid(kb, lb, tb)
+            phi[rest], normal[rest], Hr = self._signed(xr, q, kind, gid, near, lower, hessian)
+            if hessian:
+                H[rest] = Hr
+        return phi, normal, (H if hessian else None)
+
+    def _signed(self, x, q, kind, gid, near, lower, hessian):
+        """Signed distance, normal and Hessian (or None) at ``x (n, 3)`` [m] from each point's closest feature
+        ``q (n, 3)`` [m], ``kind, gid``, exact where ``near``, else the lower bound ``lower (n,)`` [m] (module
+        docstring)."""
+        n = len(x)
+        near = near.copy()
         if self.closed:
             box = ~near & np.all((x >= self.lo) & (x <= self.hi), axis=1)
             if box.any():  # a point deep inside (none in a sound run) gets its exact distance too
