@@ -42,7 +42,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["END", "ROUNDS", "SHY", "TOUCH", "FeatureSweep", "corner_crossing_times", "edge_crossing_times", "unit_roots"]
+__all__ = ["END", "ROUNDS", "SHY", "TOUCH", "FeatureSweep", "corner_crossing_times", "edge_crossing_times",
+           "unit_roots"]
 
 ROUNDS = 8
 """Tests along the shortened steps before the nodes of an edge still crossing are left at the step's start."""

@@ -110,17 +110,18 @@ def signed_in_sets(x, surface, ik, dk, moved, consts, hessian, phi, normal, H, o
 
     ``surface = (V, T, centroid, nf, ne, nv, edge_of, edges, rim_edge, rim_vertex)``: the obstacle's nodes [m],
     triangles, centroids [m], face / edge / vertex pseudo-normals, triangle edges, edges' nodes, and open-boundary
-    flags; ``consts = (R, band, half, mode, lo (3), hi (3))``: the largest centroid-to-corner radius, the exact
-    band [m], the shell's half thickness [m], ``mode`` 0 closed, 1 open with a side, 2 a two-sided shell, and
-    the bounding box [m]. Fills ``phi (n,)`` [m], ``normal (n, 3)``, ``H (n, 3, 3)`` [1/m] (when ``hessian``)
-    and ``out (n, 6)``: the closest point of the nearest candidate [m], its distance ``r`` [m], the lower bound
-    of the distance [m], and a status: 0 done; 1 unproven and within the band, or unproven with a held set (the
-    caller seeks its set again, or searches every triangle within ``r + R``); 2 beyond the band inside a closed
-    surface's box (the caller's winding number)."""
+    flags; ``consts = (R, band, half, mode, lo (3), hi (3), every)``: the largest centroid-to-corner radius, the
+    exact band [m], the shell's half thickness [m], ``mode`` 0 closed, 1 open with a side, 2 a two-sided shell, the
+    bounding box [m], and ``every`` 1 when each point's candidates hold every triangle that can be nearest (a ball
+    search's, padded with repeats; ``dk`` 0: no early stop), else 0. Fills ``phi (n,)`` [m], ``normal (n, 3)``, ``H
+    (n, 3, 3)`` [1/m] (when ``hessian``) and ``out (n, 6)``: the closest point of the nearest candidate [m], its
+    distance ``r`` [m], the lower bound of the distance [m], and a status: 0 done; 1 unproven and within the band,
+    or unproven with a held set (the caller seeks its set again, or searches every triangle within ``r + R``); 2
+    beyond the band inside a closed surface's box (the caller's winding number)."""
     V, T, centroid, nf, ne, nv, edge_of, edges, rim_edge, rim_vertex = surface
     R, band, half, mode = consts[0], consts[1], consts[2], int(consts[3])
     n, K = ik.shape
-    whole = T.shape[0] <= K
+    whole = T.shape[0] <= K or consts[10] > 0
     for p in range(n):
         p0, p1, p2 = x[p, 0], x[p, 1], x[p, 2]
         d2, s0, s1, s2, kd, lc, t, c2 = nearest_one(p0, p1, p2, V, T, centroid, ik[p], dk[p], moved[p], R)

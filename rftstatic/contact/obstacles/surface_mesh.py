@@ -74,6 +74,11 @@ stops at the first that cannot be nearer (a point on the surface tests a few), a
 off the surface (the sheet hanging beside a finely tessellated body) is still proven among them, without the
 search of every triangle within its distance plus ``R``."""
 
+WIDEST = 512
+"""The most centroids a compiled candidate set grows to: where fresh sets of :data:`WIDER` fail to prove the
+nearest triangle for more than a quarter of the points sought again (slivers along a rounded edge: the nearest
+centroids all lie within a few millimetres), the next calls use sets twice as large."""
+
 HELD_SETS = 8
 """Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
 midpoints, the feature contact's points ...): a static obstacle's triangles never move, so a point that moved
@@ -205,12 +210,13 @@ class SurfaceObstacle(Obstacle):
         self._ctree = cKDTree(self.centroid)
         self._vtree = cKDTree(V)
         self._sets = {}  # candidate sets of the last calls, by their number of points (_candidates)
+        self._wider, self.widest = WIDER, WIDEST  # their size, doubled while fresh sets fail to prove (surface_query)
         self._surface = tuple(np.ascontiguousarray(a) for a in (
             V, T.astype(np.int64), self.centroid, self.nf, self.ne, self.nv, self.edge_of.astype(np.int64),
             self.edges.astype(np.int64), self.boundary_edge, self.boundary_vertex))
         mode = 0 if self.closed else (2 if self.thickness is not None else 1)
         half = 0.0 if self.thickness is None else 0.5 * self.thickness
-        self._consts = np.array([self.radius, self.band, half, mode, *self.lo, *self.hi], float)
+        self._consts = np.array([self.radius, self.band, half, mode, *self.lo, *self.hi, 0.0], float)
         # the compiled query pays off where the numpy twin searches subsets; a box's 12 triangles are all tested
         # at once in numpy, without importing numba (0.5 s)
         self.compiled = numba_available() and len(T) > NEAREST
@@ -316,48 +322,10 @@ class SurfaceObstacle(Obstacle):
         q, kind, gid, exact, lower = self._closest(x)
         return self._signed(x, q, kind, gid, exact & (lower < self.band), lower, hessian)
 
-    def _kernel_call(self, x, ik, dk, moved, hessian):
-        from rftstatic.contact.obstacles._surface_numba import signed_in_sets
-
-        n = len(x)
-        phi, normal, out = np.empty(n), np.empty((n, 3)), np.empty((n, 6))
-        H = np.empty((n, 3, 3) if hessian else (1, 3, 3))
-        signed_in_sets(np.ascontiguousarray(x), self._surface, np.ascontiguousarray(ik), np.ascontiguousarray(dk),
-                       moved, self._consts, hessian, phi, normal, H, out)
-        return phi, normal, H, out
-
     def _evaluate_compiled(self, x, hessian):
-        """:meth:`_evaluate` by the compiled :func:`.surface_kernels.signed_in_sets` over the held candidate sets;
-        the points it leaves (status 1: a held set that no longer proves the nearest triangle is sought again
-        where the point is, then every triangle within ``r + R``; status 2: beyond the band inside the box) go
-        through the numpy path (:meth:`_signed`)."""
-        K = min(WIDER, len(self.T))
-        ik, dk, moved = self._candidates(x, K)
-        phi, normal, H, out = self._kernel_call(x, ik, dk, moved, hessian)
-        again = np.flatnonzero((out[:, 5] == 1.0) & (moved > 0))
-        if again.size:  # sets kept from the last call that no longer prove the nearest: the K nearest now
-            dka, ika = self._ctree.query(x[again], k=K)
-            dka, ika = dka.reshape(len(again), K), ika.reshape(len(again), K)
-            x_ref, ik_held, dk_held = self._sets[len(x)]
-            x_ref[again], ik_held[again], dk_held[again] = x[again], ika, dka
-            phi[again], normal[again], Ha, out[again] = self._kernel_call(x[again], ika, dka, np.zeros(len(again)),
-                                                                          hessian)
-            if hessian:
-                H[again] = Ha
-        rest = np.flatnonzero(out[:, 5] != 0.0)
-        if rest.size:
-            xr, o = x[rest], out[rest]
-            q, lower = o[:, :3].copy(), o[:, 4]
-            kind, gid = np.zeros(len(rest), np.int8), np.zeros(len(rest), np.int64)
-            ball = np.flatnonzero(o[:, 5] == 1.0)
-            near = o[:, 5] == 1.0
-            if ball.size:
-                qb, kb, lb, tb = self._ball(xr[ball], o[ball, 3])
-                q[ball], kind[ball], gid[ball] = qb, kb, self._gid(kb, lb, tb)
-            phi[rest], normal[rest], Hr = self._signed(xr, q, kind, gid, near, lower, hessian)
-            if hessian:
-                H[rest] = Hr
-        return phi, normal, (H if hessian else None)
+        from rftstatic.contact.obstacles.surface_query import evaluate_compiled
+
+        return evaluate_compiled(self, x, hessian)
 
     def _signed(self, x, q, kind, gid, near, lower, hessian):
         """Signed distance, normal and Hessian (or None) at ``x (n, 3)`` [m] from each point's closest feature
