@@ -69,8 +69,8 @@ def test_a_sheet_thrown_at_a_thin_table_top_stays_on_it_in_explicit_steps(tmp_pa
     beside = np.any(np.abs(model.X3[:, :2]) > 0.05 + 1e-9, axis=1)
     assert beside.sum() == 81 - 25 and np.all(x[beside, 2] < -0.03)  # those beside it fell past its rim
     assert np.all(ob.signed_distance(x)[0] > -1e-9)
-    # the sheet's triangles on the table cross nothing (those from it down past its rim cut the rim between their
-    # nodes: the kinematic contact keeps nodes, not edges, off the obstacle)
+    # the sheet's triangles on the table cross nothing (here the rim lies exactly under a row of nodes, whose edges
+    # pivot about it as node contacts: 8 pairs there; rims between nodes: tests/contact/test_feature_sweep.py)
     on = np.all(over[model.mesh.tri], axis=1)
     assert on.sum() == 8 and obstacle_crossings(x, model.mesh.tri[on], *ob.surface())["pairs"] == 0
 
