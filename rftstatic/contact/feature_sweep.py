@@ -19,12 +19,15 @@ touching the rim (``|c0|`` round-off) is on the side the rim's outward normal ``
 only when ``f`` leaves that side (``sign f`` after the root opposite ``sign (w . (n_f x (b0 - a0)))``, the
 sign ``f`` takes when the edge is moved along ``n_f``).
 
-Each sheet node stops at the least ``t*`` of its edges, ``x0 + (1 - SHY) t* (x1 - x0)`` (just clear of the rim,
-:data:`SHY`), and loses the
-part of its velocity towards the rim (``v <- v - min(v . n_f, 0) n_f``). Nodes of one edge stopping at
-different times move the edge off its swept path, so the pairs are tested again along the shortened steps
-until none crosses (:data:`ROUNDS`; after them the nodes of an edge still crossing stay at ``x0``). A sheet that
-starts clear of the rims never passes one.
+A pair that crosses within the step is lifted at the step's end, as the node contact projects a node: the sheet's
+point nearest the feature (barycentric weights ``w_k`` of the edge's or triangle's nodes, closest parameter of
+the two segments or the corner's projection) moves by ``depth n``, ``n`` the unit normal of the edge pair's plane
+(``(q - p) x (b - a)``) or of the triangle, on the feature's outer side (``n . n_f > 0``), ``depth`` what puts it
+:data:`SHY` of the sheet edge's length clear of the feature: node ``k`` moves ``w_k depth n / sum_j w_j^2``
+(averaged over its pairs). So a sheet edge can pivot about a rim (its nodes move in opposite senses about the
+contact point) instead of stopping where it met it; the pairs are tested again along the corrected steps until
+none crosses (:data:`ROUNDS`). The contact point's velocity towards the feature is then removed the same way
+(``v_k <- v_k - w_k min(v_c . n, 0) n / sum_j w_j^2``, ``v_c = sum_k w_k v_k``).
 
 A corner ``p`` of the obstacle (outward normal ``n_c``) against a moving sheet triangle ``a b c`` is the same with
 the cubic ``f(t) = (p - a) . ((b - a) x (c - a))`` (:func:`unit_roots`: its critical points cut [0, 1] into
@@ -46,14 +49,16 @@ __all__ = ["END", "ROUNDS", "SHY", "TOUCH", "FeatureSweep", "corner_crossing_tim
            "unit_roots"]
 
 ROUNDS = 8
-"""Tests along the shortened steps before the nodes of an edge still crossing are left at the step's start."""
+"""Rounds of crossing tests and lifts along the corrected steps."""
 
 TOUCH = 1e-9
 """Segments whose closest points lie within this fraction of the sheet edge's length meet."""
 
-SHY = 1e-3
-"""A stopped edge goes this fraction of its step less far than to the rim: it ends just clear of it (on the side
-it came from), so its next step starts outside."""
+SHY = 1e-6
+"""A lifted sheet edge or triangle ends this fraction of its (edge) length clear of the feature, on its outer side:
+its next step starts outside. Small: each lift of a sheet resting on a rim moves its nodes against the neighbouring
+ones, and a clearance of 1e-3 lengths a lift pumped strain energy into a table cloth relaxing over a table's rim
+(the explicit energy check stopped it at 1.16 s; 1e-6: stable, validation/mesh_obstacles.md)."""
 
 END = 1e-6
 """A meeting point within this fraction of the sheet edge's length of one of its nodes is the node's contact."""
@@ -252,36 +257,77 @@ class FeatureSweep:
                                    f.points[f.corners[pt[:, 0]]], f.corner_normals[pt[:, 0]])
         return ((te, n2, f.edge_normals[ee[:, 0]]), (tc, n3, f.corner_normals[pt[:, 0]]))
 
+    def _lifts(self, x, ee, pt, hit_e, hit_c):
+        """The crossing pairs' lifts at the end positions ``x``: ``(nodes (P, m), weights (P, m), n (P, 3), depth
+        (P,))`` per pair kind: the sheet's point nearest the feature (barycentric ``weights`` of its ``nodes``) must
+        move ``depth`` [m] along ``n`` (away from the feature, on its outer side) to clear it by ``SHY`` of the
+        sheet edge's length."""
+        f = self.f
+        out = []
+        i = np.flatnonzero(hit_e)
+        if i.size:
+            nodes, fe = f.edges[ee[i, 1]], f.fedges[ee[i, 0]]
+            a, b, p, q = x[nodes[:, 0]], x[nodes[:, 1]], f.points[fe[:, 0]], f.points[fe[:, 1]]
+            s, u = _closest_params(a, b, p, q)
+            nf = f.edge_normals[ee[i, 0]]
+            n = _cross(q - p, b - a)
+            nn = np.linalg.norm(n, axis=1, keepdims=True)
+            n = np.where(nn > 1e-12 * np.linalg.norm(b - a, axis=1, keepdims=True) * np.linalg.norm(q - p, axis=1,
+                                                                                             keepdims=True),
+                         n / np.maximum(nn, 1e-300), nf)
+            n *= np.where(_dot(n, nf) < 0, -1.0, 1.0)[:, None]
+            gap = a + s[:, None] * (b - a) - p - u[:, None] * (q - p)
+            depth = SHY * np.linalg.norm(b - a, axis=1) - _dot(gap, n)
+            out.append((nodes, np.column_stack([1.0 - s, s]), n, depth))
+        i = np.flatnonzero(hit_c)
+        if i.size:
+            nodes = f.tri[pt[i, 1]]
+            a, b, c = (x[nodes[:, k]] for k in range(3))
+            p, nc = f.points[f.corners[pt[i, 0]]], f.corner_normals[pt[i, 0]]
+            n = _cross(b - a, c - a)
+            area2 = np.linalg.norm(n, axis=1)
+            n = n / np.maximum(area2, 1e-300)[:, None]
+            n *= np.where(_dot(n, nc) < 0, -1.0, 1.0)[:, None]
+            w = np.column_stack([_dot(_cross(c - b, p - b), n), _dot(_cross(a - c, p - c), n),
+                                 _dot(_cross(b - a, p - a), n)]) / np.maximum(area2, 1e-300)[:, None]
+            w = np.clip(w, 0.0, None)
+            w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-300)
+            depth = SHY * np.sqrt(area2) - _dot(a - p, n)
+            out.append((nodes, w, n, depth))
+        return out
+
     def stop(self, x0: np.ndarray, x1: np.ndarray, v: np.ndarray):
-        """Nodes stopped on a sharp feature: ``(x (N, 3) [m], v (N, 3) [m/s], stopped (N,) bool)`` from the step
-        ``x0 -> x1`` ``(N, 3)`` [m] and the velocities ``v`` (module docstring)."""
+        """Sheet edges and triangles kept off the sharp features: ``(x (N, 3) [m], v (N, 3) [m/s], moved (N,)
+        bool)`` from the step ``x0 -> x1`` ``(N, 3)`` [m] and the velocities ``v`` (module docstring)."""
         x0, x1 = np.asarray(x0, float), np.asarray(x1, float)
         x, v = x1.copy(), np.array(v, float, copy=True)
-        stopped = np.zeros(len(x0), bool)
+        moved = np.zeros(len(x0), bool)
         if self._stree is None:
-            return x, v, stopped
+            return x, v, moved
         ee, pt = self.pairs(x0, x1)
         if not (len(ee) or len(pt)):
-            return x, v, stopped
-        tnode = np.ones(len(x0))
-        normal = np.zeros((len(x0), 3))
-        for sweep in range(ROUNDS + 1):
-            crossing = False
-            for t, nodes, nf in self.times(x0, x, ee, pt):
-                hit = np.isfinite(t)
-                if not hit.any():
-                    continue
-                crossing = True
-                m = nodes.shape[1]
-                flat = nodes[hit].ravel()
-                # relative to the original step: the shortened step x0 -> x is tnode of it
-                tt = np.repeat((1.0 - SHY) * t[hit], m) * tnode[flat] if sweep < ROUNDS else np.zeros(flat.size)
-                np.minimum.at(tnode, flat, tt)
-                normal[flat] = np.repeat(nf[hit], m, axis=0)
-            if not crossing:
+            return x, v, moved
+        applied = []
+        for _ in range(ROUNDS):
+            (te, _, _), (tc, _, _) = self.times(x0, x, ee, pt)
+            lifts = self._lifts(x, ee, pt, np.isfinite(te), np.isfinite(tc))
+            if not lifts:
                 break
-            stopped = tnode < 1.0
-            x = np.where(stopped[:, None], x0 + tnode[:, None] * (x1 - x0), x1)
-        vn = np.einsum("ni,ni->n", v, normal)
-        v -= (stopped * np.minimum(vn, 0.0))[:, None] * normal
-        return x, v, stopped
+            applied += lifts
+            dx, count = np.zeros_like(x), np.zeros(len(x))
+            for nodes, w, n, depth in lifts:  # the contact point moves depth n: node k by w_k depth n / sum w^2
+                lift = (np.maximum(depth, 0.0) / np.einsum("pk,pk->p", w, w))[:, None, None] * w[:, :, None] * n[:, None]
+                for k in range(nodes.shape[1]):
+                    for i in range(3):
+                        dx[:, i] += np.bincount(nodes[:, k], lift[:, k, i], minlength=len(x))
+                    count += np.bincount(nodes[:, k], minlength=len(x))
+            hit = count > 0
+            x[hit] += dx[hit] / count[hit, None]
+            moved |= hit
+        for nodes, w, n, _ in applied:  # the lifted contact points stop approaching the features
+            vc = np.einsum("pk,pki->pi", w, v[nodes])
+            vn = np.minimum(_dot(vc, n), 0.0)
+            dv = (-vn / np.einsum("pk,pk->p", w, w))[:, None, None] * w[:, :, None] * n[:, None]
+            for k in range(nodes.shape[1]):
+                np.add.at(v, nodes[:, k], dv[:, k])
+        return x, v, moved

@@ -39,7 +39,7 @@ def kinematic_contact(
     straight step ``x_old -> x`` crossed a thin part of an obstacle (continuous collision detection,
     :meth:`~rftstatic.contact.obstacles.Obstacle.segment_crossings`) is first stopped where it crossed, on its
     side, and loses its velocity into the obstacle there; with ``sweep`` the sheet's edges and triangles are
-    first stopped before the obstacles' sharp features they would sweep over (:mod:`rftstatic.contact.feature_sweep`).
+    first lifted off the obstacles' sharp features they swept over (:mod:`rftstatic.contact.feature_sweep`).
     Obstacles are treated one after the other.
 
     Parameters

@@ -90,13 +90,13 @@ def _thrown(tmp_path, sweep):
 
 def test_a_thrown_sheet_is_not_cut_by_a_rim_between_its_nodes(tmp_path):
     """Without the sweep the edges from the nodes landing on the box (x = 5 cm) to those falling past it (7.5 cm)
-    pass under its rim (6.1 cm): the independent check counts crossing pairs. With it they stop on the rim, and
-    no sheet triangle crosses the box."""
+    pass under its rim (6.1 cm): the independent check counts crossing pairs. With it they are lifted onto the
+    rim (pivoting about it), and no sheet triangle crosses the box."""
     model, ob, x = _thrown(tmp_path, sweep=False)
     assert obstacle_crossings(x, model.mesh.tri, *ob.surface())["pairs"] > 0
     model, ob, x = _thrown(tmp_path, sweep=True)
     r = obstacle_crossings(x, model.mesh.tri, *ob.surface())
     assert r["pairs"] == 0 and np.all(ob.signed_distance(x)[0] > -1e-9)
     rim = np.isclose(model.X3[:, 0], 0.075) & (model.X3[:, 1] > -0.063) & (model.X3[:, 1] < 0.037)
-    assert rim.sum() == 4 and np.all(x[rim, 2] > -0.01)  # beyond the rim, held by it
+    assert rim.sum() == 4 and np.all(x[rim, 2] > -0.01)  # beyond the rim, held up by it (5 free-fall steps: 3 cm)
     assert 0 < SHY < 0.01

@@ -65,7 +65,9 @@ def test_a_sheet_thrown_at_a_thin_table_top_stays_on_it_in_explicit_steps(tmp_pa
     res = run_explicit(model, ExplicitOptions(t_end=5 * dt, dt=dt, energy_check=False), V0=V0, obstacles=[ob])
     x = model.X3 + res.U
     over = np.all(np.abs(model.X3[:, :2]) < 0.05 - 1e-9, axis=1)  # the 3 x 3 nodes inside the table's outline
-    assert over.sum() == 9 and np.allclose(x[over, 2], -0.0005)  # on the table's top face, not through it
+    # on the table's top face (z = -0.5 mm), not through it; the sheet's edges over its rim (under a row of nodes
+    # here) lifted some up to 0.15 mm (rftstatic.contact.feature_sweep)
+    assert over.sum() == 9 and np.all((x[over, 2] >= -0.0005 - 1e-12) & (x[over, 2] < -0.0003))
     beside = np.any(np.abs(model.X3[:, :2]) > 0.05 + 1e-9, axis=1)
     assert beside.sum() == 81 - 25 and np.all(x[beside, 2] < -0.03)  # those beside it fell past its rim
     assert np.all(ob.signed_distance(x)[0] > -1e-9)
