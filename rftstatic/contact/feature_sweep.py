@@ -43,6 +43,8 @@ corners within a triangle's largest radius plus ``s`` of its centroid every corn
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 
 __all__ = ["END", "ROUNDS", "SHY", "TOUCH", "FeatureSweep", "corner_crossing_times", "edge_crossing_times",
@@ -91,10 +93,39 @@ def _poly(c, t):
     return c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
 
 
-def unit_roots(c: np.ndarray, rounds: int = 60) -> np.ndarray:
+def _quadratic_roots(c: np.ndarray) -> np.ndarray:
+    """The real roots ``(P, 2)`` (``inf`` padded) of ``c[:, 0] + c[:, 1] t + c[:, 2] t^2`` (the stable pair
+    ``q / c2``, ``c0 / q`` with ``q = -(c1 + sign(c1) sqrt(disc)) / 2``; ``-c0 / c1`` where ``c2`` vanishes)."""
+    c0, c1, c2 = c[:, 0], c[:, 1], c[:, 2]
+    disc = c1 * c1 - 4.0 * c2 * c0
+    q = -0.5 * (c1 + np.where(c1 >= 0, 1.0, -1.0) * np.sqrt(np.maximum(disc, 0.0)))
+    quad, lin = (c2 != 0) & (disc >= 0), (c2 == 0) & (c1 != 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r1 = np.where(quad, q / c2, np.where(lin, -c0 / c1, np.inf))
+        r2 = np.where(quad & (q != 0), c0 / q, np.inf)
+    return np.nan_to_num(np.column_stack([r1, r2]), nan=np.inf)
+
+
+def unit_roots(c: np.ndarray, rounds: int = 44) -> np.ndarray:
     """The real roots ``(P, 3)`` in [0, 1] (ascending, ``inf`` padded) of the cubics ``c (P, 4)`` (coefficients
-    of ``1, t, t^2, t^3``): the critical points cut [0, 1] into monotone pieces, a piece whose ends differ in
-    sign (or touch 0) holds one root, found by bisection to ``2^-rounds``."""
+    of ``1, t, t^2, t^3``). A quadratic (``c3 = 0``: the edge pairs) in closed form (:func:`_quadratic_roots`,
+    roots within 1e-12 below 0 taken as 0); a cubic by its critical points, which cut [0, 1] into monotone
+    pieces: a piece whose ends differ in sign (or touch 0) holds one root, found by bisection to ``2^-rounds``."""
+    P = len(c)
+    roots = np.full((P, 3), np.inf)
+    sq = np.flatnonzero(c[:, 3] == 0)
+    if sq.size:
+        r = _quadratic_roots(c[sq])
+        r = np.where((r >= -1e-12) & (r <= 1.0), np.maximum(r, 0.0), np.inf)
+        roots[sq, :2] = r
+    cu = np.flatnonzero(c[:, 3] != 0)
+    if cu.size:
+        roots[cu] = _cubic_unit_roots(c[cu], rounds)
+    return np.sort(roots, axis=1)
+
+
+def _cubic_unit_roots(c: np.ndarray, rounds: int) -> np.ndarray:
+    """:func:`unit_roots` of proper cubics, by bisection on the monotone pieces."""
     P = len(c)
     with np.errstate(divide="ignore", invalid="ignore"):
         A, B, C = 3.0 * c[:, 3], 2.0 * c[:, 2], c[:, 1]  # f' = A t^2 + B t + C
@@ -107,22 +138,20 @@ def unit_roots(c: np.ndarray, rounds: int = 60) -> np.ndarray:
     cps = np.where((cps > 0.0) & (cps < 1.0), cps, 1.0)
     knots = np.sort(np.column_stack([np.zeros(P), cps, np.ones(P)]), axis=1)  # (P, 4)
     roots = np.full((P, 3), np.inf)
-    for k in range(3):
-        lo, hi = knots[:, k].copy(), knots[:, k + 1].copy()
-        flo, fhi = _poly(c, lo), _poly(c, hi)
-        has = (hi > lo) & (flo * fhi <= 0.0) | ((k == 0) & (flo == 0.0))
-        i = np.flatnonzero(has)
-        if not i.size:
-            continue
-        lo, hi, flo = lo[i], hi[i], flo[i]
+    lo, hi = knots[:, :3].ravel(), knots[:, 1:].ravel()  # the 3 pieces of every cubic, bisected together
+    flo, fhi = _poly(np.repeat(c, 3, axis=0), lo), _poly(np.repeat(c, 3, axis=0), hi)
+    first = np.tile([True, False, False], P)
+    i = np.flatnonzero((hi > lo) & (flo * fhi <= 0.0) | (first & (flo == 0.0)))
+    if i.size:
+        ci, lo, hi, flo = c[i // 3], lo[i], hi[i], flo[i]
         for _ in range(rounds):
             mid = 0.5 * (lo + hi)
-            fm = _poly(c[i], mid)
+            fm = _poly(ci, mid)
             left = (flo == 0.0) | (np.sign(fm) != np.sign(flo))
             hi, lo = np.where(left, mid, hi), np.where(left, lo, mid)
             flo = np.where(left, flo, fm)
-        roots[i, k] = np.where(flo == 0.0, lo, hi)
-    return np.sort(roots, axis=1)
+        roots.ravel()[i] = np.where(flo == 0.0, lo, hi)
+    return roots
 
 
 def _first(c, side, meets, tol):
@@ -205,6 +234,8 @@ class FeatureSweep:
         self.f = features
         self._stree = cKDTree(features.samples) if len(features.samples) else None
         self._ctree = cKDTree(features.points[features.corners]) if len(features.corners) else None
+        used = features.points[np.unique(features.fedges)] if len(features.fedges) else np.zeros((1, 3))
+        self._lo, self._hi = used.min(axis=0), used.max(axis=0)  # the features' box (sheet parts beyond: no query)
 
     @classmethod
     def for_sheet(cls, obstacles, tri, edges, X):
@@ -225,23 +256,43 @@ class FeatureSweep:
         s = float(np.sqrt(np.max(np.einsum("ni,ni->n", x1 - x0, x1 - x0), initial=0.0)))
         a, b = x0[f.edges[:, 0]], x0[f.edges[:, 1]]
         half = 0.5 * float(np.max(np.linalg.norm(b - a, axis=1), initial=0.0))
-        lists = self._stree.query_ball_point(0.5 * (a + b), half + s + 0.5 * f.sample_step + 1e-12 * (1 + half))
+        reach = half + s + 0.5 * f.sample_step + 1e-12 * (1 + half)
+        mid = 0.5 * (a + b)
+        near = np.flatnonzero(np.all((mid > self._lo - reach) & (mid < self._hi + reach), axis=1))
+        lists = self._stree.query_ball_point(mid[near], reach)
         counts = np.fromiter(map(len, lists), np.int64, len(lists))
         ee = np.zeros((0, 2), np.int64)
         if counts.sum():
-            samples = np.fromiter((k for m in lists for k in m), np.int64, int(counts.sum()))
-            key = np.unique(f.sample_owner[samples] * len(f.edges) + np.repeat(np.arange(len(f.edges)), counts))
+            samples = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
+            key = np.unique(f.sample_owner[samples] * len(f.edges) + np.repeat(near, counts))
             ee = np.stack([key // len(f.edges), key % len(f.edges)], axis=1)
         pt = np.zeros((0, 2), np.int64)
         if self._ctree is not None:
             t = x0[f.tri]
             c = t.mean(axis=1)
             r = float(np.max(np.linalg.norm(t - c[:, None], axis=2)))
-            lists = self._ctree.query_ball_point(c, r + s + 1e-12 * (1 + r))
+            reach = r + s + 1e-12 * (1 + r)
+            near = np.flatnonzero(np.all((c > self._lo - reach) & (c < self._hi + reach), axis=1))
+            lists = self._ctree.query_ball_point(c[near], reach)
             counts = np.fromiter(map(len, lists), np.int64, len(lists))
             if counts.sum():
-                corners = np.fromiter((k for m in lists for k in m), np.int64, int(counts.sum()))
-                pt = np.stack([corners, np.repeat(np.arange(len(f.tri)), counts)], axis=1)
+                corners = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
+                pt = np.stack([corners, np.repeat(near, counts)], axis=1)
+        # a pair can only meet if its distance at x0 (bounded below by the midpoints and half lengths, the centroid
+        # and radius) is within the step of its sheet nodes (the features are held)
+        step = np.sqrt(np.einsum("ni,ni->n", x1 - x0, x1 - x0))
+        if len(ee):
+            a, b = x0[f.edges[ee[:, 1], 0]], x0[f.edges[ee[:, 1], 1]]
+            p, q = f.points[f.fedges[ee[:, 0], 0]], f.points[f.fedges[ee[:, 0], 1]]
+            bound = (np.linalg.norm(0.5 * (a + b - p - q), axis=1)
+                     - 0.5 * (np.linalg.norm(b - a, axis=1) + np.linalg.norm(q - p, axis=1)))
+            ee = ee[bound <= step[f.edges[ee[:, 1]]].max(axis=1) * (1 + 1e-9) + 1e-12 * (1 + half)]
+        if len(pt):
+            t = x0[f.tri[pt[:, 1]]]
+            c = t.mean(axis=1)
+            bound = np.linalg.norm(f.points[f.corners[pt[:, 0]]] - c, axis=1) - np.linalg.norm(
+                t - c[:, None], axis=2).max(axis=1)
+            pt = pt[bound <= step[f.tri[pt[:, 1]]].max(axis=1) * (1 + 1e-9) + 1e-12 * (1 + half)]
         return ee, pt
 
     def times(self, x0, x1, ee, pt):
@@ -307,16 +358,17 @@ class FeatureSweep:
         ee, pt = self.pairs(x0, x1)
         if not (len(ee) or len(pt)):
             return x, v, moved
-        applied = []
+        applied, ee_a, pt_a = [], ee, pt
         for _ in range(ROUNDS):
-            (te, _, _), (tc, _, _) = self.times(x0, x, ee, pt)
-            lifts = self._lifts(x, ee, pt, np.isfinite(te), np.isfinite(tc))
+            (te, _, _), (tc, _, _) = self.times(x0, x, ee_a, pt_a)
+            lifts = self._lifts(x, ee_a, pt_a, np.isfinite(te), np.isfinite(tc))
             if not lifts:
                 break
             applied += lifts
             dx, count = np.zeros_like(x), np.zeros(len(x))
             for nodes, w, n, depth in lifts:  # the contact point moves depth n: node k by w_k depth n / sum w^2
-                lift = (np.maximum(depth, 0.0) / np.einsum("pk,pk->p", w, w))[:, None, None] * w[:, :, None] * n[:, None]
+                lift = ((np.maximum(depth, 0.0) / np.einsum("pk,pk->p", w, w))[:, None, None] * w[:, :, None]
+                        * n[:, None])
                 for k in range(nodes.shape[1]):
                     for i in range(3):
                         dx[:, i] += np.bincount(nodes[:, k], lift[:, k, i], minlength=len(x))
@@ -324,6 +376,9 @@ class FeatureSweep:
             hit = count > 0
             x[hit] += dx[hit] / count[hit, None]
             moved |= hit
+            # only the pairs of the nodes just lifted changed their steps: the others stay clear
+            ee_a = ee[hit[self.f.edges[ee[:, 1]]].any(axis=1)]
+            pt_a = pt[hit[self.f.tri[pt[:, 1]]].any(axis=1)]
         for nodes, w, n, _ in applied:  # the lifted contact points stop approaching the features
             vc = np.einsum("pk,pki->pi", w, v[nodes])
             vn = np.minimum(_dot(vc, n), 0.0)

@@ -46,6 +46,11 @@ def test_cubic_roots_and_a_triangle_falling_on_a_corner():
     found = unit_roots(c)
     want = np.where((r >= 0) & (r <= 1), r, np.inf)
     assert np.allclose(np.sort(want, axis=1), found, atol=1e-12, equal_nan=False)
+    quad = c.copy()
+    quad[:, 0], quad[:, 1], quad[:, 2], quad[:, 3] = k * r[:, 0] * r[:, 1], -k * (r[:, 0] + r[:, 1]), k, 0.0
+    want = np.where((r[:, :2] >= 0) & (r[:, :2] <= 1), r[:, :2], np.inf)  # (t - r1)(t - r2) in closed form
+    found = unit_roots(quad)
+    assert np.allclose(np.sort(want, axis=1), found[:, :2], atol=1e-12) and np.isinf(found[:, 2]).all()
     # a box corner at the origin (outward normal (1, 1, 1) / sqrt 3) under a falling, tilting triangle
     corner, n_c = np.zeros((1, 3)), np.ones((1, 3)) / np.sqrt(3.0)
     tri = [np.array([[-1.0, -1.0, 0.002]]), np.array([[1.0, -1.0, 0.002]]), np.array([[0.0, 1.0, 0.002]])]
