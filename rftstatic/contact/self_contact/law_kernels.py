@@ -10,7 +10,7 @@ import numpy as np
 
 from rftstatic.contact.self_contact import distance
 
-__all__ = ["psd_project", "additive_ccd", "additive_ccd_nodes", "additive_ccd_times"]
+__all__ = ["psd_project", "additive_ccd", "additive_ccd_nodes"]
 
 _SIDES = (((0,), (1, 2, 3)), ((0, 1), (2, 3)))
 
@@ -51,28 +51,18 @@ def additive_ccd(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rou
                              np.ascontiguousarray(dx4, dtype=float).reshape(4 * P, 3),
                              np.arange(4 * P, dtype=np.int64).reshape(P, 4), kind, float(eta), int(max_rounds),
                              float(floor)))
-    return float(additive_ccd_times(x4, dx4, kind, eta, max_rounds, floor, compiled=compiled).min())
-
-
-def additive_ccd_times(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, max_rounds: int,
-                       floor: float = 0.0, *, compiled: bool | None = None) -> np.ndarray:
-    """The safe time ``(P,)`` in [0, 1] of each pair of :func:`additive_ccd` (numpy, the distances compiled
-    when ``compiled``): the time it first comes within its target ``g``, 1 if never on the step."""
     d2 = distance.point_triangle_distance2 if kind == 0 else distance.edge_edge_distance2
 
     def dist2(y4):
         return d2(y4, compiled=compiled)
-    out = np.ones(len(x4))
-    if not len(x4):
-        return out
     a, b = _SIDES[kind]
     rel = dx4[:, list(a)][:, :, None, :] - dx4[:, list(b)][:, None, :, :]
     ell = np.sqrt(np.max(np.einsum("pabi,pabi->pab", rel, rel), axis=(1, 2)))  # (P,) relative speed bound
     d0 = np.sqrt(dist2(x4))
     g = np.where(d0 > floor, np.maximum(eta * d0, floor), eta * d0)
-    keep = np.flatnonzero((ell > 0) & (ell * 1.0 > d0 - g))  # the others cannot reach g by t = 1
-    if not len(keep):
-        return out
+    keep = (ell > 0) & (ell * 1.0 > d0 - g)  # the others cannot reach g by t = 1
+    if not np.any(keep):
+        return 1.0
     x4, dx4, ell, d0, g = x4[keep], dx4[keep], ell[keep], d0[keep], g[keep]
     t = np.zeros(len(d0))
     dcur = d0.copy()
@@ -92,8 +82,7 @@ def additive_ccd_times(x4: np.ndarray, dx4: np.ndarray, kind: int, eta: float, m
         # close to the target: the pair is about to reach eta d0; keep the time reached
         stuck = dcur[idx] - g[idx] <= 1e-3 * (d0[idx] - g[idx])
         live[idx[stuck]] = False
-    out[keep] = t
-    return out
+    return float(t.min())
 
 
 def additive_ccd_nodes(x: np.ndarray, dx: np.ndarray, nodes: np.ndarray, kind: int, eta: float,
