@@ -270,12 +270,29 @@ def _relax(scene, opts, state, saver) -> dict:
         converged, skipped, t, steps, stopped_by = False, 0, track.t, track.steps, "t_end"
         log.warning("remesh relax: t_end = %.4g s reached before the sheet came to rest on a settled mesh",
                     d.t_end)
+    U = _settle(model, obstacles, U)
     meshes = track.meshes
     meshes.append({"mesh": model.mesh, "model": model, "U": U, "t": t, "step": steps, "final": True})
     extras = extras0  # probes and obstacles are defined in reference coordinates: the same on every mesh
     return {"route": "remesh_relax", "model": model, "extras": extras, "U": U, "records": records,
             "converged": bool(converged), "meshes": meshes, "t": t, "steps": steps, "skipped": skipped,
             "dynamics": d, "alphas": list(stepper.alphas), "stopped_by": stopped_by, "max_steps": max_steps}
+
+
+def _settle(model, obstacles, U):
+    """The final displacements ``U (N, 3)`` [m] with every free node inside an obstacle moved onto its surface (the
+    kinematic contact's projection, :func:`rftstatic.contact.kinematic.kinematic_contact`): a run that stops on a
+    remesh (``t_end`` reached in the step that remeshed) ends on the transfer's interpolation, which no explicit
+    step has corrected; supported dofs are kept."""
+    from rftstatic.contact.kinematic import kinematic_contact
+
+    if not obstacles:
+        return U
+    x = model.X3 + U
+    x_new, _, n = kinematic_contact(obstacles, x, np.zeros_like(x))
+    if n:
+        log.info("remesh relax: %d nodes inside an obstacle after the last transfer moved onto its surface", n)
+    return np.where(model.free, x_new - model.X3, U)
 
 
 def _check_node_budget(scene, opts, mesh) -> float:

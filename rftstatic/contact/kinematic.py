@@ -23,7 +23,7 @@ from rftstatic.contact.obstacles import Obstacle
 
 def kinematic_contact(
     obstacles: Obstacle | Sequence[Obstacle], x: np.ndarray, v: np.ndarray, friction=None, dt: float = 0.0,
-    x_old: np.ndarray | None = None
+    x_old: np.ndarray | None = None, sweep=None
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Kinematic contact correction after an explicit step (§6.3), with Coulomb friction impulses.
 
@@ -38,7 +38,9 @@ def kinematic_contact(
     Without friction tangential and outward velocities are kept. Given the step's start ``x_old``, a node whose
     straight step ``x_old -> x`` crossed a thin part of an obstacle (continuous collision detection,
     :meth:`~rftstatic.contact.obstacles.Obstacle.segment_crossings`) is first stopped where it crossed, on its
-    side, and loses its velocity into the obstacle there. Obstacles are treated one after the other.
+    side, and loses its velocity into the obstacle there; with ``sweep`` the sheet's edges and triangles are
+    first lifted off the obstacles' sharp features they swept over (:mod:`rftstatic.contact.feature_sweep`).
+    Obstacles are treated one after the other.
 
     Parameters
     ----------
@@ -48,6 +50,7 @@ def kinematic_contact(
     friction : :class:`rftstatic.contact.friction.FrictionLaw` (coefficients per obstacle), or None
     dt : the step [s] whose tangential move friction corrects
     x_old : (N, 3) positions at the start of the step [m], or None (no continuous collision detection)
+    sweep : :class:`rftstatic.contact.feature_sweep.FeatureSweep` of the obstacles' sharp features, or None
 
     Returns
     -------
@@ -59,6 +62,8 @@ def kinematic_contact(
     x_new = _as_points(x).copy()
     v_new = _as_points(v, x_new.shape[0], name="v").copy()
     touched = np.zeros(x_new.shape[0], dtype=bool)
+    if sweep is not None and x_old is not None:
+        x_new, v_new, touched = sweep.stop(x_old, x_new, v_new)
     for m, ob in enumerate(items):
         ccd = getattr(ob, "segment_crossings", None)  # any object with signed_distance may act here
         crossed = None if x_old is None or ccd is None else ccd(x_old, x_new)

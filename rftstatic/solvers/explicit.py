@@ -201,6 +201,11 @@ class _Loop:
         else:
             self.self_filter = None
         self.n_contact = 0
+        self.sweep = None  # the sheet against the obstacles' sharp features along each step (feature_sweep)
+        if obstacles:
+            from rftstatic.contact.feature_sweep import FeatureSweep
+
+            self.sweep = FeatureSweep.for_sheet(obstacles, model.mesh.tri, model.mesh.topology.edges, model.X3)
 
     def begin(self, dt, *, start_consistent, state):
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
@@ -278,7 +283,8 @@ class _Loop:
             # Eq. 22
             U += dt * V
             if self.obstacles:
-                self.n_contact = _contact(self.model, self.obstacles, U, V, mass, acc, self.friction, dt, self.P)
+                self.n_contact = _contact(self.model, self.obstacles, U, V, mass, acc, self.friction, dt, self.P,
+                                          self.sweep)
                 if fixed_any:
                     np.copyto(U, Ufix, where=~free)
             step += 1
@@ -358,12 +364,13 @@ def _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, ene
         t=rec["time"], step=step, dt=dt, suggested_dt=suggested)
 
 
-def _contact(model, obstacles, U, V, mass, acc, friction=None, dt=0.0, P=None) -> int:
+def _contact(model, obstacles, U, V, mass, acc, friction=None, dt=0.0, P=None, sweep=None) -> int:
     from rftstatic.contact.kinematic import kinematic_contact
 
     X3 = model.X3
     x = X3 + U
-    x_new, v_new, n_active = kinematic_contact(obstacles, x, V, friction, dt, x_old=x - dt * V)  # the step: U += dt V
+    x_new, v_new, n_active = kinematic_contact(obstacles, x, V, friction, dt, x_old=x - dt * V,  # the step: U += dt V
+                                               sweep=sweep)
     if n_active and P is not None:  # the load's work on the projection's moves: a work term of the balance (a
         # sheet resting on an obstacle at the start would otherwise gain P . dx a step against its tiny scale)
         acc["projection"] = acc.get("projection", 0.0) + float(np.einsum("ni,ni->", P, (x_new - X3 - U) * model.free))

@@ -57,8 +57,11 @@ TOOL_REPORTS = {
                     "Cusick mesh (pattern, rings, sectors, element) and RFT6 locking numbers (tools/"
                     "fabric_rule_sensitivity.py, tools/cusick_mesh_study.py)",
     "mesh_obstacles": "obstacles from triangle-mesh files: sphere-30 on icospheres against the analytic sphere "
-                      "(convergence with the facet size, wall time), the crossing check, the box under the sheet, "
-                      "ipctk against the project's distance kernels (tools/icosphere.py, tools/ipctk_compare.py)",
+                      "(convergence with the facet size, wall time), the crossing check and the penalty onset "
+                      "that clears it, the box under the sheet, the rounded square pedestal as a mesh, sheet edges "
+                      "against sharp edges in explicit steps, ipctk against the project's distance kernels "
+                      "(tools/icosphere.py, tools/rounded_box.py, tools/mesh_obstacle_runs.py, "
+                      "tools/ipctk_compare.py)",
     "cusick_route": "the Cusick tester's route: which drape the load steps and the dynamic relaxation find on "
                     "cusick-30, their energies, fold counts over seeds, lift amplitudes, fabrics and model changes "
                     "(tools/cusick_route_study.py)",

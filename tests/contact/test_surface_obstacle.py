@@ -254,6 +254,51 @@ def test_compiled_and_numpy_queries_and_held_candidate_sets_agree_with_brute_for
         assert phi.shape == (0,) and normal.shape == (0, 3) and ob.normal_gradient(np.zeros((0, 3))).shape == (0, 3, 3)
 
 
+def _grid_plate(n):
+    """An open n x n square plate of 2 (n - 1)^2 counter-clockwise triangles on [-1, 1]^2 at z = 0 (normals +z),
+    its middle row raised into a ridge (convex and reflex edges)."""
+    t = np.linspace(-1.0, 1.0, n)
+    X, Y = np.meshgrid(t, t, indexing="ij")
+    Z = np.where(np.abs(X) < 1e-12, 0.3, 0.0)
+    V = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    i, j = np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="ij")
+    a = (i * n + j).ravel()
+    return V, np.vstack([np.column_stack([a, a + n, a + n + 1]), np.column_stack([a, a + n + 1, a + 1])])
+
+
+@pytest.mark.parametrize("kind", ["closed", "front", "back", "thickness"])
+def test_compiled_signed_distance_equals_the_numpy_twin(tmp_path, kind):
+    """The compiled whole-query kernel (:func:`rftstatic.contact.obstacles.surface_kernels.signed_in_sets`) gives
+    the numpy path's signed distance, normal and Hessian everywhere: near faces, edges and vertices, inside, far
+    beyond the band (inside a closed surface's box: its winding number), for closed and open surfaces, after
+    the points moved (held candidate sets)."""
+    if kind == "closed":
+        path, keys = _write(tmp_path / "ico.obj", *_icosphere(3)), {}
+        centre, size = np.array([0.0, 0.0, -0.05]), 0.05
+    else:
+        path = _write(tmp_path / "plate.obj", *_grid_plate(11))
+        keys = {"thickness": 0.0004} if kind == "thickness" else {"side": kind}
+        centre, size = np.zeros(3), 0.01
+    twins = []
+    for compiled in (False, True):
+        ob = SurfaceObstacle(path, scale=5.0 if kind == "closed" else 1.0, scene_length=0.01,
+                             translate=[0, 0, -0.05] if kind == "closed" else [0, 0, 0], **keys)
+        ob.compiled = compiled
+        twins.append(ob)
+    assert len(twins[0].T) > 64
+    rng = np.random.default_rng(4)
+    x = centre + rng.uniform(-3 * size, 3 * size, (600, 3))
+    x[:300] = centre + rng.uniform(-1.05 * size, 1.05 * size, (300, 3))
+    x[:20] = centre + rng.uniform(-0.05 * size, 0.05 * size, (20, 3))  # deep inside: beyond the band
+    for step in (0.0, 1e-4, 3e-3):
+        xs = x + rng.normal(scale=step, size=x.shape)
+        (p0, n0), (p1, n1) = (ob.signed_distance(xs) for ob in twins)
+        H0, H1 = (ob.normal_gradient(xs) for ob in twins)
+        assert np.abs(p1 - p0).max() < 1e-15 and np.abs(n1 - n0).max() < 1e-12
+        assert np.abs(H1 - H0).max() <= 1e-9 * np.abs(H0).max()
+    assert (p0 < 0).sum() > (0 if kind == "thickness" else 20) and (np.abs(H0).sum(axis=(1, 2)) > 0).sum() > 20
+
+
 def test_a_step_through_a_thin_shell_stops_on_its_side(tmp_path):
     """Continuous collision detection of the kinematic contact: nodes stepped 3 mm down through a 0.4 mm
     plate would end below it (projected onto its far face) without it; with it they stop on top, their

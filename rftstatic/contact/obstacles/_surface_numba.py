@@ -1,6 +1,6 @@
 """Compiled (numba) twin of :mod:`.surface_kernels`, made from its own code as
 :mod:`rftstatic.contact.self_contact._kernels_numba` does (a copy of each function whose globals resolve to
-the compiled twins; :func:`~.surface_kernels.closest_one` inlined into the loop). Imported only when numba
+the compiled twins; :func:`~.surface_kernels.closest_one` and :func:`~.surface_kernels.nearest_one` inlined into the loops). Imported only when numba
 is installed (:meth:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle.compiled`)."""
 
 import types
@@ -19,5 +19,8 @@ def _compile(f, name, **options):
 
 
 _compile(surface_kernels.closest_one, "closest_one", inline="always")
+_compile(surface_kernels.nearest_one, "nearest_one", inline="always")
 _compile(surface_kernels.nearest_in_sets, "nearest_in_sets")
+_compile(surface_kernels.signed_in_sets, "signed_in_sets")
 nearest_in_sets = _scope["nearest_in_sets"]
+signed_in_sets = _scope["signed_in_sets"]

@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FACE", "EDGE", "VERTEX", "closest_on_triangles", "pseudo_normals", "winding_number"]
+__all__ = ["FACE", "EDGE", "VERTEX", "closest_on_triangles", "merge_nodes", "pseudo_normals", "rotation", "sharp_edges",
+           "winding_number"]
 
 FACE, EDGE, VERTEX = 0, 1, 2
 """Closest-feature kinds of :func:`closest_on_triangles`."""
@@ -130,3 +131,63 @@ def winding_number(x: np.ndarray, V: np.ndarray, T: np.ndarray, chunk: int = 2_0
                + np.einsum("pti,pti->pt", c, a) * lb)
         out[s:s + step] = np.arctan2(det, den).sum(axis=1) / (2.0 * np.pi)
     return out
+
+
+def sharp_edges(V, T, edges, edge_of, nf, ne, boundary_edge, feature_angle, *, two_sided=False):
+    """The sharp features of a triangle surface ``V (n, 3)`` [m], ``T (t, 3)`` with unique ``edges (m, 2)``,
+    ``edge_of (t, 3)``, face and edge pseudo-normals ``nf``, ``ne``: the convex edges whose faces meet at more than
+    ``feature_angle`` [deg] from flat and the open boundary (``boundary_edge (m,)``); returns ``(feature edges
+    (k, 2), their outward normals (k, 3), corners (c,))``, the corners the ends or junctions of feature edges. An
+    open rim's outward direction lies in its face's plane, away from it, tilted along the face's normal for a
+    one-sided surface (not ``two_sided``)."""
+    e_tris = np.full((len(edges), 2), -1, np.int64)
+    flat = edge_of.ravel()
+    order = np.argsort(flat, kind="stable")
+    start = np.searchsorted(flat[order], np.arange(len(edges)))
+    e_tris[:, 0] = order[start] // 3
+    two = boundary_edge == False  # noqa: E712 (numpy)
+    e_tris[two, 1] = order[start[two] + 1] // 3
+    n0, n1 = nf[e_tris[:, 0]], nf[np.maximum(e_tris[:, 1], 0)]
+    bend = np.degrees(np.arccos(np.clip(np.einsum("ei,ei->e", n0, n1), -1.0, 1.0)))
+    # convex: the far corner of the second face lies behind the first face's plane
+    t1 = T[np.maximum(e_tris[:, 1], 0)]
+    far = V[t1].sum(axis=1) - V[edges].sum(axis=1)  # the corner not on the edge
+    convex = np.einsum("ei,ei->e", far - V[edges[:, 0]], n0) < 0
+    sharp = (two & convex & (bend > feature_angle)) | boundary_edge
+    # an open rim's outward direction: in the plane of its face, away from it (and along the face's normal
+    # for a one-sided surface)
+    rim = boundary_edge
+    e0, e1 = V[edges[rim, 0]], V[edges[rim, 1]]
+    nr = nf[e_tris[rim, 0]]
+    out = np.cross(nr, e1 - e0)
+    third = V[T[e_tris[rim, 0]]].sum(axis=1) - e0 - e1
+    out *= np.where(np.einsum("ei,ei->e", out, 0.5 * (e0 + e1) - third) < 0, -1.0, 1.0)[:, None]
+    out /= np.linalg.norm(out, axis=1, keepdims=True)
+    if not two_sided:
+        out = out + nr
+        out /= np.linalg.norm(out, axis=1, keepdims=True)
+    normals = ne.copy()
+    normals[rim] = out
+    deg = np.bincount(edges[sharp].ravel(), minlength=len(V))
+    return edges[sharp], normals[sharp], np.flatnonzero((deg > 0) & (deg != 2))
+
+
+def rotation(angles_deg) -> np.ndarray:
+    """Rotation matrix (3, 3) of the angles [deg] about x, then y, then z."""
+    rx, ry, rz = np.radians(np.asarray(angles_deg, float))
+    cx, sx, cy, sy, cz, sz = np.cos(rx), np.sin(rx), np.cos(ry), np.sin(ry), np.cos(rz), np.sin(rz)
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+def merge_nodes(P, tri):
+    """Merge coincident nodes (1e-12 of the bounding-box diagonal; an STL file repeats them per facet)."""
+    diag = float(np.linalg.norm(np.ptp(P, axis=0))) or 1.0
+    key = np.round(P / (1e-12 * diag)).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    used = np.unique(inverse.ravel()[tri.ravel()])
+    remap = np.full(len(first), -1, np.int64)
+    remap[used] = np.arange(len(used))
+    return P[first[used]], remap[inverse.ravel()[tri]]

@@ -49,8 +49,8 @@ import numpy as np
 from rftstatic.compiled import numba_available
 from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures, _as_points
 from rftstatic.contact.obstacles.registry import register
-from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, pseudo_normals,
-                                                          winding_number)
+from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, merge_nodes,
+                                                          pseudo_normals, rotation, sharp_edges, winding_number)
 
 __all__ = ["FILE_UNITS", "SurfaceObstacle"]
 
@@ -74,6 +74,11 @@ stops at the first that cannot be nearer (a point on the surface tests a few), a
 off the surface (the sheet hanging beside a finely tessellated body) is still proven among them, without the
 search of every triangle within its distance plus ``R``."""
 
+WIDEST = 512
+"""The most centroids a compiled candidate set grows to: where fresh sets of :data:`WIDER` fail to prove the
+nearest triangle for more than a quarter of the points sought again (slivers along a rounded edge: the nearest
+centroids all lie within a few millimetres), the next calls use sets twice as large."""
+
 HELD_SETS = 8
 """Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
 midpoints, the feature contact's points ...): a static obstacle's triangles never move, so a point that moved
@@ -87,26 +92,6 @@ triangles: 7.5 deg) are not. On a curved body the sheet's flat triangles then di
 their nodes by about the chord sagitta ``h^2 / (8 R)``, as they do into an analytic sphere; ``feature_angle =
 1`` keeps every convex edge and vertex off the sheet (0 crossing pairs) at the cost measured in
 validation/mesh_obstacles.md."""
-
-
-def _rotation(angles_deg) -> np.ndarray:
-    rx, ry, rz = np.radians(np.asarray(angles_deg, float))
-    cx, sx, cy, sy, cz, sz = np.cos(rx), np.sin(rx), np.cos(ry), np.sin(ry), np.cos(rz), np.sin(rz)
-    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx
-
-
-def _merge(P, tri):
-    """Merge coincident nodes (1e-12 of the bounding-box diagonal; an STL file repeats them per facet)."""
-    diag = float(np.linalg.norm(np.ptp(P, axis=0))) or 1.0
-    key = np.round(P / (1e-12 * diag)).astype(np.int64)
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    used = np.unique(inverse.ravel()[tri.ravel()])
-    remap = np.full(len(first), -1, np.int64)
-    remap[used] = np.arange(len(used))
-    return P[first[used]], remap[inverse.ravel()[tri]]
 
 
 @register
@@ -173,12 +158,12 @@ class SurfaceObstacle(Obstacle):
         if not self.path.is_file():
             raise MeshError(f"{self.path}: no such file; give path relative to the scene file, or absolute")
         P, tri, notes = read_triangles(self.path, quads="triangulate")
-        P, tri = _merge(P, tri)
+        P, tri = merge_nodes(P, tri)
         unit = FILE_UNITS[units] if units is not None else self.scene_length
         if not (np.isfinite(self.rotate).all() and np.isfinite(self.translate).all()):
             raise ValueError(f"rotate and translate must be finite, got {rotate!r} and {translate!r}")
         with np.errstate(over="ignore", invalid="ignore"):
-            V = (P * (unit * self.scale)) @ _rotation(self.rotate).T + self.translate
+            V = (P * (unit * self.scale)) @ rotation(self.rotate).T + self.translate
             size = float(np.linalg.norm(np.ptp(V, axis=0)))
         if not (np.isfinite(V).all() and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
             raise ValueError(f"scale = {scale!r} (file units {units or 'of the scene'}) makes the obstacle {size:.3g} m "
@@ -225,6 +210,13 @@ class SurfaceObstacle(Obstacle):
         self._ctree = cKDTree(self.centroid)
         self._vtree = cKDTree(V)
         self._sets = {}  # candidate sets of the last calls, by their number of points (_candidates)
+        self._wider, self.widest = WIDER, WIDEST  # their size, doubled while fresh sets fail to prove (surface_query)
+        self._surface = tuple(np.ascontiguousarray(a) for a in (
+            V, T.astype(np.int64), self.centroid, self.nf, self.ne, self.nv, self.edge_of.astype(np.int64),
+            self.edges.astype(np.int64), self.boundary_edge, self.boundary_vertex))
+        mode = 0 if self.closed else (2 if self.thickness is not None else 1)
+        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        self._consts = np.array([self.radius, self.band, half, mode, *self.lo, *self.hi, 0.0], float)
         # the compiled query pays off where the numpy twin searches subsets; a box's 12 triangles are all tested
         # at once in numpy, without importing numba (0.5 s)
         self.compiled = numba_available() and len(T) > NEAREST
@@ -325,9 +317,22 @@ class SurfaceObstacle(Obstacle):
 
     def _evaluate(self, x, hessian):
         x = _as_points(x)
-        n = len(x)
+        if self.compiled:
+            return self._evaluate_compiled(x, hessian)
         q, kind, gid, exact, lower = self._closest(x)
-        near = exact & (lower < self.band)
+        return self._signed(x, q, kind, gid, exact & (lower < self.band), lower, hessian)
+
+    def _evaluate_compiled(self, x, hessian):
+        from rftstatic.contact.obstacles.surface_query import evaluate_compiled
+
+        return evaluate_compiled(self, x, hessian)
+
+    def _signed(self, x, q, kind, gid, near, lower, hessian):
+        """Signed distance, normal and Hessian (or None) at ``x (n, 3)`` [m] from each point's closest feature
+        ``q (n, 3)`` [m], ``kind, gid``, exact where ``near``, else the lower bound ``lower (n,)`` [m] (module
+        docstring)."""
+        n = len(x)
+        near = near.copy()
         if self.closed:
             box = ~near & np.all((x >= self.lo) & (x <= self.hi), axis=1)
             if box.any():  # a point deep inside (none in a sound run) gets its exact distance too
@@ -445,38 +450,9 @@ class SurfaceObstacle(Obstacle):
 
     # --- sharp features ---------------------------------------------------------------------------
     def _features(self):
-        e_tris = np.full((len(self.edges), 2), -1, np.int64)
-        flat = self.edge_of.ravel()
-        order = np.argsort(flat, kind="stable")
-        start = np.searchsorted(flat[order], np.arange(len(self.edges)))
-        e_tris[:, 0] = order[start] // 3
-        two = self.boundary_edge == False  # noqa: E712 (numpy)
-        e_tris[two, 1] = order[start[two] + 1] // 3
-        n0, n1 = self.nf[e_tris[:, 0]], self.nf[np.maximum(e_tris[:, 1], 0)]
-        bend = np.degrees(np.arccos(np.clip(np.einsum("ei,ei->e", n0, n1), -1.0, 1.0)))
-        # convex: the far corner of the second face lies behind the first face's plane
-        t1 = self.T[np.maximum(e_tris[:, 1], 0)]
-        far = self.V[t1].sum(axis=1) - self.V[self.edges].sum(axis=1)  # the corner not on the edge
-        convex = np.einsum("ei,ei->e", far - self.V[self.edges[:, 0]], n0) < 0
-        sharp = (two & convex & (bend > self.feature_angle)) | self.boundary_edge
-        # an open rim's outward direction: in the plane of its face, away from it (and along the face's normal
-        # for a one-sided surface)
-        rim = self.boundary_edge
-        e0, e1 = self.V[self.edges[rim, 0]], self.V[self.edges[rim, 1]]
-        nf = self.nf[e_tris[rim, 0]]
-        out = np.cross(nf, e1 - e0)
-        third = self.V[self.T[e_tris[rim, 0]]].sum(axis=1) - e0 - e1
-        out *= np.where(np.einsum("ei,ei->e", out, 0.5 * (e0 + e1) - third) < 0, -1.0, 1.0)[:, None]
-        out /= np.linalg.norm(out, axis=1, keepdims=True)
-        if self.thickness is None:
-            out = out + nf
-            out /= np.linalg.norm(out, axis=1, keepdims=True)
-        normals = self.ne.copy()
-        normals[rim] = out
-        self.feature_edges = self.edges[sharp]
-        self.feature_normals = normals[sharp]
-        deg = np.bincount(self.feature_edges.ravel(), minlength=len(self.V))
-        self.feature_corners = np.flatnonzero((deg > 0) & (deg != 2))
+        self.feature_edges, self.feature_normals, self.feature_corners = sharp_edges(
+            self.V, self.T, self.edges, self.edge_of, self.nf, self.ne, self.boundary_edge, self.feature_angle,
+            two_sided=self.thickness is not None)
 
     def sharp_features(self):
         """The sharp edges and their end or junction corners, with their pseudo-normals."""

@@ -7,7 +7,9 @@ crosses the other by more than ``tol``). Touching is not crossing: a sheet resti
 ``tol`` (default 1e-9 mean sheet edge lengths) counts 0 pairs.
 
 Broad phase: ``cKDTree``s of both meshes' triangle centroids, pairs whose centroid distance is below the
-two largest centroid-to-corner radii plus ``within``; the narrow phase is vectorised over the pairs.
+two largest centroid-to-corner radii plus ``within``; the narrow phase is vectorised over the pairs: the crossing
+test over the pairs whose bounding boxes overlap (within ``tol``), the exact distance over those whose boxes lie
+within the nearest vertex pair's distance (the smallest distance is among them).
 """
 
 from __future__ import annotations
@@ -53,11 +55,21 @@ def obstacle_crossings(x: np.ndarray, tri: np.ndarray, V: np.ndarray, T: np.ndar
     rq = float(np.max(np.linalg.norm(Q - cq[:, None], axis=2)))
     m = cKDTree(cp).sparse_distance_matrix(cKDTree(cq), rp + rq + within, output_type="ndarray")
     i, j = m["i"].astype(np.int64), m["j"].astype(np.int64)
-    crossing = _crossing(P[i], Q[j], tol)
-    dist = _pair_distance(P[i], Q[j], crossing)
+    # the gap between the pairs' bounding boxes bounds their distance from below: only pairs whose boxes
+    # overlap within tol can cross, and only those within the nearest vertex pair's distance can be nearest
+    gap = np.maximum(0.0, np.maximum(P.min(axis=1)[i] - Q.max(axis=1)[j], Q.min(axis=1)[j] - P.max(axis=1)[i]))
+    box = np.sqrt(np.einsum("mi,mi->m", gap, gap))
+    cand = np.flatnonzero(box <= tol)
+    crossing = np.zeros(len(i), bool)
+    crossing[cand] = _crossing(P[i[cand]], Q[j[cand]], tol)
+    smallest = float("inf")
+    if len(i):
+        vv = np.linalg.norm(P[i][:, :, None] - Q[j][:, None, :], axis=3).min(axis=(1, 2))
+        cand = np.flatnonzero(box <= vv.min())
+        smallest = float(_pair_distance(P[i[cand]], Q[j[cand]], crossing[cand]).min())
     first = None if not crossing.any() else int(np.flatnonzero(crossing)[0])
     return {"pairs": int(crossing.sum()),
             "first": None if first is None else [int(i[first]), int(j[first])],
             "first_at": None if first is None else P[i[first]].mean(axis=0).tolist(),
-            "smallest_distance": float(dist.min()) if len(dist) else float("inf"),
+            "smallest_distance": smallest,
             "within": within, "tol": tol, "seconds": time.perf_counter() - t0}
