@@ -53,8 +53,8 @@ def main(argv=None):
         f"{platform.node()}, {os.cpu_count()} cores, load average at the end {load}: the machine was shared, so "
         "wall times are single runs under that load).",
         "",
-        "`cases/skirt-a-line.toml`: the two-panel A-line skirt of `cases/patterns/skirt-a-line.toml` (waist 70 cm, "
-        "96 cm 18 cm below the waist, hem 156 cm, length 60 cm; front and back placed 18 cm before and behind the "
+        "`cases/skirt-a-line.toml`: the two-panel A-line skirt of `cases/patterns/skirt-a-line.toml` (waist 72 cm, "
+        "100 cm 18 cm below the waist, hem 165 cm, length 60 cm; front and back placed 18 cm before and behind the "
         "form's axis) on a size-36 dress form (bust 84, waist 66, hip 92 cm), wool (`wool-kang-yu`), RFT6, "
         "frictionless. The seams are pulled shut by seam springs in damped explicit runs without gravity, merged, "
         "and the sewn skirt is draped under gravity by the relaxation route and Newton (`rftstatic.app.garment`, "

@@ -76,7 +76,7 @@ BODY_KEYS = ("bust_girth", "waist_girth", "hip_girth", "bust_height", "waist_hei
 """Length keys of ``[body]`` (scene units), passed to :class:`~rftstatic.garment.body.DressForm` in metres;
 its depth / width ratios (``*_depth``) are passed as given."""
 DEPTH_KEYS = ("bust_depth", "waist_depth", "hip_depth", "shoulder_depth", "neck_depth")
-CLOSING_TIME = 1.0
+CLOSING_TIME = 0.5
 """Longest run of the seam-closing stage [s] of simulated time, at each spring stiffness
 (:func:`rftstatic.garment.sewing.close_seams`); a run stops as soon as the seams are closed."""
 CLEARANCE = 1.5

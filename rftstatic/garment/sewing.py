@@ -43,11 +43,11 @@ SEAM_PULL = 1.0
 weight [-]: k_0 = SEAM_PULL W / (S g_0) for S pairs of largest gap g_0, so the seams close about as fast as the
 garment would fall, with no violent snap (a stiffer first pull overshoots and tears the membrane)."""
 
-CLOSING_RUNS = 8
+CLOSING_RUNS = 12
 """Most explicit runs of the closing (:func:`close_seams`): a run that comes to rest short of closing is followed
 by one with stiffer springs, a run stopped on a closed gap that springs open again by one at the same stiffness."""
 
-SEAM_STIFFENING = 10.0
+SEAM_STIFFENING = 3.0
 """Factor on the spring stiffness from one closing run to the next [-] (:func:`close_seams`)."""
 
 SEAM_STIFFNESS = 0.5

@@ -29,11 +29,11 @@ def test_toml_and_json_give_the_same_skirt():
     _same(toml, js)
     assert toml.units == js.units == "cm"
     front = toml.panel("front")
-    # cm -> m, and the waist arc: radius 48.84 cm over a 34.26 cm chord
-    np.testing.assert_allclose(front.vertices[2], [0.1713, 0.5619])
-    half = np.arcsin(0.1713 / 0.4884)
-    assert front.edge_length(2) == pytest.approx(0.4884 * 2 * half, rel=1e-12)
-    assert front.edge_length(1) == pytest.approx(np.hypot(0.3817 - 0.1713, 0.5619), rel=1e-12)
+    # cm -> m, and the waist arc: radius 46.29 cm over a 35.10 cm chord
+    np.testing.assert_allclose(front.vertices[2], [0.1755, 0.5552])
+    half = np.arcsin(0.1755 / 0.4629)
+    assert front.edge_length(2) == pytest.approx(0.4629 * 2 * half, rel=1e-12)
+    assert front.edge_length(1) == pytest.approx(np.hypot(0.4030 - 0.1755, 0.5552), rel=1e-12)
 
 
 def test_units_convert_to_si():
