@@ -11,7 +11,7 @@ import logging
 
 import numpy as np
 
-from rftstatic.contact.friction import commit, initial_lag
+from rftstatic.contact.friction import anchored_lag, commit, initial_lag
 from rftstatic.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
@@ -43,6 +43,15 @@ def link(model, state, U) -> None:
     if lag is None:
         lag = state.contact_history[KEY] = initial_lag(law, model.contact, model.positions(U), model.load)
     state.candidates.friction = lag
+
+
+def anchor(model, state, U) -> None:
+    """Anchor the lag at the relaxed displacements ``U (N, 3)`` [m] before a Newton handover of the relaxation
+    route (:func:`~rftstatic.contact.friction.anchored_lag`; nothing without friction): the relaxation's impulses
+    held the sheet where it rests, the lag holds it there for Newton."""
+    law = law_of(model)
+    if law is not None:
+        state.contact_history[KEY] = anchored_lag(law, model.contact, model.positions(U))
 
 
 def predict(model, state, lam_to: float) -> None:
