@@ -164,3 +164,40 @@ def test_a_frictional_relaxation_interrupted_mid_segment_resumes_bit_identical(t
     resumed = app.run(scene, tmp_path / "cut", progress=False, figures=False, resume=True)
     assert np.array_equal(resumed.U, full.U)
     assert resumed.summary["relax"]["steps"] == full.summary["relax"]["steps"]
+
+
+def test_the_cusick_friction_scene_holds_the_specimen_by_friction_alone():
+    """cases/cusick-30-friction.toml: the specimen on the support disc (a round pedestal) with the disc's own
+    friction 0.5, no clamp, no support and no in-plane hold; the default route."""
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.schema import load_scene
+
+    scene = load_scene("cusick-30-friction")
+    model, _ = build_model(scene)
+    law = model.contact.friction
+    assert law.mu_static.tolist() == [0.5] and law.mu_kinetic.tolist() == [0.5]
+    assert model.free.all()  # nothing clamped or held: friction alone keeps the specimen on the disc
+    assert scene.get("solver.start") == "relax"
+
+
+@pytest.mark.slow
+def test_the_cusick_friction_scene_converges_and_friction_keeps_the_specimen_on_the_disc(tmp_path):
+    """Coarse (h = 3 cm, 100 nodes; 10-15 s each): with and without the disc's friction the default route converges
+    to a stable drape; with friction the specimen's part on the disc moves less."""
+    import json
+
+    import meshio
+
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.schema import load_scene
+
+    X = build_model(load_scene("cusick-30-friction", ["mesh.h=3.0"]))[0].mesh.X * 100
+    disc = np.linalg.norm(X, axis=1) < 8.5
+    slide = {}
+    for mu in (0.5, 0.0):
+        rc, out = _case(tmp_path / str(mu), "mesh.h=3.0", f"obstacles.0.friction={mu}", name="cusick-30-friction")
+        s = json.loads((out / "summary.json").read_text())
+        assert rc == 0 and s["converged"] and s["stable_minimum"]
+        p = meshio.read(out / "deformed.vtu").points
+        slide[mu] = float(np.linalg.norm(p[disc, :2] - X[disc], axis=1).max())
+    assert slide[0.5] < slide[0.0]
