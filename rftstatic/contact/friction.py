@@ -127,18 +127,25 @@ def friction_terms(lag: dict, x: np.ndarray, *, tangent: bool = True):
     return energy, force, blocks
 
 
-def _contacts(penalty, x):
+def _contacts(penalty, x, candidates=None):
     """Contact nodes of the penalty law at ``x (N, 3)`` [m]: nodes ``(C,)``, their obstacle ``(C,)``, normal force
-    magnitude ``k A |d1|`` [N] and unit normal ``(C, 3)`` of the obstacle they are deepest in."""
-    phi, normal = penalty._distances(x)
-    if phi.shape[0] == 0:
+    magnitude ``k A |d1|`` [N] and unit normal ``(C, 3)`` of the obstacle they are deepest in; ``candidates``: the
+    solve's candidate list (:class:`~rftstatic.contact.candidates.CandidateList`; only its nodes are measured),
+    or None (every node)."""
+    if candidates is None:
+        near = np.arange(x.shape[0])
+        phi, normal = penalty._distances(x)
+    else:
+        near = penalty._near(x, candidates)[0]
+        phi, normal = penalty._distances_of(x[near])
+    if phi.shape[0] == 0 or near.size == 0:
         return np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 3))
     deepest = phi.argmin(axis=0)
-    cols = np.arange(x.shape[0])
+    cols = np.arange(near.size)
     d1 = penalty._slope(phi[deepest, cols])
-    lam = -penalty.stiffness * penalty.node_area * d1
-    nodes = np.flatnonzero(lam > 0.0)
-    return nodes, deepest[nodes], lam[nodes], normal[deepest[nodes], nodes]
+    lam = -penalty.stiffness * penalty.node_area[near] * d1
+    hit = np.flatnonzero(lam > 0.0)
+    return near[hit], deepest[hit], lam[hit], normal[deepest[hit], hit]
 
 
 def initial_lag(law: FrictionLaw, penalty, x: np.ndarray, load: np.ndarray) -> dict:
@@ -213,12 +220,14 @@ def anchored_lag(law: FrictionLaw, penalty, x: np.ndarray) -> dict:
     return _lag(law, nodes, obstacle, force, normal, x[nodes].copy(), np.zeros(nodes.size, bool), 1.0)
 
 
-def penalty_impulses(law: FrictionLaw, penalty, x: np.ndarray, v: np.ndarray, minv: np.ndarray, dt: float) -> float:
+def penalty_impulses(law: FrictionLaw, penalty, x: np.ndarray, v: np.ndarray, minv: np.ndarray, dt: float,
+                     candidates=None) -> float:
     """Coulomb friction impulses (F5) of one explicit step on the penalty contact, in place on the half-step
     velocities ``v (N, 3)`` [m/s], for positions ``x (N, 3)`` [m] at which the step's force was evaluated, inverse
-    lumped masses ``minv (N, 3)`` [1/kg] (0 on supported dofs) and the step ``dt`` [s]; returns the kinetic energy
-    the impulses took away [J]."""
-    nodes, obstacle, lam, normal = _contacts(penalty, x)
+    lumped masses ``minv (N, 3)`` [1/kg] (0 on supported dofs) and the step ``dt`` [s]; ``candidates``: the solve's
+    candidate list (only its nodes are measured; None: every node). Returns the kinetic energy the impulses took
+    away [J]."""
+    nodes, obstacle, lam, normal = _contacts(penalty, x, candidates)
     if nodes.size == 0:
         return 0.0
     vc = v[nodes]

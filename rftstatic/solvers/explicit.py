@@ -278,7 +278,7 @@ class _Loop:
             V, Vnew = Vnew, V
             if self.penalty_friction is not None:  # Coulomb impulses on the penalty contact (F5)
                 acc["contact"] += penalty_impulses(self.penalty_friction, self.model.contact, self.model.X3 + U, V,
-                                                   minv, dt)
+                                                   minv, dt, state.candidates)
             if self.self_filter is not None:  # no pair of the sheet passes through another on this step
                 acc["contact"] += self.self_filter(state.self_pairs, self.model.X3 + U, V, dt)
             # Eq. 22
