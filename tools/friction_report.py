@@ -374,7 +374,7 @@ Crossing pairs by the independent triangle-triangle tests (cloth/table and the c
 by the default route. The tester itself clamps the specimen between two discs (cusick-30: the clamped inner ring;
 its DC and folds are in [textile_tests.md](textile_tests.md)). Slide: the largest in-plane move of the specimen's
 nodes on the disc (r < 8.5 cm) [cm]; frictionless, only the rigid in-plane modes are held. Friction does not make
-that move smaller here: it is the specimen's own deformation over the disc's edge, not a slide of the whole.
+that move smaller here (why is not measured: the move mixes the specimen's stretch and any slide).
 
 | friction on the disc | exit | converged | stable | explicit steps | Newton its | DC [%] | folds | slide on the disc [cm] | wall [s] |
 |---|---|---|---|---|---|---|---|---|---|

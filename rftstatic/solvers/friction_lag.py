@@ -66,14 +66,15 @@ def link(model, state, U) -> None:
 
 
 def anchor(model, state, U) -> None:
-    """Anchor the lag at the relaxed displacements ``U (N, 3)`` [m] before a Newton handover of the relaxation
-    route (:func:`~rftstatic.contact.friction.anchored_lag`; nothing without friction): the relaxation's impulses
-    held the sheet where it rests, the lag holds it there for Newton."""
+    """Anchor (and link) the lag at the relaxed displacements ``U (N, 3)`` [m] before a Newton handover of the
+    relaxation route (:func:`~rftstatic.contact.friction.anchored_lag`; nothing without friction): the relaxation's
+    impulses held the sheet where it rests, the lag holds it there for Newton."""
     law, slaw = law_of(model), self_law_of(model)
     if law is not None:
         state.contact_history[KEY] = anchored_lag(law, model.contact, model.positions(U))
     if slaw is not None:  # the relaxation is frictionless between layers: their lag starts again at Newton's commit
         state.contact_history[SELF_KEY] = empty_pairs_lag(slaw)
+    link(model, state, U)  # the tangent of the stability check before the handover sees the anchored lag
 
 
 def predict(model, state, lam_to: float) -> None:

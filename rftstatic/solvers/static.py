@@ -337,8 +337,9 @@ def _relax_route(model, opts, callback, state, first):
         if route.phase == "relax":
             yield from _relax_segment(model, opts, plan, route, fail, state, t0)
         final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
-        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, state.solver,
-                                                                           slip=state.bending_slip):
+        friction_lag.anchor(model, state, route.U)  # Coulomb friction: stick anchors at the relaxed state
+        if not final and route.tol_force < 1.0 and not _positive_definite(
+                model, route.U, state.solver, slip=state.bending_slip, candidates=state.candidates):
             route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
         handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest,
@@ -354,11 +355,10 @@ def _relax_route(model, opts, callback, state, first):
             options = (polish if final else short.replace(max_continuations=FIRST_HANDOVER_CONTINUATIONS)
                        if first_try else basin if long_try else short)
             history = state.bending_slip, state.dissipated  # committed by a converged Newton
-            friction_lag.anchor(model, state, route.U)  # Coulomb friction: stick anchors at the relaxed state
             res = solve_load_steps(model, U0=route.U, options=options, callback=callback, state=state,
                                    iteration_fallback=final or long_try or first_try)
             if first_try and not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
-                                                       slip=state.bending_slip):
+                                                       slip=state.bending_slip, candidates=state.candidates):
                 state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
                 raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not a "
                                        "stable minimum", res)
