@@ -48,6 +48,9 @@ class ContactOptions:
                                           "0.05 cm); below half the smallest edge", kind="float", unit="length",
                                           low=0.0, open_low=True)
     self_factor: float = option(1.0, "multiplier of the automatic self-contact stiffness", low=0.0, open_low=True)
+    self_friction: float = option(0.0, "Coulomb friction coefficient mu between the sheet's layers in self-contact "
+                                  "(lagged by the static Newton solves; 0: frictionless); needs contact.self",
+                                  low=0.0)
 
     def __post_init__(__dataclass_self__):
         check(__dataclass_self__, "contact")

@@ -7,13 +7,13 @@ import math
 
 import numpy as np
 
-from rftstatic.scenes.options import static_options
 from rftstatic.scenes.schema import Scene
 
 
 def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
     """The scene's Coulomb friction law (:class:`rftstatic.contact.friction.FrictionLaw`), or None when
-    frictionless: lagged on the static load-step route, impulses in a dynamic run (relaxation refuses it)."""
+    frictionless: lagged on the static routes (load steps; relaxation commits the lag at every sample, its Newton
+    handovers settle it), impulses in a dynamic run."""
     mu_s = np.full(n_obstacles, c.friction if c.friction_static is None else c.friction_static)
     mu_k = np.full(n_obstacles, c.friction if c.friction_kinetic is None else c.friction_kinetic)
     for i, spec in enumerate(scene.get("obstacles", [])[:n_obstacles]):
@@ -27,11 +27,10 @@ def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
     if np.any(mu_k > mu_s):
         raise scene.error("contact.friction_kinetic", f"the kinetic coefficient {mu_k.max():g} exceeds the static "
                           f"one {mu_s.min():g}; give friction_kinetic <= friction_static")
-    static = scene.analysis == "static" and static_options(scene, progress=False).route.start == "load-steps"
-    if not (static or scene.analysis == "dynamic"):
-        raise scene.error("contact.friction", "friction acts on the static load-step route (analysis = \"static\", "
-                          'solver.start = "load-steps") and in dynamic runs (analysis = "dynamic"); dynamic '
-                          "relaxation is frictionless in this version: set contact.friction = 0 for it")
+    if scene.analysis not in ("static", "dynamic"):
+        raise scene.error("contact.friction", f'friction acts in static solves (analysis = "static", by load steps '
+                          f'or by relaxation and Newton) and dynamic runs (analysis = "dynamic"), not in analysis = '
+                          f'"{scene.analysis}": set contact.friction = 0 for it')
     from rftstatic.contact.friction import SLIP_LENGTH, FrictionLaw
 
     size = float(np.ptp(mesh.X, axis=0).max())

@@ -32,6 +32,9 @@ def build_self_contact(scene: Scene, mesh, material, kernels: str | None = None)
     ``kernels``: the run's kernel back end (:func:`rftstatic.scenes.build.run_kernels`)."""
     contact = contact_options(scene)
     if not contact.self:
+        if contact.self_friction > 0:
+            raise scene.error("contact.self_friction", f"{contact.self_friction!r} needs the self-contact: set "
+                              "contact.self = true, or contact.self_friction = 0")
         return None
     from rftstatic.contact.self_contact.law import SelfContact, auto_stiffness
 
@@ -59,7 +62,13 @@ def build_self_contact(scene: Scene, mesh, material, kernels: str | None = None)
                           "by the sheet's weight)")
     k = auto_stiffness(weight=material.weight, node_area=float(mesh.node_area.mean()), thickness=d,
                        factor=contact.self_factor)
+    friction = None
+    if contact.self_friction > 0:  # the slip length as on obstacles: a share of the sheet's size
+        from rftstatic.contact.friction import SLIP_LENGTH, FrictionLaw
+
+        mu = np.array([contact.self_friction])
+        friction = FrictionLaw(mu, mu, eps=SLIP_LENGTH * float(np.ptp(mesh.X, axis=0).max()))
     try:
-        return SelfContact(mesh, d, k, kernels=kernels)
+        return SelfContact(mesh, d, k, kernels=kernels, friction=friction)
     except ValueError as exc:
         raise scene.error(key, f"{shown!r}: {exc}") from None

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rftstatic.contact.friction import penalty_impulses
 from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.model.state import State
@@ -206,6 +207,8 @@ class _Loop:
             from rftstatic.contact.feature_sweep import FeatureSweep
 
             self.sweep = FeatureSweep.for_sheet(obstacles, model.mesh.tri, model.mesh.topology.edges, model.X3)
+        # friction of the penalty contact (rftstatic.contact.friction, F5); kinematic obstacles take `friction`
+        self.penalty_friction = getattr(model.contact, "friction", None) if model.contact is not None else None
 
     def begin(self, dt, *, start_consistent, state):
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
@@ -278,6 +281,9 @@ class _Loop:
                         state.U, state.V, state.t, state.step = U, V, t, step
                         stopped = bool(callback(state, rec))
             V, Vnew = Vnew, V
+            if self.penalty_friction is not None:  # Coulomb impulses on the penalty contact (F5)
+                acc["contact"] += penalty_impulses(self.penalty_friction, self.model.contact, self.model.X3 + U, V,
+                                                   minv, dt, state.candidates)
             if self.self_filter is not None:  # no pair of the sheet passes through another on this step
                 acc["contact"] += self.self_filter(state.self_pairs, self.model.X3 + U, V, dt)
             # Eq. 22

@@ -158,7 +158,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                          lam_next, nt.reason, nt.residual)
                 nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement")
                 result.iterations += nt.iterations
-            if nt.converged and friction_lag.law_of(model) is not None:  # the lagged friction settles here
+            if nt.converged and friction_lag.active(model):  # the lagged friction settles here
                 nt, its = friction_lag.settle(model, state, nt, lam_next, lambda V: newton(
                     model, V, lam_next, opts.newton, state, max_step, scheme="displacement"))
                 result.iterations += its

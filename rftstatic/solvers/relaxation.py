@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rftstatic.contact.friction import held_residual, seated
 from rftstatic.element.explicit_force import BACKENDS
 from rftstatic.errors import ParameterError
 from rftstatic.model.state import State
@@ -19,6 +20,7 @@ from rftstatic.solvers.explicit import EXPLICIT, ExplicitResult, explicit_steps
 from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.rest import RELAX_MASS_SCALE, RELAX_REST, AtRest, RestCriterion
 from rftstatic.solvers.step_plan import MAX_STEPS_KEY
+from rftstatic.solvers.timestep import lumped_mass
 
 log = logging.getLogger(__name__)
 
@@ -103,7 +105,9 @@ def relax_steps(model, state: State, options: RelaxOptions, *, given_velocity: b
     At rest: ``options.rest`` (:class:`~rftstatic.solvers.rest.RestCriterion`) at a sample, kinetic energy
     against its peak and the out-of-balance force on the free dofs ``|P - F(U)|`` against ``|P|``. Mass scaling
     (default s = 100 as in §6) lengthens the stable step by sqrt(s); the load is not scaled, so the resting
-    state is the static equilibrium.
+    state is the static equilibrium. With Coulomb friction on the penalty contact the explicit steps apply its
+    impulses (:func:`rftstatic.contact.friction.penalty_impulses`), and a relaxation from rest starts with the sheet
+    seated on the penalty (:func:`rftstatic.contact.friction.seated`).
 
     Parameters
     ----------
@@ -121,10 +125,43 @@ def relax_steps(model, state: State, options: RelaxOptions, *, given_velocity: b
     saved = state.route.get(EXPLICIT)
     if saved is not None:  # the peaks of the samples before the interruption, as the rest test saw them
         at_rest.resume_from(saved["history"])
+    elif not given_velocity and getattr(model.contact, "friction", None) is not None:  # thrown off, it would slide
+        state.U += (seated(model.contact, model.positions(state.U), P) - model.positions(state.U)) * model.free
     run = yield from explicit_steps(model, state, options.explicit(given_velocity=given_velocity), obstacles=obstacles,
-                                    load=load, callback=at_rest)
+                                    load=load, callback=_held_rest(model, state, at_rest, P, options.mass_scale))
+    state.route.pop(FRICTION_REST, None)
     if not run.stopped:  # the caller decides what follows (the static route relaxes on or hands over)
         log.info("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
                  run.t, run.steps, run.history["kinetic"][-1], run.history["residual"][-1])
     return RelaxResult(U=run.U, converged=run.stopped, t=run.t, steps=run.steps, run=run, V=run.V,
                        peak_kinetic=at_rest.peak_kinetic)
+
+
+FRICTION_REST = "relax-friction-rest"
+"""Key in ``State.route`` of the peaks of a frictional relaxation's rest test (:func:`_held_rest`), so that a resumed
+run tests as the uninterrupted one did (its history holds the frictionless measures)."""
+
+
+def _held_rest(model, state, at_rest: AtRest, P, mass_scale):
+    """The rest test of a relaxation: ``at_rest`` itself, or with Coulomb friction on the penalty contact, one that
+    measures what the friction does not hold: the kinetic energy of the velocities its impulses left (the motion's
+    peak counts the sample's own, impulse-free, so a sheet released from rest has moved before it can rest) and the
+    out-of-balance force with the static friction's reaction taken off
+    (:func:`rftstatic.contact.friction.held_residual`)."""
+    law = getattr(model.contact, "friction", None)
+    if law is None:
+        return at_rest
+    mass = lumped_mass(model, mass_scale)
+    peaks = state.route.setdefault(FRICTION_REST, {"kinetic": at_rest.peak_kinetic, "residual": 0.0})
+    at_rest.peak_kinetic, at_rest.peak_residual = peaks["kinetic"], peaks["residual"]
+
+    def test(st, sample):
+        r = -model.residual(st.U, 1.0, candidates=st.candidates, pairs=st.self_pairs, slip=st.bending_slip)
+        r = held_residual(law, model.contact, model.positions(st.U), np.where(model.free, r - model.load + P, 0.0))
+        at_rest.peak_kinetic = max(at_rest.peak_kinetic, sample["kinetic"])
+        kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, st.V, st.V))
+        done = at_rest(st, dict(sample, kinetic=kinetic, residual=float(np.linalg.norm(r))))
+        peaks.update(kinetic=at_rest.peak_kinetic, residual=at_rest.peak_residual)
+        return done
+
+    return test

@@ -17,6 +17,7 @@ import numpy as np
 
 from rftstatic.errors import ConvergenceError, InstabilityError, ParameterError, StepLimitError
 from rftstatic.model.state import State
+from rftstatic.solvers import friction_lag
 from rftstatic.solvers.checkpoint import as_state
 from rftstatic.solvers.continuation import solve_arc_length
 from rftstatic.solvers.drive import Pause, finish
@@ -34,7 +35,6 @@ from rftstatic.units import STANDARD_GRAVITY
 __all__ = ["ConvergenceError", "RelaxRoute", "StaticOptions", "StaticResult", "compare_with_static", "solve_static"]
 
 log = logging.getLogger(__name__)
-
 
 STATIC = "static"
 """The static route's key in ``State.route``: ``{"result": StaticResult}`` once the solve is done (a checkpoint
@@ -97,8 +97,7 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
             else:
                 result = yield from load_steps(model, state, opts, U0=U0, callback=callback)
         except ConvergenceError as exc:
-            if (not opts.route.relax_fallback or model.load_terms or not np.any(model.load)
-                    or getattr(model.contact, "friction", None) is not None):  # relaxation is frictionless
+            if not opts.route.relax_fallback or model.load_terms or not np.any(model.load):
                 raise
             log.warning("load steps failed (%s); trying dynamic relaxation at full load, then Newton", exc)
             result = yield from _relax_then_newton(model, opts, callback, state, first=exc)
@@ -291,7 +290,7 @@ def _relax_then_newton(model, opts, callback, state, *, first=None):
     tangent is factorised, and Newton tries again (:data:`RELAX_BASIN_NEWTON_ITERATIONS`) only when it is positive
     definite (in the basin of a stable minimum: from an indefinite tangent a short-budget Newton may walk to a
     point that is no minimum). The relaxation ends at rest at half the solver's ``rtol`` or at its time limit;
-    Newton then finishes with the solver's own budget.
+    Newton then finishes with the solver's own budget. Coulomb friction: :func:`rftstatic.solvers.friction_lag.anchor`.
 
     A route (:mod:`rftstatic.solvers.drive`): its :class:`RelaxRoute` is ``state.route[RELAX_ROUTE]``, the
     explicit State of a segment under way ``state.route[SEGMENT]``. It pauses (final) after the failed load
@@ -338,8 +337,9 @@ def _relax_route(model, opts, callback, state, first):
         if route.phase == "relax":
             yield from _relax_segment(model, opts, plan, route, fail, state, t0)
         final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
-        if not final and route.tol_force < 1.0 and not _positive_definite(model, route.U, state.solver,
-                                                                           slip=state.bending_slip):
+        friction_lag.anchor(model, state, route.U)  # Coulomb friction: stick anchors at the relaxed state
+        if not final and route.tol_force < 1.0 and not _positive_definite(
+                model, route.U, state.solver, slip=state.bending_slip, candidates=state.candidates):
             route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
         handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest,
@@ -358,7 +358,7 @@ def _relax_route(model, opts, callback, state, first):
             res = solve_load_steps(model, U0=route.U, options=options, callback=callback, state=state,
                                    iteration_fallback=final or long_try or first_try)
             if first_try and not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
-                                                       slip=state.bending_slip):
+                                                       slip=state.bending_slip, candidates=state.candidates):
                 state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
                 raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not a "
                                        "stable minimum", res)

@@ -65,8 +65,9 @@ TOOL_REPORTS = {
     "cusick_route": "the Cusick tester's route: which drape the load steps and the dynamic relaxation find on "
                     "cusick-30, their energies, fold counts over seeds, lift amplitudes, fabrics and model changes "
                     "(tools/cusick_route_study.py)",
-    "friction_obstacles": "Coulomb friction against the exact incline (static lag and explicit impulses) and its "
-                          "cost on pedestal-square-20 (tools/friction_report.py)",
+    "friction_obstacles": "Coulomb friction against the exact incline (static lag, relaxation and explicit "
+                          "impulses), the drag tests on the floor and between layers (self_friction), its cost on "
+                          "pedestal-square-20 and the Cusick friction scene (tools/friction_report.py)",
     "bench_profile": "where the paper scenes' time goes: bench profile by phase and the bench scenes table, the "
                      "three biggest cost centres (python -m rftstatic bench profile / bench scenes)",
     "garments": "an A-line skirt sewn from two panels on the dress form: convergence, stability, seam gaps, crossings "

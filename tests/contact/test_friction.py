@@ -128,7 +128,7 @@ def test_the_incline_scene_stays_put_below_its_friction_angle_and_has_no_equilib
     (["contact.friction=-0.1"], "contact.friction"),
     (["contact.friction=nan"], "contact.friction"),
     (["contact.friction_static=0.2", "contact.friction_kinetic=0.3"], "contact.friction_kinetic"),
-    (["solver.start=relax"], "contact.friction"),
+    (["analysis=relax"], "contact.friction"),
 ])
 def test_bad_friction_input_names_its_key(tmp_path, capsys, sets, key):
     rc, _ = _case(tmp_path, *sets)

@@ -256,6 +256,8 @@ class PairCache:
     Attributes
     ----------
     stiffness_scale : factor on the law's stiffness in this solve [-] (1 until the static route raises it)
+    friction : the solve's lagged friction between layers (``State.contact_history["self_friction"]``,
+        :mod:`rftstatic.contact.self_contact.friction`), or None
     """
 
     def __init__(self, margin: float, *, compiled: bool | None = None):
@@ -264,6 +266,7 @@ class PairCache:
         self.margin = float(margin)
         self.compiled = compiled
         self.stiffness_scale = 1.0
+        self.friction = None
         self.builds = 0
         self._x = None
         self._pairs = None

@@ -58,6 +58,7 @@ from rftstatic.compiled import choose_kernels
 from rftstatic.contact.self_contact.broad_phase import PairCache, Pairs, SheetPrimitives, find_pairs
 from rftstatic.contact.self_contact.distance import (edge_edge, edge_edge_distance2, point_triangle,
                                                      point_triangle_distance2)
+from rftstatic.contact.self_contact.friction import with_friction
 from rftstatic.contact.self_contact.law_kernels import additive_ccd_nodes, psd_project
 from rftstatic.contact.self_contact.near_pairs import NearPairCache, SelfContactStats, pair_nodes
 from rftstatic.model.frozen import Frozen
@@ -167,6 +168,8 @@ class SelfContact(Frozen):
         :data:`SWEEP_PAIRS` budget)
     kernels : ``"numpy"`` or ``"compiled"``, the kernels of every loop of the law and its pair caches
         (:func:`rftstatic.compiled.choose_kernels`; default: its choice for a self-contact run on this mesh)
+    friction : Coulomb friction between the layers (a :class:`rftstatic.contact.friction.FrictionLaw` with one
+        coefficient pair), lagged by the static route (:mod:`.friction`); None: frictionless
 
     Attributes
     ----------
@@ -176,7 +179,9 @@ class SelfContact(Frozen):
     """
 
     def __init__(self, mesh, thickness: float, stiffness: float, *, margin: float | None = None,
-                 min_fraction: float = MIN_FRACTION, sweep_limit: float | None = None, kernels: str | None = None):
+                 min_fraction: float = MIN_FRACTION, sweep_limit: float | None = None, kernels: str | None = None,
+                 friction=None):
+        self.friction = friction
         self.prims = SheetPrimitives.of_mesh(mesh)
         X = mesh.X3
         e = self.prims.edges
@@ -236,7 +241,8 @@ class SelfContact(Frozen):
     def evaluate(self, x, *, tangent: bool = True, cache: PairCache | None = None,
                  project: bool = True) -> SelfContactState:
         """Energy, force and pair blocks at positions ``x (N, 3)`` [m] over the pairs within ``d + margin``
-        (:meth:`pairs`), the stiffness times the solve's ``cache.stiffness_scale`` (1 without a cache);
+        (:meth:`pairs`), the stiffness times the solve's ``cache.stiffness_scale`` (1 without a cache), with the
+        solve's lagged friction between layers ``cache.friction`` (:mod:`.friction`) added when it has one;
         ``project``: the blocks projected to PSD (False: the exact Hessian blocks, for tests)."""
         x = self._check_x(x)
         pairs = self.pairs(x, cache)
@@ -244,7 +250,15 @@ class SelfContact(Frozen):
             npt, nee = cache.npt, cache.nee
         else:
             npt, nee = self._x4(x, pairs)
-        return self.evaluate_pairs(x, npt, nee, tangent=tangent, project=project, scale=_scale(cache))
+        state = self.evaluate_pairs(x, npt, nee, tangent=tangent, project=project, scale=_scale(cache))
+        lag = getattr(cache, "friction", None)  # the solve's lagged friction between layers, if any
+        return state if lag is None else with_friction(state, lag, x, tangent)
+
+    def normal_force(self, delta, scale: float = 1.0) -> np.ndarray:
+        """The push ``-e'(delta) (A,)`` [N] of pairs at distances ``delta (A,)`` [m] below the thickness
+        (:func:`pair_law`), the stiffness times ``scale``."""
+        d = self.thickness
+        return -pair_law(np.maximum(np.asarray(delta, dtype=float), 1e-12 * d), d, self.stiffness * scale)[1]
 
     def evaluate_pairs(self, x, npt, nee, *, tangent: bool = True, project: bool = True,
                        scale: float = 1.0) -> SelfContactState:
