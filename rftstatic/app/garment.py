@@ -21,16 +21,15 @@ without gravity (each run up to :data:`CLOSING_TIME`; a pattern whose seams do n
 gap), then each seam's two sides are merged into one node, so that the bending patches reach across the seams. Every
 element keeps its panel's flat shape with the warp along the panel's grain line. The form is written as
 ``body-m.obj`` [m] in the run folder and acts as a ``type = "mesh"`` obstacle
-(:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`) by penalty contact (softer by
-:data:`CLOSING_PENALTY` while the seams close); the contact surface is the form grown by :data:`CLEARANCE` times the
-sag of the garment's mean element edge on the form's most curved section, so that the garment's flat triangles,
-whose corners rest on it, do not dip into the form between them. The static solve is the ``static`` analysis's
-(:func:`rftstatic.app.static.run`) on the sewn mesh, from the closed state, so the scene's ``[solver]``,
-``[contact]``, ``[[supports]]`` and ``[loads]`` apply unchanged; a support's ``at = [x, y]`` is a point of the plan
-view of the placed panels (the mesh's chart ``X``: its nearest node there). A pattern without seams (the one-ring
-circle skirt) skips the closing. Contact is frictionless: a skirt hangs on the form's waist-to-hip flare, and its
-rotation about the vertical axis (a zero-energy mode on a frictionless body of revolution) is held by a ``fixed``
-``[[supports]]`` component at one waist node.
+(:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`) by penalty contact; the contact surface is the
+form grown by :data:`CLEARANCE` times the sag of the garment's mean element edge on the form's most curved section,
+so that the garment's flat triangles, whose corners rest on it, do not dip into the form between them. The static
+solve is the ``static`` analysis's (:func:`rftstatic.app.static.run`) on the sewn mesh, from the closed state, so
+the scene's ``[solver]``, ``[contact]``, ``[[supports]]`` and ``[loads]`` apply unchanged; a support's ``at = [x,
+y]`` is a point of the plan view of the placed panels (the mesh's chart ``X``: its nearest node there). A pattern
+without seams (the one-ring circle skirt) skips the closing. Contact is frictionless: a skirt hangs on the form's
+waist-to-hip flare, and its rotation about the vertical axis (a zero-energy mode on a frictionless body of
+revolution) is held by a ``fixed`` ``[[supports]]`` component at one waist node.
 
 Measures added to ``summary.json`` (``garment``): the pattern's panels and seams, the largest seam gap at the
 start of the closing and when the seams were merged, the closing's simulated time, explicit steps and wall time,
@@ -89,10 +88,6 @@ BODY_FEATURE_ANGLE = 100.0
 sharp features (a body has none; the caps only close the surface). With the rims as features, the feature contact
 (obstacle edges against garment edges, :mod:`rftstatic.contact.features`) pumps energy into the closing runs: on a
 collar round the neck, total energy 0.130 -> 1.12 J in 0.3 s undamped, against 0.130 -> 0.128 J without it."""
-CLOSING_PENALTY = 0.25
-"""Factor on the form's penalty stiffness while the seams close: a softer contact allows a 2 x longer explicit step
-(the contact frequency is sqrt(k / rho)), and the closing needs no precise contact, only the garment kept outside the
-form (its depth in the contact surface stays below the clearance: the start check against the form tests it)."""
 CLOSING_DAMPING = 8.0
 """Mass damping of the seam-closing stage [1/s], about critical for a garment's swing on a body
 (2 sqrt(g / 0.5 m) = 8.9 /s)."""
@@ -218,8 +213,6 @@ def _closing_scene(scene, data):
     stage["loads"] = {"gravity": False}
     stage.pop("solver", None)
     stage["dynamics"] = {"t_end": CLOSING_TIME, "alpha": CLOSING_DAMPING}
-    contact = stage.setdefault("contact", {})
-    contact["factor"] = CLOSING_PENALTY * float(contact.get("factor", 1.0))
     return type(scene)(stage, scene.path, scene.name, scene.overrides)
 
 
