@@ -107,4 +107,5 @@ def test_seeded_releases_give_a_distribution_in_the_summary(tmp_path):
     seeds = json.loads((tmp_path / "run" / "summary.json").read_text())["seeds"]
     assert seeds["count"] == 3 and seeds["solved"] == 3 and len(seeds["fold_counts"]) == 3
     assert 0 < seeds["drape_coefficient_percent_mean"] < 100 and seeds["fold_count_mean"] >= 2
+    assert seeds["lowest_energy"]["energy"] == min(r["energy"] for r in seeds["specimens"]) < 0
     assert res.summary["seeds"] == seeds
