@@ -27,8 +27,8 @@ Studies:
   (``StaticOptions.from_state``): a candidate route, compared with the two above on the same fabrics;
 - ``release``: the release route (``solver.start = "release"``: the sheet at full weight on a support plane lowered
   step by step, Newton at each height, :mod:`rftstatic.solvers.release`) on the wool and a limp fabric (the wool's
-  rigidities x 0.25), over ``--seeds`` seeds at the scene's lift and at 0.3 element sizes, and the wool at a smaller
-  lowering step (``solver.release_step``), which a quasi-static route must not depend on;
+  rigidities x 0.25), over ``--seeds`` seeds at the scene's lift and at 0.3 element sizes, the wool at a smaller
+  lowering step (``solver.release_step``), which a quasi-static route must not depend on, and on coarser meshes;
 - ``causes``: one change at a time (isotropic bending, the alternate diagonal pattern, a ten times stiffer
   in-plane shear, a ten times softer membrane), both routes, to find what sets the fold count.
 """
@@ -65,7 +65,8 @@ LIMP = [f"material.{k}={v * 0.25}" for k, v in WOOL.items()]
 RELEASE_CASES = [("wool", []), ("wool, B x 0.25", LIMP),
                  ("wool, lift 0.3 element sizes", ["solver.perturbation=0.3"]),
                  ("wool, B x 0.25, lift 0.3 element sizes", [*LIMP, "solver.perturbation=0.3"]),
-                 ("wool, lowering step 0.2 element sizes", ["solver.release_step=0.2"])]
+                 ("wool, lowering step 0.2 element sizes", ["solver.release_step=0.2"]),
+                 ("wool, mesh 7 x 80", ["mesh.nodes=[7,80]"]), ("wool, mesh 10 x 120", ["mesh.nodes=[10,120]"])]
 CAUSES = [("as the scene", []),
           ("isotropic bending (B_weft = B_warp, B_twist = B_warp / 2)", ["material.B_weft=0.083", "material.B_twist=0.0415"]),
           ("alternate diagonal pattern", ["mesh.pattern=alternate"]),
