@@ -28,6 +28,12 @@ fraction of the element size.
 The kinematic contact of the explicit solver is :mod:`rftstatic.contact.kinematic`.
 
 Nothing here depends on the obstacles' types: only ``signed_distance`` and ``normal_gradient`` are used.
+
+Moving obstacles: the solve's candidate list may carry a translation per obstacle
+(:attr:`rftstatic.contact.candidates.CandidateList.offsets`, set through
+:attr:`rftstatic.model.state.State.obstacle_offsets`); obstacle ``m`` is then evaluated at ``x - offsets[m]``
+(``phi(x - o)``, its normal and Hessian), so a route moves a support while the Model stays frozen. Every path that
+passes the State's candidate list (Newton's energy, residual and tangent, the explicit force) sees the same pose.
 """
 
 from __future__ import annotations

@@ -109,3 +109,24 @@ def test_seeded_releases_give_a_distribution_in_the_summary(tmp_path):
     assert 0 < seeds["drape_coefficient_percent_mean"] < 100 and seeds["fold_count_mean"] >= 2
     assert seeds["lowest_energy"]["energy"] == min(r["energy"] for r in seeds["specimens"]) < 0
     assert res.summary["seeds"] == seeds
+
+
+@pytest.mark.slow
+def test_an_interrupted_release_run_resumes_to_the_same_drape(coarse, tmp_path):
+    """The app's run: interrupted after the fourth step (its checkpoint saved there), ``--resume`` ends on the
+    uninterrupted route's drape, bit for bit."""
+    from rftstatic.app import static as app
+
+    scene, model, extras, opts, result, _ = coarse
+    steps = []
+
+    def stop(lam, U):
+        steps.append(U)
+        if len(steps) == 4:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        app.run(scene, tmp_path, progress=False, figures=False, callback=stop, checkpoint_seconds=0.0)
+    res = app.run(scene, tmp_path, progress=False, figures=False, resume=True)
+    assert res.summary["checkpoint"]["resumed_from"]["phase"] == "release"
+    assert np.array_equal(res.U, result.U) and res.summary["route"] == "release"
