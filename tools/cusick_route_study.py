@@ -65,7 +65,11 @@ LIMP = [f"material.{k}={v * 0.25}" for k, v in WOOL.items()]
 RELEASE_CASES = [("wool", []), ("wool, B x 0.25", LIMP),
                  ("wool, lift 0.3 element sizes", ["solver.perturbation=0.3"]),
                  ("wool, B x 0.25, lift 0.3 element sizes", [*LIMP, "solver.perturbation=0.3"]),
+                 ("wool, lowering step 0.5 element sizes", ["solver.release_step=0.5"]),
                  ("wool, lowering step 0.2 element sizes", ["solver.release_step=0.2"]),
+                 ("wool, lowering step 0.1 element sizes", ["solver.release_step=0.1"]),
+                 ("wool, B x 0.25, lowering step 0.5 element sizes", [*LIMP, "solver.release_step=0.5"]),
+                 ("wool, B x 0.25, lowering step 0.2 element sizes", [*LIMP, "solver.release_step=0.2"]),
                  ("wool, mesh 7 x 80", ["mesh.nodes=[7,80]"]), ("wool, mesh 10 x 120", ["mesh.nodes=[10,120]"])]
 CAUSES = [("as the scene", []),
           ("isotropic bending (B_weft = B_warp, B_twist = B_warp / 2)", ["material.B_weft=0.083", "material.B_twist=0.0415"]),

@@ -100,7 +100,7 @@ class RouteOptions:
     start: str = option("load-steps", "load-steps (load-scaled Newton from the flat sheet), relax (dynamic "
                         "relaxation at full load, then Newton) or release (the sheet at full load on a support "
                         "plane lowered step by step, Newton at each)", choices=("load-steps", "relax", "release"))
-    release_step: float = option(0.5, "release route: the support's first lowering step, in element sizes (x 1.5 "
+    release_step: float = option(0.2, "release route: the support's first lowering step, in element sizes (x 1.5 "
                                  "after each converged step, up to 4 x; x 1/4 where Newton fails)", low=0.0, high=100.0,
                                  open_low=True)
     relax_fallback: bool = option(True, "try dynamic relaxation + Newton when the load steps fail")

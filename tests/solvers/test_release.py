@@ -16,7 +16,7 @@ from rftstatic.solvers.newton import start_state
 from rftstatic.solvers.release import RELEASE, release, support_lift
 from rftstatic.solvers.static import static_route
 
-COARSE = ["solver.start=release", "mesh.nodes=[5,48]"]
+COARSE = ["solver.start=release", "mesh.nodes=[5,48]", "solver.release_step=0.5"]
 """cusick-30 on a coarse polar mesh (5 rings x 48): 8 folds, DC 62.7 % in 6 s of route."""
 
 
