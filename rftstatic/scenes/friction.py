@@ -29,9 +29,12 @@ def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
                           f"one {mu_s.min():g}; give friction_kinetic <= friction_static")
     static = scene.analysis == "static" and static_options(scene, progress=False).route.start == "load-steps"
     if not (static or scene.analysis == "dynamic"):
-        raise scene.error("contact.friction", "friction acts on the static load-step route (analysis = \"static\", "
-                          'solver.start = "load-steps") and in dynamic runs (analysis = "dynamic"); dynamic '
-                          "relaxation is frictionless in this version: set contact.friction = 0 for it")
+        given = [f"contact.{k} = {getattr(c, k)!r}" for k in ("friction", "friction_static", "friction_kinetic")
+                 if getattr(c, k)]  # the keys that gave the friction, so the message names the one set
+        raise scene.error("contact.friction", f"{', '.join(given) or 'an obstacle friction'}: friction acts on the "
+                          'static load-step route (analysis = "static", solver.start = "load-steps") and in dynamic '
+                          'runs (analysis = "dynamic"); dynamic relaxation is frictionless in this version: set '
+                          "contact.friction = 0 for it")
     from rftstatic.contact.friction import SLIP_LENGTH, FrictionLaw
 
     size = float(np.ptp(mesh.X, axis=0).max())
