@@ -25,6 +25,10 @@ Studies:
 - ``soft``: the relaxation run with the membrane rigidity x 0.1 (``build_model(..., membrane_scale=0.1)``: a
   sqrt(10) times longer stable step), then Newton at full load on the true model from its rest
   (``StaticOptions.from_state``): a candidate route, compared with the two above on the same fabrics;
+- ``release``: the release route (``solver.start = "release"``: the sheet at full weight on a support plane lowered
+  step by step, Newton at each height, :mod:`rftstatic.solvers.release`) on the wool and a limp fabric (the wool's
+  rigidities x 0.25), over ``--seeds`` seeds at the scene's lift and at 0.3 element sizes, the wool at a smaller
+  lowering step (``solver.release_step``), which a quasi-static route must not depend on, and on coarser meshes;
 - ``causes``: one change at a time (isotropic bending, the alternate diagonal pattern, a ten times stiffer
   in-plane shear, a ten times softer membrane), both routes, to find what sets the fold count.
 """
@@ -56,6 +60,17 @@ FABRICS = [("wool, B x 0.25", [f"material.{k}={v * 0.25}" for k, v in WOOL.items
            ("ctd-213-medium", ["material.preset=ctd-213-medium"]),
            ("ctd-367-heavy-stiff", ["material.preset=ctd-367-heavy-stiff"]),
            ("ctd-12-light-stiff", ["material.preset=ctd-12-light-stiff"])]
+RELEASE_ROUTE = {"release": ["solver.start=release"]}
+LIMP = [f"material.{k}={v * 0.25}" for k, v in WOOL.items()]
+RELEASE_CASES = [("wool", []), ("wool, B x 0.25", LIMP),
+                 ("wool, lift 0.3 element sizes", ["solver.perturbation=0.3"]),
+                 ("wool, B x 0.25, lift 0.3 element sizes", [*LIMP, "solver.perturbation=0.3"]),
+                 ("wool, lowering step 0.5 element sizes", ["solver.release_step=0.5"]),
+                 ("wool, lowering step 0.2 element sizes", ["solver.release_step=0.2"]),
+                 ("wool, lowering step 0.1 element sizes", ["solver.release_step=0.1"]),
+                 ("wool, B x 0.25, lowering step 0.5 element sizes", [*LIMP, "solver.release_step=0.5"]),
+                 ("wool, B x 0.25, lowering step 0.2 element sizes", [*LIMP, "solver.release_step=0.2"]),
+                 ("wool, mesh 7 x 80", ["mesh.nodes=[7,80]"]), ("wool, mesh 10 x 120", ["mesh.nodes=[10,120]"])]
 CAUSES = [("as the scene", []),
           ("isotropic bending (B_weft = B_warp, B_twist = B_warp / 2)", ["material.B_weft=0.083", "material.B_twist=0.0415"]),
           ("alternate diagonal pattern", ["mesh.pattern=alternate"]),
@@ -83,6 +98,7 @@ def solve(sets: list) -> dict:
                fold_angles=drape.get("fold_angles_deg"), energy_mJ=1e3 * energy.get("total", np.nan),
                bending_mJ=1e3 * energy.get("bending", np.nan), membrane_mJ=1e3 * energy.get("membrane", np.nan),
                route=res.route, explicit_steps=(res.relax or {}).get("steps", 0), newton=res.iterations,
+               route_steps=len(res.load_steps),
                stable=res.stable)
     return row
 
@@ -123,15 +139,15 @@ def soft_then_newton(sets: list) -> dict:
             "newton": settled.iterations + res.iterations, "stable": res.stable}
 
 
-def _runs(label: str, sets: list, seeds: list, rows: list, study: str):
+def _runs(label: str, sets: list, seeds: list, rows: list, study: str, routes=None):
     for seed in seeds:
-        for route, rsets in ROUTES.items():
+        for route, rsets in (routes or ROUTES).items():
             r = solve([*sets, *rsets, f"solver.seed={seed}"])
             r.update(study=study, case=label, route_name=route, seed=seed)
             rows.append(r)
             _keep(r)
             print(json.dumps({k: r.get(k) for k in ("study", "case", "route_name", "seed", "dc", "folds",
-                                                     "energy_mJ", "explicit_steps", "time_s")}), flush=True)
+                                                     "energy_mJ", "explicit_steps", "newton", "route_steps", "stable", "time_s")}), flush=True)
 
 
 def study_rows(studies, seeds: int, cases=None) -> list:
@@ -160,6 +176,10 @@ def study_rows(studies, seeds: int, cases=None) -> list:
                 _keep(r)
                 print(json.dumps({k: r.get(k) for k in ("case", "dc", "folds", "energy_mJ", "explicit_steps",
                                                          "time_s")}), flush=True)
+    if "release" in studies:
+        for label, sets in RELEASE_CASES:
+            if cases is None or label in cases:
+                _runs(label, sets, list(range(1, seeds + 1)), rows, "release", routes=RELEASE_ROUTE)
     if "causes" in studies:
         for label, sets in CAUSES:
             if cases is None or label in cases:
@@ -198,7 +218,8 @@ def table(rows: list) -> list:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default=str(Path(__file__).resolve().parent.parent / "validation"))
-    p.add_argument("--study", action="append", choices=["routes", "fabrics", "branches", "soft", "causes"])
+    p.add_argument("--study", action="append", choices=["routes", "fabrics", "branches", "soft", "release",
+                                                              "causes"])
     p.add_argument("--seeds", type=int, default=5, help="seeds of the routes study (the fabrics study: at most 2)")
     p.add_argument("--case", action="append", help="only these cases of the fabrics and causes studies (labels)")
     args = p.parse_args(argv)

@@ -25,13 +25,15 @@ from rftstatic.solvers.static import solve_static
 log = logging.getLogger(__name__)
 
 
-def seeded_specimens(scene, model, extras, opts, first: dict, n: int) -> dict:
+def seeded_specimens(scene, model, extras, opts, first: dict, n: int, first_energy: float | None = None) -> dict:
     """Solve ``model`` from ``n - 1`` further seeds after ``opts.route.seed`` and summarise all ``n`` drapes.
 
-    ``first``: the drape summary of the run's own solve (seed ``opts.route.seed``). A seed whose solve does not
-    converge is listed (``converged: false``) and left out of the statistics.
+    ``first``: the drape summary of the run's own solve (seed ``opts.route.seed``), ``first_energy`` its total
+    potential energy (scene units). A seed whose solve does not converge is listed (``converged: false``) and left
+    out of the statistics. ``lowest_energy``: the specimen whose drape has the lowest total potential energy, the
+    best minimum found of the one model (the drapes of a drape test are several stable equilibria, §6.2).
     """
-    rows = [{"seed": opts.route.seed, "converged": True, **_row(first)}]
+    rows = [{"seed": opts.route.seed, "converged": True, **_row(first), "energy": first_energy}]
     levels = run_options(scene).levels
     for k in range(1, n):
         t0 = time.perf_counter()
@@ -44,7 +46,8 @@ def seeded_specimens(scene, model, extras, opts, first: dict, n: int) -> dict:
             res, ok = exc.result, False
         row = {"seed": seeded.route.seed, "converged": ok, "wall_time_s": time.perf_counter() - t0}
         if ok:
-            row.update(_row(drape_summary(scene, model, extras, res.U)), stable_minimum=res.stable)
+            row.update(_row(drape_summary(scene, model, extras, res.U)), stable_minimum=res.stable,
+                       energy=res.energies.get("total", np.nan) / scene.units.energy)
         rows.append(row)
     good = [r for r in rows if r["converged"] and r.get("drape_coefficient_percent") is not None]
     dc = np.array([r["drape_coefficient_percent"] for r in good])
@@ -55,6 +58,9 @@ def seeded_specimens(scene, model, extras, opts, first: dict, n: int) -> dict:
                    drape_coefficient_percent_max=float(dc.max()),
                    drape_coefficient_percent_std=float(dc.std(ddof=1)) if len(dc) > 1 else 0.0,
                    fold_count_mean=float(np.mean(folds)))
+    known = [r for r in good if r.get("energy") is not None and np.isfinite(r["energy"])]
+    if known:
+        out["lowest_energy"] = min(known, key=lambda r: r["energy"])
     return out
 
 

@@ -88,7 +88,8 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     if model.bending_friction is not None and state is not None:  # bending hysteresis: what the route dissipated
         summary["bending_hysteresis"] = hysteresis_summary(scene, model, state, result.U)
     if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
-        summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds)
+        summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds,
+                                            first_energy=summary["energies"].get("total"))
     summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or resumed else None, "writes": saver.writes,
                              "write_time_s": saver.write_time, "resumed_from": resumed}
     write_outputs(scene, model, extras, result.U, out, summary, figures=figures)

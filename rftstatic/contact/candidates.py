@@ -6,6 +6,10 @@ Until some point has moved more than ``margin / 2`` since then, every other poin
 ``margin / 2`` from the obstacles, so only the candidates need their distance: the contact computed
 with the list is the same as without it. The list is a cache of the solve (it lives in the
 :class:`~rftstatic.model.state.State`, not in the Model) and never changes a result.
+
+It also carries the one thing of the contact that is not a cache, the obstacles' poses in this solve
+(:attr:`CandidateList.offsets`: a translation per obstacle, e.g. a support lowered by a route), as the
+self-contact pair cache carries the solve's stiffness scale: every contact evaluation receives the list.
 """
 
 from __future__ import annotations
@@ -29,6 +33,26 @@ class CandidateList:
         self._gap = None  # (N,) distances at the refresh [m]
         self.pairs = None  # a law's pair list and the positions it was built at (rftstatic.contact.features)
         self.friction = None  # the solve's lagged friction (State.contact_history["friction"], rftstatic.contact.friction)
+        self._offsets = None  # (M, 3) translation of each obstacle in this solve [m]; None: all at rest
+
+    @property
+    def offsets(self) -> np.ndarray | None:
+        """``(M, 3)`` translation [m] of each of the contact law's ``M`` obstacles from its built pose in this
+        solve (obstacle ``m`` is evaluated at ``x - offsets[m]``); None: every obstacle where it was built."""
+        return self._offsets
+
+    @offsets.setter
+    def offsets(self, value) -> None:
+        new = None if value is None else np.array(value, dtype=float)
+        if new is not None and (new.ndim != 2 or new.shape[1] != 3 or not np.isfinite(new).all()):
+            raise ValueError(f"obstacle offsets must be a finite (M, 3) array [m], got {value!r}")
+        if new is not None and not new.any():
+            new = None
+        same = (new is None and self._offsets is None) or (
+            new is not None and self._offsets is not None and np.array_equal(new, self._offsets))
+        if not same:  # the distances at the last refresh are the old pose's: make the list again
+            self._offsets = new
+            self.reset()
 
     def reset(self, margin: float | None = None) -> None:
         """Forget the list (e.g. a new mesh); optionally a new ``margin`` [m]."""

@@ -28,6 +28,12 @@ fraction of the element size.
 The kinematic contact of the explicit solver is :mod:`rftstatic.contact.kinematic`.
 
 Nothing here depends on the obstacles' types: only ``signed_distance`` and ``normal_gradient`` are used.
+
+Moving obstacles: the solve's candidate list may carry a translation per obstacle
+(:attr:`rftstatic.contact.candidates.CandidateList.offsets`, set through
+:attr:`rftstatic.model.state.State.obstacle_offsets`); obstacle ``m`` is then evaluated at ``x - offsets[m]``
+(``phi(x - o)``, its normal and Hessian), so a route moves a support while the Model stays frozen. Every path that
+passes the State's candidate list (Newton's energy, residual and tangent, the explicit force) sees the same pose.
 """
 
 from __future__ import annotations
@@ -174,12 +180,29 @@ class PenaltyContact(Frozen):
         """Signed distances ``(M, N)`` [m] and normals ``(M, N, 3)`` for the ``M`` obstacles."""
         return self._distances_of(_as_points(x, self.n_nodes))
 
-    def _distances_of(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """As :meth:`_distances` for any number of points ``(P, 3)`` [m]."""
+    def _distances_of(self, x: np.ndarray, offsets=None) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`_distances` for any number of points ``(P, 3)`` [m]; ``offsets (M, 3)`` [m]: the obstacles'
+        translations in the solve (:attr:`~rftstatic.contact.candidates.CandidateList.offsets`), None: none."""
         if not self.obstacles:
             return np.full((0, x.shape[0]), np.inf), np.zeros((0, x.shape[0], 3))
-        phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
+        if offsets is None:
+            phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
+        else:  # a translated obstacle: its distance at the point moved back by the translation
+            phis, normals = zip(*(ob.signed_distance(x - o) for ob, o in zip(self.obstacles, offsets)))
         return np.stack(phis), np.stack(normals)
+
+    def _offsets(self, candidates):
+        """The obstacles' translations ``(M, 3)`` [m] the solve's ``candidates`` carry, or None."""
+        offsets = getattr(candidates, "offsets", None)
+        if offsets is None:
+            return None
+        if offsets.shape != (len(self.obstacles), 3):
+            raise ValueError(f"obstacle offsets have shape {offsets.shape}, the contact has {len(self.obstacles)} "
+                             "obstacles: give one (x, y, z) translation per obstacle")
+        if self.features is not None:
+            raise ValueError("obstacle offsets move smooth obstacles only: this contact has sharp features "
+                             "(edges of a surface obstacle), whose edge contact does not move with them")
+        return offsets
 
     def evaluate(self, x: np.ndarray, *, tangent: bool = True, candidates: CandidateList | None = None
                  ) -> ContactState:
@@ -197,9 +220,10 @@ class PenaltyContact(Frozen):
         """
         x = _as_points(x, self.n_nodes)
         n = x.shape[0]
+        offsets = self._offsets(candidates)
         cand, gap = self._near(x, candidates)
         xc = x[cand]
-        phi, normal = self._distances_of(xc)
+        phi, normal = self._distances_of(xc, offsets)
         e, d1, d2 = self._density(phi)  # energy density, d/dphi, d2/dphi2 per unit k A  (M, C)
         ka = self.stiffness * self.node_area[cand]  # (C,) [N/m]
         energy = float(np.sum(ka * np.sum(e, axis=0)))
@@ -213,7 +237,7 @@ class PenaltyContact(Frozen):
                 act = phi[m] <= self.smoothing
                 if not np.any(act):
                     continue
-                H = ob.normal_gradient(xc[act])
+                H = ob.normal_gradient(xc[act] if offsets is None else xc[act] - offsets[m])
                 nn = np.einsum("ni,nj->nij", normal[m, act], normal[m, act])
                 block = d2[m, act, None, None] * nn + d1[m, act, None, None] * H
                 if ob.psd_tangent:
@@ -249,7 +273,7 @@ class PenaltyContact(Frozen):
         hit = candidates.lookup(x)
         if hit is not None:
             return hit
-        phi, _ = self._distances_of(x)
+        phi, _ = self._distances_of(x, self._offsets(candidates))
         gap = phi.min(axis=0)
         return candidates.refresh(x, gap), gap.copy()
 
@@ -295,7 +319,7 @@ class PenaltyContact(Frozen):
         cand, _ = self._near(x, candidates)
         force = np.zeros((x.shape[0], 3))
         if cand.size:
-            phi, normal = self._distances_of(x[cand])
+            phi, normal = self._distances_of(x[cand], self._offsets(candidates))
             d1 = self._slope(phi)
             force[cand] = np.einsum("n,mn,mni->ni", self.stiffness * self.node_area[cand], d1, normal)
         if self.features is not None:

@@ -121,6 +121,22 @@ class State:
         self.self_pairs.stiffness_scale = float(value)
 
     @property
+    def obstacle_offsets(self) -> np.ndarray | None:
+        """``(M, 3)`` translation [m] of each obstacle of the model's contact law from its built pose in this solve
+        (a support lowered by a route, :mod:`rftstatic.solvers.release`); None: all where they were built. Not a
+        cache: it travels on the candidate list :attr:`candidates` to every contact evaluation
+        (:attr:`rftstatic.contact.candidates.CandidateList.offsets`)."""
+        return None if self.candidates is None else self.candidates.offsets
+
+    @obstacle_offsets.setter
+    def obstacle_offsets(self, value) -> None:
+        if self.candidates is None:
+            if value is None:
+                return
+            raise ValueError("this state has no penalty contact: it has no obstacles to move")
+        self.candidates.offsets = value
+
+    @property
     def V_half(self) -> np.ndarray:
         """The half-step velocity v_(n-1/2) of the central-difference scheme [m/s] (= ``V``)."""
         return self.V

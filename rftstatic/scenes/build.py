@@ -28,6 +28,7 @@ from rftstatic.scenes.ranges import (
     sheet_size,
 )
 from rftstatic.scenes.schema import MESH_NODES, Scene
+from rftstatic.scenes.release import release_support
 from rftstatic.scenes.self_contact import build_self_contact
 
 MESH_KEYS = {
@@ -316,7 +317,8 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     check_obstacle_positions(scene, mesh)
     check_obstacle_sizes(scene, mesh, OBSTACLE_POSITION_KEYS)
     obstacles = build_obstacles(scene)
-    if not obstacles:
+    support = release_support(scene, mesh, law)  # the release route's support: the law's last obstacle
+    if not obstacles and not support:
         return None, []
     if start_check:
         check_surface_obstacles(scene, mesh, obstacles, law)
@@ -336,7 +338,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
                          weight=max(material.weight, 1e-300), h=h, factor=c.factor)
     if hold:
         hold_inplane_rigid_modes(mesh, supports)
-    return PenaltyContact(obstacles, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh,
+    return PenaltyContact(obstacles + support, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh,
                           friction=friction), obstacles
 
 

@@ -28,9 +28,11 @@ def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
         raise scene.error("contact.friction_kinetic", f"the kinetic coefficient {mu_k.max():g} exceeds the static "
                           f"one {mu_s.min():g}; give friction_kinetic <= friction_static")
     if scene.analysis not in ("static", "dynamic"):
-        raise scene.error("contact.friction", f'friction acts in static solves (analysis = "static", by load steps '
-                          f'or by relaxation and Newton) and dynamic runs (analysis = "dynamic"), not in analysis = '
-                          f'"{scene.analysis}": set contact.friction = 0 for it')
+        given = [f"contact.{k} = {getattr(c, k)!r}" for k in ("friction", "friction_static", "friction_kinetic")
+                 if getattr(c, k)]  # the keys that gave the friction, so the message names the one set
+        raise scene.error("contact.friction", f"{', '.join(given) or 'an obstacle friction'}: friction acts in static "
+                          'solves (analysis = "static", by load steps or by relaxation and Newton) and dynamic runs '
+                          f'(analysis = "dynamic"), not in analysis = "{scene.analysis}": set contact.friction = 0 for it')
     from rftstatic.contact.friction import SLIP_LENGTH, FrictionLaw
 
     size = float(np.ptp(mesh.X, axis=0).max())

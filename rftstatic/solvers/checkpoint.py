@@ -88,8 +88,9 @@ CHECKPOINT_FORMAT = 2
 
 SAVED = ("U", "V", "t", "step", "lam", "load_branches", "contact_history", "modes", "factorisations", "lm_scale",
          "modified_shift", "fallback", "route", "bending_slip", "dissipated")
-"""The :class:`~rftstatic.model.state.State` fields a checkpoint keeps (with ``self_contact_scale``); the
-contact candidate list, the self-contact pair cache and the linear solver are caches, made again."""
+"""The :class:`~rftstatic.model.state.State` fields a checkpoint keeps (with ``self_contact_scale`` and
+``obstacle_offsets``); the contact candidate list, the self-contact pair cache and the linear solver are caches,
+made again."""
 
 
 def encode(value, arrays: dict):
@@ -176,6 +177,7 @@ def saved_fields(state) -> dict:
     """The fields of ``state`` a checkpoint keeps (:data:`SAVED`, and the self-contact stiffness scale)."""
     saved = {name: getattr(state, name) for name in SAVED}
     saved["self_contact_scale"] = state.self_contact_scale
+    saved["obstacle_offsets"] = state.obstacle_offsets
     return saved
 
 
@@ -236,6 +238,8 @@ def restore_state(model, saved: dict, state=None):
             setattr(state, name, saved[name])
     if state.self_pairs is not None:
         state.self_contact_scale = saved.get("self_contact_scale", 1.0)
+    if state.candidates is not None:
+        state.obstacle_offsets = saved.get("obstacle_offsets")
     return state
 
 

@@ -97,8 +97,12 @@ class IncrementOptions:
 class RouteOptions:
     """How the static solve starts and where it falls back (scene keys ``solver.<name>``)."""
 
-    start: str = option("load-steps", "load-steps (load-scaled Newton from the flat sheet) or relax (dynamic "
-                        "relaxation at full load, then Newton)", choices=("load-steps", "relax"))
+    start: str = option("load-steps", "load-steps (load-scaled Newton from the flat sheet), relax (dynamic "
+                        "relaxation at full load, then Newton) or release (the sheet at full load on a support "
+                        "plane lowered step by step, Newton at each)", choices=("load-steps", "relax", "release"))
+    release_step: float = option(0.2, "release route: the support's first lowering step, in element sizes (x 1.5 "
+                                 "after each converged step, up to 4 x; x 1/4 where Newton fails)", low=0.0, high=100.0,
+                                 open_low=True)
     relax_fallback: bool = option(True, "try dynamic relaxation + Newton when the load steps fail")
     perturbation: float = option(0.0, "seeded out-of-plane start, in element sizes (0: the flat sheet)",
                                  low=0.0, high=MAX_PERTURBATION)

@@ -28,6 +28,7 @@ from rftstatic.solvers.newton import StaticResult, start_state
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
 from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RelaxOptions, relax_steps
+from rftstatic.solvers.release import RELEASE, release
 from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.units import STANDARD_GRAVITY
@@ -88,6 +89,8 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
         return done["result"]
     if RELAX_ROUTE in state.route or opts.route.start == "relax":
         result = yield from _relax_then_newton(model, opts, callback, state)
+    elif RELEASE in state.route or opts.route.start == "release":  # the support lowered: rftstatic.solvers.release
+        result = yield from release(model, state, opts, U0=U0, callback=callback)
     else:
         try:
             if opts.increments.continuation == "arc-length":
@@ -477,9 +480,8 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
 
 
 def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None, candidates=None) -> bool:
-    """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation);
-    ``pairs``: a self-contact pair cache, ``slip``: the committed bending slip, ``candidates``: the contact candidate
-    list with the lagged friction (:meth:`~rftstatic.model.model.Model.tangent`)."""
+    """Whether the exact tangent at load factor ``lam`` is positive definite at ``U`` (one factorisation); ``pairs``,
+    ``slip``, ``candidates``: the solve's caches (:meth:`~rftstatic.model.model.Model.tangent`)."""
     if not solver.detects_indefinite:
         return True
     _, K = model.tangent(U, lam=lam, pairs=pairs, slip=slip, candidates=candidates)
@@ -493,8 +495,6 @@ def _positive_definite(model, U, solver, lam=1.0, pairs=None, slip=None, candida
 def compare_with_static(model, U_relaxed, U_static=None) -> dict:
     """Difference between a relaxed state and the static Newton solution (``solve_static`` if not given):
     ``{"max_difference": [m], "max_displacement": [m], "relative": [-]}``."""
-    if U_static is None:
-        U_static = solve_static(model, options=StaticOptions(progress=False)).U
-    d = float(np.linalg.norm(U_relaxed - U_static, axis=1).max())
-    s = float(np.linalg.norm(U_static, axis=1).max())
+    U_static = solve_static(model, options=StaticOptions(progress=False)).U if U_static is None else U_static
+    d, s = (float(np.linalg.norm(v, axis=1).max()) for v in (U_relaxed - U_static, U_static))
     return {"max_difference": d, "max_displacement": s, "relative": d / max(s, 1e-300)}

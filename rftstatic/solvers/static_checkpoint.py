@@ -44,6 +44,7 @@ from rftstatic.solvers.checkpoint import (
 )
 from rftstatic.solvers.load_steps import LOAD_STEPS
 from rftstatic.solvers.newton import start_state
+from rftstatic.solvers.release import RELEASE
 from rftstatic.solvers.static import RELAX_ROUTE, SEGMENT, STATIC
 
 CHECKPOINT_SECONDS = 10.0
@@ -102,7 +103,7 @@ def load_static_state(path, model, options, *, scene: str = ""):
 
 def where(state) -> dict:
     """Where the saved static solve ``state`` stood (for ``summary.json``): phase, and load factor and load
-    steps, or relaxation time [s] and handovers."""
+    steps, or relaxation time [s] and handovers, or the release route's support height [m] and steps."""
     r = state.route
     if STATIC in r:
         res = r[STATIC]["result"]
@@ -112,6 +113,9 @@ def where(state) -> dict:
         seg = r.get(SEGMENT)
         t = route.t_used + (0.0 if seg is None else seg["t"] if isinstance(seg, dict) else seg.t)
         return {"phase": route.phase, "relaxation_time_s": t, "handovers": len(route.info.get("handovers", []))}
+    if RELEASE in r:
+        path = r[RELEASE]
+        return {"phase": "release", "support_height_m": path.height, "steps": len(path.result.load_steps)}
     if LOAD_STEPS in r:
         path = r[LOAD_STEPS]
         return {"phase": "load-steps", "load_factor": path.lam, "load_steps": len(path.result.load_steps)}
