@@ -32,7 +32,8 @@ def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
                  if getattr(c, k)]  # the keys that gave the friction, so the message names the one set
         raise scene.error("contact.friction", f"{', '.join(given) or 'an obstacle friction'}: friction acts in static "
                           'solves (analysis = "static", by load steps or by relaxation and Newton) and dynamic runs '
-                          f'(analysis = "dynamic"), not in analysis = "{scene.analysis}": set contact.friction = 0 for it')
+                          f'(analysis = "dynamic"), not in analysis = "{scene.analysis}": set contact.friction = 0 '
+                          "for it")
     from rftstatic.contact.friction import SLIP_LENGTH, FrictionLaw
 
     size = float(np.ptp(mesh.X, axis=0).max())
