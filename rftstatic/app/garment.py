@@ -59,7 +59,8 @@ import numpy as np
 from rftstatic.app import static
 from rftstatic.garment.body import DressForm
 from rftstatic.garment.meshing import check_placement, mesh_pattern, place
-from rftstatic.garment.sewing import SEAM_STIFFNESS, close_seams, panel_mesh, seam_pairs, sew
+from rftstatic.garment.sewing import (SEAM_STIFFNESS, ClosingResult, carry_closed, close_seams, panel_mesh, seam_pairs,
+                                     sew)
 from rftstatic.garment.readers import read_pattern
 from rftstatic.io.files import to_jsonable, write_json, write_vtu
 from rftstatic.post.measures.boundary import boundary_loop, fold_count
@@ -117,15 +118,20 @@ def _pattern_path(scene) -> Path:
     return path
 
 
-def dressed_mesh(scene):
-    """``(pmesh, mesh, uv)``: the meshed pattern, its panels placed around the form as one mesh with the panels apart
-    (:func:`rftstatic.garment.sewing.panel_mesh`: each element flat in its panel with the warp along the grain, the
-    placed positions its reference [m], the plan view its chart ``X``) and every node's flat pattern coordinates
-    ``uv (N, 2)`` [m]."""
+def _size(scene, key, default=None) -> float:
+    h = scene.get(key, default)
+    if not isinstance(h, (int, float)) or isinstance(h, bool) or not h > 0:
+        raise scene.error(key, f"{h!r}: give an element size (> 0, scene units)")
+    return float(h)
+
+
+def dressed_mesh(scene, h=None):
+    """``(pmesh, mesh, uv)``: the meshed pattern (element size ``h`` [scene units], default ``garment.h``), its
+    panels placed around the form as one mesh with the panels apart (:func:`rftstatic.garment.sewing.panel_mesh`:
+    each element flat in its panel with the warp along the grain, the placed positions its reference [m], the plan
+    view its chart ``X``) and every node's flat pattern coordinates ``uv (N, 2)`` [m]."""
     path = _pattern_path(scene)
-    h = scene.get("garment.h")
-    if not isinstance(h, (int, float)) or not h > 0:
-        raise scene.error("garment.h", f"{h!r}: give the target element size (> 0, scene units)")
+    h = _size(scene, "garment.h") if h is None else h
     pmesh = mesh_pattern(read_pattern(path), float(h) * scene.units.length)
     P = place(pmesh)
     world = np.stack([P[:, 0], -P[:, 2], P[:, 1]], axis=1)
@@ -216,14 +222,15 @@ def _closing_scene(scene, data):
     return type(scene)(stage, scene.path, scene.name, scene.overrides)
 
 
-def close(scene, data, mesh, pairs, *, progress=True):
+def close(scene, data, mesh, pairs, *, progress=True, start_check=True):
     """Close the seams ``pairs (S, 2)`` of the panel ``mesh`` on the scene's body (stage 1 of
-    :mod:`rftstatic.garment.sewing`): :class:`~rftstatic.garment.sewing.ClosingResult`."""
+    :mod:`rftstatic.garment.sewing`): :class:`~rftstatic.garment.sewing.ClosingResult`. ``start_check``: refuse
+    a start that cuts the contact surface (:func:`rftstatic.scenes.build.build_contact`)."""
     from rftstatic.model.model import Model
     from rftstatic.scenes.build import build_model
 
     stage = _closing_scene(scene, data)
-    base, _ = build_model(stage, mesh=mesh, contact="penalty", quiet=True)
+    base, _ = build_model(stage, mesh=mesh, contact="penalty", quiet=True, start_check=start_check)
     Dm = base.material.Dm
 
     def build(springs):
@@ -234,6 +241,63 @@ def close(scene, data, mesh, pairs, *, progress=True):
     return close_seams(build, pairs, (), weight=weight,
                        stiffest=SEAM_STIFFNESS * min(Dm[0, 0], Dm[1, 1]), t_stage=CLOSING_TIME,
                        alpha=CLOSING_DAMPING, progress=progress)
+
+
+def _with_body(data, path) -> dict:
+    """A copy of the scene's table ``data`` with the form's contact surface ``path`` (an OBJ in metres) as a mesh
+    obstacle."""
+    data = copy.deepcopy(data)
+    data.setdefault("obstacles", []).append({"type": "mesh", "path": str(Path(path).resolve()), "units": "m",
+                                             "feature_angle": BODY_FEATURE_ANGLE})
+    return data
+
+
+def _closing_levels(scene, data, out, form, pmesh, mesh, pairs, *, progress=True):
+    """The closing (stage 1 of :mod:`rftstatic.garment.sewing`), on a coarser mesh first when ``garment.closing_h``
+    is larger than ``garment.h``: ``(mesh, closing, levels)``, the garment's panel mesh (placed at the carried
+    closed positions after a coarse closing), the :class:`~rftstatic.garment.sewing.ClosingResult` of the whole
+    closing (times and steps of both levels added) and one summary row per level."""
+    h = _size(scene, "garment.h")
+    h_close = _size(scene, "garment.closing_h", h)
+    levels, coarse = [], None
+    if h_close > h:
+        cp, cmesh, _ = dressed_mesh(scene, h_close)
+        clearance = CLEARANCE * form.chord_clearance(float(cmesh.element_size.mean()))
+        form.write_obj(out / "body-closing-m.obj", clearance=clearance)
+        coarse = close(scene, _with_body(data, out / "body-closing-m.obj"), cmesh, seam_pairs(cp), progress=progress)
+        levels.append(_level_row(scene, h_close, cmesh, coarse))
+        mesh = panel_mesh(pmesh, carry_closed(cp, coarse.x, pmesh))
+        _check_off_form(scene, form, mesh, f"carried from the closing on the {h_close:g} mesh (garment.closing_h)")
+    # a carried start lies on the coarse contact surface, which the fine one (closer to the form) may cut between
+    # the coarse mesh's nodes: checked against the form itself above, the penalty contact pushes it out
+    closing = close(scene, data, mesh, pairs, progress=progress, start_check=coarse is None)
+    levels.append(_level_row(scene, h, mesh, closing))
+    if coarse is not None:
+        closing = ClosingResult(x=closing.x, largest_gap_start=coarse.largest_gap_start,
+                                largest_gap=closing.largest_gap, time=coarse.time + closing.time,
+                                steps=coarse.steps + closing.steps, wall_time=coarse.wall_time + closing.wall_time,
+                                closed=closing.closed)
+    return mesh, closing, levels
+
+
+def _check_off_form(scene, form, mesh, what) -> None:
+    """Refuse a garment ``mesh`` whose placed positions cross the form itself (the independent triangle-pair test of
+    :func:`rftstatic.post.measures.obstacle_crossings.obstacle_crossings` against ``form.surface()``)."""
+    P, T = form.surface()
+    start = obstacle_crossings(mesh.X3, mesh.tri, P, T)
+    if start["pairs"]:
+        u = scene.units.length
+        raise scene.error("garment.pattern", f"the garment {what} crosses the form ({start['pairs']} triangle pairs, "
+                          f"the first at {np.round(np.asarray(start['first_at']) / u, 3).tolist()}): place the panels "
+                          "off the form, or close on a finer mesh (garment.closing_h)")
+
+
+def _level_row(scene, h, mesh, closing) -> dict:
+    u = scene.units.length
+    return {"h": h, "nodes": mesh.n_nodes, "elements": mesh.n_elements,
+            "mean_element_size": float(mesh.element_size.mean()) / u,
+            "largest_seam_gap_start": closing.largest_gap_start / u, "largest_seam_gap": closing.largest_gap / u,
+            "time": closing.time, "steps": closing.steps, "wall_time": closing.wall_time}
 
 
 def run(scene, out: Path, *, progress=True, figures=True):
@@ -251,12 +315,11 @@ def run(scene, out: Path, *, progress=True, figures=True):
     data.pop("garment")
     data.pop("body")
     data["analysis"] = "static"
-    data.setdefault("obstacles", []).append({"type": "mesh", "path": str((out / "body-m.obj").resolve()),
-                                              "units": "m", "feature_angle": BODY_FEATURE_ANGLE})
+    data = _with_body(data, out / "body-m.obj")
     pairs = seam_pairs(pmesh)
-    closing, corner_uv = None, mesh.tri
+    closing, corner_uv, levels = None, mesh.tri, []
     if len(pairs):
-        closing = close(scene, data, mesh, pairs, progress=progress)
+        mesh, closing, levels = _closing_levels(scene, data, out, form, pmesh, mesh, pairs, progress=progress)
         if not closing.closed:
             raise scene.error("garment.pattern", f"the seams did not close in {closing.time:.3g} s: the largest gap is "
                               f"{closing.largest_gap / u:.3g} {scene.units.name.split('-')[0]} (from "
@@ -265,12 +328,8 @@ def run(scene, out: Path, *, progress=True, figures=True):
                               f"{clearance / u:.3g} {scene.units.name.split('-')[0]} outside the form at this mesh "
                               "size: a finer garment.h brings it closer)")
         mesh, _ = sew(mesh, pairs, closing.x, where=Path(pmesh.pattern.source).name)
+    _check_off_form(scene, form, mesh, "as placed and sewn")
     P, T = form.surface()
-    start = obstacle_crossings(mesh.X3, mesh.tri, P, T)
-    if start["pairs"]:
-        raise scene.error("garment.pattern", f"the placed or sewn garment crosses the form at the start "
-                          f"({start['pairs']} triangle pairs, the first at "
-                          f"{np.round(np.asarray(start['first_at']) / u, 3).tolist()}): place the panels off the form")
     solved = type(scene)(data, scene.path, scene.name, scene.overrides)
     # the start is checked against the form itself above: the contact surface, grown by the clearance, is cut by
     # the garment's flat triangles between their nodes by up to their sag (which the clearance is for)
@@ -279,7 +338,7 @@ def run(scene, out: Path, *, progress=True, figures=True):
     hem = _hem(model.mesh, model.positions(U))
     garment = _garment_measures(scene, model, U, pmesh, hem, closing)
     body = obstacle_crossings(model.positions(U), model.mesh.tri, P, T)
-    garment.update({"contact_clearance": clearance / u, "body_crossing_pairs": body["pairs"],
+    garment.update({"contact_clearance": clearance / u, "body_crossing_pairs": body["pairs"], "closing_levels": levels,
                     "body_smallest_distance": body["smallest_distance"] / u})
     summary = dict(result.summary)
     summary["analysis"] = "garment"

@@ -15,6 +15,13 @@ A garment is solved in two stages (:mod:`rftstatic.app.garment`):
    :func:`rftstatic.element.patch.unfolded_opposites`), so the sewn garment bends across its seams like
    cloth, and the garment's static equilibrium on the body is solved from there with the real loads.
 
+The closing may run on a coarser mesh of the same pattern (``garment.closing_h``): its closed positions are then
+carried to the garment's mesh through the flat pattern (:func:`carry_closed`: every node of a panel at its panel
+coordinates in the coarse panel's closed surface), where a short closing run of the fine mesh's own seam springs
+finishes the job. The closing's explicit step is set by the smallest element (membrane and contact frequencies),
+so each halving of the element size costs about eight times the explicit steps; the carried start leaves the fine
+mesh only the last millimetres.
+
 Seams of kind ``sew`` are closed and merged; ``open`` seams are left open (a slit); ``fold`` seams (a hem
 turned back, which needs a rest angle of 180 deg across the seam) are refused, naming the seam.
 """
@@ -29,8 +36,8 @@ import numpy as np
 from rftstatic.garment.pattern import PatternError
 from rftstatic.mesh.trimesh import TriMesh
 
-__all__ = ["panel_mesh", "seam_pairs", "sew", "close_seams", "ClosingResult", "CLOSING_RUNS", "SEAM_CLOSED",
-           "SEAM_PULL", "SEAM_STIFFENING", "SEAM_STIFFNESS"]
+__all__ = ["panel_mesh", "seam_pairs", "sew", "close_seams", "carry_closed", "ClosingResult", "CLOSING_RUNS",
+           "SEAM_CLOSED", "SEAM_PULL", "SEAM_STIFFENING", "SEAM_STIFFNESS"]
 
 log = logging.getLogger(__name__)
 
@@ -141,6 +148,26 @@ def sew(mesh: TriMesh, pairs: np.ndarray, x: np.ndarray, *, where: str = "patter
     sewn = TriMesh(X=chart, tri=tri, name=mesh.name, element_X=mesh.element_X, placed=merged,
                    info={**mesh.info, "sewn_from_nodes": n})
     return sewn, node_of
+
+
+def carry_closed(coarse, x, fine) -> np.ndarray:
+    """Positions (N_fine, 3) [m] of the nodes of ``fine`` (a :class:`~rftstatic.garment.meshing.PatternMesh` of the
+    same pattern) on the closed garment ``x (N_coarse, 3)`` [m] of the mesh ``coarse``: each panel's nodes at their
+    panel coordinates on the coarse panel's surface, by the quadratic of its RF patches
+    (:func:`rftstatic.remesh.transfer.transfer_fields`, route ``"patch"``: the nodes lie on the curved patch
+    surfaces, not on the coarse chords, so the fine triangles are not shortened across the coarse folds; a node
+    of a curved edge just outside the coarse panel's polygon takes its nearest triangle's quadratic). Seam nodes
+    of the two sides of a seam sit at the same fraction of the seam's arc length on both meshes
+    (:mod:`rftstatic.garment.meshing`), so the fine seams open no wider than the coarse ones."""
+    from rftstatic.remesh.transfer import transfer_fields
+
+    if len(coarse.meshes) != len(fine.meshes):
+        raise ValueError(f"the coarse mesh has {len(coarse.meshes)} panels, the fine one {len(fine.meshes)}")
+    out = np.empty((fine.n_nodes, 3))
+    for p, (mc, mf) in enumerate(zip(coarse.meshes, fine.meshes)):
+        (out[fine.offsets[p]:fine.offsets[p + 1]],) = transfer_fields(
+            mc, mf.X, [x[coarse.offsets[p]:coarse.offsets[p + 1]]], method="patch")
+    return out
 
 
 @dataclass

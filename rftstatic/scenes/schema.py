@@ -169,7 +169,9 @@ SCHEMA = {
     "cantilever": (schema_entries(CantileverOptions), "cantilever bending tester (analysis = \"cantilever\"): the "
                    "strip's mesh.size[0] is the first overhang; python -m rftstatic options cantilever"),
     "garment": ({"pattern": (str, "pattern file, GarmentCode JSON or TOML (relative to the scene)"),
-                 "h": (NUM, "target element size of the garment mesh [length]")},
+                 "h": (NUM, "target element size of the garment mesh [length]"),
+                 "closing_h": (NUM, "element size of the mesh the seams are closed on, if coarser than h [length]: "
+                               "the closed shape is carried to the garment mesh (rftstatic.garment.sewing)")},
                 "the garment of analysis = \"garment\" (rftstatic.app.garment)"),
     "body": ({"kind": (str, "dress-form (rftstatic.garment.body.DressForm)"),
               **{k: (NUM, "dress form measurement [length]") for k in

@@ -39,6 +39,19 @@ def test_the_a_line_skirt_sews_and_drapes(tmp_path):
     assert summary["garment"]["hem_folds"] >= 2
 
 
+@pytest.mark.slow
+def test_the_dress_sews_on_a_coarse_mesh_and_drapes_on_its_own(tmp_path):
+    # four panels, six seams; the seams closed on a 6 cm mesh, carried to the 4 cm garment mesh and closed there
+    out = tmp_path / "out"
+    assert main(["case", "dress", "--out", str(out), "--no-figures", "--set", "garment.h=4",
+                 "--set", "garment.closing_h=6"]) == 0
+    summary = _check_dressed(out, load_scene("dress").path.parent / "patterns" / "dress-shift.toml", 0.04)
+    levels = summary["garment"]["closing_levels"]
+    assert [r["h"] for r in levels] == [6, 4]
+    assert levels[1]["largest_seam_gap_start"] < levels[0]["largest_seam_gap_start"] / 30  # carried nearly closed
+    assert summary["garment"]["panels"] == 4
+
+
 def test_the_garmentcode_json_skirt_is_the_toml_skirt(tmp_path):
     # the same A-line skirt written to GarmentCode's published schema: the same panels, placement and seam pairs, so
     # the sewing and the drape (test_the_a_line_skirt_sews_and_drapes) are the same run
