@@ -57,6 +57,7 @@ from pathlib import Path
 import numpy as np
 
 from rftstatic.app import static
+from rftstatic.contact.obstacles.surface_mesh import SurfaceObstacle
 from rftstatic.garment.body import DressForm
 from rftstatic.garment.meshing import check_placement, mesh_pattern, place
 from rftstatic.garment.sewing import (SEAM_STIFFNESS, ClosingResult, carry_closed, close_seams, panel_mesh, seam_pairs,
@@ -81,7 +82,8 @@ CLOSING_TIME = 0.5
 (:func:`rftstatic.garment.sewing.close_seams`); a run stops as soon as the seams are closed."""
 CLEARANCE = 1.5
 """The contact surface's distance outside the form over the sag of the garment's mean element edge on the
-form's most curved section (:meth:`rftstatic.garment.body.DressForm.chord_clearance`) [-]: the garment's nodes
+form's most curved section below the garment's highest point as placed (the shoulders for a dress,
+:meth:`rftstatic.garment.body.DressForm.chord_clearance`) [-]: the garment's nodes
 rest on that surface, so its flat triangles stay off the form itself (0 crossing pairs with ``body.obj``,
 ``garment.body_crossing_pairs``)."""
 BODY_FEATURE_ANGLE = 100.0
@@ -262,14 +264,16 @@ def _closing_levels(scene, data, out, form, pmesh, mesh, pairs, *, progress=True
     levels, coarse = [], None
     if h_close > h:
         cp, cmesh, _ = dressed_mesh(scene, h_close)
-        clearance = CLEARANCE * form.chord_clearance(float(cmesh.element_size.mean()))
+        clearance = CLEARANCE * form.chord_clearance(float(cmesh.element_size.mean()), float(cmesh.X3[:, 2].max()))
         form.write_obj(out / "body-closing-m.obj", clearance=clearance)
         coarse = close(scene, _with_body(data, out / "body-closing-m.obj"), cmesh, seam_pairs(cp), progress=progress)
         levels.append(_level_row(scene, h_close, cmesh, coarse))
-        mesh = panel_mesh(pmesh, carry_closed(cp, coarse.x, pmesh))
+        # the carried nodes lie on the coarse patches, which may dip below the fine contact surface where the form
+        # is most curved (a shoulder): such nodes are moved out onto it, then checked against the form itself
+        surface = SurfaceObstacle(out / "body-m.obj", units="m", feature_angle=BODY_FEATURE_ANGLE)
+        mesh = panel_mesh(pmesh, surface.project(carry_closed(cp, coarse.x, pmesh)))
         _check_off_form(scene, form, mesh, f"carried from the closing on the {h_close:g} mesh (garment.closing_h)")
-    # a carried start lies on the coarse contact surface, which the fine one (closer to the form) may cut between
-    # the coarse mesh's nodes: checked against the form itself above, the penalty contact pushes it out
+    # (a carried start's triangles cut the contact surface by their sag, as the static stage's do: start_check off)
     closing = close(scene, data, mesh, pairs, progress=progress, start_check=coarse is None)
     levels.append(_level_row(scene, h, mesh, closing))
     if coarse is not None:
@@ -309,7 +313,8 @@ def run(scene, out: Path, *, progress=True, figures=True):
     form = dress_form(scene)
     pmesh, mesh, uv = dressed_mesh(scene)
     # the contact surface [m]: the form grown by the sag of the garment's mean edge (body.obj: the form itself)
-    clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.mean()))
+    top = float(mesh.X3[:, 2].max())  # the garment's highest point as placed: a dress reaches the shoulders
+    clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.mean()), top)
     form.write_obj(out / "body-m.obj", clearance=clearance)
     data = copy.deepcopy(scene.data)
     data.pop("garment")

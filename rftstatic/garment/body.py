@@ -159,20 +159,22 @@ class DressForm:
                                np.stack([np.full(around, nt), top + k, top + (k + 1) % around], -1)])
         return P, np.concatenate([side, caps]).astype(np.int64)
 
-    def smallest_radius(self) -> float:
-        """The smallest radius of curvature [m] of the form's sections between its bottom and its bust (where
-        garments rest): ``min b^2 / a`` over the sections (semi-axes a >= b), at the ends of each ellipse's major
-        axis."""
+    def smallest_radius(self, top: float | None = None) -> float:
+        """The smallest radius of curvature [m] of the form's sections between its bottom and ``top`` [m] (the
+        highest point of the garment; default the bust; at most the neck base): ``min b^2 / a`` over the sections
+        (semi-axes a >= b), at the ends of each ellipse's major axis. A dress reaches the shoulders, whose flat
+        sections (depth ratio 0.45) curve about twice as tightly as the hips'."""
         zl = self.levels()[0]
-        z = np.linspace(zl[0], self.bust_height, 64)
+        top = self.bust_height if top is None else min(max(top, zl[0]), self.neck_height)
+        z = np.linspace(zl[0], top, 64)
         a, b = self.section(z)
         lo, hi = np.minimum(a, b), np.maximum(a, b)
         return float((lo * lo / hi).min())
 
-    def chord_clearance(self, h: float) -> float:
+    def chord_clearance(self, h: float, top: float | None = None) -> float:
         """Depth [m] by which a flat triangle of size ``h`` [m] whose corners touch the form can dip into it: the
-        sag of a chord, ``h^2 / (8 R)`` with R the :meth:`smallest_radius`."""
-        return h * h / (8.0 * self.smallest_radius())
+        sag of a chord, ``h^2 / (8 R)`` with R the :meth:`smallest_radius` below ``top`` [m]."""
+        return h * h / (8.0 * self.smallest_radius(top))
 
     def girth(self, z, *, around: int = 64) -> float:
         """Perimeter [m] of the form's sampled section at height ``z`` [m] (the polygon of ``around`` points)."""
