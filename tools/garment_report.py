@@ -1,6 +1,6 @@
 """Write validation/garments.md: garments sewn from panels on the dress form, measured by independent checks.
 
-    python tools/garment_report.py [--out validation] [--a-line-h 1.45 1.1] [--circle-h 1.48 1.1] [--dress-h 1.45 1.1]
+    python tools/garment_report.py [--out validation] [--a-line-h 3 2] [--circle-h 4.5 3] [--dress-h 2 1.45]
 
 Every number comes from a whole-process run made here (``python -m rftstatic case SCENE --set garment.h=H``), one
 after the other: each scene on its own mesh (the whole ``case`` command, figures and all, timed: the issue's time
@@ -77,7 +77,7 @@ SCENES = (
     ("dress", "dress_h", "## The dress (four panels, six seams)",
      "`cases/dress.toml`: the sleeveless shift dress of `cases/patterns/dress-shift.toml` (front, back and two side "
      "panels; four side seams and two shoulder seams; bust 98, hip 104, hem 108 cm; hem 55 cm above the floor as "
-     "placed), the seams closed on a 5 cm mesh and carried to the garment's mesh; it hangs from its shoulder seams "
+     "placed), the seams closed on a 3 cm mesh and carried to the garment's mesh; it hangs from its shoulder seams "
      "and neckline on the form's shoulders."),
 )
 """(scene, option, heading, description) of each section."""
@@ -98,9 +98,9 @@ def _verdict(name, done) -> list:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "validation"))
-    ap.add_argument("--a-line-h", type=float, nargs="+", default=[1.45, 1.1])
-    ap.add_argument("--circle-h", type=float, nargs="+", default=[1.48, 1.1])
-    ap.add_argument("--dress-h", type=float, nargs="+", default=[1.45, 1.1])
+    ap.add_argument("--a-line-h", type=float, nargs="+", default=[3.0, 2.0])
+    ap.add_argument("--circle-h", type=float, nargs="+", default=[4.5, 3.0])
+    ap.add_argument("--dress-h", type=float, nargs="+", default=[2.0, 1.45])
     ap.add_argument("--work", default="/tmp/garment-report")
     a = ap.parse_args(argv)
     work = Path(a.work)
