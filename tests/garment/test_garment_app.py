@@ -60,3 +60,19 @@ def test_bad_body_measurements_name_the_key():
     scene = load_scene("skirt-circle", ["body.waist_height=50.0"])
     with pytest.raises(SceneError, match="body.*height"):
         dress_form(scene)
+
+
+@pytest.mark.parametrize("key, value", [("garment.h", "-1.0"), ("garment.h", "0.0"), ("garment.closing_h", "-2.0")])
+def test_bad_element_sizes_exit_2_naming_the_key(tmp_path, capsys, key, value):
+    from rftstatic.cli import main
+
+    assert main(["case", "skirt-a-line", "--set", f"{key}={value}", "--out", str(tmp_path / "o"), "--no-figures"]) == 2
+    assert key in capsys.readouterr().err
+
+
+def test_a_missing_pattern_file_names_the_key(tmp_path):
+    from rftstatic.app.garment import run
+
+    scene = load_scene("skirt-a-line", ["garment.pattern=patterns/none.toml"])
+    with pytest.raises(SceneError, match="garment.pattern.*none.toml"):
+        run(scene, tmp_path)
