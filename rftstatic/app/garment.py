@@ -27,9 +27,11 @@ so that the garment's flat triangles, whose corners rest on it, do not dip into 
 solve is the ``static`` analysis's (:func:`rftstatic.app.static.run`) on the sewn mesh, from the closed state, so
 the scene's ``[solver]``, ``[contact]``, ``[[supports]]`` and ``[loads]`` apply unchanged; a support's ``at = [x,
 y]`` is a point of the plan view of the placed panels (the mesh's chart ``X``: its nearest node there). A pattern
-without seams (the one-ring circle skirt) skips the closing. Contact is frictionless: a skirt hangs on the form's
-waist-to-hip flare, and its rotation about the vertical axis (a zero-energy mode on a frictionless body of
-revolution) is held by a ``fixed`` ``[[supports]]`` component at one waist node.
+without seams (the one-ring circle skirt) skips the closing. ``[contact] friction`` (Coulomb, garment on form)
+acts in the closing's explicit runs (impulses) and in the static solve (lagged from the last state, stick anchors:
+:mod:`rftstatic.contact.friction`); the scenes are frictionless: a skirt hangs on the form's waist-to-hip flare, and
+a circle skirt's rotation about the vertical axis (a zero-energy mode on a frictionless body of revolution) is held
+by a ``fixed`` ``[[supports]]`` component at one waist node.
 
 Measures added to ``summary.json`` (``garment``): the pattern's panels and seams, the largest seam gap at the
 start of the closing and when the seams were merged, the closing's simulated time, explicit steps and wall time,
