@@ -10,8 +10,11 @@ height, with a depth / width ratio per level. The measurements follow ISO 8559-1
 - neck girth at the neck base.
 
 Above the bust the section widens to the shoulder breadth at the shoulder height and narrows to the neck
-girth at the neck base; the neck is a short upright cylinder. The bottom and the top are closed with flat
-caps.
+girth at the neck base; the neck is a short upright cylinder. The bottom and the top are closed with half
+ellipsoids below the bottom section and above the neck top (depth = the end section's half-depth b), so the
+form has no sharp rim: in the vertical plane through the major axis the rim curves with radius b^2 / a, the end
+section's own smallest radius (a garment hanging past the bottom of the form slides over it; a flat cap's
+90 deg rim cut the flat triangles of a skirt draped past it).
 
 Between two levels each semi-axis is interpolated in height by a monotone cubic (PCHIP), so the girths are
 met at their heights and no section bulges past its neighbours. An ellipse of half-width ``a`` and
@@ -124,29 +127,28 @@ class DressForm:
         """``(P, tri)``: the closed form as points (P, 3) [m] and outward-wound triangles (T, 3).
 
         ``sections`` rings between the bottom and the neck top (every defining level among them, so each girth
-        is met at its height), ``around`` points per ring; each flat cap is a centre point and ``around / 2 pi``
-        rings shrinking to it (its triangles about the size of the side's, not a fan of long slivers: a mesh
-        obstacle's nearest-triangle proof works with its largest triangle). ``clearance`` [m] > 0
-        gives the form grown by that much: every semi-axis longer by it and the caps moved out by it (a surface
-        about ``clearance`` outside the form, at least ``clearance`` times the cosine of the side's slope: the
-        contact surface that keeps a coarse garment's flat triangles off the curved form, :meth:`chord_clearance`).
+        is met at its height), ``around`` points per ring; each end is a half ellipsoid (module docstring) of rings
+        spaced evenly in the angle about its rim, about as far apart as the side's rings, to a centre point.
+        ``clearance`` [m] > 0 gives the form grown by that much: every semi-axis and the ends' depths longer by it
+        (a surface ``clearance`` outside the form: the contact surface that keeps a coarse garment's flat triangles
+        off the curved form, :meth:`chord_clearance`).
         """
         zl = self.levels()[0]
         z = np.unique(np.concatenate([np.linspace(zl[0], zl[-1], sections), zl]))
         a, b = self.section(z)
-        if clearance:
-            a, b = a + clearance, b + clearance
-            z = z + clearance * (np.arange(len(z)) == len(z) - 1) - clearance * (np.arange(len(z)) == 0)
+        depth = np.array([b[0], b[-1]]) + clearance  # the ends' depths [m]
+        a, b = a + clearance, b + clearance
         t = 2.0 * np.pi * np.arange(around) / around
-        m = max(1, int(round(around / (2.0 * np.pi))))  # cap rings: cap triangles about as small as the side's
-        shrink = np.arange(m, 0, -1) / m  # 1 (the end section) down to 1/m
-        zs = np.concatenate([np.full(m - 1, z[0]), z, np.full(m - 1, z[-1])])
-        f = np.concatenate([shrink[:0:-1], np.ones(len(z)), shrink[1:]])  # bottom cap rings, sides, top cap rings
-        aa = np.concatenate([np.full(m - 1, a[0]), a, np.full(m - 1, a[-1])]) * f
-        bb = np.concatenate([np.full(m - 1, b[0]), b, np.full(m - 1, b[-1])]) * f
+        spacing = (z[-1] - z[0]) / sections
+        m = [max(2, int(np.ceil(0.5 * np.pi * c / spacing))) for c in depth]  # dome rings (rim excluded) + 1
+        th = [0.5 * np.pi * np.arange(1, k) / k for k in m]  # angles of the dome rings above the rim (0, pi/2)
+        zs = np.concatenate([z[0] - depth[0] * np.sin(th[0][::-1]), z, z[-1] + depth[1] * np.sin(th[1])])
+        f = np.concatenate([np.cos(th[0][::-1]), np.ones(len(z)), np.cos(th[1])])  # the rings' shrink factors
+        aa = np.concatenate([np.full(m[0] - 1, a[0]), a, np.full(m[1] - 1, a[-1])]) * f
+        bb = np.concatenate([np.full(m[0] - 1, b[0]), b, np.full(m[1] - 1, b[-1])]) * f
         ring = np.stack([aa[:, None] * np.cos(t), bb[:, None] * np.sin(t), np.broadcast_to(zs[:, None], (len(zs), around))],
                         axis=-1)
-        P = np.concatenate([ring.reshape(-1, 3), [[0.0, 0.0, zs[0]], [0.0, 0.0, zs[-1]]]])
+        P = np.concatenate([ring.reshape(-1, 3), [[0.0, 0.0, z[0] - depth[0]], [0.0, 0.0, z[-1] + depth[1]]]])
         k = np.arange(around)
         rings = len(zs)
         r = np.arange(rings - 1)[:, None] * around
