@@ -153,9 +153,12 @@ class ForceKernel:
             W += term.potential(x) if energy else 0.0
         if self.contact is not None:
             x = self.X3 + U
-            f += self.contact.force(x, candidates=candidates)
-            if energy:
-                W += self.contact.energy(x, candidates=candidates)
+            if energy:  # one distance query for both (a surface obstacle's query is most of a contact step)
+                state = self.contact.evaluate(x, tangent=False, candidates=candidates)
+                f += state.force
+                W += state.energy
+            else:
+                f += self.contact.force(x, candidates=candidates)
         if self.self_contact is not None:
             fs = self.self_contact.near_force(self.X3 + U, pairs, energy=energy)
             if energy:

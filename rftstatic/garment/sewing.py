@@ -54,6 +54,10 @@ CLOSING_RUNS = 12
 """Most explicit runs of the closing (:func:`close_seams`): a run that comes to rest short of closing is followed
 by one with stiffer springs, a run stopped on a closed gap that springs open again by one at the same stiffness."""
 
+CLOSING_SAMPLE = 10
+"""Explicit steps between two looks at the seam gaps in a closing run (each look also evaluates the energy
+balance, a second contact query on the body's surface)."""
+
 SEAM_STIFFENING = 3.0
 """Factor on the spring stiffness from one closing run to the next [-] (:func:`close_seams`)."""
 
@@ -210,8 +214,8 @@ def close_seams(build, pairs, obstacles, *, weight: float, stiffest: float, t_st
     """Pull the seams ``pairs (S, 2)`` shut (stage 1 of the module docstring) by damped explicit runs
     (:func:`rftstatic.solvers.explicit.run_explicit`, mass damping ``alpha`` [1/s], the model's penalty contact
     and any ``obstacles`` acting kinematically), each of at most ``t_stage`` [s] and stopped as soon as the
-    largest gap is below half of :data:`SEAM_CLOSED` of the mean element size (the run takes one more step; the
-    run at the stiffest springs goes to its end). The
+    largest gap is below half of :data:`SEAM_CLOSED` of the mean element size (looked at every
+    :data:`CLOSING_SAMPLE` steps; the run takes one more step; the run at the stiffest springs goes to its end). The
     first run's springs pull with :data:`SEAM_PULL` times the garment's ``weight`` [N]; a run that comes to rest
     short of closing is followed by one with springs :data:`SEAM_STIFFENING` times stiffer, up to ``stiffest``
     [N/m], at most :data:`CLOSING_RUNS` runs, each going on from where the last stopped (positions and
@@ -241,7 +245,7 @@ def close_seams(build, pairs, obstacles, *, weight: float, stiffest: float, t_st
             # their run goes to its end (damped) rather than stop on a passing small gap
             return not last and bool(springs.gaps(X3 + state.U).max(initial=0.0) <= 0.5 * tol)
 
-        opts = ExplicitOptions(t_end=t_stage, alpha=alpha, progress=progress,
+        opts = ExplicitOptions(t_end=t_stage, alpha=alpha, progress=progress, sample_every=CLOSING_SAMPLE,
                                dt=_closing_step(model, U, alpha))
         run = run_explicit(model, opts, U0=U, V0=V, obstacles=obstacles, callback=closed, friction=friction)
         U, V, t, steps = run.U, run.V, t + float(run.t), steps + int(run.steps)
