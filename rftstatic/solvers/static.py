@@ -150,7 +150,7 @@ def _stiffen_self_contact(model, result, opts, state):
             log.warning("self-contact: Newton with the raised stiffness did not converge (%s); the equilibrium "
                         "of the last stiffness stands", exc)
             break
-        result = replace(result, self_contact_stiffenings=result.self_contact_stiffenings + 1,
+        result = replace(result, stable=None, self_contact_stiffenings=result.self_contact_stiffenings + 1,
                          self_contact_scale=state.self_contact_scale, U=res.U, residual=res.residual,
                          energies=res.energies, iterations=result.iterations + res.iterations,
                          factorisations=result.factorisations + res.factorisations,
@@ -159,13 +159,15 @@ def _stiffen_self_contact(model, result, opts, state):
 
 
 def _check_stability(model, result, state):
-    """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact
-    tangent positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver
-    cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
-    solver = state.solver
-    stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs,
+    """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact tangent
+    positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver cannot tell.
+    The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with. A result whose
+    route tested its ``U`` already (``stable`` set) is returned as it is."""
+    if result.stable is not None:
+        return result
+    stable = (_positive_definite(model, result.U, state.solver, lam=result.lam, pairs=state.self_pairs,
                                   slip=state.bending_slip, candidates=state.candidates)
-              if solver.detects_indefinite else None)
+              if state.solver.detects_indefinite else None)
     return replace(result, stable=stable)
 
 
@@ -252,10 +254,8 @@ def _relax_plan(model, first) -> _RelaxPlan:
     ConvergenceError when the sheet has no mass to move (a weightless material), when its stable step
     collapsed or when it would need more than :data:`MAX_RELAX_STEPS` explicit steps."""
 
-    def refuse(message):
-        if first is not None:
-            return ConvergenceError(f"{first}; {message}", first.result)
-        return ConvergenceError(message, None)
+    def refuse(text):
+        return ConvergenceError(text, None) if first is None else ConvergenceError(f"{first}; {text}", first.result)
 
     if not model.material.mass_per_area > 0:  # the explicit motion needs a mass (lumped_mass refuses none)
         raise refuse(f"no dynamic relaxation: the material's areal weight is {model.material.weight:g} N/m^2, so "
@@ -314,8 +314,8 @@ def _relax_route(model, opts, callback, state, first):
     plan = _relax_plan(model, first)
     if route is None:
         route = state.route[RELAX_ROUTE] = _start_route(model, opts, plan, first)
-        if first is not None:  # the end of the failed load steps' phase
-            yield _route_pause(route)
+        if first is not None:
+            yield _route_pause(route)  # the end of the failed load steps' phase
     polish = opts.from_state(relax_fallback=False)
     # a handover that fails gives way to more relaxation, not to the slower displacement iteration
     # (solved without the fallback to the displacement iteration)
@@ -328,8 +328,7 @@ def _relax_route(model, opts, callback, state, first):
     def fail(text, result=None):
         if result is not None:
             result = replace(result, route="relax+newton", relax=info, seed=route.seed)
-        if first is not None:
-            text = f"{first}; {text}"
+        text = text if first is None else f"{first}; {text}"
         return ConvergenceError(text, result if result is not None else (first.result if first else None))
 
     if route.phase in ("start", "guide"):
@@ -360,11 +359,13 @@ def _relax_route(model, opts, callback, state, first):
             history = state.bending_slip, state.dissipated  # committed by a converged Newton
             res = solve_load_steps(model, U0=route.U, options=options, callback=callback, state=state,
                                    iteration_fallback=final or long_try or first_try)
-            if first_try and not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
-                                                       slip=state.bending_slip, candidates=state.candidates):
-                state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
-                raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not a "
-                                       "stable minimum", res)
+            if first_try:  # kept only if a stable minimum; then the final stability check need not test it again
+                if not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
+                                          slip=state.bending_slip, candidates=state.candidates):
+                    state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
+                    raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not "
+                                           "a stable minimum", res)
+                res = replace(res, stable=True)
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
             if final:
@@ -413,8 +414,7 @@ def _start_route(model, opts, plan, first) -> RelaxRoute:
         U = np.zeros((model.mesh.n_nodes, 3))
         U[:, 2] = start_perturbation(model.mesh, opts.route) * model.free[:, 2]
     info = {"mass_scale": plan.mass_scale, "alpha_per_s": plan.alpha, "time_s": 0.0, "steps": 0, "handovers": [],
-            "after_failure": None if first is None else str(first)}
-    # the first stop: motion died down, |r| < |P|
+            "after_failure": None if first is None else str(first)}  # the first stop: motion died down, |r| < |P|
     return RelaxRoute(phase="start", U=U, V=None, t_used=0.0, peak=0.0, tol_force=1.0, span=plan.max_time,
                       at_rest=False, seed=seed, info=info, first=first)
 
