@@ -239,3 +239,28 @@ def test_the_first_handover_reaches_the_minimum_the_longer_relaxation_leads_to(m
     assert first.relax["steps"] < longer.relax["steps"]
     assert first.energies["total"] == pytest.approx(longer.energies["total"], rel=1e-9)
     assert np.abs(first.U - longer.U).max() < 1e-5 * np.abs(longer.U).max()  # the scene's rtol = 1e-5
+
+
+def test_the_stability_check_reuses_the_first_handovers_test(monkeypatch):
+    """The first handover keeps its Newton result only if the exact tangent is positive definite there; the final
+    stability check then does not factorise that same state again (one definiteness test, not two), and its
+    answer is that test's: a fresh test at the result's U says the same."""
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.options import static_options
+    from rftstatic.scenes.schema import load_scene
+
+    scene = load_scene("pedestal-square-20", ["mesh.nodes=[7,7]"])
+    model, _ = build_model(scene)
+    tested = []
+    definite = static._positive_definite
+
+    def counted(model, U, *args, **kw):
+        tested.append(U.copy())
+        return definite(model, U, *args, **kw)
+
+    monkeypatch.setattr(static, "_positive_definite", counted)
+    res = static.solve_static(model, options=static_options(scene, progress=False))
+    assert res.converged and res.stable is True and len(res.relax["handovers"]) == 1
+    assert len(tested) == 1 and np.array_equal(tested[0], res.U)
+    solver = static.start_state(model).solver
+    assert definite(model, res.U, solver)
