@@ -264,3 +264,35 @@ def test_the_stability_check_reuses_the_first_handovers_test(monkeypatch):
     assert len(tested) == 1 and np.array_equal(tested[0], res.U)
     solver = static.start_state(model).solver
     assert definite(model, res.U, solver)
+
+
+def test_the_mixed_try_from_a_given_state_is_short_when_the_displacement_iteration_follows(monkeypatch):
+    """At the whole load from a given state the mixed iteration gets FROM_STATE_MIXED_ITERATIONS (not twice
+    MIXED_ITERATIONS) before the displacement iteration takes over with the full budget; without that fallback
+    (the relaxation route's intermediate handovers) it keeps its own budget."""
+    from rftstatic.solvers import load_steps, mixed
+    from rftstatic.solvers.iteration import Iteration
+
+    mod = strip_model(11, 3)
+    opts = static.StaticOptions.from_keys(progress=False, relax_fallback=False, max_iterations=30).from_state()
+    U0 = np.zeros((mod.mesh.n_nodes, 3))
+    calls = []
+    real = load_steps.newton
+
+    def recorded(model, U, lam, newton_opts, state, max_step, *, scheme=None, **kw):
+        used = scheme or newton_opts.iteration
+        calls.append((used, newton_opts.max_iterations))
+        if used == "mixed":  # made to fail at its budget: the displacement iteration follows
+            return Iteration(False, U, 2 * newton_opts.max_iterations, np.inf, "forced", scheme="mixed")
+        return real(model, U, lam, newton_opts, state, max_step, scheme=scheme, **kw)
+
+    monkeypatch.setattr(load_steps, "newton", recorded)
+    res = load_steps.solve_load_steps(mod, U0=U0, options=opts)
+    assert res.converged and res.lam == 1.0
+    assert calls[0][0] == "mixed" and 2 * calls[0][1] == load_steps.FROM_STATE_MIXED_ITERATIONS
+    assert calls[1] == ("displacement", 30)
+    assert load_steps.FROM_STATE_MIXED_ITERATIONS < 2 * mixed.MIXED_ITERATIONS
+    calls.clear()
+    with pytest.raises(static.ConvergenceError):
+        load_steps.solve_load_steps(mod, U0=U0, options=opts.replace(max_continuations=0), iteration_fallback=False)
+    assert calls == [("mixed", 30)]
