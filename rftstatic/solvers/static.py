@@ -41,6 +41,9 @@ STATIC = "static"
 """The static route's key in ``State.route``: ``{"result": StaticResult}`` once the solve is done (a checkpoint
 written then lets an interrupted output step lose nothing)."""
 
+TESTED = "stable-at"
+"""Key in ``State.route`` of the U [m] where the route has just found the exact tangent positive definite."""
+
 RELAX_ROUTE = "relax-route"
 """The relaxation route's key in ``State.route``: its :class:`RelaxRoute`."""
 
@@ -112,8 +115,8 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
 
 
 SELF_CONTACT_STIFFENINGS = 3
-"""Most times the self-contact stiffness is raised (x :data:`SELF_CONTACT_STIFFENING`) after a converged
-solve whose smallest pair distance is below half the thickness, each followed by Newton from that state."""
+"""Most times the self-contact stiffness is raised (x :data:`SELF_CONTACT_STIFFENING`) after a converged solve whose
+smallest pair distance is below half the thickness, each followed by Newton from that state."""
 
 SELF_CONTACT_MIN_GAP = 0.5
 """Smallest pair distance of a converged self-contact equilibrium, as a share of the thickness d, below
@@ -159,13 +162,16 @@ def _stiffen_self_contact(model, result, opts, state):
 
 
 def _check_stability(model, result, state):
-    """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact
-    tangent positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver
-    cannot tell. The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with."""
-    solver = state.solver
-    stable = (_positive_definite(model, result.U, solver, lam=result.lam, pairs=state.self_pairs,
+    """``result.stable``: is the converged equilibrium a strict local minimum of the energy (the exact tangent
+    positive definite, one Cholesky factorisation by the solve's solver)? None when the linear solver cannot tell.
+    The tangent takes the solve's self-contact pairs, with the stiffness scale it converged with. Not factorised
+    again at the ``U`` the relaxation route's first handover found positive definite (``state.route[TESTED]``)."""
+    tested = state.route.pop(TESTED, None)
+    if tested is not None and np.array_equal(tested, result.U):
+        return replace(result, stable=True)
+    stable = (_positive_definite(model, result.U, state.solver, lam=result.lam, pairs=state.self_pairs,
                                   slip=state.bending_slip, candidates=state.candidates)
-              if solver.detects_indefinite else None)
+              if state.solver.detects_indefinite else None)
     return replace(result, stable=stable)
 
 
@@ -173,13 +179,13 @@ MAX_RELAX_STEPS = 200_000
 """Largest number of explicit steps the relaxation route may take before it is not attempted."""
 
 RELAX_TIME_ALLOWANCE = 2.0
-"""The relaxation may run this many times its expected need (100 damping times) before Newton takes
-over for good; the step-count check uses the expected need."""
+"""The relaxation may run this many times its expected need (100 damping times) before Newton takes over for good;
+the step-count check uses the expected need."""
 
 RELAX_SEGMENT_STEPS = int(RELAX_TIME_ALLOWANCE * MAX_RELAX_STEPS)
-"""Most explicit steps of one relaxation segment: the longest segment (the route's whole time) at the
-reference state's step. A segment from a state whose stable step is far shorter (a start lifted by many
-element sizes stretches the membrane) is refused before its first step, a ConvergenceError."""
+"""Most explicit steps of one relaxation segment: the longest segment (the route's whole time) at the reference
+state's step. A segment from a state whose stable step is far shorter (a start lifted by many element sizes
+stretches the membrane) is refused before its first step, a ConvergenceError."""
 
 RELAX_NEWTON_ITERATIONS = 10
 """Newton's ``max_iterations`` (doubled at full load: 20 iterations) from a relaxed state before the
@@ -193,11 +199,10 @@ own equilibrium (energy to 1e-13) in 67 iterations on sphere-30 (instead of 13,2
 116 on pedestal-round-50 (11,076 steps), 165 on pedestal-square-80 (19,521 steps)."""
 
 RELAX_BASIN_NEWTON_ITERATIONS = 40
-"""Newton's ``max_iterations`` (80 at full load) from the first relaxed state whose exact tangent is
-positive definite: in the basin of a stable minimum, Newton's line-searched descent gets there even on
-a flat energy (the 80 cm sheet at 81 x 81 needs 38-44 iterations; relaxing on and retrying with 20
-iterations took four tries and 8,700 explicit steps more). Later handovers get
-:data:`RELAX_NEWTON_ITERATIONS` again."""
+"""Newton's ``max_iterations`` (80 at full load) from the first relaxed state whose exact tangent is positive
+definite: in the basin of a stable minimum, Newton's line-searched descent gets there even on a flat energy (the
+80 cm sheet at 81 x 81 needs 38-44 iterations; relaxing on and retrying with 20 iterations took four tries and
+8,700 explicit steps more). Later handovers get :data:`RELAX_NEWTON_ITERATIONS` again."""
 
 
 @dataclass
@@ -252,10 +257,8 @@ def _relax_plan(model, first) -> _RelaxPlan:
     ConvergenceError when the sheet has no mass to move (a weightless material), when its stable step
     collapsed or when it would need more than :data:`MAX_RELAX_STEPS` explicit steps."""
 
-    def refuse(message):
-        if first is not None:
-            return ConvergenceError(f"{first}; {message}", first.result)
-        return ConvergenceError(message, None)
+    def refuse(text):
+        return ConvergenceError(text, None) if first is None else ConvergenceError(f"{first}; {text}", first.result)
 
     if not model.material.mass_per_area > 0:  # the explicit motion needs a mass (lumped_mass refuses none)
         raise refuse(f"no dynamic relaxation: the material's areal weight is {model.material.weight:g} N/m^2, so "
@@ -284,21 +287,21 @@ def _relax_plan(model, first) -> _RelaxPlan:
 def _relax_then_newton(model, opts, callback, state, *, first=None):
     """Dynamic relaxation at full load to near rest, then Newton to the full tolerance.
 
-    The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while
-    the out-of-balance force is still of the order of the weight (``|r| < |P|``): Newton usually
-    converges from there in a few iterations, and the slow tail of the relaxation (half of its steps
-    on a 33 x 33 drape) is skipped. Newton gets a short budget (:data:`RELAX_NEWTON_ITERATIONS`), here continued
-    while the energy falls (:data:`FIRST_HANDOVER_CONTINUATIONS`; taken if a stable minimum). When it fails, the
-    relaxation resumes (same displacements and velocities) in chunks of a few damping times; after each chunk the
-    tangent is factorised, and Newton tries again (:data:`RELAX_BASIN_NEWTON_ITERATIONS`) only when it is positive
-    definite (in the basin of a stable minimum: from an indefinite tangent a short-budget Newton may walk to a
-    point that is no minimum). The relaxation ends at rest at half the solver's ``rtol`` or at its time limit;
-    Newton then finishes with the solver's own budget. Coulomb friction: :func:`rftstatic.solvers.friction_lag.anchor`.
+    The relaxation first stops when the motion has died down (kinetic energy 1e-4 of its peak) while the
+    out-of-balance force is still of the order of the weight (``|r| < |P|``): Newton usually converges from there in
+    a few iterations, and the slow tail of the relaxation (half of its steps on a 33 x 33 drape) is skipped. Newton
+    gets a short budget (:data:`RELAX_NEWTON_ITERATIONS`), here continued while the energy falls
+    (:data:`FIRST_HANDOVER_CONTINUATIONS`; taken if a stable minimum). When it fails, the relaxation resumes (same
+    displacements and velocities) in chunks of a few damping times; after each chunk the tangent is factorised, and
+    Newton tries again (:data:`RELAX_BASIN_NEWTON_ITERATIONS`) only when it is positive definite (in the basin of a
+    stable minimum: from an indefinite tangent a short-budget Newton may walk to a point that is no minimum). The
+    relaxation ends at rest at half the solver's ``rtol`` or at its time limit; Newton then finishes with the
+    solver's own budget. Coulomb friction: :func:`rftstatic.solvers.friction_lag.anchor`.
 
-    A route (:mod:`rftstatic.solvers.drive`): its :class:`RelaxRoute` is ``state.route[RELAX_ROUTE]``, the
-    explicit State of a segment under way ``state.route[SEGMENT]``. It pauses (final) after the failed load
-    steps, at the end of every segment and after every failed handover, and after every explicit step of a
-    segment; given a State with a saved route, it goes on from there.
+    A route (:mod:`rftstatic.solvers.drive`): its :class:`RelaxRoute` is ``state.route[RELAX_ROUTE]``, the explicit
+    State of a segment under way ``state.route[SEGMENT]``. It pauses (final) after the failed load steps, at the end
+    of every segment and after every failed handover, and after every explicit step of a segment; given a State with
+    a saved route, it goes on from there.
     """
     try:
         return (yield from _relax_route(model, opts, callback, state, first))
@@ -314,22 +317,19 @@ def _relax_route(model, opts, callback, state, first):
     plan = _relax_plan(model, first)
     if route is None:
         route = state.route[RELAX_ROUTE] = _start_route(model, opts, plan, first)
-        if first is not None:  # the end of the failed load steps' phase
-            yield _route_pause(route)
+        if first is not None:
+            yield _route_pause(route)  # the end of the failed load steps' phase
     polish = opts.from_state(relax_fallback=False)
-    # a handover that fails gives way to more relaxation, not to the slower displacement iteration
-    # (solved without the fallback to the displacement iteration)
+    # a handover that fails gives way to more relaxation (no fallback to the slower displacement iteration)
     short = polish.replace(max_continuations=0, min_increment=1.0, max_iterations=RELAX_NEWTON_ITERATIONS)
-    # in the basin of a stable minimum the line-searched displacement iteration gets there where the
-    # mixed one (at most 2 x MIXED_ITERATIONS) wanders: the long try may fall back to it
+    # in a stable minimum's basin the line-searched displacement iteration gets there where the mixed one wanders
     basin = short.replace(max_iterations=RELAX_BASIN_NEWTON_ITERATIONS)
     info = route.info
 
     def fail(text, result=None):
         if result is not None:
             result = replace(result, route="relax+newton", relax=info, seed=route.seed)
-        if first is not None:
-            text = f"{first}; {text}"
+        text = text if first is None else f"{first}; {text}"
         return ConvergenceError(text, result if result is not None else (first.result if first else None))
 
     if route.phase in ("start", "guide"):
@@ -360,11 +360,13 @@ def _relax_route(model, opts, callback, state, first):
             history = state.bending_slip, state.dissipated  # committed by a converged Newton
             res = solve_load_steps(model, U0=route.U, options=options, callback=callback, state=state,
                                    iteration_fallback=final or long_try or first_try)
-            if first_try and not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
-                                                       slip=state.bending_slip, candidates=state.candidates):
-                state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
-                raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not a "
-                                       "stable minimum", res)
+            if first_try:  # kept only if a stable minimum (which the final stability check then knows)
+                if not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
+                                          slip=state.bending_slip, candidates=state.candidates):
+                    state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
+                    raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not "
+                                           "a stable minimum", res)
+                state.route[TESTED] = res.U
         except ConvergenceError as exc:
             handover["newton"] = str(exc)
             if final:
@@ -374,8 +376,7 @@ def _relax_route(model, opts, callback, state, first):
                     result = replace(result, U=route.U, lam=1.0, residual=float(np.linalg.norm(r)))
                 raise fail(f"{exc} (after dynamic relaxation to t = {route.t_used:.3g} s, {info['steps']} steps; "
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
-            log.info("Newton did not converge from the relaxed state at t = %.3g s (%s); relaxing further",
-                     route.t_used, exc)
+            log.info("Newton failed from the relaxed state at t = %.3g s (%s); relaxing on", route.t_used, exc)
             route.tol_force, route.span, route.phase = 0.5 * opts.newton.rtol, plan.chunk, "relax"
             yield _route_pause(route)
             continue
@@ -413,8 +414,7 @@ def _start_route(model, opts, plan, first) -> RelaxRoute:
         U = np.zeros((model.mesh.n_nodes, 3))
         U[:, 2] = start_perturbation(model.mesh, opts.route) * model.free[:, 2]
     info = {"mass_scale": plan.mass_scale, "alpha_per_s": plan.alpha, "time_s": 0.0, "steps": 0, "handovers": [],
-            "after_failure": None if first is None else str(first)}
-    # the first stop: motion died down, |r| < |P|
+            "after_failure": None if first is None else str(first)}  # the first stop: motion died down, |r| < |P|
     return RelaxRoute(phase="start", U=U, V=None, t_used=0.0, peak=0.0, tol_force=1.0, span=plan.max_time,
                       at_rest=False, seed=seed, info=info, first=first)
 

@@ -239,3 +239,60 @@ def test_the_first_handover_reaches_the_minimum_the_longer_relaxation_leads_to(m
     assert first.relax["steps"] < longer.relax["steps"]
     assert first.energies["total"] == pytest.approx(longer.energies["total"], rel=1e-9)
     assert np.abs(first.U - longer.U).max() < 1e-5 * np.abs(longer.U).max()  # the scene's rtol = 1e-5
+
+
+def test_the_stability_check_reuses_the_first_handovers_test(monkeypatch):
+    """The first handover keeps its Newton result only if the exact tangent is positive definite there; the final
+    stability check then does not factorise that same state again (one definiteness test, not two), and its
+    answer is that test's: a fresh test at the result's U says the same."""
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.options import static_options
+    from rftstatic.scenes.schema import load_scene
+
+    scene = load_scene("pedestal-square-20", ["mesh.nodes=[7,7]"])
+    model, _ = build_model(scene)
+    tested = []
+    definite = static._positive_definite
+
+    def counted(model, U, *args, **kw):
+        tested.append(U.copy())
+        return definite(model, U, *args, **kw)
+
+    monkeypatch.setattr(static, "_positive_definite", counted)
+    res = static.solve_static(model, options=static_options(scene, progress=False))
+    assert res.converged and res.stable is True and len(res.relax["handovers"]) == 1
+    assert len(tested) == 1 and np.array_equal(tested[0], res.U)
+    solver = static.start_state(model).solver
+    assert definite(model, res.U, solver)
+
+
+def test_the_mixed_try_from_a_given_state_is_short_when_the_displacement_iteration_follows(monkeypatch):
+    """At the whole load from a given state the mixed iteration gets FROM_STATE_MIXED_ITERATIONS (not twice
+    MIXED_ITERATIONS) before the displacement iteration takes over with the full budget; without that fallback
+    (the relaxation route's intermediate handovers) it keeps its own budget."""
+    from rftstatic.solvers import load_steps, mixed
+    from rftstatic.solvers.iteration import Iteration
+
+    mod = strip_model(11, 3)
+    opts = static.StaticOptions.from_keys(progress=False, relax_fallback=False, max_iterations=30).from_state()
+    U0 = np.zeros((mod.mesh.n_nodes, 3))
+    calls = []
+    real = load_steps.newton
+
+    def recorded(model, U, lam, newton_opts, state, max_step, *, scheme=None, **kw):
+        used = scheme or newton_opts.iteration
+        calls.append((used, newton_opts.max_iterations))
+        if used == "mixed":  # made to fail at its budget: the displacement iteration follows
+            return Iteration(False, U, 2 * newton_opts.max_iterations, np.inf, "forced", scheme="mixed")
+        return real(model, U, lam, newton_opts, state, max_step, scheme=scheme, **kw)
+
+    monkeypatch.setattr(load_steps, "newton", recorded)
+    res = load_steps.solve_load_steps(mod, U0=U0, options=opts)
+    assert res.converged and res.lam == 1.0
+    assert calls[0][0] == "mixed" and 2 * calls[0][1] == load_steps.FROM_STATE_MIXED_ITERATIONS
+    assert calls[1] == ("displacement", 30)
+    assert load_steps.FROM_STATE_MIXED_ITERATIONS < 2 * mixed.MIXED_ITERATIONS
+    calls.clear()
+    with pytest.raises(static.ConvergenceError):
+        load_steps.solve_load_steps(mod, U0=U0, options=opts.replace(max_continuations=0), iteration_fallback=False)
+    assert calls == [("mixed", 30)]

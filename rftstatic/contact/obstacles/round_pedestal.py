@@ -19,6 +19,7 @@ from rftstatic.contact.obstacles.base import (
     _rounded_box,
     _vertical_q,
 )
+from rftstatic.contact.obstacles import pedestal_kernels
 from rftstatic.contact.obstacles.registry import register
 
 __all__ = ["RoundPedestal"]
@@ -42,7 +43,8 @@ class RoundPedestal(Obstacle):
     ``e = (x_xy - centre_xy) / rho`` and ``g = dphi/dq``, ``G = d^2phi/dq^2``:
     ``normal = g_0 e + g_1 s_z e_z`` and ``H = J^T G J + g_0 (P_xy - e e^T) / rho`` where the rows of
     ``J`` are ``e`` and ``s_z e_z``. On the axis (``rho = 0``) ``e`` is taken as ``+x`` and the curvature
-    term is dropped (one-sided choice; the axis is inside the solid).
+    term is dropped (one-sided choice; the axis is inside the solid). Calls on many points run the compiled
+    twin (:mod:`rftstatic.contact.obstacles.pedestal_kernels`), equal to round-off.
     """
 
     type_name = "round-pedestal"
@@ -83,11 +85,24 @@ class RoundPedestal(Obstacle):
         phi, g, G = _rounded_box(q, r, hessian)
         return phi, g, G, J, e, rho, on_axis
 
+    def _compiled(self, x, hessian):
+        from rftstatic.contact.obstacles._pedestal_numba import round_all
+
+        cx, cy = self.centre_xy
+        params = (float(cx), float(cy), self.radius, self.top_z, float(self.height), self.edge_radius)
+        return pedestal_kernels.run(round_all, x, params, hessian)
+
     def signed_distance(self, x):
+        x = _as_points(x)
+        if pedestal_kernels.compiled_for(len(x)):
+            return self._compiled(x, False)[:2]
         phi, g, _, J, *_ = self._parts(x, hessian=False)
         return phi, np.einsum("na,nai->ni", g, J)
 
     def normal_gradient(self, x):
+        x = _as_points(x)
+        if pedestal_kernels.compiled_for(len(x)):
+            return self._compiled(x, True)[2]
         _, g, G, J, e, rho, on_axis = self._parts(x)
         H = np.einsum("nai,nab,nbj->nij", J, G, J)
         pxy = np.diag([1.0, 1.0, 0.0])

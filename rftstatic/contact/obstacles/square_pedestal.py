@@ -18,6 +18,7 @@ from rftstatic.contact.obstacles.base import (
     _rounded_box,
     _vertical_q,
 )
+from rftstatic.contact.obstacles import pedestal_kernels
 from rftstatic.contact.obstacles.registry import register
 
 __all__ = ["SquarePedestal"]
@@ -41,7 +42,8 @@ class SquarePedestal(Obstacle):
     ``phi`` is the rounded-box distance (:mod:`rftstatic.contact.obstacles.base`) with
     ``q_i = |p_i| - (b_i - r)``; its gradient and Hessian follow by the chain rule through
     ``dq_i/dx_i = sign(p_i)``. Infinitely tall by default: only its top face and rounded top edge are
-    ever met by a sheet that starts flat above it.
+    ever met by a sheet that starts flat above it. Calls on many points run the compiled twin
+    (:mod:`rftstatic.contact.obstacles.pedestal_kernels`), equal to round-off.
     """
 
     type_name = "square-pedestal"
@@ -86,12 +88,25 @@ class SquarePedestal(Obstacle):
         q = np.column_stack([np.abs(p) - (self.half_width - r), qz])
         return q, sign
 
+    def _compiled(self, x, hessian):
+        from rftstatic.contact.obstacles._pedestal_numba import square_all
+
+        (cx, cy), (hx, hy) = self.centre_xy, self.half_width
+        params = (float(cx), float(cy), float(hx), float(hy), self.top_z, float(self.height), self.edge_radius)
+        return pedestal_kernels.run(square_all, x, params, hessian)
+
     def signed_distance(self, x):
+        x = _as_points(x)
+        if pedestal_kernels.compiled_for(len(x)):
+            return self._compiled(x, False)[:2]
         q, sign = self._q(x)
         phi, g, _ = _rounded_box(q, self.edge_radius, hessian=False)
         return phi, g * sign
 
     def normal_gradient(self, x):
+        x = _as_points(x)
+        if pedestal_kernels.compiled_for(len(x)):
+            return self._compiled(x, True)[2]
         q, sign = self._q(x)
         _, _, G = _rounded_box(q, self.edge_radius)
         return G * sign[:, :, None] * sign[:, None, :]
