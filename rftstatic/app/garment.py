@@ -89,10 +89,11 @@ form's most curved section below the garment's highest point as placed (the shou
 rest on that surface, so its flat triangles stay off the form itself (0 crossing pairs with ``body.obj``,
 ``garment.body_crossing_pairs``)."""
 BODY_FEATURE_ANGLE = 100.0
-"""The form's ``feature_angle`` [deg] as a mesh obstacle: above the 90 deg rims of its flat caps, so the form has no
-sharp features (a body has none; the caps only close the surface). With the rims as features, the feature contact
-(obstacle edges against garment edges, :mod:`rftstatic.contact.features`) pumps energy into the closing runs: on a
-collar round the neck, total energy 0.130 -> 1.12 J in 0.3 s undamped, against 0.130 -> 0.128 J without it."""
+"""The form's ``feature_angle`` [deg] as a mesh obstacle: above its sharpest edge (46 deg between the facets at the
+shoulder points, where the sections stop widening), so the form has no sharp features (a body has none). With
+edges as features, the feature contact (obstacle edges against garment edges, :mod:`rftstatic.contact.features`)
+pumped energy into the closing runs: on a collar round the neck, with the rims of the form's former flat caps as
+features, total energy 0.130 -> 1.12 J in 0.3 s undamped, against 0.130 -> 0.128 J without them."""
 CLOSING_DAMPING = 8.0
 """Mass damping of the seam-closing stage [1/s], about critical for a garment's swing on a body
 (2 sqrt(g / 0.5 m) = 8.9 /s)."""
