@@ -10,7 +10,10 @@ height, with a depth / width ratio per level. The measurements follow ISO 8559-1
 - neck girth at the neck base.
 
 Above the bust the section widens to the shoulder breadth at the shoulder height and narrows to the neck
-girth at the neck base; the neck is a short upright cylinder. The bottom and the top are closed with half
+girth at the neck base along a quarter ellipse in each semi-axis (a rounded shoulder top: horizontal at the
+neck base, vertical at the shoulder points, where it curves with radius C^2 / A, C the height from the shoulder to
+the neck base and A the half-width it narrows by: 2.7 cm on the size-36 form; the monotone cubic there was a ridge
+of 4.5 mm radius that a dress's flat triangles cut); the neck is a short upright cylinder. The bottom and the top are closed with half
 ellipsoids below the bottom section and above the neck top (depth = the end section's half-depth b), so the
 form has no sharp rim: in the vertical plane through the major axis the rim curves with radius b^2 / a, the end
 section's own smallest radius (a garment hanging past the bottom of the form slides over it; a flat cap's
@@ -117,11 +120,28 @@ class DressForm:
                 np.concatenate([b, [self.shoulder_depth * a_s, bn, bn]]))
 
     def section(self, z):
-        """``(a, b)`` [m]: the semi-axes of the section at heights ``z`` [m] (within the form)."""
+        """``(a, b)`` [m]: the semi-axes of the section at heights ``z`` [m] (within the form): PCHIP between the
+        levels, and between the shoulder and the neck base a quarter ellipse in each semi-axis (the shoulder's
+        rounded top, module docstring)."""
         from scipy.interpolate import PchipInterpolator
 
         zl, al, bl = self.levels()
-        return PchipInterpolator(zl, al)(z), PchipInterpolator(zl, bl)(z)
+        z = np.asarray(z, float)
+        a, b = PchipInterpolator(zl, al)(z), PchipInterpolator(zl, bl)(z)
+        zs, zn = zl[4], zl[5]
+        top = (z > zs) & (z < zn)
+        if np.any(top):
+            s = np.sqrt(1.0 - ((z[top] - zs) / (zn - zs)) ** 2)
+            a[top] = al[5] + (al[4] - al[5]) * s
+            b[top] = bl[5] + (bl[4] - bl[5]) * s
+        return a, b
+
+    def shoulder_radius(self) -> float:
+        """Radius of curvature [m] of the shoulder's rounded top at the shoulder points, in the vertical plane across
+        the body: the quarter ellipse of :meth:`section`, ``C^2 / A`` with ``C`` the height from the shoulder to the
+        neck base and ``A`` the half-width it narrows by."""
+        zl, al, _ = self.levels()
+        return float((zl[5] - zl[4]) ** 2 / (al[4] - al[5]))
 
     def surface(self, *, sections: int = 80, around: int = 64, clearance: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """``(P, tri)``: the closed form as points (P, 3) [m] and outward-wound triangles (T, 3).
@@ -164,14 +184,16 @@ class DressForm:
     def smallest_radius(self, top: float | None = None) -> float:
         """The smallest radius of curvature [m] of the form's sections between its bottom and ``top`` [m] (the
         highest point of the garment; default the bust; at most the neck base): ``min b^2 / a`` over the sections
-        (semi-axes a >= b), at the ends of each ellipse's major axis. A dress reaches the shoulders, whose flat
-        sections (depth ratio 0.45) curve about twice as tightly as the hips'."""
+        (semi-axes a >= b), at the ends of each ellipse's major axis, and above the shoulders the
+        :meth:`shoulder_radius`. A dress reaches the shoulders, whose flat sections (depth ratio 0.45) curve about
+        twice as tightly as the hips'."""
         zl = self.levels()[0]
         top = self.bust_height if top is None else min(max(top, zl[0]), self.neck_height)
         z = np.linspace(zl[0], top, 64)
         a, b = self.section(z)
         lo, hi = np.minimum(a, b), np.maximum(a, b)
-        return float((lo * lo / hi).min())
+        radius = float((lo * lo / hi).min())
+        return min(radius, self.shoulder_radius()) if top > self.shoulder_height else radius
 
     def chord_clearance(self, h: float, top: float | None = None) -> float:
         """Depth [m] by which a flat triangle of size ``h`` [m] whose corners touch the form can dip into it: the
