@@ -120,7 +120,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     out.mkdir(parents=True, exist_ok=True)
     analysis = scene.analysis
     o = dynamics_options(scene)
-    obstacles = tuple(extras.get("obstacles", ()))
+    # obstacles act kinematically, unless one moves (rftstatic.scenes.motion): then all act by the model's penalty
+    obstacles = tuple(extras.get("obstacles", ())) if model.contact is None else ()
     friction = contact_friction(scene, contact_options(scene), len(obstacles), model.mesh) if obstacles else None
     names, pnodes, pw = probe_interpolation(model.mesh, extras.get("probes", {}))
     t_end = o.t_end
@@ -186,7 +187,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
 
     summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)
     summary["max_steps"] = limit
-    if (crossings := obstacle_crossing_summary(scene, model, extras, run.U)) is not None:
+    poses = run.state.obstacle_poses if run.state is not None else None  # a moved body: checked in its pose
+    if (crossings := obstacle_crossing_summary(scene, model, extras, run.U, poses=poses)) is not None:
         summary["obstacle_crossings"] = crossings
     summary["dt_reason"] = reason
     reading = RestCriterion(o.rest_tolerance).record()  # time_at_rest: the kinetic energy alone
