@@ -92,13 +92,14 @@ def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 
 
 def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True, resume=False,
-                      callback=None, backend="auto") -> dict:
+                      callback=None, backend="auto", U0=None) -> dict:
     """:func:`_run`, returning only the summary."""
     return _run(scene, model, extras, out, progress=progress, figures=figures, resume=resume, callback=callback,
-                backend=backend)[0]
+                backend=backend, U0=U0)[0]
 
 
-def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False, callback=None, backend="auto"):
+def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False, callback=None, backend="auto",
+         U0=None):
     """Run a ``dynamic`` or ``relax`` scene and write its outputs into ``out`` (module docstring).
 
     Parameters
@@ -109,6 +110,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     resume : continue from ``out/checkpoint.npz`` (a fresh run, logged, when there is none)
     callback : extra ``callback(state, sample)`` at every history sample; returning True stops the run
     backend : force back end of :func:`rftstatic.solvers.explicit.run_explicit`
+    U0 : (N, 3) displacements [m] the run starts from at rest (None: the reference), e.g. a drape's equilibrium
 
     Returns
     -------
@@ -176,7 +178,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         options = ExplicitOptions(t_end=plan.t_end, dt=plan.dt, alpha=o.alpha, mass_scale=o.mass_scale,
                                   rest_tol=o.rest_tolerance, backend=backend, max_steps=limit,
                                   max_steps_name=_limit_name(o, model.mesh.n_nodes), progress=progress)
-        state = State.initial(model)
+        state = State.initial(model, U0)
         route = explicit_steps(model, state, options, obstacles=obstacles, frame_times=save_times,
                                probes=pnodes.ravel(), callback=watch, plan=plan, friction=friction)
         reason = plan.reason

@@ -32,7 +32,7 @@ from rftstatic.contact.motion import INTERPOLATIONS, Keyframes, ObstacleMotion
 from rftstatic.errors import ParameterError
 from rftstatic.optionspec import check, option
 
-__all__ = ["MotionOptions", "MOTION_LISTS", "has_motion", "list_rows", "obstacle_motion"]
+__all__ = ["GarmentMotionOptions", "MotionOptions", "MOTION_LISTS", "has_motion", "list_rows", "obstacle_motion"]
 
 MOTION_LISTS = {
     "times": "keyframe times [time], strictly increasing (required)",
@@ -63,6 +63,26 @@ class MotionOptions:
 
     def __post_init__(__dataclass_self__):
         check(__dataclass_self__, "obstacles.motion")
+
+
+@dataclass(frozen=True, kw_only=True)
+class GarmentMotionOptions:
+    """``[motion]`` of an ``analysis = "garment-motion"`` scene (:mod:`rftstatic.app.garment_motion`): the explicit
+    run on the moving form after the static drape, in SI. The form's keyframes are ``[body.motion]`` (the keys of
+    ``obstacles.motion``)."""
+
+    t_end: float = option(4.0, "simulated time of the run on the moving form, from the draped state", unit="time",
+                          low=0.0, open_low=True)
+    alpha: float = option(2.0, "mass damping of the run (air drag on the absolute velocity; the skirt's swing is "
+                          "critically damped near 2 sqrt(g / L) = 9 /s for L = 0.5 m)", unit="rate", low=0.0,
+                          high=1e6)
+    friction: float = option(0.4, "Coulomb coefficient mu of the garment on the form, static and kinetic", low=0.0)
+    samples: int = option(40, "regular states saved (VTU, GIF frame, crossing checks)", low=1, high=1000)
+    rest_tolerance: float = option(1e-3, "kinetic / peak kinetic energy at which the garment has settled", low=0.0,
+                                   high=1.0, open_low=True)
+
+    def __post_init__(__dataclass_self__):
+        check(__dataclass_self__, "motion")
 
 
 def has_motion(scene) -> bool:

@@ -12,13 +12,13 @@ from rftstatic.optionspec import describe
 from rftstatic.remesh.options import RemeshOptions
 from rftstatic.scenes.contact_options import ContactOptions
 from rftstatic.scenes.dynamics_options import DynamicsOptions
-from rftstatic.scenes.motion import MotionOptions, list_rows
+from rftstatic.scenes.motion import GarmentMotionOptions, MotionOptions, list_rows
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 
 __all__ = ["SECTIONS", "UNDECLARED", "option_rows", "format_rows"]
 
 SECTIONS = {"solver": SOLVER_GROUPS, "dynamics": (DynamicsOptions,), "remesh": (RemeshOptions,),
-            "contact": (ContactOptions,), "cantilever": (CantileverOptions,)}
+            "contact": (ContactOptions,), "cantilever": (CantileverOptions,), "motion": (GarmentMotionOptions,)}
 """Scene table -> its declared option groups (``dynamics.frames``, a list of times bounded by ``t_end``, is the one
 scene key of these tables that is not a declared option: :mod:`rftstatic.scenes.dynamics_options`)."""
 
