@@ -97,8 +97,10 @@ def moving_scene(scene, body_obj: Path, given: dict, opts: GarmentMotionOptions)
                           "feature_angle": garment.BODY_FEATURE_ANGLE, "friction": opts.friction,
                           "motion": body["motion"]}]
     t_end = given["t_end"]
+    keys = body["motion"].get("times", []) if isinstance(body["motion"], dict) else []
+    frames = sorted({0.0, float(t_end), *(float(t) for t in keys if isinstance(t, (int, float)) and 0 <= t <= t_end)})
     data["dynamics"] = {"t_end": t_end, "alpha": given["alpha"], "samples": int(given["samples"]),
-                        "rest_tolerance": given["rest_tolerance"], "frames": [0.0, t_end]}
+                        "rest_tolerance": given["rest_tolerance"], "frames": frames}
     return type(scene)(data, scene.path, scene.name, scene.overrides)
 
 

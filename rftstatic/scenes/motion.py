@@ -71,13 +71,13 @@ class GarmentMotionOptions:
     run on the moving form after the static drape, in SI. The form's keyframes are ``[body.motion]`` (the keys of
     ``obstacles.motion``)."""
 
-    t_end: float = option(4.0, "simulated time of the run on the moving form, from the draped state", unit="time",
+    t_end: float = option(5.0, "simulated time of the run on the moving form, from the draped state", unit="time",
                           low=0.0, open_low=True)
-    alpha: float = option(2.0, "mass damping of the run (air drag on the absolute velocity; the skirt's swing is "
+    alpha: float = option(3.0, "mass damping of the run (air drag on the absolute velocity; the skirt's swing is "
                           "critically damped near 2 sqrt(g / L) = 9 /s for L = 0.5 m)", unit="rate", low=0.0,
                           high=1e6)
     friction: float = option(0.4, "Coulomb coefficient mu of the garment on the form, static and kinetic", low=0.0)
-    samples: int = option(40, "regular states saved (VTU, GIF frame, crossing checks)", low=1, high=1000)
+    samples: int = option(50, "regular states saved (VTU, GIF frame, crossing checks)", low=1, high=1000)
     rest_tolerance: float = option(1e-3, "kinetic / peak kinetic energy at which the garment has settled", low=0.0,
                                    high=1.0, open_low=True)
 
