@@ -104,17 +104,20 @@ def moving_scene(scene, body_obj: Path, given: dict, opts: GarmentMotionOptions)
     return type(scene)(data, scene.path, scene.name, scene.overrides)
 
 
-def _stage(scene, out, drape, opts, given):
-    from rftstatic.scenes.build import build_model
+def _stage(scene, out, opts, given):
+    """The moving stage's scene, its keyframes checked (before the drape is run: a bad key fails at once)."""
+    from rftstatic.scenes.motion import obstacle_motion
 
     stage = moving_scene(scene, out / DRAPE / "body-m.obj", given, opts)
-    times = stage.data["obstacles"][0]["motion"].get("times")
-    turn_end = max(times) if isinstance(times, list) and times else 0.0
-    if not (isinstance(turn_end, (int, float)) and turn_end < given["t_end"]):
+    try:
+        motion = obstacle_motion(stage, 1)
+    except Exception as exc:  # the stage's keys are the scene's [body.motion]: name them so
+        raise type(exc)(str(exc).replace("obstacles.0.motion", "body.motion")) from None
+    if not motion.end < opts.t_end:
         raise scene.error("motion.t_end", f"{given['t_end']!r} ends before the form stops (body.motion.times end at "
-                          f"{turn_end!r}): give a t_end after the last keyframe, with time to settle")
-    model, extras = build_model(stage, mesh=drape.model.mesh, contact="penalty", start_check=False)
-    return stage, model, extras
+                          f"{motion.end / scene.units.time:g}): give a t_end after the last keyframe, with time to "
+                          "settle")
+    return stage
 
 
 def run(scene, out: Path, *, progress=True, figures=True, resume=False):
@@ -125,10 +128,12 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False):
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    from rftstatic.scenes.build import build_model
+
     opts, given = motion_options(scene)
-    drape_scene = _drape_scene(scene)
-    drape = garment.run(drape_scene, out / DRAPE, progress=progress, figures=figures)
-    stage, model, extras = _stage(scene, out, drape, opts, given)
+    stage = _stage(scene, out, opts, given)
+    drape = garment.run(_drape_scene(scene), out / DRAPE, progress=progress, figures=figures)
+    model, extras = build_model(stage, mesh=drape.model.mesh, contact="penalty", start_check=False)
     summary, explicit = dynamic._run(stage, model, extras, out, progress=progress, figures=figures, resume=resume,
                                      U0=drape.U)
     form = garment.dress_form(scene)
