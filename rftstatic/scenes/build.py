@@ -27,6 +27,7 @@ from rftstatic.scenes.ranges import (
     check_weight,
     sheet_size,
 )
+from rftstatic.scenes.motion import has_motion, obstacle_motion
 from rftstatic.scenes.schema import MESH_NODES, Scene
 from rftstatic.scenes.release import release_support
 from rftstatic.scenes.self_contact import build_self_contact
@@ -289,8 +290,6 @@ def contact_law(scene: Scene) -> str:
     """The contact law the scene's analysis uses: ``"penalty"`` for static, ``"kinematic"`` for dynamic/relax; a
     dynamic scene with a moving obstacle (:mod:`rftstatic.scenes.motion`) uses the penalty, which evaluates it in
     its pose."""
-    from rftstatic.scenes.motion import has_motion
-
     return "penalty" if scene.analysis == "static" or (scene.analysis == "dynamic" and has_motion(scene)) else \
         "kinematic"
 
@@ -327,8 +326,6 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
         return None, []
     if start_check:
         check_surface_obstacles(scene, mesh, obstacles, law)
-    from rftstatic.scenes.motion import obstacle_motion
-
     motion = obstacle_motion(scene, len(obstacles) + len(support))  # keyframes: a scene error outside dynamic runs
     c = contact_options(scene)
     friction = contact_friction(scene, c, len(obstacles), mesh)
