@@ -40,6 +40,7 @@ class CandidateList:
         self.pairs = None  # a law's pair list and the positions it was built at (rftstatic.contact.features)
         self.friction = None  # the solve's lagged friction (State.contact_history["friction"], rftstatic.contact.friction)
         self._poses = None  # the obstacles' poses in this solve (rftstatic.contact.motion.Poses); None: as built
+        self._shape_ref = None  # (M,) deforming obstacles' shape times at the refresh [s]
 
     @property
     def poses(self) -> Poses | None:
@@ -80,17 +81,22 @@ class CandidateList:
         """Forget the list (e.g. a new mesh); optionally a new ``margin`` [m]."""
         if margin is not None:
             self.margin = float(margin)
-        self._indices = self._x = self._gap = self.pairs = None
+        self._indices = self._x = self._gap = self.pairs = self._shape_ref = None
 
-    def lookup(self, x: np.ndarray):
+    @property
+    def shape_times(self) -> np.ndarray | None:
+        """``(M,)`` the deforming obstacles' shape times [s] at the last refresh (NaN: rigid), or None."""
+        return self._shape_ref
+
+    def lookup(self, x: np.ndarray, slack: float = 0.0):
         """``(indices (C,), lower bounds (N,) of every point's distance [m])`` while the list is valid for
         positions ``x (N, 3)`` [m], else None (refresh it: :meth:`refresh`). The bounds are exact
-        values at the refresh minus the largest motion since; callers fill in the candidates' exact
-        distances."""
+        values at the refresh minus the largest motion since (plus ``slack`` [m], the largest motion of a
+        deforming obstacle's surface since); callers fill in the candidates' exact distances."""
         if self._x is None or self._x.shape[-2:] != x.shape:
             return None
         d = self._frames(x) - self._x
-        moved = float(np.sqrt(np.max(np.einsum("...i,...i->...", d, d), initial=0.0)))
+        moved = float(np.sqrt(np.max(np.einsum("...i,...i->...", d, d), initial=0.0))) + slack
         if moved > 0.5 * self.margin:
             return None
         return self._indices, self._gap - moved
@@ -99,6 +105,7 @@ class CandidateList:
         """Make the list from every point's distance ``gap (N,)`` [m] at ``x (N, 3)`` [m]; return the indices."""
         self._indices = np.flatnonzero(gap < self.margin)
         self._x = np.array(self._frames(x), dtype=float, copy=True)
+        self._shape_ref = None if self._poses is None else np.array(self._poses.shape_time)
         self._gap = np.array(gap, dtype=float, copy=True)
         self.refreshes += 1
         return self._indices

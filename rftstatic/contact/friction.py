@@ -234,7 +234,7 @@ def penalty_impulses(law: FrictionLaw, penalty, x: np.ndarray, v: np.ndarray, mi
     if nodes.size == 0:
         return 0.0
     vc = v[nodes]
-    surface = _surface_velocity(penalty._offsets(candidates), x[nodes], obstacle)
+    surface = _surface_velocity(penalty, penalty._offsets(candidates), x[nodes], obstacle)
     rel = vc - surface
     vt = rel - np.einsum("ci,ci->c", rel, normal)[:, None] * normal
     speed = np.linalg.norm(vt, axis=1)
@@ -250,15 +250,20 @@ def penalty_impulses(law: FrictionLaw, penalty, x: np.ndarray, v: np.ndarray, mi
     return 0.5 * float(np.sum(m * (np.einsum("ci,ci->c", vc, vc) - np.einsum("ci,ci->c", vnew, vnew))))
 
 
-def _surface_velocity(poses, x, obstacle):
+def _surface_velocity(penalty, poses, x, obstacle):
     """Velocity ``(C, 3)`` [m/s] of the obstacle surface each contact node at ``x (C, 3)`` [m] touches (its
-    ``obstacle (C,)``), by the solve's ``poses`` (:class:`rftstatic.contact.motion.Poses`; None: all at rest)."""
+    ``obstacle (C,)``), by the solve's ``poses`` (:class:`rftstatic.contact.motion.Poses`; None: all at rest): a
+    rigid body's, or a deforming one's (:meth:`rftstatic.contact.sequence.SurfaceSequence.surface_velocity`)."""
     out = np.zeros_like(x)
     if poses is None:
         return out
     for m in np.unique(obstacle):  # the few obstacles
         on = obstacle == m
-        out[on] = poses.velocity(x[on], int(m))
+        t = poses.shape_time[m]
+        if np.isnan(t):
+            out[on] = poses.velocity(x[on], int(m))
+        else:
+            out[on] = penalty.obstacles[m].surface_velocity(x[on], float(t), poses.step)
     return out
 
 

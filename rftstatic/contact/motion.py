@@ -60,6 +60,9 @@ class Poses:
     translation : (M, 3) translation ``s`` [m]
     rate_matrix : (M, 3, 3) ``A`` of the surface velocity ``v(x) = A x + b`` [1/s]
     rate_offset : (M, 3) ``b`` of that velocity [m/s]
+    shape_time : (M,) time [s] a deforming obstacle's shape is taken at
+        (:class:`rftstatic.contact.sequence.SurfaceSequence`), NaN for a rigid one (None: all rigid)
+    step : the step [s] the surface velocities are the chord of (0: at rest)
     """
 
     rotation: np.ndarray
@@ -67,9 +70,17 @@ class Poses:
     translation: np.ndarray
     rate_matrix: np.ndarray
     rate_offset: np.ndarray
+    shape_time: np.ndarray | None = None
+    step: float = 0.0
 
     def __post_init__(self):
         m = np.asarray(self.rotation).shape[0] if np.ndim(self.rotation) == 3 else -1
+        st = np.full(max(m, 0), np.nan) if self.shape_time is None else np.array(self.shape_time, dtype=float)
+        if st.shape != (m,) or np.isinf(st).any():
+            raise ValueError(f"Poses.shape_time must be (M,) = ({m},) times or NaN, got {self.shape_time!r}")
+        st.setflags(write=False)
+        object.__setattr__(self, "shape_time", st)
+        object.__setattr__(self, "step", float(self.step))
         for name, shape in (("rotation", (m, 3, 3)), ("centre", (m, 3)), ("translation", (m, 3)),
                             ("rate_matrix", (m, 3, 3)), ("rate_offset", (m, 3))):
             v = np.array(getattr(self, name), dtype=float)
@@ -98,8 +109,14 @@ class Poses:
 
     @property
     def at_rest(self) -> bool:
-        """True if no obstacle is moved from its built pose and none moves."""
-        return not (self.rotated or self.translation.any() or self.rate_matrix.any() or self.rate_offset.any())
+        """True if no obstacle is moved from its built pose and none moves or deforms."""
+        return not (self.rotated or self.translation.any() or self.rate_matrix.any() or self.rate_offset.any()
+                    or self.deforming)
+
+    @property
+    def deforming(self) -> bool:
+        """True if some obstacle's shape follows time (:attr:`shape_time`)."""
+        return bool(np.isfinite(self.shape_time).any())
 
     def to_body(self, x: np.ndarray, m: int) -> np.ndarray:
         """Points ``x (P, 3)`` [m] in obstacle ``m``'s body frame, ``R^T (x - c - s) + c`` (P1)."""
@@ -194,21 +211,25 @@ class Keyframes:
 
 
 class ObstacleMotion:
-    """The keyframed motions of the ``M`` obstacles of a contact law (None for an obstacle that stays put).
+    """The keyframed motions of the ``M`` obstacles of a contact law (None for an obstacle that stays put; a
+    :class:`~rftstatic.contact.sequence.ShapeClock` for a surface sequence, whose shape follows the time).
 
     Parameters
     ----------
-    motions : sequence of ``M`` :class:`Keyframes` or None
+    motions : sequence of ``M`` :class:`Keyframes`, ShapeClock or None
     """
 
     def __init__(self, motions):
+        from rftstatic.contact.sequence import ShapeClock
+
         self.motions = tuple(motions)
-        if not all(m is None or isinstance(m, Keyframes) for m in self.motions):
-            raise TypeError("ObstacleMotion takes one Keyframes or None per obstacle")
+        if not all(m is None or isinstance(m, (Keyframes, ShapeClock)) for m in self.motions):
+            raise TypeError("ObstacleMotion takes one Keyframes, ShapeClock or None per obstacle")
+        self._clock = np.array([not (m is None or isinstance(m, Keyframes)) for m in self.motions], bool)
 
     @property
     def end(self) -> float:
-        """Time [s] from which every obstacle holds its pose."""
+        """Time [s] from which every obstacle holds its pose and shape."""
         return max((m.end for m in self.motions if m is not None), default=0.0)
 
     def _pose(self, t):
@@ -217,7 +238,7 @@ class ObstacleMotion:
         c = np.zeros((m, 3))
         s = np.zeros((m, 3))
         for i, km in enumerate(self.motions):  # one entry per obstacle (a handful)
-            if km is not None:
+            if isinstance(km, Keyframes):
                 ang, s[i] = km.angle_translation(t)
                 R[i] = rotation(km.axis, ang)
                 c[i] = km.centre
@@ -234,4 +255,5 @@ class ObstacleMotion:
             Q = np.einsum("mij,mkj->mik", R1, R0)  # R_1 R_0^T
             A = (Q - np.eye(3)) / dt
             b = (c + s1 - np.einsum("mij,mj->mi", Q, c + s0)) / dt
-        return Poses(R0, c, s0, A, b)
+        shape = np.where(self._clock, float(t), np.nan)
+        return Poses(R0, c, s0, A, b, shape, dt if dt is not None and dt > 0 else 0.0)

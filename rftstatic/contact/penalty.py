@@ -193,15 +193,38 @@ class PenaltyContact(Frozen):
         None: as built."""
         if not self.obstacles:
             return np.full((0, x.shape[0]), np.inf), np.zeros((0, x.shape[0], 3))
+        obstacles = self._shaped(poses)
         if poses is None:
-            phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
+            phis, normals = zip(*(ob.signed_distance(x) for ob in obstacles))
         elif not poses.rotated:  # a translated obstacle: its distance at the point moved back by the translation
-            phis, normals = zip(*(ob.signed_distance(x - o) for ob, o in zip(self.obstacles, poses.translation)))
+            phis, normals = zip(*(ob.signed_distance(x - o) for ob, o in zip(obstacles, poses.translation)))
         else:  # (P2): the distance in the body frame, the normal rotated back to the world
-            pairs = [ob.signed_distance(poses.to_body(x, m)) for m, ob in enumerate(self.obstacles)]
+            pairs = [ob.signed_distance(poses.to_body(x, m)) for m, ob in enumerate(obstacles)]
             phis = [p for p, _ in pairs]
             normals = [poses.to_world(n, m) for m, (_, n) in enumerate(pairs)]
         return np.stack(phis), np.stack(normals)
+
+    def _shaped(self, poses):
+        """The obstacles as they are shaped at the poses' times: a deforming one
+        (:class:`~rftstatic.contact.sequence.SurfaceSequence`, a finite ``poses.shape_time``) by its ``shape_at``."""
+        if poses is None or not poses.deforming:
+            return self.obstacles
+        return [ob if np.isnan(t) else ob.shape_at(t) for ob, t in zip(self.obstacles, poses.shape_time)]
+
+    def _slack(self, candidates, poses) -> float:
+        """Largest surface motion [m] of the deforming obstacles since the candidate list's refresh."""
+        ref = getattr(candidates, "shape_times", None)
+        if poses is None or not poses.deforming:
+            return 0.0 if ref is None or not np.isfinite(ref).any() else np.inf
+        if ref is None:
+            return np.inf
+        out = 0.0
+        for ob, t0, t1 in zip(self.obstacles, ref, poses.shape_time):
+            if np.isnan(t0) != np.isnan(t1):
+                return np.inf
+            if not np.isnan(t1):
+                out = max(out, ob.drift(float(t0), float(t1)))
+        return out
 
     def _offsets(self, candidates):
         """The obstacles' poses (:class:`~rftstatic.contact.motion.Poses`) the solve's ``candidates`` carry, or
@@ -244,7 +267,7 @@ class PenaltyContact(Frozen):
         force[cand] = np.einsum("n,mn,mni->ni", ka, d1, normal)
         blocks = np.zeros((n, 3, 3))
         if tangent:
-            for m, ob in enumerate(self.obstacles):
+            for m, ob in enumerate(self._shaped(offsets)):
                 # touching nodes (phi = 0) get the one-sided Hessian too: a sheet laid on a support
                 # then starts with the support's stiffness instead of a singular tangent
                 act = phi[m] <= self.smoothing
@@ -289,10 +312,11 @@ class PenaltyContact(Frozen):
             return np.arange(0), np.full(n, np.inf)
         if candidates is None:
             return np.arange(n), np.full(n, np.inf)
-        hit = candidates.lookup(x)
+        poses = self._offsets(candidates)
+        hit = candidates.lookup(x, self._slack(candidates, poses))
         if hit is not None:
             return hit
-        phi, _ = self._distances_of(x, self._offsets(candidates))
+        phi, _ = self._distances_of(x, poses)
         gap = phi.min(axis=0)
         return candidates.refresh(x, gap), gap.copy()
 
