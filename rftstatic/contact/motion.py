@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Poses", "Keyframes", "ObstacleMotion", "rotation", "INTERPOLATIONS"]
+__all__ = ["Poses", "Keyframes", "ObstacleMotion", "ShapeClock", "rotation", "INTERPOLATIONS"]
 
 INTERPOLATIONS = ("smooth", "linear")
 """How the pose goes between two keyframes (module docstring)."""
@@ -50,6 +50,15 @@ def rotation(axis, angle):
 
 
 @dataclass(frozen=True)
+class ShapeClock:
+    """The entry of :class:`ObstacleMotion` for a deforming obstacle
+    (:class:`~rftstatic.contact.obstacles.surface_sequence.SurfaceSequence`): its shape follows the run's time;
+    ``end`` [s] the time of its last frame."""
+
+    end: float
+
+
+@dataclass(frozen=True)
 class Poses:
     """The rigid poses of the ``M`` obstacles of a contact law at one time (P1) and their surfaces' velocity.
 
@@ -61,7 +70,8 @@ class Poses:
     rate_matrix : (M, 3, 3) ``A`` of the surface velocity ``v(x) = A x + b`` [1/s]
     rate_offset : (M, 3) ``b`` of that velocity [m/s]
     shape_time : (M,) time [s] a deforming obstacle's shape is taken at
-        (:class:`rftstatic.contact.sequence.SurfaceSequence`), NaN for a rigid one (None: all rigid)
+        (:class:`rftstatic.contact.obstacles.surface_sequence.SurfaceSequence`), NaN for a rigid one (None: all
+        rigid)
     step : the step [s] the surface velocities are the chord of (0: at rest)
     """
 
@@ -212,7 +222,7 @@ class Keyframes:
 
 class ObstacleMotion:
     """The keyframed motions of the ``M`` obstacles of a contact law (None for an obstacle that stays put; a
-    :class:`~rftstatic.contact.sequence.ShapeClock` for a surface sequence, whose shape follows the time).
+    :class:`ShapeClock` for a surface sequence, whose shape follows the time).
 
     Parameters
     ----------
@@ -220,8 +230,6 @@ class ObstacleMotion:
     """
 
     def __init__(self, motions):
-        from rftstatic.contact.sequence import ShapeClock
-
         self.motions = tuple(motions)
         if not all(m is None or isinstance(m, (Keyframes, ShapeClock)) for m in self.motions):
             raise TypeError("ObstacleMotion takes one Keyframes, ShapeClock or None per obstacle")

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rftstatic.contact.motion import INTERPOLATIONS, Keyframes, ObstacleMotion
+from rftstatic.contact.motion import INTERPOLATIONS, Keyframes, ObstacleMotion, ShapeClock
 from rftstatic.errors import ParameterError
 from rftstatic.optionspec import check, option
 
@@ -85,9 +85,18 @@ class GarmentMotionOptions:
         check(__dataclass_self__, "motion")
 
 
+SEQUENCE = "mesh-sequence"
+"""The obstacle type whose shape follows time (:class:`rftstatic.contact.obstacles.surface_sequence.SurfaceSequence`)."""
+
+
+def _moves(spec) -> bool:
+    """An ``[[obstacles]]`` entry with a ``motion`` table, or a surface sequence."""
+    return isinstance(spec, dict) and ("motion" in spec or str(spec.get("type", "")).replace("_", "-") == SEQUENCE)
+
+
 def has_motion(scene) -> bool:
-    """True if some ``[[obstacles]]`` entry of ``scene`` has a ``motion`` table."""
-    return any(isinstance(spec, dict) and "motion" in spec for spec in scene.get("obstacles", []))
+    """True if some ``[[obstacles]]`` entry of ``scene`` moves: a ``motion`` table or a ``mesh-sequence``."""
+    return any(_moves(spec) for spec in scene.get("obstacles", []))
 
 
 def _numbers(scene, key, value, shape):
@@ -145,11 +154,21 @@ def obstacle_motion(scene, n_obstacles: int) -> ObstacleMotion | None:
     if not has_motion(scene):
         return None
     if scene.analysis != "dynamic":
-        i = next(i for i, s in enumerate(specs) if isinstance(s, dict) and "motion" in s)
-        raise scene.error(f"obstacles.{i}.motion", f'moves the obstacle in time: it needs analysis = "dynamic" '
-                          f'(this scene is "{scene.analysis}"); remove the motion table or make the scene dynamic')
+        i = next(i for i, s in enumerate(specs) if _moves(s))
+        key = f"obstacles.{i}.motion" if "motion" in specs[i] else f"obstacles.{i}.type"
+        raise scene.error(key, f'moves the obstacle in time: it needs analysis = "dynamic" (this scene is '
+                          f'"{scene.analysis}"); remove the motion table or make the scene dynamic')
     motions = [None] * n_obstacles
     for i, spec in enumerate(specs[:n_obstacles]):
         if isinstance(spec, dict) and "motion" in spec:
-            motions[i] = _keyframes(scene, i, spec["motion"])
+            if not _moves({k: v for k, v in spec.items() if k != "motion"}):
+                motions[i] = _keyframes(scene, i, spec["motion"])
+                continue
+            raise scene.error(f"obstacles.{i}.motion", f"a {SEQUENCE} moves by its frames: give the frames in their "
+                              "pose, or remove the motion table")
+        if _moves(spec):  # a surface sequence: its shape follows the run's time (built and checked by from_spec)
+            times = spec.get("times")
+            end = max(times) if isinstance(times, list) and times and all(
+                isinstance(t, (int, float)) for t in times) else 0.0
+            motions[i] = ShapeClock(float(end) * scene.units.time)
     return ObstacleMotion(motions)

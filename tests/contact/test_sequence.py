@@ -1,4 +1,4 @@
-"""A body given as surfaces of one topology at increasing times (rftstatic.contact.sequence): the shape between
+"""A body given as surfaces of one topology at increasing times (rftstatic.contact.obstacles.surface_sequence): the shape between
 frames is the surface built from the interpolated vertices, a sequence of translated copies is the rigid
 translation, a sheet sticking on a sequence that moves follows it and a frictionless one stays put; bad frames
 are refused."""
@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from rftstatic.contact.friction import FrictionLaw, seated
-from rftstatic.contact.motion import ObstacleMotion, Poses
+from rftstatic.contact.motion import ObstacleMotion, Poses, ShapeClock
 from rftstatic.contact.obstacles.surface_mesh import SurfaceObstacle
 from rftstatic.contact.penalty import PenaltyContact, auto_penalty
-from rftstatic.contact.sequence import ShapeClock, SurfaceSequence
+from rftstatic.contact.obstacles.surface_sequence import SurfaceSequence
 from rftstatic.material import preset
 from rftstatic.mesh.surface import read_triangles
 from rftstatic.mesh.trimesh import rectangle
@@ -55,7 +55,7 @@ def _poses(m, t):
 def test_the_shape_between_frames_is_the_surface_of_the_interpolated_vertices(tmp_path):
     """A ball growing from 3 to 4 cm in 1 s: at t = 0.25 s its contact (energy, force, tangent) is that of the 3.25 cm
     ball built from a file; at and outside the frames' times, that of the frames."""
-    seq = SurfaceSequence(_ball(tmp_path, [0.03, 0.04]), [0.0, 1.0])
+    seq = SurfaceSequence.from_frames(_ball(tmp_path, [0.03, 0.04]), [0.0, 1.0])
     built = _ball(tmp_path / "..", [0.0325])[0]
     rng = np.random.default_rng(3)
     x = _near(built, rng)
@@ -76,7 +76,7 @@ def test_a_sequence_of_translated_copies_is_the_rigid_translation(tmp_path):
     """Frames of one ball moved 2 cm along x: at t = 0.5 s the contact equals that of the first frame translated
     by 1 cm through the rigid poses."""
     frames = _ball(tmp_path, [0.03, 0.03], shift=(0.02, 0.0, 0.0))
-    seq = SurfaceSequence(frames, [0.0, 1.0])
+    seq = SurfaceSequence.from_frames(frames, [0.0, 1.0])
     rng = np.random.default_rng(5)
     x = _near(frames[0], rng) + [0.01, 0.0, 0.0]
     area = np.full(len(x), 1e-5)
@@ -96,11 +96,11 @@ def test_a_sequence_of_translated_copies_is_the_rigid_translation(tmp_path):
 def test_bad_frames_are_refused(tmp_path):
     balls = _ball(tmp_path, [0.03, 0.04])
     with pytest.raises(ValueError, match="strictly increasing"):
-        SurfaceSequence(balls, [1.0, 1.0])
+        SurfaceSequence.from_frames(balls, [1.0, 1.0])
     P, T, _ = read_triangles("cases/icosphere-3.obj")
     other = _surface(_obj(tmp_path / "other.obj", 0.03 * P, T[:, [0, 2, 1]][::-1]))
     with pytest.raises(ValueError, match="another topology"):
-        SurfaceSequence([balls[0], other], [0.0, 1.0])
+        SurfaceSequence.from_frames([balls[0], other], [0.0, 1.0])
 
 
 @pytest.mark.slow
@@ -113,7 +113,7 @@ def test_a_sheet_on_a_moving_table_sequence_follows_it_with_friction(tmp_path):
     P = 0.01 * P
     move = np.array([0.003, 0.0, 0.0015])
     frames = [_surface(_obj(tmp_path / "a.obj", P, T)), _surface(_obj(tmp_path / "b.obj", P + move, T))]
-    seq = SurfaceSequence(frames, [0.02, 0.32])
+    seq = SurfaceSequence.from_frames(frames, [0.02, 0.32])
     mesh = rectangle(0.1, 0.1, 7, 7, origin=(-0.05, -0.05))
     mat = preset("wool-kang-yu")
     h = float(mesh.element_size.mean())

@@ -1,4 +1,11 @@
-"""A body given as a sequence of triangle surfaces of one topology, interpolated in time (a deforming obstacle).
+"""A body given as a sequence of triangle surfaces of one topology, interpolated in time (scene type
+``mesh-sequence``, a deforming obstacle).
+
+Scene keys: ``paths`` (the frame files, each as the ``mesh`` type reads it: any surface meshio reads, relative to
+the scene), ``times`` (one per frame [s], strictly increasing), ``units`` of the files (default the scene's length
+unit), ``feature_angle`` [deg] (default 100: a deforming surface may have no sharp features, whose edge contact
+does not follow it). It acts in ``analysis = "dynamic"`` runs only (by the penalty contact,
+:mod:`rftstatic.scenes.motion`); before its first time it is its first frame.
 
 Frames ``V_0, ..., V_(F-1)`` (each ``(n, 3)`` [m], the same triangles) at times ``t_0 < ... < t_(F-1)``: the surface
 at time ``t`` has the vertices
@@ -23,38 +30,58 @@ vertex motion since its refresh to the nodes' own (:meth:`SurfaceSequence.drift`
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from rftstatic.contact.obstacles.base import Obstacle
+from rftstatic.contact.obstacles.base import NUMBERS, Obstacle, SceneKey
+from rftstatic.contact.obstacles.registry import register
 from rftstatic.contact.obstacles.surface_geometry import pseudo_normals
+from rftstatic.contact.obstacles.surface_mesh import SurfaceObstacle
 
-__all__ = ["SurfaceSequence", "ShapeClock"]
-
-
-@dataclass(frozen=True)
-class ShapeClock:
-    """The entry of :class:`~rftstatic.contact.motion.ObstacleMotion` for a :class:`SurfaceSequence`: its shape
-    follows the run's time; ``end`` [s] the time of its last frame."""
-
-    end: float
+__all__ = ["SurfaceSequence"]
 
 
+@register
 class SurfaceSequence(Obstacle):
     """Triangle surfaces of one topology at increasing times, linearly interpolated (S1).
 
     Parameters
     ----------
-    frames : sequence of F >= 2 :class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle` with the same
-        triangles (the same files' topology, after their nodes were merged and turned outward), in metres
+    paths : F >= 2 surface files of one mesh (the ``mesh`` type's :class:`SurfaceObstacle`)
     times : (F,) frame times [s], strictly increasing
+    units, feature_angle, scene_length, base_dir : as :class:`SurfaceObstacle`'s, for every frame
     """
 
     type_name = "mesh-sequence"
+    scene_keys: ClassVar[dict[str, SceneKey]] = {
+        "paths": SceneKey("paths", required=True, length=False, kinds=(list,),
+                          help="the frames' surface files, one topology (relative to the scene)"),
+        "times": SceneKey("times", required=True, length=False, kinds=NUMBERS,
+                          help="time of each frame [s], strictly increasing; linear in time between frames"),
+        "units": SceneKey("units", length=False, kinds=(str,), help="length unit of the files (default the scene's)"),
+        "feature_angle": SceneKey("feature_angle", length=False, kinds=(int, float),
+                                  help="as for type = mesh (default 100: no sharp features)"),
+    }
     psd_tangent = True
 
-    def __init__(self, frames, times):
+    def __init__(self, paths, times, units=None, feature_angle=100.0, *, scene_length=1.0, base_dir=None):
+        if not isinstance(paths, (list, tuple)) or not all(isinstance(p, str) for p in paths):
+            raise ValueError(f"paths must be a list of surface files, got {paths!r}")
+        frames = [SurfaceObstacle(p, units=units, feature_angle=feature_angle, scene_length=scene_length,
+                                  base_dir=base_dir) for p in paths]
+        self._setup(frames, times)
+        self.units, self.feature_angle = units, float(feature_angle)
+
+    @classmethod
+    def from_frames(cls, frames, times) -> SurfaceSequence:
+        """A sequence of built :class:`SurfaceObstacle` frames (same triangles, metres) at ``times (F,)`` [s]."""
+        seq = cls.__new__(cls)
+        seq._setup(list(frames), times)
+        seq.units, seq.feature_angle = "m", float(frames[0].feature_angle)
+        return seq
+
+    def _setup(self, frames, times):
         self.frames = list(frames)
         t = np.asarray(times, dtype=float).ravel()
         if len(self.frames) < 2 or t.shape != (len(self.frames),) or np.any(np.diff(t) <= 0) or not np.isfinite(t).all():
@@ -147,7 +174,17 @@ class SurfaceSequence(Obstacle):
         return lo, hi
 
     def params(self):
-        return {"frames": [str(getattr(f, "path", "")) for f in self.frames], "times": self.times.tolist()}
+        return {"paths": [str(f.path) for f in self.frames], "times": self.times.tolist(), "units": "m",
+                "feature_angle": self.feature_angle}
+
+    def as_dict(self):
+        out = super().as_dict()
+        out["units"] = "m"  # the frames' coordinates in metres (each file's own unit applied)
+        return out
+
+    def describe(self):
+        return (f"mesh-sequence({len(self.frames)} frames of {len(self.frames[0].V)} nodes, {len(self.frames[0].T)} "
+                f"triangles, t = {self.times[0]:g}..{self.times[-1]:g} s)")
 
     def surface(self):
         return self.frames[0].surface()
