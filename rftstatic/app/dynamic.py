@@ -337,7 +337,9 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     short = f"{scene.name} ({run_label(model)})"
     views = [v for v in scene.get("output.views", ["iso", "side"]) if v in ("iso", "side", "top")]
     shown = [(X3 + frames[i][1]) / u.length for i in idx[: len(summary["frames"])]]
-    solids = run_solids(scene.data, X3 / u.length, np.concatenate(shown)) if shown else []
+    # a moving obstacle (rftstatic.contact.motion) is not drawn: one pose would be wrong in the other frames
+    moving = getattr(model.contact, "motion", None) is not None
+    solids = run_solids(scene.data, X3 / u.length, np.concatenate(shown)) if shown and not moving else []
     for entry, i in zip(summary["frames"], idx):
         t, U = frames[i]
         files = plot_views(str(out / f"frame_t{_tag(entry['time'])}"), (X3 + U) / u.length, tri, views=views,

@@ -105,3 +105,31 @@ def test_a_turntable_run_interrupted_mid_turn_resumes_to_the_bit(tmp_path):
     a = meshio.read(tmp_path / "full" / "series" / last).points
     b = meshio.read(tmp_path / "cut" / "series" / last).points
     assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("setting, message", [
+    ("obstacles.0.times=[0.8,0.3]", r"obstacles\.0: .*strictly increasing"),
+    ("obstacles.0.times=[0.3]", r"obstacles\.0: .*one per frame"),
+    ('obstacles.0.paths=["ball-r5.obj","table-top.obj"]', r"obstacles\.0: .*another topology"),
+    ('analysis="static"', r"obstacles\.0\.type: moves the obstacle in time: it needs analysis = \"dynamic\""),
+])
+def test_bad_mesh_sequences_exit_2(tmp_path, capsys, setting, message):
+    import re
+
+    rc = main(["case", "ball-grow", "--no-figures", "--out", str(tmp_path / "run"), "--set", setting])
+    err = capsys.readouterr().err
+    assert rc == 2 and "ball-grow.toml" in err and re.search(message, err), err
+
+
+@pytest.mark.slow
+def test_a_growing_ball_lifts_the_sheet_by_its_growth(tmp_path):
+    """ball-grow (about 1 min): the ball's top rises 2 cm between its frames; the sheet's point on it rises
+    2 cm within 0.02 cm (1.995 cm measured) and the sheet comes to rest."""
+    rc = main(["case", "ball-grow", "--no-figures", "--out", str(tmp_path / "run")])
+    assert rc == 0
+    s = json.loads((tmp_path / "run" / "summary.json").read_text())
+    p = s["probes"]["top"]
+    t, z = np.array(p["time"]), np.array(p["z"])
+    rise = z[np.searchsorted(t, 1.0)] - z[np.searchsorted(t, 0.3)]
+    assert rise == pytest.approx(2.0, abs=0.02)
+    assert s["at_rest"] and s["self_intersections"]["pairs"] == 0
