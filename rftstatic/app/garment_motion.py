@@ -192,7 +192,8 @@ def _measures(scene, model, drape, explicit, form, opts, out) -> dict:
         "time_at_rest": None if settled_from is None else settled_from / u.time,
         "settled": bool(settled_from is not None and settled_from >= motion.end),
         "compared_with_static_turned": {
-            "max_node_distance": float(d.max()) / u.length, "rms_node_distance": float(np.sqrt(np.mean(d**2))) / u.length,
+            "max_node_distance": float(d.max()) / u.length,
+            "rms_node_distance": float(np.sqrt(np.mean(d**2))) / u.length,
             "hem_drape_coefficient": _dc(model, x_end), "hem_drape_coefficient_static": _dc(model, turned),
             "hem_folds": _folds(model, x_end), "hem_folds_static": _folds(model, turned)},
     }

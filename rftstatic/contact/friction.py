@@ -253,7 +253,8 @@ def penalty_impulses(law: FrictionLaw, penalty, x: np.ndarray, v: np.ndarray, mi
 def _surface_velocity(penalty, poses, x, obstacle):
     """Velocity ``(C, 3)`` [m/s] of the obstacle surface each contact node at ``x (C, 3)`` [m] touches (its
     ``obstacle (C,)``), by the solve's ``poses`` (:class:`rftstatic.contact.motion.Poses`; None: all at rest): a
-    rigid body's, or a deforming one's (:meth:`rftstatic.contact.obstacles.surface_sequence.SurfaceSequence.surface_velocity`)."""
+    rigid body's, or a deforming one's
+    (:meth:`rftstatic.contact.obstacles.surface_sequence.SurfaceSequence.surface_velocity`)."""
     out = np.zeros_like(x)
     if poses is None:
         return out

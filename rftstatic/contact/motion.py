@@ -23,8 +23,9 @@ speed 1.5 x the segment's mean): a garment on a turning body is not struck by a 
 a stick friction cannot pass on in one step (it needs ``mu lambda dt / m`` per step); the linear law is for a
 constant speed (a turntable at a steady rate), its velocity jumps at the keys.
 
-The keyframes belong to the scene (frozen with the contact law, :attr:`rftstatic.contact.penalty.PenaltyContact.motion`);
-the pose at the current time is State (:attr:`rftstatic.model.state.State.obstacle_poses`).
+The keyframes belong to the scene (frozen with the contact law,
+:attr:`rftstatic.contact.penalty.PenaltyContact.motion`); the pose at the current time is State
+(:attr:`rftstatic.model.state.State.obstacle_poses`).
 """
 
 from __future__ import annotations

@@ -206,7 +206,8 @@ class PenaltyContact(Frozen):
 
     def _shaped(self, poses):
         """The obstacles as they are shaped at the poses' times: a deforming one
-        (:class:`~rftstatic.contact.obstacles.surface_sequence.SurfaceSequence`, a finite ``poses.shape_time``) by its ``shape_at``."""
+        (:class:`~rftstatic.contact.obstacles.surface_sequence.SurfaceSequence`, a finite ``poses.shape_time``) by
+        its ``shape_at``."""
         if poses is None or not poses.deforming:
             return self.obstacles
         return [ob if np.isnan(t) else ob.shape_at(t) for ob, t in zip(self.obstacles, poses.shape_time)]

@@ -84,9 +84,10 @@ class SurfaceSequence(Obstacle):
     def _setup(self, frames, times):
         self.frames = list(frames)
         t = np.asarray(times, dtype=float).ravel()
-        if len(self.frames) < 2 or t.shape != (len(self.frames),) or np.any(np.diff(t) <= 0) or not np.isfinite(t).all():
-            raise ValueError(f"a surface sequence needs two or more frames at strictly increasing times, one per frame; "
-                             f"got {len(self.frames)} frames at times {np.asarray(times).tolist()!r}")
+        bad = len(self.frames) < 2 or t.shape != (len(self.frames),) or not np.isfinite(t).all()
+        if bad or np.any(np.diff(t) <= 0):
+            raise ValueError(f"a surface sequence needs two or more frames at strictly increasing times, one per "
+                             f"frame; got {len(self.frames)} frames at times {np.asarray(times).tolist()!r}")
         base = self.frames[0]
         for k, f in enumerate(self.frames[1:], 1):
             if f.V.shape != base.V.shape or not np.array_equal(f.T, base.T):
