@@ -214,18 +214,26 @@ class _Loop:
 
     def _pose(self, state, t, work=True):
         """Set the obstacles' poses of the step from ``t`` [s] (and their surfaces' velocity over it) on ``state``;
-        ``work``: add the work the move does on the sheet, the change of the contact energy at fixed positions, to
-        ``acc["body_work"]`` (a term of the energy balance: :func:`_sample`)."""
+        ``work``: add the work the move does on the sheet to ``acc["body_work"]`` (a term of the energy balance:
+        :func:`_sample`): the change of the contact energy ``E(x, pose)`` from the last pose to this one, the mean
+        of its values at this step's positions and the last step's (the trapezoidal rule, second order in the
+        step; at the positions alone it was first order: 6.4e-6 J of a 9.3e-5 J lift unbooked at dt = 2e-4 s)."""
         if self.motion is None:
             return
         moving = work and t <= self.motion.end + self.dt
+        contact, acc = self.model.contact, self.acc
         if moving:
             x = self.model.X3 + state.U
-            before = self.model.contact.energy(x, candidates=state.candidates)
+            before = contact.energy(x, candidates=state.candidates)
         state.obstacle_poses = self.motion.poses(t, self.dt)
         if moving:
-            after = self.model.contact.energy(x, candidates=state.candidates)
-            self.acc["body_work"] = self.acc.get("body_work", 0.0) + after - before
+            after = contact.energy(x, candidates=state.candidates)
+            w = after - before
+            last = acc.get("pose_last")  # (positions, contact energy) of the last step at its pose
+            if last is not None:
+                w = 0.5 * (w + contact.energy(last[0], candidates=state.candidates) - last[1])
+            acc["body_work"] = acc.get("body_work", 0.0) + w
+            acc["pose_last"] = (x, after)
 
     def begin(self, dt, *, start_consistent, state):
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
