@@ -122,7 +122,8 @@ class OptionSpec:
         if self.kind == "str" and self.choices and value not in self.choices:
             near = difflib.get_close_matches(value, self.choices, n=1)
             hint = f' (did you mean "{near[0]}"?)' if near else ""
-            return f'"{value}" is not one of {", ".join(self.choices)}{hint}'
+            text = value if value.isprintable() else value.encode("unicode_escape").decode()  # one line
+            return f'"{text}" is not one of {", ".join(self.choices)}{hint}'
         if self.kind in ("int", "float"):
             if not math.isfinite(value):
                 return f"must be a finite number, got {shown!r}"

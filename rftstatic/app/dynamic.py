@@ -92,13 +92,14 @@ def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 
 
 def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True, resume=False,
-                      callback=None, backend="auto") -> dict:
+                      callback=None, backend="auto", U0=None) -> dict:
     """:func:`_run`, returning only the summary."""
     return _run(scene, model, extras, out, progress=progress, figures=figures, resume=resume, callback=callback,
-                backend=backend)[0]
+                backend=backend, U0=U0)[0]
 
 
-def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False, callback=None, backend="auto"):
+def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False, callback=None, backend="auto",
+         U0=None):
     """Run a ``dynamic`` or ``relax`` scene and write its outputs into ``out`` (module docstring).
 
     Parameters
@@ -109,6 +110,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     resume : continue from ``out/checkpoint.npz`` (a fresh run, logged, when there is none)
     callback : extra ``callback(state, sample)`` at every history sample; returning True stops the run
     backend : force back end of :func:`rftstatic.solvers.explicit.run_explicit`
+    U0 : (N, 3) displacements [m] the run starts from at rest (None: the reference), e.g. a drape's equilibrium
 
     Returns
     -------
@@ -120,7 +122,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     out.mkdir(parents=True, exist_ok=True)
     analysis = scene.analysis
     o = dynamics_options(scene)
-    obstacles = tuple(extras.get("obstacles", ()))
+    # obstacles act kinematically, unless one moves (rftstatic.scenes.motion): then all act by the model's penalty
+    obstacles = tuple(extras.get("obstacles", ())) if model.contact is None else ()
     friction = contact_friction(scene, contact_options(scene), len(obstacles), model.mesh) if obstacles else None
     names, pnodes, pw = probe_interpolation(model.mesh, extras.get("probes", {}))
     t_end = o.t_end
@@ -175,7 +178,7 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
         options = ExplicitOptions(t_end=plan.t_end, dt=plan.dt, alpha=o.alpha, mass_scale=o.mass_scale,
                                   rest_tol=o.rest_tolerance, backend=backend, max_steps=limit,
                                   max_steps_name=_limit_name(o, model.mesh.n_nodes), progress=progress)
-        state = State.initial(model)
+        state = State.initial(model, U0)
         route = explicit_steps(model, state, options, obstacles=obstacles, frame_times=save_times,
                                probes=pnodes.ravel(), callback=watch, plan=plan, friction=friction)
         reason = plan.reason
@@ -186,7 +189,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
 
     summary = _summary(scene, model, analysis, o, run, names, pnodes, pw, wall, resumed_from)
     summary["max_steps"] = limit
-    if (crossings := obstacle_crossing_summary(scene, model, extras, run.U)) is not None:
+    poses = run.state.obstacle_poses if run.state is not None else None  # a moved body: checked in its pose
+    if (crossings := obstacle_crossing_summary(scene, model, extras, run.U, poses=poses)) is not None:
         summary["obstacle_crossings"] = crossings
     summary["dt_reason"] = reason
     reading = RestCriterion(o.rest_tolerance).record()  # time_at_rest: the kinetic energy alone
@@ -333,7 +337,9 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     short = f"{scene.name} ({run_label(model)})"
     views = [v for v in scene.get("output.views", ["iso", "side"]) if v in ("iso", "side", "top")]
     shown = [(X3 + frames[i][1]) / u.length for i in idx[: len(summary["frames"])]]
-    solids = run_solids(scene.data, X3 / u.length, np.concatenate(shown)) if shown else []
+    # a moving obstacle (rftstatic.contact.motion) is not drawn: one pose would be wrong in the other frames
+    moving = getattr(model.contact, "motion", None) is not None
+    solids = run_solids(scene.data, X3 / u.length, np.concatenate(shown)) if shown and not moving else []
     for entry, i in zip(summary["frames"], idx):
         t, U = frames[i]
         files = plot_views(str(out / f"frame_t{_tag(entry['time'])}"), (X3 + U) / u.length, tri, views=views,

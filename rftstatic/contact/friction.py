@@ -38,7 +38,9 @@ velocity of a contact node, whose penalty normal force at ``x_n`` is ``lambda``,
     |v_t| <= mu_s lambda dt / m     (stick),     else     v_t <- v_t (1 - mu_k lambda dt / (m |v_t|))   (slide)   (F5)
 
 (``m`` the node's scaled lumped mass): a node at rest under a tangential force ``F_t`` gets ``|v_t| = F_t dt / m``
-and sticks exactly while ``F_t <= mu_s lambda``, a sliding node is slowed by ``mu_k lambda``. The impulses only
+and sticks exactly while ``F_t <= mu_s lambda``, a sliding node is slowed by ``mu_k lambda``. On a moving obstacle
+(:mod:`rftstatic.contact.motion`) ``v_t`` is the velocity relative to the obstacle's surface at the node (the chord
+velocity of the step), so a sticking node moves with the body. The impulses only
 take kinetic energy away, so the explicit step stays as stable as without friction (a lagged stick spring of
 stiffness ``2 mu lambda / eps`` would not: at a penalty's transient normal force it exceeds the stable step's
 limit by far), and they need no history: a relaxation resumed from its checkpoint is the same run. Its Newton
@@ -137,7 +139,7 @@ def _contacts(penalty, x, candidates=None):
         phi, normal = penalty._distances(x)
     else:
         near = penalty._near(x, candidates)[0]
-        phi, normal = penalty._distances_of(x[near])
+        phi, normal = penalty._distances_of(x[near], penalty._offsets(candidates))
     if phi.shape[0] == 0 or near.size == 0:
         return np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, 3))
     deepest = phi.argmin(axis=0)
@@ -221,17 +223,20 @@ def anchored_lag(law: FrictionLaw, penalty, x: np.ndarray) -> dict:
 
 
 def penalty_impulses(law: FrictionLaw, penalty, x: np.ndarray, v: np.ndarray, minv: np.ndarray, dt: float,
-                     candidates=None) -> float:
+                     candidates=None, work: dict | None = None) -> float:
     """Coulomb friction impulses (F5) of one explicit step on the penalty contact, in place on the half-step
     velocities ``v (N, 3)`` [m/s], for positions ``x (N, 3)`` [m] at which the step's force was evaluated, inverse
     lumped masses ``minv (N, 3)`` [1/kg] (0 on supported dofs) and the step ``dt`` [s]; ``candidates``: the solve's
     candidate list (only its nodes are measured; None: every node). Returns the kinetic energy the impulses took
-    away [J]."""
+    away [J]; on moving obstacles the work their impulses did on the sheet, ``sum m dv . v_surface`` [J], is added
+    to ``work["body_work"]`` (given a dict)."""
     nodes, obstacle, lam, normal = _contacts(penalty, x, candidates)
     if nodes.size == 0:
         return 0.0
     vc = v[nodes]
-    vt = vc - np.einsum("ci,ci->c", vc, normal)[:, None] * normal
+    surface = _surface_velocity(penalty, penalty._offsets(candidates), x[nodes], obstacle)
+    rel = vc - surface
+    vt = rel - np.einsum("ci,ci->c", rel, normal)[:, None] * normal
     speed = np.linalg.norm(vt, axis=1)
     inv_mass = minv[nodes].max(axis=1)  # 1 / m [1/kg]; 0 for a node held in every dof
     cap = lam * dt * inv_mass  # [m/s] the largest tangential change friction can make in the step
@@ -240,7 +245,27 @@ def penalty_impulses(law: FrictionLaw, penalty, x: np.ndarray, v: np.ndarray, mi
     vnew = np.where(minv[nodes] > 0, vc - (1.0 - scale)[:, None] * vt, vc)  # supported dofs keep their velocity
     m = np.where(inv_mass > 0, 1.0 / np.maximum(inv_mass, 1e-300), 0.0)
     v[nodes] = vnew
+    if work is not None and surface.any():
+        work["body_work"] = work.get("body_work", 0.0) + float(np.einsum("c,ci,ci->", m, vnew - vc, surface))
     return 0.5 * float(np.sum(m * (np.einsum("ci,ci->c", vc, vc) - np.einsum("ci,ci->c", vnew, vnew))))
+
+
+def _surface_velocity(penalty, poses, x, obstacle):
+    """Velocity ``(C, 3)`` [m/s] of the obstacle surface each contact node at ``x (C, 3)`` [m] touches (its
+    ``obstacle (C,)``), by the solve's ``poses`` (:class:`rftstatic.contact.motion.Poses`; None: all at rest): a
+    rigid body's, or a deforming one's
+    (:meth:`rftstatic.contact.obstacles.surface_sequence.SurfaceSequence.surface_velocity`)."""
+    out = np.zeros_like(x)
+    if poses is None:
+        return out
+    for m in np.unique(obstacle):  # the few obstacles
+        on = obstacle == m
+        t = poses.shape_time[m]
+        if np.isnan(t):
+            out[on] = poses.velocity(x[on], int(m))
+        else:
+            out[on] = penalty.obstacles[m].surface_velocity(x[on], float(t), poses.step)
+    return out
 
 
 def seated(penalty, x: np.ndarray, load: np.ndarray) -> np.ndarray:

@@ -29,11 +29,14 @@ The kinematic contact of the explicit solver is :mod:`rftstatic.contact.kinemati
 
 Nothing here depends on the obstacles' types: only ``signed_distance`` and ``normal_gradient`` are used.
 
-Moving obstacles: the solve's candidate list may carry a translation per obstacle
-(:attr:`rftstatic.contact.candidates.CandidateList.offsets`, set through
-:attr:`rftstatic.model.state.State.obstacle_offsets`); obstacle ``m`` is then evaluated at ``x - offsets[m]``
-(``phi(x - o)``, its normal and Hessian), so a route moves a support while the Model stays frozen. Every path that
-passes the State's candidate list (Newton's energy, residual and tangent, the explicit force) sees the same pose.
+Moving obstacles: the solve's candidate list may carry a rigid pose per obstacle
+(:attr:`rftstatic.contact.candidates.CandidateList.poses`, set through
+:attr:`rftstatic.model.state.State.obstacle_poses`, or translations only through
+:attr:`rftstatic.model.state.State.obstacle_offsets`); obstacle ``m`` is then evaluated in its body frame,
+``phi(x) = phi_b(R^T (x - c - s) + c)``, its normal ``R n_b`` and Hessian ``R H_b R^T`` ((P1)-(P2) of
+:mod:`rftstatic.contact.motion`), so a route or a keyframed motion (:attr:`PenaltyContact.motion`) moves an
+obstacle while the Model stays frozen. Every path that passes the State's candidate list (Newton's energy,
+residual and tangent, the explicit force, the friction impulses) sees the same pose.
 """
 
 from __future__ import annotations
@@ -139,8 +142,12 @@ class PenaltyContact(Frozen):
     """
 
     def __init__(self, obstacles: Obstacle | Sequence[Obstacle], node_area, stiffness: float,
-                 smoothing: float = 0.0, sheet=None, friction=None):
+                 smoothing: float = 0.0, sheet=None, friction=None, motion=None):
         self.obstacles = _as_list(obstacles)
+        self.motion = motion  # a rftstatic.contact.motion.ObstacleMotion (keyframes) or None; the pose is State
+        if motion is not None and len(motion.motions) != len(self.obstacles):
+            raise ValueError(f"the motion gives {len(motion.motions)} obstacle motions, the contact has "
+                             f"{len(self.obstacles)} obstacles: give one (or None) per obstacle")
         self.friction = friction  # a rftstatic.contact.friction.FrictionLaw, lagged through the candidate list
         self.smoothing = _positive("smoothing", smoothing, allow_zero=True)
         area = np.asarray(node_area, dtype=float)
@@ -180,29 +187,59 @@ class PenaltyContact(Frozen):
         """Signed distances ``(M, N)`` [m] and normals ``(M, N, 3)`` for the ``M`` obstacles."""
         return self._distances_of(_as_points(x, self.n_nodes))
 
-    def _distances_of(self, x: np.ndarray, offsets=None) -> tuple[np.ndarray, np.ndarray]:
-        """As :meth:`_distances` for any number of points ``(P, 3)`` [m]; ``offsets (M, 3)`` [m]: the obstacles'
-        translations in the solve (:attr:`~rftstatic.contact.candidates.CandidateList.offsets`), None: none."""
+    def _distances_of(self, x: np.ndarray, poses=None) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`_distances` for any number of points ``(P, 3)`` [m]; ``poses``: the obstacles' poses in the
+        solve (:class:`~rftstatic.contact.motion.Poses`, :attr:`~rftstatic.contact.candidates.CandidateList.poses`),
+        None: as built."""
         if not self.obstacles:
             return np.full((0, x.shape[0]), np.inf), np.zeros((0, x.shape[0], 3))
-        if offsets is None:
-            phis, normals = zip(*(ob.signed_distance(x) for ob in self.obstacles))
-        else:  # a translated obstacle: its distance at the point moved back by the translation
-            phis, normals = zip(*(ob.signed_distance(x - o) for ob, o in zip(self.obstacles, offsets)))
+        obstacles = self._shaped(poses)
+        if poses is None:
+            phis, normals = zip(*(ob.signed_distance(x) for ob in obstacles))
+        elif not poses.rotated:  # a translated obstacle: its distance at the point moved back by the translation
+            phis, normals = zip(*(ob.signed_distance(x - o) for ob, o in zip(obstacles, poses.translation)))
+        else:  # (P2): the distance in the body frame, the normal rotated back to the world
+            pairs = [ob.signed_distance(poses.to_body(x, m)) for m, ob in enumerate(obstacles)]
+            phis = [p for p, _ in pairs]
+            normals = [poses.to_world(n, m) for m, (_, n) in enumerate(pairs)]
         return np.stack(phis), np.stack(normals)
 
+    def _shaped(self, poses):
+        """The obstacles as they are shaped at the poses' times: a deforming one
+        (:class:`~rftstatic.contact.obstacles.surface_sequence.SurfaceSequence`, a finite ``poses.shape_time``) by
+        its ``shape_at``."""
+        if poses is None or not poses.deforming:
+            return self.obstacles
+        return [ob if np.isnan(t) else ob.shape_at(t) for ob, t in zip(self.obstacles, poses.shape_time)]
+
+    def _slack(self, candidates, poses) -> float:
+        """Largest surface motion [m] of the deforming obstacles since the candidate list's refresh."""
+        ref = getattr(candidates, "shape_times", None)
+        if poses is None or not poses.deforming:
+            return 0.0 if ref is None or not np.isfinite(ref).any() else np.inf
+        if ref is None:
+            return np.inf
+        out = 0.0
+        for ob, t0, t1 in zip(self.obstacles, ref, poses.shape_time):
+            if np.isnan(t0) != np.isnan(t1):
+                return np.inf
+            if not np.isnan(t1):
+                out = max(out, ob.drift(float(t0), float(t1)))
+        return out
+
     def _offsets(self, candidates):
-        """The obstacles' translations ``(M, 3)`` [m] the solve's ``candidates`` carry, or None."""
-        offsets = getattr(candidates, "offsets", None)
-        if offsets is None:
+        """The obstacles' poses (:class:`~rftstatic.contact.motion.Poses`) the solve's ``candidates`` carry, or
+        None."""
+        poses = getattr(candidates, "poses", None)
+        if poses is None:
             return None
-        if offsets.shape != (len(self.obstacles), 3):
-            raise ValueError(f"obstacle offsets have shape {offsets.shape}, the contact has {len(self.obstacles)} "
-                             "obstacles: give one (x, y, z) translation per obstacle")
+        if poses.n_obstacles != len(self.obstacles):
+            raise ValueError(f"obstacle offsets have shape {(poses.n_obstacles, 3)}, the contact has "
+                             f"{len(self.obstacles)} obstacles: give one (x, y, z) translation per obstacle")
         if self.features is not None:
             raise ValueError("obstacle offsets move smooth obstacles only: this contact has sharp features "
                              "(edges of a surface obstacle), whose edge contact does not move with them")
-        return offsets
+        return poses
 
     def evaluate(self, x: np.ndarray, *, tangent: bool = True, candidates: CandidateList | None = None
                  ) -> ContactState:
@@ -231,13 +268,19 @@ class PenaltyContact(Frozen):
         force[cand] = np.einsum("n,mn,mni->ni", ka, d1, normal)
         blocks = np.zeros((n, 3, 3))
         if tangent:
-            for m, ob in enumerate(self.obstacles):
+            for m, ob in enumerate(self._shaped(offsets)):
                 # touching nodes (phi = 0) get the one-sided Hessian too: a sheet laid on a support
                 # then starts with the support's stiffness instead of a singular tangent
                 act = phi[m] <= self.smoothing
                 if not np.any(act):
                     continue
-                H = ob.normal_gradient(xc[act] if offsets is None else xc[act] - offsets[m])
+                if offsets is None:
+                    H = ob.normal_gradient(xc[act])
+                elif not offsets.rotated:
+                    H = ob.normal_gradient(xc[act] - offsets.translation[m])
+                else:  # (P2): R H_b R^T at the point in the body frame
+                    R = offsets.rotation[m]
+                    H = np.einsum("ij,njk,lk->nil", R, ob.normal_gradient(offsets.to_body(xc[act], m)), R)
                 nn = np.einsum("ni,nj->nij", normal[m, act], normal[m, act])
                 block = d2[m, act, None, None] * nn + d1[m, act, None, None] * H
                 if ob.psd_tangent:
@@ -270,10 +313,11 @@ class PenaltyContact(Frozen):
             return np.arange(0), np.full(n, np.inf)
         if candidates is None:
             return np.arange(n), np.full(n, np.inf)
-        hit = candidates.lookup(x)
+        poses = self._offsets(candidates)
+        hit = candidates.lookup(x, self._slack(candidates, poses))
         if hit is not None:
             return hit
-        phi, _ = self._distances_of(x, self._offsets(candidates))
+        phi, _ = self._distances_of(x, poses)
         gap = phi.min(axis=0)
         return candidates.refresh(x, gap), gap.copy()
 

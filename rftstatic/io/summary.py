@@ -185,7 +185,7 @@ def self_intersection_summary(scene, model, U, *, states=()) -> dict:
     return out
 
 
-def obstacle_crossing_summary(scene, model, extras, U) -> list | None:
+def obstacle_crossing_summary(scene, model, extras, U, poses=None) -> list | None:
     """For each obstacle with a triangle surface (:meth:`~rftstatic.contact.obstacles.Obstacle.surface`), the
     independent crossing check of the state ``U (N, 3)`` [m]
     (:func:`~rftstatic.post.measures.obstacle_crossings.obstacle_crossings`: ``pairs`` of sheet and obstacle
@@ -193,7 +193,9 @@ def obstacle_crossing_summary(scene, model, extras, U) -> list | None:
     signed distance of a node to it (the obstacle's own distance: negative inside) and ``deepest_chord``, the
     least signed distance (0 if none is negative) of a sheet triangle's centroid or edge midpoint (how far the
     flat triangles dip into it between their nodes), lengths in scene units; None when no obstacle has a
-    surface."""
+    surface. ``poses``: the obstacles' poses (:class:`rftstatic.contact.motion.Poses`) the state is checked
+    against (the sheet taken into each obstacle's body frame: a rigid motion keeps every distance); None: as
+    built."""
     u = scene.units.length
     x = model.positions(U)
     out = []
@@ -204,6 +206,8 @@ def obstacle_crossing_summary(scene, model, extras, U) -> list | None:
         if not np.isfinite(x).all():
             out.append({"obstacle": i, "applicable": False, "reason": "non-finite positions"})
             continue
+        if poses is not None:
+            x = poses.to_body(model.positions(U), i)
         r = obstacle_crossings(x, model.mesh.tri, *surface)
         mids = np.concatenate([x[model.mesh.tri].mean(axis=1), 0.5 * (x[model.mesh.topology.edges].sum(axis=1))])
         out.append({"obstacle": i, "pairs": r["pairs"], "first": r["first"],

@@ -137,6 +137,23 @@ class State:
         self.candidates.offsets = value
 
     @property
+    def obstacle_poses(self):
+        """The rigid pose of each obstacle of the model's contact law in this solve
+        (:class:`rftstatic.contact.motion.Poses`: rotation, translation and the surfaces' velocity, e.g. a body
+        turned by its keyframes); None: all where they were built. Not a cache: it travels on the candidate list
+        :attr:`candidates` to every contact evaluation (:attr:`rftstatic.contact.candidates.CandidateList.poses`);
+        :attr:`obstacle_offsets` is its translation part."""
+        return None if self.candidates is None else self.candidates.poses
+
+    @obstacle_poses.setter
+    def obstacle_poses(self, value) -> None:
+        if self.candidates is None:
+            if value is None:
+                return
+            raise ValueError("this state has no penalty contact: it has no obstacles to move")
+        self.candidates.poses = value
+
+    @property
     def V_half(self) -> np.ndarray:
         """The half-step velocity v_(n-1/2) of the central-difference scheme [m/s] (= ``V``)."""
         return self.V

@@ -14,6 +14,7 @@ ANALYSES = {
     "relax": "rftstatic.app.dynamic",  # dynamic relaxation to rest (§6)
     "remeshed": "rftstatic.app.remeshed",
     "garment": "rftstatic.app.garment",  # a garment pattern on a dress form (issue 37)
+    "garment-motion": "rftstatic.app.garment_motion",  # the dressed form turned by keyframes (issue 37 item 4)
     "cantilever": "rftstatic.app.cantilever",  # Peirce's cantilever tester: the overhang at which the tip meets 41.5 deg  # a scene with [remesh]: global adaptive remeshing (§5-6)
 }
 """Analysis name -> module that runs it."""

@@ -27,6 +27,7 @@ from rftstatic.scenes.ranges import (
     check_weight,
     sheet_size,
 )
+from rftstatic.scenes.motion import has_motion, obstacle_motion
 from rftstatic.scenes.schema import MESH_NODES, Scene
 from rftstatic.scenes.release import release_support
 from rftstatic.scenes.self_contact import build_self_contact
@@ -286,8 +287,11 @@ CONTACT_LAWS = ("penalty", "kinematic")
 
 
 def contact_law(scene: Scene) -> str:
-    """The contact law the scene's analysis uses: ``"penalty"`` for static, ``"kinematic"`` for dynamic/relax."""
-    return "penalty" if scene.analysis == "static" else "kinematic"
+    """The contact law the scene's analysis uses: ``"penalty"`` for static, ``"kinematic"`` for dynamic/relax; a
+    dynamic scene with a moving obstacle (:mod:`rftstatic.scenes.motion`) uses the penalty, which evaluates it in
+    its pose."""
+    return "penalty" if scene.analysis == "static" or (scene.analysis == "dynamic" and has_motion(scene)) else \
+        "kinematic"
 
 
 def build_obstacles(scene: Scene) -> list:
@@ -322,6 +326,7 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
         return None, []
     if start_check:
         check_surface_obstacles(scene, mesh, obstacles, law)
+    motion = obstacle_motion(scene, len(obstacles) + len(support))  # keyframes: a scene error outside dynamic runs
     c = contact_options(scene)
     friction = contact_friction(scene, c, len(obstacles), mesh)
     hold = c.hold_inplane if c.hold_inplane is not None else friction is None
@@ -336,10 +341,10 @@ def build_contact(scene: Scene, mesh, material, supports: Supports, *, law: str 
     if k is None:
         k = auto_penalty(membrane_rigidity=material.membrane_scale, bending_rigidity=material.bending_scale,
                          weight=max(material.weight, 1e-300), h=h, factor=c.factor)
-    if hold:
+    if hold and motion is None:  # a moving body drives the sheet: its rigid modes are the motion's to take
         hold_inplane_rigid_modes(mesh, supports)
     return PenaltyContact(obstacles + support, mesh.node_area, k, smoothing=c.smoothing * h, sheet=mesh,
-                          friction=friction), obstacles
+                          friction=friction, motion=motion), obstacles
 
 
 OBSTACLE_POSITION_KEYS = {"centre": "xyz", "top": "z", "height": "z", "translate": "xyz"}

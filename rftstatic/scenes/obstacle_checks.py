@@ -45,5 +45,5 @@ def check_surface_obstacles(scene, mesh, obstacles, law: str) -> None:
                 what = (f"{int(inside.sum())} sheet nodes lie inside it, the deepest (node {n}) at "
                         f"{np.round(mesh.X3[n] / u, 6).tolist()}, {-phi[n] / u:.6g} deep")
             raise scene.error(f"obstacles.{i}", f"the obstacle cuts through the flat sheet at the start: {what}; move "
-                              "it (translate) so that it lies on one side of the sheet (touching within "
-                              f"{START_TOUCH:g} edge lengths is allowed)")
+                              "it (translate) or the sheet (mesh.z, mesh.origin) so that it lies on one side of the "
+                              f"sheet (touching within {START_TOUCH:g} edge lengths is allowed)")

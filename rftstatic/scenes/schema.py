@@ -25,6 +25,7 @@ from rftstatic.remesh.options import RemeshOptions
 from rftstatic.scenes.contact_options import ContactOptions
 from rftstatic.scenes.dynamics_options import FRAMES_HELP, DynamicsOptions
 from rftstatic.scenes.analyses import SCENE_ANALYSES
+from rftstatic.scenes.motion import GarmentMotionOptions
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 from rftstatic.units import UNIT_SYSTEMS, UnitSystem, unit_system
 
@@ -179,8 +180,12 @@ SCHEMA = {
                   "shoulder_breadth", "shoulder_height", "neck_girth", "neck_height", "neck_length",
                   "bottom_height")},
               **{k: (NUM, "depth / width ratio of the section [-]") for k in
-                 ("bust_depth", "waist_depth", "hip_depth", "shoulder_depth", "neck_depth")}},
+                 ("bust_depth", "waist_depth", "hip_depth", "shoulder_depth", "neck_depth")},
+              "motion": (obstacle_schema()["motion"][0], "the form's keyframes (analysis = \"garment-motion\"; the "
+                         "keys of obstacles.motion, rftstatic.scenes.motion)")},
              "the dress form of analysis = \"garment\""),
+    "motion": (schema_entries(GarmentMotionOptions), "the run on the moving form of analysis = \"garment-motion\" "
+               "(rftstatic.app.garment_motion): python -m rftstatic options motion"),
     "probes": ([{"name": (str, "probe name"), "at": (XY, "[x, y] reference point")}], "tracked points"),
     "output": ({
         "views": (ListOf(str, choices=("side", "top", "iso")), "PNG views: side, top, iso"),

@@ -12,12 +12,13 @@ from rftstatic.optionspec import describe
 from rftstatic.remesh.options import RemeshOptions
 from rftstatic.scenes.contact_options import ContactOptions
 from rftstatic.scenes.dynamics_options import DynamicsOptions
+from rftstatic.scenes.motion import GarmentMotionOptions, MotionOptions, list_rows
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions
 
 __all__ = ["SECTIONS", "UNDECLARED", "option_rows", "format_rows"]
 
 SECTIONS = {"solver": SOLVER_GROUPS, "dynamics": (DynamicsOptions,), "remesh": (RemeshOptions,),
-            "contact": (ContactOptions,), "cantilever": (CantileverOptions,)}
+            "contact": (ContactOptions,), "cantilever": (CantileverOptions,), "motion": (GarmentMotionOptions,)}
 """Scene table -> its declared option groups (``dynamics.frames``, a list of times bounded by ``t_end``, is the one
 scene key of these tables that is not a declared option: :mod:`rftstatic.scenes.dynamics_options`)."""
 
@@ -27,14 +28,22 @@ UNDECLARED = {"dynamics": ("frames",)}
 its own check (:mod:`rftstatic.scenes.dynamics_options`: a list of times bounded by ``t_end``)."""
 
 
+OBSTACLE_SECTIONS = {"obstacles.motion": (MotionOptions,)}
+"""Tables inside an ``[[obstacles]]`` entry whose scalar keys are declared options (listed by ``options SECTION``;
+their list keys and the obstacle keys are in the obstacle reference: :mod:`rftstatic.scenes.motion`)."""
+
+
 def option_rows(section: str | None = None) -> list[dict]:
     """One row per declared key (``key``, ``type``, ``unit``, ``range``, ``default``, ``help``, ``group``) of
     ``section`` (None: every section); an unknown section is a :class:`SceneError` naming the known ones."""
     if section is None:
         return [row for name in SECTIONS for row in describe(SECTIONS[name], name)]
+    if section in OBSTACLE_SECTIONS:
+        return list_rows(section) + describe(OBSTACLE_SECTIONS[section], section)
     if section not in SECTIONS:
-        raise SceneError(f'options: no section "{section}" declares its keys as data; known: {", ".join(SECTIONS)} '
-                         "(the other tables: the scene-key reference of the documentation, docs/howto/scenes.md)")
+        raise SceneError(f'options: no section "{section}" declares its keys as data; known: {", ".join(SECTIONS)}, '
+                         f'{", ".join(OBSTACLE_SECTIONS)} (the other tables: the scene-key reference of the '
+                         "documentation, docs/howto/scenes.md)")
     return describe(SECTIONS[section], section)
 
 

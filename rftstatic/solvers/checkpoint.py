@@ -88,8 +88,8 @@ CHECKPOINT_FORMAT = 2
 
 SAVED = ("U", "V", "t", "step", "lam", "load_branches", "contact_history", "modes", "factorisations", "lm_scale",
          "modified_shift", "fallback", "route", "bending_slip", "dissipated")
-"""The :class:`~rftstatic.model.state.State` fields a checkpoint keeps (with ``self_contact_scale`` and
-``obstacle_offsets``); the contact candidate list, the self-contact pair cache and the linear solver are caches,
+"""The :class:`~rftstatic.model.state.State` fields a checkpoint keeps (with ``self_contact_scale``,
+``obstacle_offsets`` and ``obstacle_poses``); the contact candidate list, the self-contact pair cache and the linear solver are caches,
 made again."""
 
 
@@ -178,6 +178,7 @@ def saved_fields(state) -> dict:
     saved = {name: getattr(state, name) for name in SAVED}
     saved["self_contact_scale"] = state.self_contact_scale
     saved["obstacle_offsets"] = state.obstacle_offsets
+    saved["obstacle_poses"] = state.obstacle_poses
     return saved
 
 
@@ -240,6 +241,8 @@ def restore_state(model, saved: dict, state=None):
         state.self_contact_scale = saved.get("self_contact_scale", 1.0)
     if state.candidates is not None:
         state.obstacle_offsets = saved.get("obstacle_offsets")
+        if saved.get("obstacle_poses") is not None:  # a rotated pose (offsets: its translation part)
+            state.obstacle_poses = saved["obstacle_poses"]
     return state
 
 

@@ -33,7 +33,7 @@ def test_dynamic_scenes_use_kinematic_contact_and_the_registry(tmp_path):
     model, extras = api.build_model(scene)
     assert model.contact is None and extras["obstacles"]  # relax: the obstacles act kinematically
     assert api.analysis_of(api.load_scene("hang-20")) == "dynamic"
-    assert set(api.ANALYSES) == {"static", "dynamic", "relax", "remeshed", "cantilever", "garment"}
+    assert set(api.ANALYSES) == {"static", "dynamic", "relax", "remeshed", "cantilever", "garment", "garment-motion"}
 
 
 def test_run_by_name_with_overrides_and_bad_input(tmp_path):

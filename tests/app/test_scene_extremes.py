@@ -60,6 +60,8 @@ def tiny(data: dict) -> dict:
     for ob in data.get("obstacles", []):
         if "path" in ob:
             ob["path"] = str(CASES_DIR / ob["path"])
+        if isinstance(ob.get("paths"), list):  # a mesh-sequence's frames
+            ob["paths"] = [str(CASES_DIR / p) for p in ob["paths"]]
     m = data.setdefault("mesh", {})
     kind = m.get("kind", "rectangle")
     if kind in TINY_NODES:

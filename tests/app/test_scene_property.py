@@ -74,7 +74,7 @@ EXTREME_EVERY = 5
 STEP_CAP_EVERY = 40
 """One scene in this many asks for an explicit run beyond the default step cap (:func:`beyond_the_step_cap`)."""
 
-CASES = tuple(sorted(p.stem for p in CASES_DIR.glob("*.toml") if 'analysis = "garment"' not in p.read_text()))
+CASES = tuple(sorted(p.stem for p in CASES_DIR.glob("*.toml") if 'analysis = "garment' not in p.read_text()))
 """The case files with a ``[mesh]`` to shrink (a garment scene's mesh comes from its pattern: tests/garment)."""
 
 

@@ -42,6 +42,7 @@ from rftstatic.contact.obstacles.round_pedestal import RoundPedestal
 from rftstatic.contact.obstacles.sphere import Sphere
 from rftstatic.contact.obstacles.surface_mesh import SurfaceObstacle
 from rftstatic.contact.obstacles.square_pedestal import SquarePedestal
+from rftstatic.contact.obstacles.surface_sequence import SurfaceSequence
 
 __all__ = [
     "NUMBER",
@@ -54,6 +55,7 @@ __all__ = [
     "Sphere",
     "SquarePedestal",
     "SurfaceObstacle",
+    "SurfaceSequence",
     "from_spec",
     "obstacle_class",
     "obstacle_types",

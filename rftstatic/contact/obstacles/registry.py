@@ -81,7 +81,14 @@ def obstacle_class(name: str) -> type[Obstacle]:
 
 
 CONTACT_KEYS = {"friction": ((int, float), "Coulomb friction coefficient of the sheet on this obstacle, static and "
-                                           "kinetic, instead of contact.friction")}
+                                           "kinetic, instead of contact.friction"),
+                "motion": ({"times": ((list,), "keyframe times [time], strictly increasing"),
+                            "angles": ((list,), "rotation angle at each key [deg] about axis (default all 0)"),
+                            "axis": ((list,), "rotation axis [x, y, z] (default [0, 0, 1])"),
+                            "centre": ((list,), "a point of the rotation axis [x, y, z] (default the origin)"),
+                            "translations": ((list,), "translation [x, y, z] at each key (default all 0)"),
+                            "interpolation": ((str,), "smooth (default) or linear between keys")},
+                           "keyframed rigid motion of this obstacle in a dynamic run (rftstatic.scenes.motion)")}
 """Keys every ``[[obstacles]]`` table may have that belong to the contact with it, not to its shape (read by the
 scene's contact, :func:`rftstatic.scenes.build.contact_friction`; not passed to the obstacle)."""
 
