@@ -34,7 +34,7 @@ def _check_dressed(out, pattern_path, h):
 @pytest.mark.slow
 def test_the_a_line_skirt_sews_and_drapes(tmp_path):
     out = tmp_path / "out"
-    assert main(["case", "skirt-a-line", "--out", str(out), "--no-figures"]) == 0
+    assert main(["case", "skirt-a-line", "--out", str(out), "--no-figures", "--set", "garment.h=3"]) == 0
     summary = _check_dressed(out, load_scene("skirt-a-line").path.parent / "patterns" / "skirt-a-line.toml", 0.03)
     assert summary["garment"]["hem_folds"] >= 2
 
