@@ -14,25 +14,30 @@ self-contact kernels (:mod:`rftstatic.contact.self_contact.distance`: exact squa
 and gradients of the point-triangle and edge-edge pairs, the obstacle's points held; ``r`` [m] is the sheet's
 closest point minus the feature's, ``r = 1/2 sum_k ds/dx_k`` over the sheet's nodes) *signed* by the side:
 
-    delta = sigma(psi) |r|,   psi = z / |r|,
+    delta = sigma |r|,   sigma = 1 - (1 - sigma_0(psi)) chi(|r| / d),   psi = z / |r|  (clipped to [-1, 1]),
 
-``z`` the depth of the sheet's closest point behind the obstacle's surface at the feature (an edge: the wedge of
-its two faces, ``max(r . n1, r . n2)``; a corner: the obstacle's signed distance at the corner + ``r``), so
-``psi`` in [-1, 1] says how far into the obstacle ``r`` points, and ``sigma`` (:func:`side_factor`) is +1 outside
-or on a face (``psi >= -SIDE_BAND[0]``), -1 behind the feature (``psi <= -SIDE_BAND[1]``: a sheet passing under
-a rim, ``psi = -cos(bend / 2)``), a C1 cubic between. So a sheet that starts touching a rim (``delta = 0``, a
-cloth laid on a table) or is pushed past it within a step is pushed back out, never further through (an unsigned
-distance would push it on once it crossed), and the energy keeps growing behind the feature. ``delta`` is
-continuous: a side read by a threshold (the first version: behind once ``z < -0.1 |r|``) made the energy jump by
-``~2 k d |r|`` where a sheet resting on a face beside a rim was pressed into it (by the node penalty's
-penetration), and an undamped explicit run of a collar on a form with its rims as features gained energy each
-time a node crossed that surface (0.130 -> 1.12 J in 0.3 s). Energy and force are exact: ``grad delta = sigma
-grad |r| + sigma' (dz/dr - psi r / |r|) . dr/dx``, the last term (only in the band, where ``sigma' != 0``) from
-the kernels' Hessians (``dr/dx_b = 1/2 sum_k d2s/dx_k dx_b``). The tangent is the Gauss-Newton part ``e'' grad
-delta grad delta^T`` (positive semi-definite): the remaining ``e' hess delta`` grows as ``1 / |r|`` for a sheet
-edge touching an obstacle edge (parallel edges at zero distance make it singular), and with ``e' < 0`` its PSD
-projection keeps little of it. Limitations: a corner's side uses the obstacle's signed distance (its faces near
-the corner); a two-sided rim has no wedge (never behind).
+``z`` [m] the obstacles' signed distance at a probe point of the sheet (a corner pair: the triangle's closest
+point; an edge pair: :meth:`FeatureContact._probe`, at the crossing of a sheet edge under the feature), so ``psi``
+says how far behind the surface the sheet lies relative to its distance from the feature; ``sigma_0``
+(:func:`side_factor`) is +1 outside or on a face (``psi >= -SIDE_BAND[0]``), -1 behind the feature (``psi <=
+-SIDE_BAND[1]``: a sheet passing under a 90 deg rim has ``psi = -0.71``), a C1 cubic between; ``chi`` (1 within
+``d``, 0 beyond ``2 d``, C1) keeps the side local, so that every pair's energy vanishes before it leaves the pair
+list. So a sheet that starts touching a rim (``delta = 0``, a cloth laid on a table) or is pushed past it within a
+step is pushed back out, never further through (an unsigned distance would push it on once it crossed). ``delta``
+is continuous: a side read by a threshold (the first version: behind once ``z < -0.1 |r|`` at the closest point)
+made the energy jump by ``~2 k d |r|`` where a sheet resting on a face beside a rim was pressed into it (by the
+node penalty's penetration), and an undamped explicit run of a collar on a form with its rims as features gained
+energy each time a node crossed that surface (0.130 -> 1.12 J in 0.3 s). The probe is not the closest point: the
+closest points of a sheet edge near parallel to a rim slide along it far faster than the nodes move (the gradient
+of ``z`` there was 1000 x the force's scale). Energy and force are exact: ``grad delta = (sigma - sigma_0' chi psi
+- |r| chi' (1 - sigma_0) / d) grad |r| + sigma_0' chi grad z``, ``grad |r| = ds/dx / (2 |r|)``, ``grad z`` the
+obstacle's normal times the probe's derivative (a corner pair's from the kernel's Hessian, ``dr/dx_b = 1/2 sum_k
+d2s/dx_k dx_b``). The tangent is the Gauss-Newton part ``e'' grad delta grad delta^T`` (positive semi-definite):
+the remaining ``e' hess delta`` grows as ``1 / |r|`` for a sheet edge touching an obstacle edge (parallel edges at
+zero distance make it singular), and with ``e' < 0`` its PSD projection keeps little of it. Limitations: at a sheet
+edge exactly parallel to a feature edge the closest points jump from one end to the other, and ``r`` with them:
+inside the band ``delta`` jumps there by ``|r|`` times the change of ``sigma`` (small: both ends lie at the same
+distance); a rim bent by more than about 170 deg (``psi > -0.05`` under it) reads as outside.
 
 Broad phase: the obstacle's feature edges are sampled at the sheet's mean edge length; a ``cKDTree`` of the
 sheet's edge midpoints (triangle centroids) lists the pairs within ``d + margin``; the list is kept in the
@@ -49,10 +54,12 @@ from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
 
 __all__ = ["FeatureContact", "FeatureState", "SIDE_BAND", "side_factor"]
 
-SIDE_BAND = (0.05, 0.2)
+SIDE_BAND = (0.05, 0.5)
 """The band of relative depths ``-psi`` (:func:`side_factor`) over which a pair's side turns from outside (+1) to
 behind its feature (-1): a sheet resting on a face beside a rim, pressed into it by less than 5 % of its distance
-from the rim, is outside; one passing under a rim bent by up to about 155 deg is behind (``cos(bend / 2) >= 0.2``)."""
+from the rim, is outside; one passing under a rim bent by up to 120 deg (``cos(bend / 2) >= 0.5``) is behind, and
+more than half so up to about 150 deg. Wide, so that the signed distance's curvature, ``~ sigma_0'' / |r|``, stays
+within ten times that of the distance itself (a band of width 0.15 was too stiff for the explicit step)."""
 
 
 class FeatureState:
@@ -181,19 +188,40 @@ class FeatureContact:
         i = np.arange(len(c))
         return np.stack(phis)[k, i], np.stack(normals)[k, i]
 
-    def _depth_gradient(self, kernel, x4, slot, r, w, xs, nz):
-        """``dz/dx (P, m, 3)`` [-] over the sheet's ``m`` nodes of the pairs ``x4 (P, 4, 3)`` [m]: ``z`` the signed
-        distance at the sheet's closest point ``c = sum_k w_k x_k`` (``nz (P, 3)`` its gradient), ``dc/dx_b = w_b I +
-        sum_k x_k dw_k/dx_b``. From ``ds/dx_k = 2 w_k r``: ``dr/dx_b = 1/2 sum_k d2s/dx_k dx_b`` and ``dw_k/dx_b = (1/2
-        d2s/dx_k dx_b - w_k dr/dx_b)^T r / |r|^2`` (the kernels' exact Hessians)."""
-        _, _, H, _ = kernel(x4, hessian=True, compiled=self.compiled)
-        m = xs.shape[1]
-        idx = np.arange(12).reshape(4, 3)[slot].ravel()  # the sheet's dofs in x4
-        Hs = H[:, idx][:, :, idx].reshape(len(x4), m, 3, m, 3)  # [p, k, i, b, l]
-        drdx = 0.5 * Hs.sum(axis=1)  # [p, i, b, l]
-        rr = r / np.maximum(np.einsum("pi,pi->p", r, r), 1e-300)[:, None]
-        dw = np.einsum("pkibl,pi->pkbl", 0.5 * Hs, rr) - w[:, :, None, None] * np.einsum("pibl,pi->pbl", drdx, rr)[:, None]
-        return w[:, :, None] * nz[:, None, :] + np.einsum("pk,pkbl->pbl", np.einsum("pki,pi->pk", xs, nz), dw)
+    @staticmethod
+    def _probe(x4):
+        """The sheet points whose depth decides the side of edge pairs ``x4 (P, 4, 3)`` [m] (sheet edge ``a b``,
+        feature edge ``p q``), ``(P, 3)`` [m], and their gradients ``dc/dx (P, 2, 3, 3)`` over ``a, b``: the point
+        of the sheet edge nearest ``a*``, the point of the feature edge nearest the sheet edge's midpoint (both
+        clamped to their edges). At a sheet edge crossing under the feature it lies at the crossing; unlike the
+        closest points it moves no faster than the nodes (a sheet edge near parallel to the feature edge)."""
+        a, b, p = x4[:, 0], x4[:, 1], x4[:, 2]
+        w, e = x4[:, 3] - p, b - a
+        ww = np.maximum(np.einsum("pi,pi->p", w, w), 1e-300)
+        ee = np.maximum(np.einsum("pi,pi->p", e, e), 1e-300)
+        t1 = np.einsum("pi,pi->p", 0.5 * (a + b) - p, w) / ww
+        W = np.einsum("pi,pj->pij", w, w) * (((t1 > 0.0) & (t1 < 1.0)) / ww)[:, None, None]  # d a* / d midpoint
+        s = p + np.clip(t1, 0.0, 1.0)[:, None] * w - a  # a* - a
+        t2 = np.einsum("pi,pi->p", s, e) / ee
+        inner = ((t2 > 0.0) & (t2 < 1.0)) / ee
+        tc = np.clip(t2, 0.0, 1.0)
+        We = 0.5 * np.einsum("pij,pj->pi", W, e)
+        eye = np.eye(3)
+        # dt2/da = (W e / 2 - e - s + 2 t2 e) / |e|^2, dt2/db = (W e / 2 + s - 2 t2 e) / |e|^2 (inside the edge)
+        dta = (We - e - s + 2.0 * t2[:, None] * e) * inner[:, None]
+        dtb = (We + s - 2.0 * t2[:, None] * e) * inner[:, None]
+        dca = (1.0 - tc)[:, None, None] * eye + np.einsum("pi,pj->pij", e, dta)  # [p, i (c), j (x_a)]
+        dcb = tc[:, None, None] * eye + np.einsum("pi,pj->pij", e, dtb)
+        return a + tc[:, None] * e, np.stack([dca, dcb], axis=1)
+
+    def _corner_gradient(self, x4, nz):
+        """``dz/dx (P, 3, 3)`` [-] over the triangle's nodes of corner pairs ``x4 (P, 4, 3)`` [m]: ``z`` the signed
+        distance at the triangle's point closest to the corner (``nz (P, 3)`` its gradient there), ``dr/dx_b = 1/2
+        sum_k d2s/dx_k dx_b`` (from ``ds/dx_k = 2 w_k r``, the kernel's exact Hessian)."""
+        _, _, H, _ = point_triangle(x4, hessian=True, compiled=self.compiled)
+        idx = np.arange(3, 12)  # the triangle's dofs in x4
+        drdx = 0.5 * H[:, idx][:, :, idx].reshape(len(x4), 3, 3, 3, 3).sum(axis=1)  # [p, i, b, l]
+        return np.einsum("pi,pibl->pbl", nz, drdx)
 
     def evaluate(self, x: np.ndarray, *, tangent: bool = True, cache=None) -> FeatureState:
         """Energy, force and (``tangent``) the PSD node-pair blocks at ``x (N, 3)`` [m]."""
@@ -204,42 +232,48 @@ class FeatureContact:
             return FeatureState(0.0, force, *none, np.inf)
         ee, pt = self._pairs(x, cache)
         energy, rows, cols, blocks, dmin = 0.0, [], [], [], np.inf
-        parts = (  # (x4 rows, the sheet nodes, their slots in x4, the kernel, the features)
+        parts = (  # (x4 rows, the sheet nodes, their slots in x4, the kernel)
             (np.concatenate([x[self.edges[ee[:, 1]]], self.points[self.fedges[ee[:, 0]]]], axis=1),
-             self.edges[ee[:, 1]], slice(0, 2), edge_edge, ee[:, 0]),
+             self.edges[ee[:, 1]], slice(0, 2), edge_edge),
             (np.concatenate([self.points[self.corners[pt[:, 0]], None], x[self.tri[pt[:, 1]]]], axis=1),
-             self.tri[pt[:, 1]], slice(1, 4), point_triangle, pt[:, 0]),
+             self.tri[pt[:, 1]], slice(1, 4), point_triangle),
         )
         d, k = self.gap, self.stiffness
-        for kind, (x4, nodes, slot, kernel, feature) in enumerate(parts):  # the two pair kinds
+        for kind, (x4, nodes, slot, kernel) in enumerate(parts):  # the two pair kinds
             if not len(x4):
                 continue
             s, g, _, _ = kernel(x4, hessian=False, compiled=self.compiled)
-            g, xs = g[:, slot], x4[:, slot]
+            g = g[:, slot]
             dist = np.sqrt(np.maximum(s, 0.0))
             r = 0.5 * g.sum(axis=1)  # sheet point - feature point: ds/dx_k = 2 w_k r, sum w_k = 1
-            w = np.linalg.norm(g, axis=2) / (2.0 * np.maximum(dist, 1e-300))[:, None]  # barycentric weights (P, m)
-            z, nz = self._depth(np.einsum("pk,pki->pi", w, xs))
+            if kind == 0:
+                c, dc = self._probe(x4)
+            else:
+                c, dc = x4[:, 0] + r, None
+            z, nz = self._depth(c)
             psi = np.clip(z / np.maximum(dist, 1e-300), -1.0, 1.0)
             side, slope = side_factor(psi)
+            reach, reach_slope = _cubic_step(dist / d - 1.0)  # chi(|r| / d): 1 within d, 0 beyond 2 d
+            side, slope, fade = 1.0 - (1.0 - side) * reach, slope * reach, (1.0 - side) * reach_slope
             delta = side * dist
             dmin = min(dmin, float(delta.min()))
             act = delta < d
             if not act.any():
                 continue
-            delta, g, nodes, side, slope = delta[act], g[act], nodes[act], side[act], slope[act]
-            dist, r, w, xs, nz, psi = dist[act], r[act], w[act], xs[act], nz[act], psi[act]
+            delta, g, nodes, side, slope, fade = delta[act], g[act], nodes[act], side[act], slope[act], fade[act]
+            dist, nz, psi = dist[act], nz[act], psi[act]
             gap = d - delta
             e1, e2 = -k / d * gap**2, 2.0 * k / d * gap  # dE/ddelta, d2E/ddelta2
             energy += float(np.sum(k / (3.0 * d) * gap**3))
-            # grad delta = sigma grad |r| + sigma' (grad z - psi grad |r|), grad |r| = ds/dx / (2 |r|)
-            gn = g / (2.0 * np.maximum(dist, 1e-300))[:, None, None]
-            gd = gn * side[:, None, None]
+            # grad delta (module docstring); slope = sigma_0' chi, fade = (1 - sigma_0) chi'
+            gd = g * ((side - dist * fade / d - slope * psi) / (2.0 * np.maximum(dist, 1e-300)))[:, None, None]
             band = np.flatnonzero(slope != 0.0)
             if band.size:
-                gd[band] += slope[band, None, None] * (self._depth_gradient(kernel, x4[act][band], slot, r[band],
-                                                                            w[band], xs[band], nz[band])
-                                                       - psi[band, None, None] * gn[band])
+                if kind == 0:
+                    dz = np.einsum("pi,pbij->pbj", nz[band], dc[act][band])
+                else:
+                    dz = self._corner_gradient(x4[act][band], nz[band])
+                gd[band] += slope[band, None, None] * dz
             fn = (e1[:, None, None] * gd).reshape(-1, 3)
             for i in range(3):  # the three components
                 force[:, i] += np.bincount(nodes.ravel(), fn[:, i], minlength=n)
@@ -255,10 +289,16 @@ class FeatureContact:
         return FeatureState(energy, force, *none, dmin)
 
 
+def _cubic_step(u):
+    """``1 - 3 u^2 + 2 u^3`` on ``u`` in [0, 1] (1 below, 0 above) and its derivative: a C1 step down."""
+    u = np.clip(u, 0.0, 1.0)
+    return 1.0 - u * u * (3.0 - 2.0 * u), -6.0 * u * (1.0 - u)
+
+
 def side_factor(psi):
-    """The side ``sigma (P,)`` of pairs whose relative depth is ``psi = z / |r| (P,)`` (:meth:`FeatureContact._depth`)
-    and ``d sigma / d psi``: +1 (outside) for ``psi >= -SIDE_BAND[0]``, -1 (behind the feature) for ``psi <=
-    -SIDE_BAND[1]``, a C1 cubic between, so that the signed distance ``sigma |r|`` is continuous (module docstring)."""
+    """The side ``sigma_0 (P,)`` of pairs whose relative depth is ``psi = z / |r| (P,)`` (module docstring) and ``d
+    sigma_0 / d psi``: +1 (outside) for ``psi >= -SIDE_BAND[0]``, -1 (behind the feature) for ``psi <=
+    -SIDE_BAND[1]``, a C1 cubic between, so that the signed distance is continuous."""
     lo, hi = SIDE_BAND
-    u = np.clip((-psi - lo) / (hi - lo), 0.0, 1.0)
-    return 1.0 - 2.0 * u * u * (3.0 - 2.0 * u), 12.0 * u * (1.0 - u) / (hi - lo)
+    step, slope = _cubic_step((-psi - lo) / (hi - lo))
+    return 2.0 * step - 1.0, -2.0 * slope / (hi - lo)
