@@ -22,6 +22,10 @@ Start: from ``U0`` and the velocity ``V0`` at t = 0, the default ``start="consis
 constant acceleration (free fall gives ``z = z0 + V0 t - g t^2 / 2`` to round-off);
 ``start="given"`` takes ``V0`` as ``v_(-1/2)``.
 
+Friction: Coulomb impulses after each velocity update, on the penalty contact
+(:func:`rftstatic.contact.friction.penalty_impulses`), between the sheet's layers in self-contact
+(:func:`rftstatic.contact.self_contact.friction.pair_impulses`) and in the kinematic contact.
+
 Energy bookkeeping (history): kinetic energy at step n from the mean of the two half-step
 velocities, potential = stored (bending + membrane + penalty) energy - P.D_n, dissipated = the work
 of the damping force ``sum alpha dt v_(n-1/2) M v_(n+1/2)`` plus, with bending hysteresis, the friction's
@@ -45,6 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.contact.friction import penalty_impulses
+from rftstatic.contact.self_contact.friction import pair_impulses
 from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.model.state import State
@@ -207,6 +212,7 @@ class _Loop:
             self.self_filter = StepFilter(sc, self.minv)
         else:
             self.self_filter = None
+        self.self_friction = getattr(sc, "friction", None)  # Coulomb impulses between layers (self_contact.friction)
         self.n_contact = 0
         self.sweep = None  # the sheet against the obstacles' sharp features along each step (feature_sweep)
         if obstacles:
@@ -297,6 +303,9 @@ class _Loop:
             if self.penalty_friction is not None:  # Coulomb impulses on the penalty contact (F5)
                 acc["contact"] += penalty_impulses(self.penalty_friction, self.model.contact, self.model.X3 + U, V,
                                                    minv, dt, state.candidates)
+            if self.self_friction is not None:  # Coulomb impulses between the sheet's layers
+                acc["contact"] += pair_impulses(self.self_friction, self.model.self_contact, self.model.X3 + U, V,
+                                                minv, dt, state.self_pairs)
             if self.self_filter is not None:  # no pair of the sheet passes through another on this step
                 acc["contact"] += self.self_filter(state.self_pairs, self.model.X3 + U, V, dt)
             # Eq. 22
