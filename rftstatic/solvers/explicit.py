@@ -36,8 +36,8 @@ obstacles. Supports may move at a prescribed velocity (``model.supports.velocity
 over the run's second half is :attr:`ExplicitResult.drive_reaction`. The kinematic contact is not conservative:
 it removes the inward normal velocity (``contact_loss``, the kinetic energy removed, reported apart) and its
 position projection does work that is not tracked; on balance it lowers ``total``, by about ``contact_loss``.
-Growth of ``total`` beyond ``energy_tol`` times the energy scale of the run (or a non-finite value) raises :class:`InstabilityError`
-naming the time, the step and the step size to use.
+Growth of ``total`` beyond ``energy_tol`` times the energy scale of the run (or a non-finite value) raises
+:class:`InstabilityError` naming the time, the step and the step size to use.
 """
 
 from __future__ import annotations
