@@ -5,8 +5,9 @@
 Every number comes from a run made here: the static incline (load steps, lagged friction; and the default route,
 relaxation with friction impulses then Newton) below and above its friction angle, the explicit incline (Coulomb
 impulses, kinematic and on the penalty) against g (sin theta - mu_k cos theta), the drag tests (on the floor and
-between two layers in self-contact), the cost of friction on pedestal-square-20, table-cloth and the Cusick
-friction scene, each scene in this process one after the other.
+between two layers in self-contact; static and explicit, and the drag scene), the energy of the sharp-feature
+contact in undamped explicit runs (tools/friction_explicit_rows.py), the cost of friction on pedestal-square-20,
+table-cloth and the Cusick friction scene, each scene in this process one after the other.
 """
 
 from __future__ import annotations
@@ -20,6 +21,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from friction_explicit_rows import (drag_scene_row, explicit_drag_rows, feature_energy_rows,  # noqa: E402
+                                    layer_drag_explicit_rows)
 
 ROOT = Path(__file__).resolve().parent.parent
 G = 9.80665
@@ -259,6 +264,8 @@ def main(argv=None) -> int:
         px = penalty_incline()
         dr = drag_rows()
         ld = layer_drag_rows()
+        edr, eld, dsc = explicit_drag_rows(), layer_drag_explicit_rows(), drag_scene_row(tmp)
+        fe = feature_energy_rows(tmp)
         co, ratio = cost(tmp)
         rc_rows, relax_ratio = relax_cost(tmp)
         tc = table_cloth(tmp)
@@ -343,6 +350,50 @@ Tolerance 2 %.
 |---|---|---|---|---|---|---|---|
 """ + "\n".join(ld) + f"""
 
+## Drag on the explicit route (exact: a sliding sheet pulls back with mu times the weight it drags)
+
+The 10 cm square resting on the floor (9 x 9), its edge x = 0 held in x and y and moving along -x at 1 cm/s
+(`Supports.velocity`, `[[supports]] velocity` in a scene) for 0.2 s, undamped; friction by the kinematic contact's
+impulses (a dynamic run) or the penalty's (the relaxation's, F5; the sheet seated on the penalty). Reaction: the
+mean of the held dofs' `F - P` along x over the run's second half (`ExplicitResult.drive_reaction`), over mu times
+the weight of the nodes the edge drags (the held nodes' own friction acts on the support, not through the sheet).
+Tolerance 2 %.
+
+| impulses | mu | edge moved [mm] | reaction / (mu W dragged) | error | verdict |
+|---|---|---|---|---|---|
+""" + "\n".join(edr) + f"""
+
+Between layers: the two layers above, the upper one's edge moving at 1 cm/s for 0.2 s, undamped, with Coulomb
+impulses between the layers (`rftstatic.contact.self_contact.friction.pair_impulses`: a pair slides with
+`mu_k lambda dt`, or sticks with the impulse that stops it shared at its busiest node). Columns: the mean reaction
+along x over the weight W of the upper layer's nodes not held, frictionless and with mu, and their difference over
+mu. Tolerance 2 %.
+
+| mu | reaction / W, frictionless | reaction / W, mu | difference / (mu W) | error | verdict |
+|---|---|---|---|---|---|
+""" + "\n".join(eld) + f"""
+
+The drag scene `cases/drag-floor.toml` (the floor drag above as a dynamic scene, mu 0.3; its summary's `drive`):
+
+| exit | explicit steps | mu | reaction along the motion [gf] | weight dragged [gf] | reaction / (mu W) | error | wall [s] | verdict |
+|---|---|---|---|---|---|---|---|---|
+""" + dsc + f"""
+
+## Sharp-feature contact in undamped explicit runs: the energy is kept
+
+The obstacle's sharp edges and corners against the sheet's edges and triangles (`rftstatic.contact.features`) are a
+potential whose signed distance turns continuously from outside to behind the feature (side band
+`SIDE_BAND`); force = -grad energy to central-difference precision (`tests/contact/test_feature_energy.py`, relative
+error < 1e-4 over edge and corner pairs outside, in the band and behind). Undamped runs, the total energy (kinetic +
+stored + penalty - load work) against its start; "lowest": the least signed pair distance over the gap d (negative:
+pairs went behind the feature). The first version read the side by a threshold (behind once the sheet's closest
+point lay deeper than 0.1 of its distance): its energy jumped where a node pressed into the face beside a rim, by
+19 % on the 4-node square and +2.2 % on the sliding sheet (runs of this session at commit 2957005).
+
+| run | feature pairs | lowest | total energy at start [J] | at end [J] | largest change |
+|---|---|---|---|---|---|
+""" + "\n".join(fe) + f"""
+
 ## Cost: pedestal-square-20 (33 x 33) by load steps, frictionless and mu = 0.3
 
 | mu | exit | converged | stable | Newton its | DC [%] | folds | wall [s] |
@@ -386,11 +437,11 @@ load-step route does (`tests/contact/test_friction.py`).
 
 ## Not yet built (issue 36)
 
-- A drag scene: the drag tests above run through the library (successive solves with the edge moved); scenes
-  have no prescribed non-zero displacement yet.
-- Friction between layers in dynamic relaxation and dynamic runs: `self_friction` acts in the static Newton
-  solves (load steps, and the relaxation route's handovers, whose lag between layers starts empty); the explicit
-  steps have no impulses between layers.
+- A moving support in static scenes (a displacement reached with the load factor): `[[supports]] velocity` acts
+  in dynamic runs only; the static drag tests move the edge through the library (successive solves).
+- The relaxation's rest test with friction between layers: it takes off what obstacle friction holds
+  (`held_residual`), not what the pairs' impulses hold, so a relaxation with `self_friction` may run to its end
+  before the Newton handover (table-cloth is validated on the load steps).
 - The Cusick tester's upper disc (the specimen sandwiched between two discs): `cusick-30-friction` leaves it off.
 """
     Path(args.out, "friction_obstacles.md").write_text(text)

@@ -23,7 +23,8 @@ Outputs in the run folder, every number in the scene's units:
   ``at_rest`` the kinetic energy alone, :class:`~rftstatic.solvers.rest.RestCriterion`), energies, flags,
   the self-intersection check of the final state and of every saved state
   (:func:`rftstatic.io.summary.self_intersection_summary`) and, for a triangle-surface obstacle, the final
-  state's sheet/obstacle crossing check (:func:`rftstatic.io.summary.obstacle_crossing_summary`);
+  state's sheet/obstacle crossing check (:func:`rftstatic.io.summary.obstacle_crossing_summary`), and with
+  moving supports their mean reaction (``drive``, :func:`rftstatic.scenes.drive.drive_summary`);
 * ``checkpoint.npz`` every ``checkpoint_every`` of simulated time (default 0.2 s); ``--resume``
   continues from it and reproduces the uninterrupted run bitwise (:mod:`rftstatic.solvers.checkpoint`).
 
@@ -46,6 +47,7 @@ from rftstatic.io.summary import (obstacle_crossing_summary, self_contact_summar
                                   summary_header)
 from rftstatic.post.probes import probe_interpolation
 from rftstatic.scenes.build import build_model
+from rftstatic.scenes.drive import drive_summary
 from rftstatic.scenes.friction import contact_friction
 from rftstatic.scenes.options import contact_options, dynamics_options, static_options
 from rftstatic.model.state import State
@@ -193,6 +195,8 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     if (crossings := obstacle_crossing_summary(scene, model, extras, run.U, poses=poses)) is not None:
         summary["obstacle_crossings"] = crossings
     summary["dt_reason"] = reason
+    if (dragged := drive_summary(scene, model, run, friction)) is not None:
+        summary["drive"] = dragged
     reading = RestCriterion(o.rest_tolerance).record()  # time_at_rest: the kinetic energy alone
     summary["rest_test"] = {"at_rest": rest.criterion.record() if analysis == "relax" else reading,
                             "time_at_rest": reading}

@@ -10,18 +10,34 @@ the gap ``d`` [m] contributes
 
 (``k`` [N/m]: :data:`rftstatic.contact.penalty.FEATURE_STIFFNESS` times a node's penalty spring
 ``k_penalty A``): slope and curvature vanish at ``delta = d`` (C2 onset). ``delta`` is the distance of the
-self-contact kernels (:mod:`rftstatic.contact.self_contact.distance`: exact squared distances and gradients
-of the point-triangle and edge-edge pairs, the obstacle's points held), *signed* by the
-side: negative when the sheet's closest point lies inside the obstacle (its signed distance, by more than
-:data:`SIDE_DEPTH` of the pair's distance). So a sheet that starts touching a rim (``delta = 0``, a cloth laid on a table) or is pushed past
-it within a step is pushed back out, never further through (an unsigned distance would push it on once it
-crossed), and the energy keeps growing behind the feature. Energy and force are exact (``grad delta =
-+-grad s / (2 |delta|)``); the tangent is the Gauss-Newton part ``e'' grad delta grad delta^T`` (positive
-semi-definite): the remaining ``e' hess delta`` grows as ``1 / delta`` for a sheet edge touching an obstacle
-edge (parallel edges at zero distance make it singular), and with ``e' < 0`` its PSD projection keeps
-little of it. Limitation: the side is read at one point; a sheet edge passing under a 90 deg rim exactly
-along one of its faces' planes has that point on the surface (``phi = 0``) and reads as outside (the
-independent crossing check, :mod:`rftstatic.post.measures.obstacle_crossings`, would count it).
+self-contact kernels (:mod:`rftstatic.contact.self_contact.distance`: exact squared distances ``s = |r|^2``
+and gradients of the point-triangle and edge-edge pairs, the obstacle's points held; ``r`` [m] is the sheet's
+closest point minus the feature's, ``r = 1/2 sum_k ds/dx_k`` over the sheet's nodes) *signed* by the side:
+
+    delta = sigma |r|,   sigma = 1 - (1 - sigma_0(psi)) chi(|r| / d),   psi = z / |r|  (clipped to [-1, 1]),
+
+``z`` [m] the obstacles' signed distance at a probe point of the sheet (a corner pair: the triangle's closest
+point; an edge pair: :meth:`FeatureContact._probe`, at the crossing of a sheet edge under the feature), so ``psi``
+says how far behind the surface the sheet lies relative to its distance from the feature; ``sigma_0``
+(:func:`side_factor`) is +1 outside or on a face (``psi >= -SIDE_BAND[0]``), -1 behind the feature (``psi <=
+-SIDE_BAND[1]``: a sheet passing under a 90 deg rim has ``psi = -0.71``), a C1 cubic between; ``chi`` (1 within
+``d``, 0 beyond ``2 d``, C1) keeps the side local, so that every pair's energy vanishes before it leaves the pair
+list. So a sheet that starts touching a rim (``delta = 0``, a cloth laid on a table) or is pushed past it within a
+step is pushed back out, never further through (an unsigned distance would push it on once it crossed). ``delta``
+is continuous: a side read by a threshold (the first version: behind once ``z < -0.1 |r|`` at the closest point)
+made the energy jump by ``~2 k d |r|`` where a sheet resting on a face beside a rim was pressed into it (by the
+node penalty's penetration), and an undamped explicit run of a collar on a form with its rims as features gained
+energy each time a node crossed that surface (0.130 -> 1.12 J in 0.3 s). The probe is not the closest point: the
+closest points of a sheet edge near parallel to a rim slide along it far faster than the nodes move (the gradient
+of ``z`` there was 1000 x the force's scale). Energy and force are exact: ``grad delta = (sigma - sigma_0' chi psi
+- |r| chi' (1 - sigma_0) / d) grad |r| + sigma_0' chi grad z``, ``grad |r| = ds/dx / (2 |r|)``, ``grad z`` the
+obstacle's normal times the probe's derivative (a corner pair's from the kernel's Hessian, ``dr/dx_b = 1/2 sum_k
+d2s/dx_k dx_b``). The tangent is the Gauss-Newton part ``e'' grad delta grad delta^T`` (positive semi-definite):
+the remaining ``e' hess delta`` grows as ``1 / |r|`` for a sheet edge touching an obstacle edge (parallel edges at
+zero distance make it singular), and with ``e' < 0`` its PSD projection keeps little of it. Limitations: at a sheet
+edge exactly parallel to a feature edge the closest points jump from one end to the other, and ``r`` with them:
+inside the band ``delta`` jumps there by ``|r|`` times the change of ``sigma`` (small: both ends lie at the same
+distance); a rim bent by more than about 170 deg (``psi > -0.05`` under it) reads as outside.
 
 Broad phase: the obstacle's feature edges are sampled at the sheet's mean edge length; a ``cKDTree`` of the
 sheet's edge midpoints (triangle centroids) lists the pairs within ``d + margin``; the list is kept in the
@@ -36,12 +52,14 @@ import numpy as np
 from rftstatic.compiled import numba_available
 from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
 
-__all__ = ["FeatureContact", "FeatureState", "SIDE_DEPTH"]
+__all__ = ["FeatureContact", "FeatureState", "SIDE_BAND", "side_factor"]
 
-SIDE_DEPTH = 0.1
-"""A pair is behind its feature when the sheet's closest point lies inside the obstacle deeper than this
-fraction of the pair's distance (:meth:`FeatureContact._side`): a sheet resting on a face beside a rim is not,
-one passing under a rim bent by up to about 170 deg is."""
+SIDE_BAND = (0.05, 0.5)
+"""The band of relative depths ``-psi`` (:func:`side_factor`) over which a pair's side turns from outside (+1) to
+behind its feature (-1): a sheet resting on a face beside a rim, pressed into it by less than 5 % of its distance
+from the rim, is outside; one passing under a rim bent by up to 120 deg (``cos(bend / 2) >= 0.5``) is behind, and
+more than half so up to about 150 deg. Wide, so that the signed distance's curvature, ``~ sigma_0'' / |r|``, stays
+within ten times that of the distance itself (a band of width 0.15 was too stiff for the explicit step)."""
 
 
 class FeatureState:
@@ -162,21 +180,48 @@ class FeatureContact:
                - np.max(np.linalg.norm(t - c[:, None], axis=2), axis=1, initial=0.0))
         return bee, bpt
 
-    def _side(self, xs, g, delta):
-        """-1 for the pairs (sheet points ``xs (P, m, 3)``, their ``ds/dx`` ``g (P, m, 3)``, distances ``delta (P,)``)
-        whose sheet closest point lies inside an obstacle deeper than ``SIDE_DEPTH |delta|``, else +1. The
-        closest point is the sheet nodes weighted by ``|ds/dx_k|`` (``2 w_k (c_sheet - c_feature)``, ``w_k`` its
-        barycentric weights). A sheet lying on a face next to a rim has its closest point on the face
-        (``phi ~ 0``): outside; one passing under a rim has it inside, about ``|delta| cos(half the rim angle)``
-        deep."""
-        if len(self.obstacles) == 0 or not len(xs):
-            return np.ones(len(xs))
-        w = np.linalg.norm(g, axis=2)
-        tot = w.sum(axis=1, keepdims=True)
-        w = np.where(tot > 0, w / np.where(tot > 0, tot, 1.0), 1.0 / xs.shape[1])
-        c = np.einsum("pk,pki->pi", w, xs)
-        phi = np.min([ob.signed_distance(c)[0] for ob in self.obstacles], axis=0)
-        return np.where(phi < -SIDE_DEPTH * delta, -1.0, 1.0)
+    def _depth(self, c):
+        """``z (P,)`` [m]: the obstacles' signed distance at the sheet's closest points ``c (P, 3)`` [m] (the least
+        over the obstacles), and its gradient ``(P, 3)``, the normal there."""
+        phis, normals = zip(*(ob.signed_distance(c) for ob in self.obstacles))
+        k = np.argmin(np.stack(phis), axis=0)
+        i = np.arange(len(c))
+        return np.stack(phis)[k, i], np.stack(normals)[k, i]
+
+    @staticmethod
+    def _probe(x4):
+        """The sheet points whose depth decides the side of edge pairs ``x4 (P, 4, 3)`` [m] (sheet edge ``a b``,
+        feature edge ``p q``), ``(P, 3)`` [m], and their gradients ``dc/dx (P, 2, 3, 3)`` over ``a, b``: the point
+        of the sheet edge nearest ``a*``, the point of the feature edge nearest the sheet edge's midpoint (both
+        clamped to their edges). At a sheet edge crossing under the feature it lies at the crossing; unlike the
+        closest points it moves no faster than the nodes (a sheet edge near parallel to the feature edge)."""
+        a, b, p = x4[:, 0], x4[:, 1], x4[:, 2]
+        w, e = x4[:, 3] - p, b - a
+        ww = np.maximum(np.einsum("pi,pi->p", w, w), 1e-300)
+        ee = np.maximum(np.einsum("pi,pi->p", e, e), 1e-300)
+        t1 = np.einsum("pi,pi->p", 0.5 * (a + b) - p, w) / ww
+        W = np.einsum("pi,pj->pij", w, w) * (((t1 > 0.0) & (t1 < 1.0)) / ww)[:, None, None]  # d a* / d midpoint
+        s = p + np.clip(t1, 0.0, 1.0)[:, None] * w - a  # a* - a
+        t2 = np.einsum("pi,pi->p", s, e) / ee
+        inner = ((t2 > 0.0) & (t2 < 1.0)) / ee
+        tc = np.clip(t2, 0.0, 1.0)
+        We = 0.5 * np.einsum("pij,pj->pi", W, e)
+        eye = np.eye(3)
+        # dt2/da = (W e / 2 - e - s + 2 t2 e) / |e|^2, dt2/db = (W e / 2 + s - 2 t2 e) / |e|^2 (inside the edge)
+        dta = (We - e - s + 2.0 * t2[:, None] * e) * inner[:, None]
+        dtb = (We + s - 2.0 * t2[:, None] * e) * inner[:, None]
+        dca = (1.0 - tc)[:, None, None] * eye + np.einsum("pi,pj->pij", e, dta)  # [p, i (c), j (x_a)]
+        dcb = tc[:, None, None] * eye + np.einsum("pi,pj->pij", e, dtb)
+        return a + tc[:, None] * e, np.stack([dca, dcb], axis=1)
+
+    def _corner_gradient(self, x4, nz):
+        """``dz/dx (P, 3, 3)`` [-] over the triangle's nodes of corner pairs ``x4 (P, 4, 3)`` [m]: ``z`` the signed
+        distance at the triangle's point closest to the corner (``nz (P, 3)`` its gradient there), ``dr/dx_b = 1/2
+        sum_k d2s/dx_k dx_b`` (from ``ds/dx_k = 2 w_k r``, the kernel's exact Hessian)."""
+        _, _, H, _ = point_triangle(x4, hessian=True, compiled=self.compiled)
+        idx = np.arange(3, 12)  # the triangle's dofs in x4
+        drdx = 0.5 * H[:, idx][:, :, idx].reshape(len(x4), 3, 3, 3, 3).sum(axis=1)  # [p, i, b, l]
+        return np.einsum("pi,pibl->pbl", nz, drdx)
 
     def evaluate(self, x: np.ndarray, *, tangent: bool = True, cache=None) -> FeatureState:
         """Energy, force and (``tangent``) the PSD node-pair blocks at ``x (N, 3)`` [m]."""
@@ -194,23 +239,41 @@ class FeatureContact:
              self.tri[pt[:, 1]], slice(1, 4), point_triangle),
         )
         d, k = self.gap, self.stiffness
-        for x4, nodes, slot, kernel in parts:  # the two pair kinds
+        for kind, (x4, nodes, slot, kernel) in enumerate(parts):  # the two pair kinds
             if not len(x4):
                 continue
             s, g, _, _ = kernel(x4, hessian=False, compiled=self.compiled)
             g = g[:, slot]
-            delta = np.sqrt(np.maximum(s, 0.0))
-            side = self._side(x4[:, slot], g, delta)
-            delta = side * delta
+            dist = np.sqrt(np.maximum(s, 0.0))
+            r = 0.5 * g.sum(axis=1)  # sheet point - feature point: ds/dx_k = 2 w_k r, sum w_k = 1
+            if kind == 0:
+                c, dc = self._probe(x4)
+            else:
+                c, dc = x4[:, 0] + r, None
+            z, nz = self._depth(c)
+            psi = np.clip(z / np.maximum(dist, 1e-300), -1.0, 1.0)
+            side, slope = side_factor(psi)
+            reach, reach_slope = _cubic_step(dist / d - 1.0)  # chi(|r| / d): 1 within d, 0 beyond 2 d
+            side, slope, fade = 1.0 - (1.0 - side) * reach, slope * reach, (1.0 - side) * reach_slope
+            delta = side * dist
             dmin = min(dmin, float(delta.min()))
             act = delta < d
             if not act.any():
                 continue
-            delta, g, nodes, side = delta[act], g[act], nodes[act], side[act]
+            delta, g, nodes, side, slope, fade = delta[act], g[act], nodes[act], side[act], slope[act], fade[act]
+            dist, nz, psi = dist[act], nz[act], psi[act]
             gap = d - delta
             e1, e2 = -k / d * gap**2, 2.0 * k / d * gap  # dE/ddelta, d2E/ddelta2
             energy += float(np.sum(k / (3.0 * d) * gap**3))
-            gd = g * (side / (2.0 * np.maximum(np.abs(delta), 1e-300)))[:, None, None]  # grad delta = +-grad s / (2 |delta|)
+            # grad delta (module docstring); slope = sigma_0' chi, fade = (1 - sigma_0) chi'
+            gd = g * ((side - dist * fade / d - slope * psi) / (2.0 * np.maximum(dist, 1e-300)))[:, None, None]
+            band = np.flatnonzero(slope != 0.0)
+            if band.size:
+                if kind == 0:
+                    dz = np.einsum("pi,pbij->pbj", nz[band], dc[act][band])
+                else:
+                    dz = self._corner_gradient(x4[act][band], nz[band])
+                gd[band] += slope[band, None, None] * dz
             fn = (e1[:, None, None] * gd).reshape(-1, 3)
             for i in range(3):  # the three components
                 force[:, i] += np.bincount(nodes.ravel(), fn[:, i], minlength=n)
@@ -224,3 +287,18 @@ class FeatureContact:
         if rows:
             return FeatureState(energy, force, np.concatenate(rows), np.concatenate(cols), np.concatenate(blocks), dmin)
         return FeatureState(energy, force, *none, dmin)
+
+
+def _cubic_step(u):
+    """``1 - 3 u^2 + 2 u^3`` on ``u`` in [0, 1] (1 below, 0 above) and its derivative: a C1 step down."""
+    u = np.clip(u, 0.0, 1.0)
+    return 1.0 - u * u * (3.0 - 2.0 * u), -6.0 * u * (1.0 - u)
+
+
+def side_factor(psi):
+    """The side ``sigma_0 (P,)`` of pairs whose relative depth is ``psi = z / |r| (P,)`` (module docstring) and ``d
+    sigma_0 / d psi``: +1 (outside) for ``psi >= -SIDE_BAND[0]``, -1 (behind the feature) for ``psi <=
+    -SIDE_BAND[1]``, a C1 cubic between, so that the signed distance is continuous."""
+    lo, hi = SIDE_BAND
+    step, slope = _cubic_step((-psi - lo) / (hi - lo))
+    return 2.0 * step - 1.0, -2.0 * slope / (hi - lo)

@@ -62,18 +62,21 @@ def locking_number(mesh: TriMesh, material: Material) -> float:
 
 @dataclass
 class Supports:
-    """Prescribed (zero) displacements.
+    """Prescribed displacements: zero, or (explicit runs) moving at a prescribed velocity.
 
     Attributes
     ----------
     clamped : node indices held fixed with zero slope across clamped edges (image rule U_img = U_c)
     pinned : node indices held fixed, free to rotate
     fixed : (N, 3) bool, further single components held fixed (e.g. in-plane rigid modes)
+    velocity : (N, 3) velocity [m/s] of the held components in explicit runs (a dragged edge,
+        :mod:`rftstatic.solvers.explicit`), zero elsewhere; None: all at rest
     """
 
     clamped: np.ndarray
     pinned: np.ndarray
     fixed: np.ndarray
+    velocity: np.ndarray | None = None
 
     @classmethod
     def none(cls, n_nodes):

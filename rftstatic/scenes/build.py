@@ -15,6 +15,7 @@ from rftstatic.errors import PatchError
 from rftstatic.mesh import trimesh as meshmod
 from rftstatic.model.model import Model, Supports, edge_load, gravity_load
 from rftstatic.post.measures.disc import clamp_disc
+from rftstatic.scenes.drive import support_velocities
 from rftstatic.scenes.material import build_material
 from rftstatic.scenes.friction import contact_friction
 from rftstatic.scenes.obstacle_checks import check_surface_obstacles
@@ -245,7 +246,7 @@ def build_supports(scene: Scene, mesh) -> Supports:
         else:
             raise scene.error(f"{key}.kind", f'"{kind}" is not a support kind; use clamped, pinned or fixed')
     cat = lambda a: np.unique(np.concatenate(a)) if a else np.zeros(0, dtype=np.int64)  # noqa: E731
-    return Supports(cat(clamped), cat(pinned), fixed)
+    return Supports(cat(clamped), cat(pinned), fixed, support_velocities(scene, mesh, select_nodes))
 
 
 def build_load(scene: Scene, mesh, material) -> np.ndarray:

@@ -149,7 +149,9 @@ SCHEMA = {
         "radius": (NUM, "the nodes within this distance of centre (a tester's clamping disc) [length]"),
         "centre": (XY, "centre of the radius selector (default [0, 0])"),
         "components": (str, "for kind = fixed: which of x, y, z are held, e.g. 'xy'"),
-    }], "prescribed (zero) displacements"),
+        "velocity": (XYZ, "[vx, vy, vz] the held components move at in a dynamic run (a dragged edge, "
+                          "rftstatic.scenes.drive) [length/time]"),
+    }], "prescribed displacements: zero, or moving at a velocity (dynamic runs)"),
     "loads": ({
         "gravity": (bool, "the material's weight, along -z"),
         "gravity_tilt": (NUM, "tilt of the weight about the y axis [deg], towards +x: the sheet on a plane "

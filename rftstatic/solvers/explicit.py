@@ -22,16 +22,22 @@ Start: from ``U0`` and the velocity ``V0`` at t = 0, the default ``start="consis
 constant acceleration (free fall gives ``z = z0 + V0 t - g t^2 / 2`` to round-off);
 ``start="given"`` takes ``V0`` as ``v_(-1/2)``.
 
+Friction: Coulomb impulses after each velocity update, on the penalty contact
+(:func:`rftstatic.contact.friction.penalty_impulses`), between the sheet's layers in self-contact
+(:func:`rftstatic.contact.self_contact.friction.pair_impulses`) and in the kinematic contact.
+
 Energy bookkeeping (history): kinetic energy at step n from the mean of the two half-step
 velocities, potential = stored (bending + membrane + penalty) energy - P.D_n, dissipated = the work
 of the damping force ``sum alpha dt v_(n-1/2) M v_(n+1/2)`` plus, with bending hysteresis, the friction's
 (:mod:`rftstatic.element.hysteresis`, H4: its slip is committed after every step, each step a converged one).
 ``total`` = kinetic + potential + dissipated is conserved up to the scheme's O(dt^2) error without
-obstacles. The kinematic contact is not conservative: it removes the inward normal velocity
-(``contact_loss``, the kinetic energy removed, reported apart) and its position projection does work that is
-not tracked; on balance it lowers ``total``, by about ``contact_loss``. Growth of ``total`` beyond
-``energy_tol`` times the energy scale of the run (or a non-finite value) raises :class:`InstabilityError`
-naming the time, the step and the step size to use.
+obstacles. Supports may move at a prescribed velocity (``model.supports.velocity``: a dragged edge); their work
+``sum (F - P) . v dt`` on the driven dofs enters ``dissipated`` with a minus sign, and the mean of that reaction
+over the run's second half is :attr:`ExplicitResult.drive_reaction`. The kinematic contact is not conservative:
+it removes the inward normal velocity (``contact_loss``, the kinetic energy removed, reported apart) and its
+position projection does work that is not tracked; on balance it lowers ``total``, by about ``contact_loss``.
+Growth of ``total`` beyond ``energy_tol`` times the energy scale of the run (or a non-finite value) raises
+:class:`InstabilityError` naming the time, the step and the step size to use.
 """
 
 from __future__ import annotations
@@ -43,6 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rftstatic.contact.friction import penalty_impulses
+from rftstatic.contact.self_contact.friction import pair_impulses
 from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.model.state import State
@@ -77,6 +84,8 @@ class ExplicitResult:
         (:meth:`~rftstatic.solvers.rest.RestCriterion.time_at_rest`), or None
     stopped : True if a callback stopped the run before ``t_end``
     wall_time : [s]; element_steps_per_second : E * steps / wall time
+    drive_reaction : (3,) mean force [N] of the sheet on its driven supports (``model.supports.velocity``) over the
+        run's second half (:func:`drive_reaction`), None without them
     state : the final :class:`~rftstatic.model.state.State` (U, V, t, step, contact candidates)
     """
 
@@ -95,6 +104,7 @@ class ExplicitResult:
     wall_time: float = 0.0
     element_steps_per_second: float = 0.0
     state: State | None = None
+    drive_reaction: np.ndarray | None = None
 
 
 EXPLICIT = "explicit"
@@ -179,7 +189,8 @@ def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(
         probes=np.asarray(loop.probe_hist, dtype=float).reshape(len(loop.probe_hist), len(probes), 3),
         frames=loop.frames, time_at_rest=RestCriterion(o.rest_tol).time_at_rest(history), stopped=stopped,
         contact_nodes=loop.n_contact, wall_time=wall,
-        element_steps_per_second=model.mesh.n_elements * state.step / max(wall, 1e-12), state=state)
+        element_steps_per_second=model.mesh.n_elements * state.step / max(wall, 1e-12), state=state,
+        drive_reaction=drive_reaction(loop.acc, state.step, dt))
 
 
 class _Loop:
@@ -201,6 +212,7 @@ class _Loop:
             self.self_filter = StepFilter(sc, self.minv)
         else:
             self.self_filter = None
+        self.self_friction = getattr(sc, "friction", None)  # Coulomb impulses between layers (self_contact.friction)
         self.n_contact = 0
         self.sweep = None  # the sheet against the obstacles' sharp features along each step (feature_sweep)
         if obstacles:
@@ -211,6 +223,8 @@ class _Loop:
         self.penalty_friction = getattr(model.contact, "friction", None) if model.contact is not None else None
         # keyframed obstacles of the penalty contact (rftstatic.contact.motion): the pose of each step is State
         self.motion = getattr(model.contact, "motion", None) if model.contact is not None else None
+        drive = getattr(model.supports, "velocity", None)  # held components moving at a prescribed velocity
+        self.drive = None if drive is None or not np.any(drive * ~self.free) else np.where(self.free, 0.0, drive)
 
     def _pose(self, state, t, work=True):
         """Set the obstacles' poses of the step from ``t`` [s] (and their surfaces' velocity over it) on ``state``;
@@ -290,6 +304,8 @@ class _Loop:
             else:
                 f = self.kernel(U, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
             self._frames_due(t, U)
+            if self.drive is not None:  # the driven supports' reaction f - P: its work and impulse (module docstring)
+                _drive_work(acc, f, P, self.drive, dt, step, n_steps)
             # Eq. 20-21, with the damping force lagged half a step
             np.subtract(P, f, out=f)
             f *= minv
@@ -308,9 +324,15 @@ class _Loop:
                         state.U, state.V, state.t, state.step = U, V, t, step
                         stopped = bool(callback(state, rec))
             V, Vnew = Vnew, V
+            if self.drive is not None:
+                np.copyto(V, self.drive, where=~free)
+                Ufix += dt * self.drive
             if self.penalty_friction is not None:  # Coulomb impulses on the penalty contact (F5)
                 acc["contact"] += penalty_impulses(self.penalty_friction, self.model.contact, self.model.X3 + U, V,
                                                    minv, dt, state.candidates, work=acc)
+            if self.self_friction is not None:  # Coulomb impulses between the sheet's layers
+                acc["contact"] += pair_impulses(self.self_friction, self.model.self_contact, self.model.X3 + U, V,
+                                                minv, dt, state.self_pairs)
             if self.self_filter is not None:  # no pair of the sheet passes through another on this step
                 acc["contact"] += self.self_filter(state.self_pairs, self.model.X3 + U, V, dt)
             # Eq. 22
@@ -354,7 +376,7 @@ def _sample(t, U, V, Vnew, W, P, g, dt, mass, minv, free, acc) -> dict:
     vbar = 0.5 * (V + Vnew)
     kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, vbar, vbar))
     ext = float(np.einsum("ni,ni->", P, U))
-    dissipated = acc["damping"] + acc.get("bending_friction", 0.0) + acc.get("projection", 0.0)
+    dissipated = acc["damping"] + acc.get("bending_friction", 0.0) + acc.get("projection", 0.0) - acc.get("drive", 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(free, g / (dt * np.where(minv > 0, minv, 1.0)), 0.0)
     body = acc.get("body_work", 0.0)  # work of moving obstacles on the sheet (rftstatic.contact.motion)
@@ -397,6 +419,29 @@ def _check_energy(rec, step, dt, estimate, model, mass_scale, alpha, safety, ene
         f"use dt <= {suggested:.4g} s (estimated critical step {estimate.dt_crit:.4g} s, "
         f"omega_max {estimate.omega_max:.4g} rad/s, mass scale {mass_scale:g})",
         t=rec["time"], step=step, dt=dt, suggested_dt=suggested)
+
+
+def _drive_work(acc, f, P, drive, dt, step, n_steps) -> None:
+    """Add a step of the driven supports' work ``(f - P) . v dt`` [J] (a work term of the energy balance) and
+    impulse ``sum (f - P) dt`` [N s] over the driven dofs (``drive (N, 3)`` [m/s], zero elsewhere); the impulse at
+    half the run is kept, so the mean reaction of its second half is ``(impulse - impulse_half) / (t - t_half)``."""
+    moving = drive != 0.0
+    r = np.where(moving, f - P, 0.0)
+    acc["drive"] = acc.get("drive", 0.0) + dt * float(np.einsum("ni,ni->", r, drive))
+    impulse = np.asarray(acc.get("drive_impulse", np.zeros(3)), float) + dt * r.sum(axis=0)
+    acc["drive_impulse"] = impulse
+    if step == n_steps // 2:
+        acc["drive_half_impulse"], acc["drive_half_step"] = impulse.copy(), int(step)
+
+
+def drive_reaction(acc, steps: int, dt: float):
+    """The mean force ``(3,)`` [N] the sheet pulls its driven supports with, ``f - P`` summed over their driven dofs,
+    over the second half of a run of ``steps`` steps of ``dt`` [s] (:func:`_drive_work`'s records ``acc``), or None
+    without a drive."""
+    if "drive_half_step" not in acc:
+        return None
+    impulse, half = np.asarray(acc["drive_half_impulse"]), int(acc["drive_half_step"])
+    return (np.asarray(acc["drive_impulse"]) - impulse) / max((steps - half) * dt, 1e-300)
 
 
 def _contact(model, obstacles, U, V, mass, acc, friction=None, dt=0.0, P=None, sweep=None) -> int:

@@ -117,12 +117,17 @@ def signed_in_sets(x, surface, ik, dk, moved, consts, hessian, phi, normal, H, o
     (n, 3, 3)`` [1/m] (when ``hessian``) and ``out (n, 6)``: the closest point of the nearest candidate [m], its
     distance ``r`` [m], the lower bound of the distance [m], and a status: 0 done; 1 unproven and within the band,
     or unproven with a held set (the caller seeks its set again, or searches every triangle within ``r + R``); 2
-    beyond the band inside a closed surface's box (the caller's winding number)."""
+    beyond the band inside a closed surface's box (the caller's winding number); 3 a held set's point beyond the
+    band by its bound alone (``dk_0 - moved - R >= band``), left untested: the caller evaluates it with its nearest
+    centroid now as its set (:data:`rftstatic.contact.obstacles.surface_mesh.FAR`)."""
     V, T, centroid, nf, ne, nv, edge_of, edges, rim_edge, rim_vertex = surface
     R, band, half, mode = consts[0], consts[1], consts[2], int(consts[3])
     n, K = ik.shape
     whole = T.shape[0] <= K or consts[10] > 0
     for p in range(n):
+        if moved[p] > 0 and dk[p, 0] - moved[p] - R >= band:
+            out[p, 5] = 3.0  # beyond the band whatever its set: the caller's nearest centroid now (FAR)
+            continue
         p0, p1, p2 = x[p, 0], x[p, 1], x[p, 2]
         d2, s0, s1, s2, kd, lc, t, c2 = nearest_one(p0, p1, p2, V, T, centroid, ik[p], dk[p], moved[p], R)
         r, dc = np.sqrt(d2), np.sqrt(c2)

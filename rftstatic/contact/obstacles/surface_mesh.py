@@ -79,6 +79,13 @@ WIDEST = 512
 nearest triangle for more than a quarter of the points sought again (slivers along a rounded edge: the nearest
 centroids all lie within a few millimetres), the next calls use sets twice as large."""
 
+FAR = "dk_0 - moved - R >= band"
+"""A point whose held candidate set bounds its distance beyond the band (its set's nearest centroid, less how far it
+moved since, less ``R``) needs only that bound: it is evaluated with its nearest centroid now as its set (a k-d
+tree query of one centroid) rather than its held set tested, failing its proof and sought again with ``K``
+centroids; its value then no longer depends on which set it held. On sphere-mesh with the level-4 icosphere the
+all-node evaluations of the candidate list's refreshes re-sought ~700 far nodes each: 2.5 of the query's 4.8 s."""
+
 HELD_SETS = 8
 """Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
 midpoints, the feature contact's points ...): a static obstacle's triangles never move, so a point that moved
@@ -266,6 +273,13 @@ class SurfaceObstacle(Obstacle):
         ik, dk, moved = self._candidates(x, K)
         q, kind, local, tri, r, dc = self._nearest_in(x, ik, dk, moved)
         whole = len(self.T) <= K
+        far = np.flatnonzero((moved > 0) & (dk[:, 0] - moved - self.radius >= self.band))
+        if far.size:  # beyond the band whatever its held set: its nearest centroid now as its set (FAR)
+            dk, moved = dk.copy(), moved.copy()
+            dkf, ikf = self._ctree.query(x[far], k=1)
+            dk[far], moved[far] = dkf[:, None], 0.0  # the set of one: its first and farthest centroid
+            q[far], kind[far], local[far], tri[far], r[far], dc[far] = self._nearest_in(
+                x[far], ikf.reshape(-1, 1), dkf.reshape(-1, 1), np.zeros(len(far)))
         beyond = dk[:, -1] - moved
         proven = whole | (beyond - self.radius >= r)
         again = np.flatnonzero(~proven & (moved > 0))

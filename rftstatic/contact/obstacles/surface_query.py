@@ -47,11 +47,19 @@ def evaluate_compiled(ob, x, hessian):
     """:meth:`~.surface_mesh.SurfaceObstacle._evaluate` of the obstacle ``ob`` at ``x (n, 3)`` [m] by the compiled
     :func:`.surface_kernels.signed_in_sets` over the held candidate sets; the points it leaves (status 1: a held
     set that no longer proves the nearest triangle is sought again where the point is, then every triangle within
-    ``r + R`` in the same loop; status 2: beyond the band inside the box) go through the numpy path
+    ``r + R`` in the same loop; status 2: beyond the band inside the box) go through the numpy path; a held set's
+    point beyond the band by its bound alone (status 3) is evaluated again with its nearest centroid now
     (:meth:`~.surface_mesh.SurfaceObstacle._signed`)."""
     K = min(ob._wider, len(ob.T))
     ik, dk, moved = ob._candidates(x, K)
     phi, normal, H, out = kernel_call(ob, x, ik, dk, moved, hessian)
+    far = np.flatnonzero(out[:, 5] == 3.0)
+    if far.size:  # beyond the band whatever its held set: its nearest centroid now as its set (FAR)
+        dkf, ikf = ob._ctree.query(x[far], k=1)
+        phi[far], normal[far], Hf, out[far] = kernel_call(ob, x[far], ikf.reshape(-1, 1), dkf.reshape(-1, 1),
+                                                          np.zeros(len(far)), hessian)
+        if hessian:
+            H[far] = Hf
     again = np.flatnonzero((out[:, 5] == 1.0) & (moved > 0))
     if again.size:  # sets kept from the last call that no longer prove the nearest: the K nearest now
         dka, ika = ob._ctree.query(x[again], k=K)

@@ -36,7 +36,7 @@ from rftstatic.contact.friction import TRAIL, FrictionLaw, _mollifier
 from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
 from rftstatic.contact.self_contact.near_pairs import NearPairCache
 
-__all__ = ["empty_pairs_lag", "pair_friction_terms", "commit_pairs", "with_friction"]
+__all__ = ["empty_pairs_lag", "pair_friction_terms", "commit_pairs", "with_friction", "pair_impulses"]
 
 
 def empty_pairs_lag(law: FrictionLaw) -> dict:
@@ -171,3 +171,37 @@ def with_friction(state, lag: dict, x: np.ndarray, tangent: bool):
     blocks = np.concatenate([state.blocks, K]) if tangent else state.blocks
     return replace(state, energy=state.energy + e, force=state.force + f,
                    nodes=np.concatenate([state.nodes, lag["nodes"]]), blocks=blocks)
+
+
+def pair_impulses(law: FrictionLaw, sc, x: np.ndarray, v: np.ndarray, minv: np.ndarray, dt: float,
+                  cache=None) -> float:
+    """Coulomb friction impulses between layers for one explicit step (the pairs' analogue of
+    :func:`rftstatic.contact.friction.penalty_impulses`), in place on the half-step velocities ``v (N, 3)`` [m/s],
+    at positions ``x (N, 3)`` [m] where the step's force was evaluated, inverse lumped masses ``minv (N, 3)``
+    [1/kg] (0 on held dofs), step ``dt`` [s], the solve's pair cache ``cache``. Every pair closer than the thickness
+    (``nodes (P, 4)``, closest points' coefficients ``w``, normal ``n``, normal force ``lambda``: :func:`_active_pairs`)
+    has the relative tangential velocity of its closest points ``v_t = T sum_a w_a v_a``; an impulse ``J`` against it
+    changes it by ``J / m_p``, ``1 / m_p = sum_a w_a^2 / m_a``. The pair slides with ``J = mu_k lambda dt`` where
+    stopping it would take more than ``mu_s lambda dt``; else it sticks, with ``J`` the stopping impulse over the
+    number of pairs at its busiest node (the pairs act together, Jacobi: a node in several sticking pairs would
+    otherwise be stopped several times over). Node ``a`` gains ``-w_a J t / m_a`` on its free dofs. Returns the
+    kinetic energy taken [J]."""
+    nodes, _, w, normal, lam = _active_pairs(sc, x, cache)
+    if not len(nodes):
+        return 0.0
+    vr = np.einsum("pa,pai->pi", w, v[nodes])
+    vt = vr - np.einsum("pi,pi->p", vr, normal)[:, None] * normal
+    speed = np.linalg.norm(vt, axis=1)
+    inv_m = minv[nodes].max(axis=2)  # (P, 4) [1/kg]; 0 for a node held in every dof
+    inv_mp = np.einsum("pa,pa->p", w * w, inv_m)
+    busy = np.bincount(nodes.ravel(), minlength=len(v))[nodes].max(axis=1)
+    stop = speed / np.maximum(inv_mp, 1e-300)  # [N s]
+    slide = stop > law.mu_static[0] * lam * dt
+    J = np.where(slide, np.minimum(law.mu_kinetic[0] * lam * dt, stop), stop / busy)
+    J = np.where(inv_mp > 0, J, 0.0)
+    t = vt / np.maximum(speed, 1e-300)[:, None]
+    dv = -(J[:, None, None] * w[:, :, None] * t[:, None, :]) * minv[nodes]  # (P, 4, 3), free dofs only
+    before = v.copy()
+    np.add.at(v, nodes.ravel(), dv.reshape(-1, 3))
+    m = np.where(minv > 0, 1.0 / np.maximum(minv, 1e-300), 0.0)
+    return 0.5 * float(np.sum(m * (before * before - v * v)))
