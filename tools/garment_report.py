@@ -24,14 +24,32 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 
 
+REUSE = False
+"""``--reuse``: take a run folder that already holds a finished run's summary.json instead of running it again
+(its whole-process wall time, not stored there, is then not shown)."""
+TIMEOUT = 900.0
+"""Longest whole-process run [s] (``--timeout``); a run stopped there is a row with exit ``timeout``."""
+
+
 def _run(scene, h, out, figures, sets=()):
+    if REUSE and (out / "summary.json").is_file():
+        return 0, float("nan"), json.loads((out / "summary.json").read_text()), []
     t = time.perf_counter()
-    p = subprocess.run([sys.executable, "-m", "rftstatic", "case", scene, "--set", f"garment.h={h}", "--out", str(out)]
-                       + [a for k in sets for a in ("--set", k)] + ([] if figures else ["--no-figures"]),
-                       capture_output=True, text=True, cwd=ROOT)
+    try:
+        p = subprocess.run([sys.executable, "-m", "rftstatic", "case", scene, "--set", f"garment.h={h}", "--out",
+                            str(out)] + [a for k in sets for a in ("--set", k)] + ([] if figures else ["--no-figures"]),
+                           capture_output=True, text=True, cwd=ROOT, timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        return "timeout", time.perf_counter() - t, None, [f"stopped after {TIMEOUT:.0f} s (--timeout)"]
     wall = time.perf_counter() - t
     summary = json.loads((out / "summary.json").read_text()) if p.returncode == 0 else None
     return p.returncode, wall, summary, (p.stdout + p.stderr).strip().splitlines()[-1:] if p.returncode else []
+
+
+def _wall(wall, figures) -> str:
+    if wall != wall:  # NaN: a reused run
+        return "(reused run)"
+    return f"{wall:.0f}{' (with figures)' if figures else ''}"
 
 
 def _table(rows) -> list:
@@ -52,7 +70,7 @@ def _table(rows) -> list:
             f"{g['body_crossing_pairs']} | "
             f"{g['body_smallest_distance']:.3f} | {g['contact_clearance']:.3f} | {s['self_intersections']['pairs']} | "
             f"{g['hem_drape_coefficient']:.4f} | {g['hem_folds']} | {s['nodes']} | {s['wall_time_s']:.0f} | "
-            f"{wall:.0f}{' (with figures)' if figures else ''} |")
+            f"{_wall(wall, figures)} |")
     out += [f"\nh = {h:g}: exit {code}: {' '.join(err)}" for h, code, wall, s, err, _ in rows if s is None]
     levels = [(h, s["garment"]["closing_levels"]) for h, code, wall, s, err, _ in rows
               if s is not None and len(s["garment"].get("closing_levels", [])) > 1]
@@ -130,13 +148,17 @@ def _cusick_section(circle, cusick) -> list:
 
 
 def main(argv=None):
+    global REUSE, TIMEOUT
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "validation"))
     ap.add_argument("--a-line-h", type=float, nargs="+", default=[1.45, 1.1])
     ap.add_argument("--circle-h", type=float, nargs="+", default=[1.48, 1.1])
     ap.add_argument("--dress-h", type=float, nargs="+", default=[2.0, 1.45])
     ap.add_argument("--work", default="/tmp/garment-report")
+    ap.add_argument("--reuse", action="store_true", help="reuse finished runs in --work (module docstring)")
+    ap.add_argument("--timeout", type=float, default=TIMEOUT, help="longest run [s]")
     a = ap.parse_args(argv)
+    REUSE, TIMEOUT = a.reuse, a.timeout
     work = Path(a.work)
     work.mkdir(parents=True, exist_ok=True)
     results = {}
@@ -194,7 +216,7 @@ def main(argv=None):
         f"{', '.join(str(r[3]['self_intersections']['pairs']) for r in done)}; every run "
         f"{'converged to a stable minimum' if stable else 'NOT all converged and stable'}.",
         "- Whole `case` commands with figures: " + ", ".join(
-            f"{scene} {rows[0][2]:.0f} s" for scene, rows in results.items() if rows) + " (issue 37: skirt-circle under "
+            f"{scene} {_wall(rows[0][2], True)} s" for scene, rows in results.items() if rows) + " (issue 37: skirt-circle under "
         "120 s, dress under 900 s, on an idle machine).",
         "- Not met yet (issue 37): fold seams; the circle skirt's node count against a published Cusick comparison "
         "(only the simulated one above); the verdicts above for the rest.",
