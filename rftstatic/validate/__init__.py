@@ -70,9 +70,9 @@ TOOL_REPORTS = {
                           "pedestal-square-20 and the Cusick friction scene (tools/friction_report.py)",
     "bench_profile": "where the paper scenes' time goes: bench profile by phase and the bench scenes table, the "
                      "three biggest cost centres (python -m rftstatic bench profile / bench scenes)",
-    "garments": "an A-line skirt sewn from two panels on the dress form: convergence, stability, seam gaps, crossings "
-                "against the form itself, the hem's drape coefficient and folds on two meshes, the cost of each stage "
-                "(tools/garment_report.py)",
+    "garments": "skirts and a four-panel dress sewn on the dress form: convergence, stability, seam gaps, crossings "
+                "against the form itself, the hem's drape coefficient and folds on two meshes, friction, the cost of "
+                "each stage, the circle skirt's node count beside its fabric's Cusick test (tools/garment_report.py)",
 }
 """Hand-made reports in ``validation/`` that the index lists below its table."""
 
