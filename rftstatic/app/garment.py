@@ -275,7 +275,7 @@ def _closing_levels(scene, data, out, form, pmesh, mesh, pairs, *, progress=True
         # is most curved (a shoulder): such nodes are moved out onto it, then checked against the form itself
         surface = SurfaceObstacle(out / "body-m.obj", units="m", feature_angle=BODY_FEATURE_ANGLE)
         mesh = panel_mesh(pmesh, surface.project(carry_closed(cp, coarse.x, pmesh)))
-        _check_off_form(scene, form, mesh, f"carried from the closing on the {h_close:g} mesh (garment.closing_h)")
+        _check_off_form(scene, form.surface(), mesh, f"carried from the closing on the {h_close:g} mesh (garment.closing_h)")
     # (a carried start's triangles cut the contact surface by their sag, as the static stage's do: start_check off)
     closing = close(scene, data, mesh, pairs, progress=progress, start_check=coarse is None)
     levels.append(_level_row(scene, h, mesh, closing))
@@ -287,10 +287,10 @@ def _closing_levels(scene, data, out, form, pmesh, mesh, pairs, *, progress=True
     return mesh, closing, levels
 
 
-def _check_off_form(scene, form, mesh, what) -> None:
+def _check_off_form(scene, surface, mesh, what) -> None:
     """Refuse a garment ``mesh`` whose placed positions cross the form itself (the independent triangle-pair test of
-    :func:`rftstatic.post.measures.obstacle_crossings.obstacle_crossings` against ``form.surface()``)."""
-    P, T = form.surface()
+    :func:`rftstatic.post.measures.obstacle_crossings.obstacle_crossings` against the form's ``surface = (P, T)``)."""
+    P, T = surface
     start = obstacle_crossings(mesh.X3, mesh.tri, P, T)
     if start["pairs"]:
         u = scene.units.length
@@ -336,8 +336,8 @@ def run(scene, out: Path, *, progress=True, figures=True):
                               f"{clearance / u:.3g} {scene.units.name.split('-')[0]} outside the form at this mesh "
                               "size: a finer garment.h brings it closer)")
         mesh, _ = sew(mesh, pairs, closing.x, where=Path(pmesh.pattern.source).name)
-    _check_off_form(scene, form, mesh, "as placed and sewn")
     P, T = form.surface()
+    _check_off_form(scene, (P, T), mesh, "as placed and sewn")
     solved = type(scene)(data, scene.path, scene.name, scene.overrides)
     # the start is checked against the form itself above: the contact surface, grown by the clearance, is cut by
     # the garment's flat triangles between their nodes by up to their sag (which the clearance is for)
