@@ -23,7 +23,8 @@ element keeps its panel's flat shape with the warp along the panel's grain line.
 ``body-m.obj`` [m] in the run folder and acts as a ``type = "mesh"`` obstacle
 (:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`) by penalty contact; the contact surface is the
 form grown by :data:`CLEARANCE` times the sag of the garment's mean element edge on the form's most curved section,
-so that the garment's flat triangles, whose corners rest on it, do not dip into the form between them. The static
+so that the garment's flat triangles, whose corners rest on it, do not dip into the form between them, its facet
+edges rounded (:func:`contact_surface`; ``body-m.obj`` holds its triangles, :data:`ROUNDING` inside it). The static
 solve is the ``static`` analysis's (:func:`rftstatic.app.static.run`) on the sewn mesh, from the closed state, so
 the scene's ``[solver]``, ``[contact]``, ``[[supports]]`` and ``[loads]`` apply unchanged; a support's ``at = [x,
 y]`` is a point of the plan view of the placed panels (the mesh's chart ``X``: its nearest node there). A pattern
@@ -44,8 +45,9 @@ the waist opening not counted) over the flat skirt's area (the opening left out 
 not overlap the projection of its own waist opening (it flares outwards from the waist); mean element size.
 The independent crossing check of the garment against the form itself (``body.obj``, not the contact surface):
 at the start of the static solve (an error if any pair crosses) and at its end, ``body_crossing_pairs`` and
-``body_smallest_distance``, with ``contact_clearance`` (the summary's ``obstacle_crossings`` are against the
-contact surface, whose triangles the garment's cut by their sag).
+``body_smallest_distance``, with ``contact_clearance`` and ``contact_rounding`` (:func:`contact_surface`; the
+summary's ``obstacle_crossings`` are against the contact surface's triangles, which lie ``contact_rounding`` inside
+it: the garment's flat triangles do not reach them).
 Outputs: ``deformed.vtu`` (cell data ``panel``), ``garment.obj`` with UVs (each node's flat pattern
 coordinates, scene units), ``body.obj`` and ``body.vtu`` (scene units).
 """
@@ -94,6 +96,13 @@ shoulder points, where the sections stop widening), so the form has no sharp fea
 edges as features, the feature contact (obstacle edges against garment edges, :mod:`rftstatic.contact.features`)
 pumped energy into the closing runs: on a collar round the neck, with the rims of the form's former flat caps as
 features, total energy 0.130 -> 1.12 J in 0.3 s undamped, against 0.130 -> 0.128 J without them."""
+ROUNDING = 0.25
+"""Radius of the contact surface's rounding over the form's smallest semi-axis (the neck's) [-]: the contact
+surface is the form grown by ``clearance - rounding`` as triangles, then by a ball of radius ``rounding``
+(``rounding`` of :class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`), so it lies ``clearance``
+outside the form with every facet edge rounded to a radius of at least ``rounding``: the contact force is smooth
+where the garment rests over facet edges and Newton's contact tangent is exact (a sharp-faceted surface's is
+clamped to its positive part, and Newton then converged linearly or stalled on garment meshes of 1.5 cm)."""
 CLOSING_DAMPING = 8.0
 """Mass damping of the seam-closing stage [1/s], about critical for a garment's swing on a body
 (2 sqrt(g / 0.5 m) = 8.9 /s)."""
@@ -248,12 +257,30 @@ def close(scene, data, mesh, pairs, *, progress=True, start_check=True):
                        alpha=CLOSING_DAMPING, progress=progress)
 
 
-def _with_body(data, path) -> dict:
-    """A copy of the scene's table ``data`` with the form's contact surface ``path`` (an OBJ in metres) as a mesh
-    obstacle."""
+def form_rounding(form: DressForm) -> float:
+    """Radius [m] of the contact surface's rounding (:data:`ROUNDING`)."""
+    zl = form.levels()[0]
+    return ROUNDING * float(np.min(form.section(np.linspace(zl[0], zl[-1], 256))))
+
+
+def contact_surface(form: DressForm, path, mesh, unit: float) -> dict:
+    """Write the form's contact surface for the garment ``mesh`` (placed) to ``path`` (an OBJ in metres) and return
+    its mesh-obstacle table (``rounding`` in scene lengths, ``unit`` [m] each): the form grown by the
+    :data:`CLEARANCE` over the chord sag of the mesh's mean element on the form's most curved section below the
+    garment's top, its facets rounded by :data:`ROUNDING`; ``clearance`` and ``rounding_m`` [m] added for the
+    summary."""
+    clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.mean()), float(mesh.X3[:, 2].max()))
+    rounding = form_rounding(form)
+    form.write_obj(path, clearance=clearance - rounding)
+    return {"type": "mesh", "path": str(Path(path).resolve()), "units": "m", "rounding": rounding / unit,
+            "feature_angle": BODY_FEATURE_ANGLE, "clearance": clearance, "rounding_m": rounding}
+
+
+def _with_body(data, body) -> dict:
+    """A copy of the scene's table ``data`` with the form's contact surface ``body`` (:func:`contact_surface`) as a
+    mesh obstacle."""
     data = copy.deepcopy(data)
-    data.setdefault("obstacles", []).append({"type": "mesh", "path": str(Path(path).resolve()), "units": "m",
-                                             "feature_angle": BODY_FEATURE_ANGLE})
+    data.setdefault("obstacles", []).append({k: v for k, v in body.items() if k not in ("clearance", "rounding_m")})
     return data
 
 
@@ -267,13 +294,14 @@ def _closing_levels(scene, data, out, form, pmesh, mesh, pairs, *, progress=True
     levels, coarse = [], None
     if h_close > h:
         cp, cmesh, _ = dressed_mesh(scene, h_close)
-        clearance = CLEARANCE * form.chord_clearance(float(cmesh.element_size.mean()), float(cmesh.X3[:, 2].max()))
-        form.write_obj(out / "body-closing-m.obj", clearance=clearance)
-        coarse = close(scene, _with_body(data, out / "body-closing-m.obj"), cmesh, seam_pairs(cp), progress=progress)
+        coarse_body = contact_surface(form, out / "body-closing-m.obj", cmesh, scene.units.length)
+        coarse = close(scene, _with_body(data, coarse_body), cmesh, seam_pairs(cp), progress=progress)
         levels.append(_level_row(scene, h_close, cmesh, coarse))
         # the carried nodes lie on the coarse patches, which may dip below the fine contact surface where the form
         # is most curved (a shoulder): such nodes are moved out onto it, then checked against the form itself
-        surface = SurfaceObstacle(out / "body-m.obj", units="m", feature_angle=BODY_FEATURE_ANGLE)
+        body = data["obstacles"][-1]
+        surface = SurfaceObstacle(body["path"], units="m", rounding=body["rounding"] * scene.units.length,
+                                  feature_angle=BODY_FEATURE_ANGLE)
         mesh = panel_mesh(pmesh, surface.project(carry_closed(cp, coarse.x, pmesh)))
         _check_off_form(scene, form.surface(), mesh, f"carried from the closing on the {h_close:g} mesh (garment.closing_h)")
     # (a carried start's triangles cut the contact surface by their sag, as the static stage's do: start_check off)
@@ -316,14 +344,13 @@ def run(scene, out: Path, *, progress=True, figures=True):
     form = dress_form(scene)
     pmesh, mesh, uv = dressed_mesh(scene)
     # the contact surface [m]: the form grown by the sag of the garment's mean edge (body.obj: the form itself)
-    top = float(mesh.X3[:, 2].max())  # the garment's highest point as placed: a dress reaches the shoulders
-    clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.mean()), top)
-    form.write_obj(out / "body-m.obj", clearance=clearance)
+    table = contact_surface(form, out / "body-m.obj", mesh, u)
+    clearance = table["clearance"]
     data = copy.deepcopy(scene.data)
     data.pop("garment")
     data.pop("body")
     data["analysis"] = "static"
-    data = _with_body(data, out / "body-m.obj")
+    data = _with_body(data, table)
     pairs = seam_pairs(pmesh)
     closing, corner_uv, levels = None, mesh.tri, []
     if len(pairs):
@@ -346,7 +373,8 @@ def run(scene, out: Path, *, progress=True, figures=True):
     hem = _hem(model.mesh, model.positions(U))
     garment = _garment_measures(scene, model, U, pmesh, hem, closing)
     body = obstacle_crossings(model.positions(U), model.mesh.tri, P, T)
-    garment.update({"contact_clearance": clearance / u, "body_crossing_pairs": body["pairs"], "closing_levels": levels,
+    garment.update({"contact_clearance": clearance / u, "contact_rounding": table["rounding_m"] / u,
+                    "body_crossing_pairs": body["pairs"], "closing_levels": levels,
                     "body_smallest_distance": body["smallest_distance"] / u})
     summary = dict(result.summary)
     summary["analysis"] = "garment"

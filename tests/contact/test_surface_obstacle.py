@@ -323,3 +323,49 @@ def test_a_step_through_a_thin_shell_stops_on_its_side(tmp_path):
     assert not hit.any()
     through = box.segment_crossings([[0.0, 0.0, 0.001]], [[0.0, 0.0, -0.03]])  # right through the 2 cm box
     assert through[0][0] and np.allclose(through[1][0], 0.0) and np.allclose(through[2][0], [0, 0, 1])
+
+
+def test_a_rounded_surface_is_the_box_grown_by_a_ball_with_an_exact_penalty_tangent(tmp_path):
+    # the 2 x 2 x 2 cm box rounded by 3 mm: phi = the distance to the box less 3 mm (a Minkowski sum), its
+    # curvature at most 1 / 3 mm, so the penalty's tangent is the exact gradient of its force everywhere,
+    # at the rounded edges and corners too (no PSD clamp), compiled and numpy paths alike
+    r = 3e-3
+    path = _write(tmp_path / "box.obj", BOX_V, BOX_F)
+    box = SurfaceObstacle(path, scene_length=0.01, rounding=r)
+    plain = SurfaceObstacle(path, scene_length=0.01)
+    assert not box.psd_tangent and plain.psd_tangent
+    rng = np.random.default_rng(4)
+    x = rng.uniform([-0.015, -0.015, -0.025], [0.015, 0.015, 0.005], (300, 3))
+    x = x[np.abs(plain.signed_distance(x)[0] - r) < 2e-3]  # within 2 mm of the rounded surface
+    assert len(x) > 60
+    phi, n = box.signed_distance(x)
+    assert np.abs(phi - (plain.signed_distance(x)[0] - r)).max() <= 1e-15
+    H = box.normal_gradient(x)
+    assert np.abs(H).max() <= 1.0 / (0.5 * r) + 1e-9  # bounded curvature
+    lo, hi = box.bounding_box()
+    assert np.allclose(lo, [-0.01 - r, -0.01 - r, -0.02 - r]) and np.allclose(hi, [0.01 + r, 0.01 + r, r])
+    # points just off the rounded surface near the top edges and corners: the onset and the penetrated range
+    q = np.array([[0.01, y, 0.0] for y in np.linspace(-0.012, 0.012, 7)] + [[0.01, 0.01, 0.0]], float)
+    d = np.array([1.0, 0.3, 1.0]) / np.linalg.norm([1.0, 0.3, 1.0])
+    x = q + (r + np.linspace(-2e-4, 8e-5, len(q)))[:, None] * d
+    pc = PenaltyContact([box], np.full(len(x), 1e-4), 1e7, smoothing=1e-4)
+    cs = pc.evaluate(x)
+    assert np.linalg.eigvalsh(cs.tangent_blocks).min() < 0  # the exact tangent softens along the rounded edges
+    h = 1e-9
+    for k in range(len(x)):
+        for i in range(3):
+            e = np.zeros_like(x)
+            e[k, i] = h
+            fd = (pc.evaluate(x + e).force[k] - pc.evaluate(x - e).force[k]) / (2 * h)
+            assert np.allclose(fd, cs.tangent_blocks[k, :, i], rtol=1e-5, atol=1e-6 * np.abs(cs.tangent_blocks).max())
+    # the compiled query (an icosphere of 320 triangles) rounds alike
+    ipath = _write(tmp_path / "ico.obj", *_icosphere(2))
+    ico, iplain = (SurfaceObstacle(ipath, scale=5.0, scene_length=0.01, rounding=rr) for rr in (r, 0.0))
+    x = rng.normal(size=(200, 3))
+    x = x / np.linalg.norm(x, axis=1, keepdims=True) * (0.05 + r + rng.uniform(-1e-3, 1e-3, (200, 1)))
+    assert ico.compiled == iplain.compiled
+    assert np.abs(ico.signed_distance(x)[0] - (iplain.signed_distance(x)[0] - r)).max() <= 1e-15
+    assert np.allclose(ico.normal_gradient(x), iplain.normal_gradient(x), rtol=1e-12, atol=0.0)
+    with pytest.raises(ValueError, match="rounding"):
+        SurfaceObstacle(path, scene_length=0.01, rounding=-1.0)
+    assert from_spec({"type": "mesh", "path": str(path), "rounding": 0.3}, 0.01).rounding == pytest.approx(r)

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FACE", "EDGE", "VERTEX", "closest_on_triangles", "merge_nodes", "pseudo_normals", "rotation", "sharp_edges",
-           "winding_number"]
+__all__ = ["FACE", "EDGE", "VERTEX", "closest_on_triangles", "merge_nodes", "plan_hull", "polygon_area_centre",
+           "pseudo_normals", "rotation", "sharp_edges", "winding_number"]
 
 FACE, EDGE, VERTEX = 0, 1, 2
 """Closest-feature kinds of :func:`closest_on_triangles`."""
@@ -191,3 +191,27 @@ def merge_nodes(P, tri):
     remap = np.full(len(first), -1, np.int64)
     remap[used] = np.arange(len(used))
     return P[first[used]], remap[inverse.ravel()[tri]]
+
+
+def plan_hull(V, offset: float = 0.0, around: int = 32):
+    """The convex hull ``(k, 2)`` [m] (counter-clockwise) of the points ``V (n, 3)`` [m] seen from above, grown by
+    ``offset`` [m] (a rounded surface's: each hull corner's circle of ``around`` points), and the mean height [m] of
+    the hull's corners."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(V[:, :2])
+    xy, z = V[hull.vertices, :2], float(V[hull.vertices, 2].mean())
+    if offset > 0:
+        t = 2.0 * np.pi * np.arange(around) / around
+        ring = (xy[:, None, :] + offset * np.stack([np.cos(t), np.sin(t)], -1)).reshape(-1, 2)
+        xy = ring[ConvexHull(ring).vertices]
+    return xy.copy(), z
+
+
+def polygon_area_centre(xy):
+    """Area [m^2] and centroid (2,) [m] of the counter-clockwise polygon ``xy (k, 2)`` [m] (the shoelace formula)."""
+    x, y = xy[:, 0], xy[:, 1]
+    cross = x * np.roll(y, -1) - np.roll(x, -1) * y
+    area = 0.5 * cross.sum()
+    centre = np.array([np.sum((x + np.roll(x, -1)) * cross), np.sum((y + np.roll(y, -1)) * cross)]) / (6 * area)
+    return float(area), centre

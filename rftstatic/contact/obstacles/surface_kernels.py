@@ -110,9 +110,10 @@ def signed_in_sets(x, surface, ik, dk, moved, consts, hessian, phi, normal, H, o
 
     ``surface = (V, T, centroid, nf, ne, nv, edge_of, edges, rim_edge, rim_vertex)``: the obstacle's nodes [m],
     triangles, centroids [m], face / edge / vertex pseudo-normals, triangle edges, edges' nodes, and open-boundary
-    flags; ``consts = (R, band, half, mode, lo (3), hi (3), every)``: the largest centroid-to-corner radius, the
-    exact band [m], the shell's half thickness [m], ``mode`` 0 closed, 1 open with a side, 2 a two-sided shell, the
-    bounding box [m], and ``every`` 1 when each point's candidates hold every triangle that can be nearest (a ball
+    flags; ``consts = (R, band, half, mode, lo (3), hi (3), every, dmin)``: the largest centroid-to-corner radius, the
+    exact band [m], the contact surface's offset [m] (a shell's half thickness or the rounding), ``mode`` 0 closed,
+    1 open with a side, 2 a two-sided shell, the bounding box [m], ``dmin`` the distance [m] below which the edges'
+    curvature ``1 / r`` is capped (a rounded surface's, else 0), and ``every`` 1 when each point's candidates hold every triangle that can be nearest (a ball
     search's, padded with repeats; ``dk`` 0: no early stop), else 0. Fills ``phi (n,)`` [m], ``normal (n, 3)``, ``H
     (n, 3, 3)`` [1/m] (when ``hessian``) and ``out (n, 6)``: the closest point of the nearest candidate [m], its
     distance ``r`` [m], the lower bound of the distance [m], and a status: 0 done; 1 unproven and within the band,
@@ -180,7 +181,7 @@ def signed_in_sets(x, surface, ik, dk, moved, consts, hessian, phi, normal, H, o
                 t0, t1, t2 = V[e1, 0] - V[e0, 0], V[e1, 1] - V[e0, 1], V[e1, 2] - V[e0, 2]
                 tl = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
                 t0, t1, t2 = t0 / tl, t1 / tl, t2 / tl
-            w = s / r
+            w = s / max(r, consts[11])
             H[p, 0, 0] = w * (1.0 - u0 * u0 - t0 * t0)
             H[p, 1, 1] = w * (1.0 - u1 * u1 - t1 * t1)
             H[p, 2, 2] = w * (1.0 - u2 * u2 - t2 * t2)

@@ -12,7 +12,13 @@ A closed surface is a solid: inside and outside come from its winding (an inward
 round, said in the notes). An open one (a table top, a shell) needs either ``side = "front"`` (the solid
 lies behind the side its triangles' right-hand normals face; ``"back"`` the other way: a point whose
 closest surface point is on the open boundary is outside) or ``thickness`` (a two-sided shell: ``phi =
-r - thickness / 2``).
+r - thickness / 2``). A closed or one-sided surface may be ``rounding`` [length] > 0: the solid grown by a ball of
+that radius (a Minkowski sum; ``phi = d - rounding`` with ``d`` the signed distance to the triangles), whose
+contact surface is smooth (C1): a facet edge or corner becomes a cylinder or sphere of radius at least
+``rounding``, so the distance's curvature is bounded (``|H| <= 1 / rounding``) and the penalty's tangent is kept
+exact instead of clamped (:attr:`SurfaceObstacle.psd_tangent`; :mod:`rftstatic.contact.penalty`). A body given by
+a finely tessellated smooth surface (a dress form) is best described so: Newton then converges quadratically where
+nodes rest over facet edges, where the clamped tangent converges linearly.
 
 The signed distance and its derivatives are those of :mod:`.surface_geometry`, exact for the points
 within ``band`` of the surface. The closest triangle is sought among each point's nearest triangle centroids
@@ -50,7 +56,8 @@ from rftstatic.compiled import numba_available
 from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures, _as_points
 from rftstatic.contact.obstacles.registry import register
 from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, merge_nodes,
-                                                          pseudo_normals, rotation, sharp_edges, winding_number)
+                                                          plan_hull, polygon_area_centre, pseudo_normals, rotation,
+                                                          sharp_edges, winding_number)
 
 __all__ = ["FILE_UNITS", "SurfaceObstacle"]
 
@@ -92,6 +99,10 @@ midpoints, the feature contact's points ...): a static obstacle's triangles neve
 less than its margin keeps its set (:meth:`SurfaceObstacle._candidates`) and Newton's iterations skip the
 k-d tree."""
 
+HESSIAN_CAP = 0.5
+"""The rounded surface's curvature ``1 / d`` is taken at ``d = HESSIAN_CAP * rounding`` where the point lies
+closer to the triangles (deeper than half the rounding into the contact surface: never in a sound run)."""
+
 FEATURE_ANGLE = 30.0
 """Default angle [deg] between two faces' normals above which their common (convex) edge is a sharp feature: a
 box's or a table's edges (90 deg) are, the edges of a tessellated curved body (an icosphere of 1,280
@@ -114,6 +125,7 @@ class SurfaceObstacle(Obstacle):
     translate : (3,) offset [m]
     side : ``"front"`` or ``"back"`` for an open surface (module docstring)
     thickness : of a two-sided open shell [m]
+    rounding : radius [m] of the ball the solid is grown by (module docstring); 0: the triangles themselves
     feature_angle : [deg] (:data:`FEATURE_ANGLE`)
     scene_length : metres per scene length unit (the file's unit when ``units`` is None)
     base_dir : directory a relative ``path`` is taken from (the scene file's)
@@ -132,12 +144,16 @@ class SurfaceObstacle(Obstacle):
         "side": SceneKey("side", length=False, kinds=(str,),
                          help='open mesh: "front" (solid behind the side its normals face) or "back"'),
         "thickness": SceneKey("thickness", kinds=NUMBER, help="open mesh: two-sided shell of this thickness"),
+        "rounding": SceneKey("rounding", kinds=NUMBER,
+                             help="closed or one-sided mesh: the solid grown by a ball of this radius (a smooth contact "
+                                  "surface, an exact contact tangent; default 0)"),
         "feature_angle": SceneKey("feature_angle", length=False,
                                   help=f"mesh edges bent more than this [deg] are sharp features (default {FEATURE_ANGLE:g})"),
     }
 
     def __init__(self, path, units=None, scale=1.0, rotate=(0.0, 0.0, 0.0), translate=(0.0, 0.0, 0.0),
-                 side=None, thickness=None, feature_angle=FEATURE_ANGLE, *, scene_length=1.0, base_dir=None):
+                 side=None, thickness=None, feature_angle=FEATURE_ANGLE, rounding=0.0, *, scene_length=1.0,
+                 base_dir=None):
         from rftstatic.errors import MeshError
         from rftstatic.mesh.surface import check_triangles, read_triangles
 
@@ -153,6 +169,7 @@ class SurfaceObstacle(Obstacle):
         self.side = side
         self.thickness = None if thickness is None else float(thickness)
         self.feature_angle = float(feature_angle)
+        self.rounding = float(rounding)
         self.scene_length = float(scene_length)
         if side not in (None, "front", "back"):
             raise ValueError(f'side must be "front" or "back", got {side!r}')
@@ -160,6 +177,10 @@ class SurfaceObstacle(Obstacle):
             raise ValueError(f"thickness must be a finite number > 0, got {thickness!r}")
         if side is not None and self.thickness is not None:
             raise ValueError("thickness and side are exclusive: a shell of a thickness has two sides; give one")
+        if not (np.isfinite(self.rounding) and self.rounding >= 0):
+            raise ValueError(f"rounding must be a finite length >= 0, got {rounding!r}")
+        if self.rounding > 0 and self.thickness is not None:
+            raise ValueError("rounding and thickness are exclusive: a shell is rounded by half its thickness; give one")
         if not (0.0 < self.feature_angle < 180.0):
             raise ValueError(f"feature_angle must lie in (0, 180) deg, got {feature_angle!r}")
         if not self.path.is_file():
@@ -222,8 +243,8 @@ class SurfaceObstacle(Obstacle):
             V, T.astype(np.int64), self.centroid, self.nf, self.ne, self.nv, self.edge_of.astype(np.int64),
             self.edges.astype(np.int64), self.boundary_edge, self.boundary_vertex))
         mode = 0 if self.closed else (2 if self.thickness is not None else 1)
-        half = 0.0 if self.thickness is None else 0.5 * self.thickness
-        self._consts = np.array([self.radius, self.band, half, mode, *self.lo, *self.hi, 0.0], float)
+        self._consts = np.array([self.radius, self.band, self.offset, mode, *self.lo, *self.hi, 0.0,
+                                 HESSIAN_CAP * self.rounding], float)
         # the compiled query pays off where the numpy twin searches subsets; a box's 12 triangles are all tested
         # at once in numpy, without importing numba (0.5 s)
         self.compiled = numba_available() and len(T) > NEAREST
@@ -355,7 +376,7 @@ class SurfaceObstacle(Obstacle):
                     qd, kd, ld, td = self._ball(x[deep])
                     q[deep], kind[deep], gid[deep] = qd, kd, self._gid(kd, ld, td)
                     near[deep] = True
-        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        half = self.offset
         phi = lower - half
         away = x - q
         normal = away / np.maximum(np.linalg.norm(away, axis=1, keepdims=True), 1e-300)
@@ -389,7 +410,8 @@ class SurfaceObstacle(Obstacle):
                 P = P - (kind == EDGE)[:, None, None] * np.einsum("pi,pj->pij", t, t)
                 # inside (s < 0) the closest point is on a face except at a reflex edge or exactly on the surface
                 # (r ~ 0, where 1 / r would be round-off): 0 there (module docstring)
-                scale = np.where((kind == FACE) | tiny | (s < 0), 0.0, s / np.where(tiny, 1.0, r))
+                scale = np.where((kind == FACE) | tiny | (s < 0), 0.0,
+                                 s / np.where(tiny, 1.0, np.maximum(r, HESSIAN_CAP * self.rounding)))
                 H[idx] = scale[:, None, None] * P
         return phi, normal, H
 
@@ -407,14 +429,24 @@ class SurfaceObstacle(Obstacle):
         from rftstatic.contact.obstacles.surface_ccd import first_crossings
 
         x0, x1 = _as_points(x0), _as_points(x1)
-        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        half = self.offset
         r = np.abs(self.signed_distance(x1)[0] + half)
         return first_crossings(self, x0, x1, np.flatnonzero(np.linalg.norm(x1 - x0, axis=1) >= r), half)
 
-    psd_tangent = True  # the distance's curvature is unbounded at sharp edges: the penalty clamps it (PSD)
+    @property
+    def offset(self) -> float:
+        """How far [m] the contact surface lies outside the triangles: half the thickness of a shell, or the
+        rounding."""
+        return 0.5 * self.thickness if self.thickness is not None else self.rounding
+
+    @property
+    def psd_tangent(self) -> bool:
+        """The penalty clamps the contact tangent (PSD) where the distance's curvature is unbounded (sharp edges,
+        no rounding); a rounded surface's curvature is at most ``1 / rounding``: its tangent stays exact."""
+        return self.rounding == 0.0
 
     def bounding_box(self):
-        half = 0.0 if self.thickness is None else 0.5 * self.thickness
+        half = self.offset
         return self.lo - half, self.hi + half
 
     def params(self):
@@ -426,6 +458,8 @@ class SurfaceObstacle(Obstacle):
             out["side"] = self.side
         if self.thickness is not None:
             out["thickness"] = self.thickness
+        if self.rounding > 0:
+            out["rounding"] = self.rounding
         return out
 
     def as_dict(self):
@@ -444,23 +478,12 @@ class SurfaceObstacle(Obstacle):
         return self.V, self.T
 
     def footprint(self):
-        """Area [m^2] and centre of the convex hull of the surface seen from above."""
-        from scipy.spatial import ConvexHull
-
-        hull = ConvexHull(self.V[:, :2])
-        xy = self.V[hull.vertices, :2]
-        x, y = xy[:, 0], xy[:, 1]
-        cross = x * np.roll(y, -1) - np.roll(x, -1) * y
-        area = 0.5 * cross.sum()
-        centre = np.array([np.sum((x + np.roll(x, -1)) * cross), np.sum((y + np.roll(y, -1)) * cross)]) / (6 * area)
-        return float(area), centre
+        """Area [m^2] and centre of the convex hull of the contact surface seen from above."""
+        return polygon_area_centre(plan_hull(self.V, self.offset)[0])
 
     def plan_outline(self, n: int = 128):
-        """The convex hull of the surface seen from above and the mean height of its corners [m]."""
-        from scipy.spatial import ConvexHull
-
-        hull = ConvexHull(self.V[:, :2])
-        return self.V[hull.vertices, :2].copy(), float(self.V[hull.vertices, 2].mean())
+        """The convex hull of the contact surface seen from above and the mean height of its corners [m]."""
+        return plan_hull(self.V, self.offset)
 
     # --- sharp features ---------------------------------------------------------------------------
     def _features(self):
