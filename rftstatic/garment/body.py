@@ -11,9 +11,11 @@ height, with a depth / width ratio per level. The measurements follow ISO 8559-1
 
 Above the bust the section widens to the shoulder breadth at the shoulder height and narrows to the neck
 girth at the neck base along a quarter ellipse in each semi-axis (a rounded shoulder top: horizontal at the
-neck base, vertical at the shoulder points, where it curves with radius C^2 / A, C the height from the shoulder to
-the neck base and A the half-width it narrows by: 2.7 cm on the size-36 form; the monotone cubic there was a ridge
-of 4.5 mm radius that a dress's flat triangles cut); the neck is a short upright cylinder. The bottom and the top are closed with half
+neck base, vertical at the shoulder points, where it curves with radius C^2 / (A - rho), C the height from the
+shoulder to the neck base, A the half-width it narrows by and rho the neck fillet's radius: 2.9 cm on the size-36
+form; the monotone cubic there was a ridge of 4.5 mm radius that a dress's flat triangles cut), which ends
+horizontal ``rho`` outside the neck and turns up into it along a concave quarter circle of radius ``rho``
+(:data:`NECK_FILLET`; the neck's girth is met ``rho`` above the neck base); the neck is a short upright cylinder. The bottom and the top are closed with half
 ellipsoids below the bottom section and above the neck top (depth = the end section's half-depth b), so the
 form has no sharp rim: in the vertical plane through the major axis the rim curves with radius b^2 / a, the end
 section's own smallest radius (a garment hanging past the bottom of the form slides over it; a flat cap's
@@ -37,7 +39,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["DressForm", "ellipse_perimeter", "semi_axes"]
+__all__ = ["DressForm", "NECK_FILLET", "ellipse_perimeter", "semi_axes"]
+
+NECK_FILLET = 0.25
+"""Radius of the concave fillet between the shoulder's top and the neck, in neck lengths [-] (1.5 cm on a 6 cm
+neck): without it the horizontal end of the shoulder's quarter ellipse met the upright neck at a right angle, a
+crease of the contact surface where its normal jumps, and a neckline resting in it kept a force jump that no
+equilibrium balances (Newton and the relaxation stalled on the dress at 1.45 cm)."""
 
 
 def ellipse_perimeter(a, b):
@@ -121,27 +129,37 @@ class DressForm:
 
     def section(self, z):
         """``(a, b)`` [m]: the semi-axes of the section at heights ``z`` [m] (within the form): PCHIP between the
-        levels, and between the shoulder and the neck base a quarter ellipse in each semi-axis (the shoulder's
-        rounded top, module docstring)."""
+        levels; between the shoulder and the neck base a quarter ellipse in each semi-axis (the shoulder's rounded
+        top), then the concave fillet into the neck (module docstring)."""
         from scipy.interpolate import PchipInterpolator
 
         zl, al, bl = self.levels()
         z = np.asarray(z, float)
         a, b = PchipInterpolator(zl, al)(z), PchipInterpolator(zl, bl)(z)
-        zs, zn = zl[4], zl[5]
+        zs, zn, rho = zl[4], zl[5], self.neck_fillet()
+        fa, fb = rho, rho * (bl[4] - bl[5]) / (al[4] - al[5])  # the fillet's run in each semi-axis [m]
         top = (z > zs) & (z < zn)
         if np.any(top):
             s = np.sqrt(1.0 - ((z[top] - zs) / (zn - zs)) ** 2)
-            a[top] = al[5] + (al[4] - al[5]) * s
-            b[top] = bl[5] + (bl[4] - bl[5]) * s
+            a[top] = al[5] + fa + (al[4] - al[5] - fa) * s
+            b[top] = bl[5] + fb + (bl[4] - bl[5] - fb) * s
+        fillet = (z >= zn) & (z < zn + rho)
+        if np.any(fillet):
+            c = 1.0 - np.sqrt(np.clip(1.0 - ((z[fillet] - zn - rho) / rho) ** 2, 0.0, 1.0))
+            a[fillet], b[fillet] = al[5] + fa * c, bl[5] + fb * c
         return a, b
+
+    def neck_fillet(self) -> float:
+        """Radius [m] of the concave fillet from the shoulder's top into the neck: :data:`NECK_FILLET` neck
+        lengths."""
+        return NECK_FILLET * self.neck_length
 
     def shoulder_radius(self) -> float:
         """Radius of curvature [m] of the shoulder's rounded top at the shoulder points, in the vertical plane across
-        the body: the quarter ellipse of :meth:`section`, ``C^2 / A`` with ``C`` the height from the shoulder to the
-        neck base and ``A`` the half-width it narrows by."""
+        the body: the quarter ellipse of :meth:`section`, ``C^2 / (A - rho)`` with ``C`` the height from the shoulder
+        to the neck base, ``A`` the half-width it narrows by and ``rho`` the neck fillet's radius."""
         zl, al, _ = self.levels()
-        return float((zl[5] - zl[4]) ** 2 / (al[4] - al[5]))
+        return float((zl[5] - zl[4]) ** 2 / (al[4] - al[5] - self.neck_fillet()))
 
     def surface(self, *, sections: int = 80, around: int = 64, clearance: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """``(P, tri)``: the closed form as points (P, 3) [m] and outward-wound triangles (T, 3).
@@ -154,7 +172,10 @@ class DressForm:
         off the curved form, :meth:`chord_clearance`).
         """
         zl = self.levels()[0]
-        z = np.unique(np.concatenate([np.linspace(zl[0], zl[-1], sections), zl]))
+        # the shoulder's top and the neck fillet at even steps along their arcs (their ends are horizontal)
+        phi = 0.5 * np.pi * np.linspace(0.0, 1.0, 13)
+        arcs = [zl[4] + (zl[5] - zl[4]) * np.sin(phi), zl[5] + self.neck_fillet() * (1.0 - np.cos(phi))]
+        z = np.unique(np.concatenate([np.linspace(zl[0], zl[-1], sections), zl, *arcs]))
         a, b = self.section(z)
         depth = np.array([b[0], b[-1]]) + clearance  # the ends' depths [m]
         a, b = a + clearance, b + clearance

@@ -165,3 +165,18 @@ def _held_rest(model, state, at_rest: AtRest, P, mass_scale):
         return done
 
     return test
+
+
+def newton_descent(model, state: State, route, result) -> bool:
+    """After a failed Newton handover, let the relaxation ``route`` (:class:`~rftstatic.solvers.static.RelaxRoute`) go
+    on from the handover's last iterate ``result.U (N, 3)`` [m], at rest, when that is at full load and lower in total
+    potential than the relaxed state ``route.U`` (on a flat landscape, e.g. leaving a saddle, Newton's line-searched
+    descent is kept instead of thrown away); return whether it did. Not with bending hysteresis (its energy depends on
+    the path: the relaxation's own history is kept)."""
+    if result is None or result.lam < 1.0 or state.bending_slip is not None or not np.all(np.isfinite(result.U)):
+        return False
+    new, old = (model.potential(U, 1.0, candidates=state.candidates) for U in (result.U, route.U))
+    if not new < old:
+        return False
+    route.U, route.V = result.U.copy(), np.zeros_like(result.U)
+    return True

@@ -27,7 +27,7 @@ from rftstatic.solvers.load_steps import load_steps, solve_load_steps
 from rftstatic.solvers.newton import StaticResult, start_state
 from rftstatic.solvers.options import StaticOptions
 from rftstatic.solvers.perturbation import fold_pattern, start_perturbation
-from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RelaxOptions, relax_steps
+from rftstatic.solvers.relaxation import RELAX_MASS_SCALE, RelaxOptions, newton_descent, relax_steps
 from rftstatic.solvers.release import RELEASE, release
 from rftstatic.solvers.rest import RestCriterion
 from rftstatic.solvers.timestep import stable_time_step
@@ -194,9 +194,7 @@ relaxation resumes; the final handover uses the solver's own budget."""
 FIRST_HANDOVER_CONTINUATIONS = 8
 """Continuations of Newton from the first relaxed state (each ``2 x`` :data:`RELAX_NEWTON_ITERATIONS` more
 displacement iterations while the energy falls, :data:`~rftstatic.solvers.load_steps.FROM_STATE_PROGRESS`),
-after the mixed iteration's short try; the result counts only if it is a stable minimum. Measured to the route's
-own equilibrium (energy to 1e-13) in 67 iterations on sphere-30 (instead of 13,285 more explicit steps),
-116 on pedestal-round-50 (11,076 steps), 165 on pedestal-square-80 (19,521 steps)."""
+after the mixed iteration's short try; the result counts only if it is a stable minimum."""
 
 RELAX_BASIN_NEWTON_ITERATIONS = 40
 """Newton's ``max_iterations`` (80 at full load) from the first relaxed state whose exact tangent is positive
@@ -376,7 +374,9 @@ def _relax_route(model, opts, callback, state, first):
                     result = replace(result, U=route.U, lam=1.0, residual=float(np.linalg.norm(r)))
                 raise fail(f"{exc} (after dynamic relaxation to t = {route.t_used:.3g} s, {info['steps']} steps; "
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
-            log.info("Newton failed from the relaxed state at t = %.3g s (%s); relaxing on", route.t_used, exc)
+            handover["descent"] = descent = newton_descent(model, state, route, exc.result)
+            log.info("Newton failed from the relaxed state at t = %.3g s (%s); relaxing on%s", route.t_used, exc,
+                     " from its last iterate (lower energy)" * descent)
             route.tol_force, route.span, route.phase = 0.5 * opts.newton.rtol, plan.chunk, "relax"
             yield _route_pause(route)
             continue

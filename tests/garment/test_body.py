@@ -35,10 +35,24 @@ def test_the_surface_is_a_closed_outward_wound_manifold():
 def test_the_sections_have_the_measured_girths_at_their_heights(around, tol):
     form = DressForm(**EXAMPLE)
     for name in ("bust", "waist", "hip", "neck"):
-        z = EXAMPLE[f"{name}_height"]
+        z = EXAMPLE[f"{name}_height"] + (form.neck_fillet() if name == "neck" else 0.0)  # above the neck's fillet
         assert form.girth(z, around=around) == pytest.approx(EXAMPLE[f"{name}_girth"], rel=tol), name
     a, _ = form.section(np.array([EXAMPLE["shoulder_height"]]))
     assert 2 * a[0] == pytest.approx(EXAMPLE["shoulder_breadth"], rel=1e-12)
+
+
+def test_the_shoulder_turns_into_the_neck_without_a_crease():
+    # the profile a(z) from the shoulder's top into the neck is C1: its direction turns smoothly from horizontal
+    # (the shoulder's top) to vertical (the neck) along the fillet (a right-angled crease before the fillet)
+    form = DressForm(**EXAMPLE)
+    zn, rho = EXAMPLE["neck_height"], form.neck_fillet()
+    z = np.linspace(zn - 0.02, zn + rho + 0.01, 4001)
+    a, _ = form.section(z)
+    turn = np.abs(np.diff(np.arctan2(np.diff(z), np.diff(a))))  # [rad] between consecutive chords
+    length = np.hypot(np.diff(z), np.diff(a))
+    assert np.max(turn / (0.5 * (length[1:] + length[:-1]))) < 1.0 / (0.5 * rho)  # curvature: no crease
+    # the fillet: a quarter circle of radius rho from rho outside the neck to the neck, rho higher
+    assert form.section(np.array([zn]))[0][0] == pytest.approx(form.section(np.array([zn + rho]))[0][0] + rho)
 
 
 def test_the_form_is_a_mesh_obstacle(tmp_path):
