@@ -24,7 +24,7 @@ element keeps its panel's flat shape with the warp along the panel's grain line.
 (:class:`rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`) by penalty contact; the contact surface is the
 form grown by :data:`CLEARANCE` times the sag of the garment's mean element edge on the form's most curved section,
 so that the garment's flat triangles, whose corners rest on it, do not dip into the form between them, its facet
-edges rounded (:func:`contact_surface`; ``body-m.obj`` holds its triangles, :data:`ROUNDING` inside it). The static
+edges and its concave valleys smoothed (the implicit surface of its facets, :func:`contact_surface`). The static
 solve is the ``static`` analysis's (:func:`rftstatic.app.static.run`) on the sewn mesh, from the closed state, so
 the scene's ``[solver]``, ``[contact]``, ``[[supports]]`` and ``[loads]`` apply unchanged; a support's ``at = [x,
 y]`` is a point of the plan view of the placed panels (the mesh's chart ``X``: its nearest node there). A pattern
@@ -45,9 +45,9 @@ the waist opening not counted) over the flat skirt's area (the opening left out 
 not overlap the projection of its own waist opening (it flares outwards from the waist); mean element size.
 The independent crossing check of the garment against the form itself (``body.obj``, not the contact surface):
 at the start of the static solve (an error if any pair crosses) and at its end, ``body_crossing_pairs`` and
-``body_smallest_distance``, with ``contact_clearance`` and ``contact_rounding`` (:func:`contact_surface`; the
-summary's ``obstacle_crossings`` are against the contact surface's triangles, which lie ``contact_rounding`` inside
-it: the garment's flat triangles do not reach them).
+``body_smallest_distance``, with ``contact_clearance`` and ``contact_smoothing`` (the smooth surface's support,
+:func:`contact_surface`; the summary's ``obstacle_crossings`` are against the contact surface's triangles, whose
+implicit surface the garment rests on: its flat triangles cut them by their sag).
 Outputs: ``deformed.vtu`` (cell data ``panel``), ``garment.obj`` with UVs (each node's flat pattern
 coordinates, scene units), ``body.obj`` and ``body.vtu`` (scene units).
 """
@@ -96,13 +96,16 @@ shoulder points, where the sections stop widening), so the form has no sharp fea
 edges as features, the feature contact (obstacle edges against garment edges, :mod:`rftstatic.contact.features`)
 pumped energy into the closing runs: on a collar round the neck, with the rims of the form's former flat caps as
 features, total energy 0.130 -> 1.12 J in 0.3 s undamped, against 0.130 -> 0.128 J without them."""
-ROUNDING = 0.25
-"""Radius of the contact surface's rounding over the form's smallest semi-axis (the neck's) [-]: the contact
-surface is the form grown by ``clearance - rounding`` as triangles, then by a ball of radius ``rounding``
-(``rounding`` of :class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`), so it lies ``clearance``
-outside the form with every facet edge rounded to a radius of at least ``rounding``: the contact force is smooth
-where the garment rests over facet edges and Newton's contact tangent is exact (a sharp-faceted surface's is
-clamped to its positive part, and Newton then converged linearly or stalled on garment meshes of 1.5 cm)."""
+FORM_TESSELLATION = {"sections": 160, "around": 128}
+"""The contact surface's rings and points per ring (:meth:`rftstatic.garment.body.DressForm.surface`): facets of
+about 0.5 cm, so that the smooth surface's support (:data:`SMOOTH`) stays small against the form's curvature."""
+SMOOTH = 3.0
+"""Support radius of the contact surface's smooth implicit surface (``smooth`` of
+:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`, :mod:`rftstatic.contact.obstacles.surface_smooth`)
+in facet radii of :data:`FORM_TESSELLATION` [-]. The triangles' own distance has a crease at every concave facet
+edge (the waist's profile, the neck's fillet), where the contact normal jumps: a node resting in such a valley keeps
+a force that no position balances, and Newton stalled on the garment meshes of 1.5 cm (the dress at 1.45 cm held a
+neckline node on a jump of 1e-3 N, 30 times the tolerance); the smooth surface has none and an exact tangent."""
 CLOSING_DAMPING = 8.0
 """Mass damping of the seam-closing stage [1/s], about critical for a garment's swing on a body
 (2 sqrt(g / 0.5 m) = 8.9 /s)."""
@@ -257,30 +260,30 @@ def close(scene, data, mesh, pairs, *, progress=True, start_check=True):
                        alpha=CLOSING_DAMPING, progress=progress)
 
 
-def form_rounding(form: DressForm) -> float:
-    """Radius [m] of the contact surface's rounding (:data:`ROUNDING`)."""
-    zl = form.levels()[0]
-    return ROUNDING * float(np.min(form.section(np.linspace(zl[0], zl[-1], 256))))
+def form_smoothing(form: DressForm) -> float:
+    """Support radius [m] of the form's smooth contact surface (:data:`SMOOTH` facet radii)."""
+    P, T = form.surface(**FORM_TESSELLATION)
+    return SMOOTH * float(np.max(np.linalg.norm(P[T] - P[T].mean(axis=1, keepdims=True), axis=2)))
 
 
 def contact_surface(form: DressForm, path, mesh, unit: float) -> dict:
     """Write the form's contact surface for the garment ``mesh`` (placed) to ``path`` (an OBJ in metres) and return
-    its mesh-obstacle table (``rounding`` in scene lengths, ``unit`` [m] each): the form grown by the
+    its mesh-obstacle table (``smooth`` in scene lengths, ``unit`` [m] each): the form grown by the
     :data:`CLEARANCE` over the chord sag of the mesh's mean element on the form's most curved section below the
-    garment's top, its facets rounded by :data:`ROUNDING`; ``clearance`` and ``rounding_m`` [m] added for the
-    summary."""
+    garment's top, tessellated finely (:data:`FORM_TESSELLATION`), its smooth implicit surface (:data:`SMOOTH`);
+    ``clearance`` and ``smooth_m`` [m] added for the summary."""
     clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.mean()), float(mesh.X3[:, 2].max()))
-    rounding = form_rounding(form)
-    form.write_obj(path, clearance=clearance - rounding)
-    return {"type": "mesh", "path": str(Path(path).resolve()), "units": "m", "rounding": rounding / unit,
-            "feature_angle": BODY_FEATURE_ANGLE, "clearance": clearance, "rounding_m": rounding}
+    smooth = form_smoothing(form)
+    form.write_obj(path, clearance=clearance, **FORM_TESSELLATION)
+    return {"type": "mesh", "path": str(Path(path).resolve()), "units": "m", "smooth": smooth / unit,
+            "feature_angle": BODY_FEATURE_ANGLE, "clearance": clearance, "smooth_m": smooth}
 
 
 def _with_body(data, body) -> dict:
     """A copy of the scene's table ``data`` with the form's contact surface ``body`` (:func:`contact_surface`) as a
     mesh obstacle."""
     data = copy.deepcopy(data)
-    data.setdefault("obstacles", []).append({k: v for k, v in body.items() if k not in ("clearance", "rounding_m")})
+    data.setdefault("obstacles", []).append({k: v for k, v in body.items() if k not in ("clearance", "smooth_m")})
     return data
 
 
@@ -300,7 +303,7 @@ def _closing_levels(scene, data, out, form, pmesh, mesh, pairs, *, progress=True
         # the carried nodes lie on the coarse patches, which may dip below the fine contact surface where the form
         # is most curved (a shoulder): such nodes are moved out onto it, then checked against the form itself
         body = data["obstacles"][-1]
-        surface = SurfaceObstacle(body["path"], units="m", rounding=body["rounding"] * scene.units.length,
+        surface = SurfaceObstacle(body["path"], units="m", smooth=body["smooth"] * scene.units.length,
                                   feature_angle=BODY_FEATURE_ANGLE)
         mesh = panel_mesh(pmesh, surface.project(carry_closed(cp, coarse.x, pmesh)))
         _check_off_form(scene, form.surface(), mesh, f"carried from the closing on the {h_close:g} mesh (garment.closing_h)")
@@ -373,7 +376,7 @@ def run(scene, out: Path, *, progress=True, figures=True):
     hem = _hem(model.mesh, model.positions(U))
     garment = _garment_measures(scene, model, U, pmesh, hem, closing)
     body = obstacle_crossings(model.positions(U), model.mesh.tri, P, T)
-    garment.update({"contact_clearance": clearance / u, "contact_rounding": table["rounding_m"] / u,
+    garment.update({"contact_clearance": clearance / u, "contact_smoothing": table["smooth_m"] / u,
                     "body_crossing_pairs": body["pairs"], "closing_levels": levels,
                     "body_smallest_distance": body["smallest_distance"] / u})
     summary = dict(result.summary)

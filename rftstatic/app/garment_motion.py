@@ -94,7 +94,7 @@ def moving_scene(scene, body_obj: Path, given: dict, opts: GarmentMotionOptions)
     body = data.pop("body")
     data["analysis"] = "dynamic"
     data["obstacles"] = [{"type": "mesh", "path": str(Path(body_obj).resolve()), "units": "m",
-                          "rounding": garment.form_rounding(garment.dress_form(scene)) / scene.units.length,
+                          "smooth": garment.form_smoothing(garment.dress_form(scene)) / scene.units.length,
                           "feature_angle": garment.BODY_FEATURE_ANGLE, "friction": opts.friction,
                           "motion": body["motion"]}]
     t_end = given["t_end"]

@@ -173,7 +173,7 @@ class DressForm:
         """
         zl = self.levels()[0]
         # the shoulder's top and the neck fillet at even steps along their arcs (their ends are horizontal)
-        phi = 0.5 * np.pi * np.linspace(0.0, 1.0, 13)
+        phi = 0.5 * np.pi * np.linspace(0.0, 1.0, 49)
         arcs = [zl[4] + (zl[5] - zl[4]) * np.sin(phi), zl[5] + self.neck_fillet() * (1.0 - np.cos(phi))]
         z = np.unique(np.concatenate([np.linspace(zl[0], zl[-1], sections), zl, *arcs]))
         a, b = self.section(z)

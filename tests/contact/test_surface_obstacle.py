@@ -369,3 +369,48 @@ def test_a_rounded_surface_is_the_box_grown_by_a_ball_with_an_exact_penalty_tang
     with pytest.raises(ValueError, match="rounding"):
         SurfaceObstacle(path, scene_length=0.01, rounding=-1.0)
     assert from_spec({"type": "mesh", "path": str(path), "rounding": 0.3}, 0.01).rounding == pytest.approx(r)
+
+
+def test_the_smooth_surface_is_c2_near_the_sphere_and_its_derivatives_are_exact(tmp_path):
+    # the IMLS surface of a level-4 icosphere (5 cm): within 0.05 mm of the analytic sphere, |grad| ~ 1, its
+    # gradient and Hessian the derivatives of phi (central differences), the penalty's tangent exact (no clamp)
+    path = _write(tmp_path / "ico4.obj", *_icosphere(4))
+    ico = SurfaceObstacle(path, scale=5.0, scene_length=0.01, smooth=0.0075)  # [m]: 3.1 facet radii
+    assert not ico.psd_tangent and ico.params()["smooth"] == pytest.approx(0.0075)
+    assert from_spec({"type": "mesh", "path": str(path), "scale": 5.0, "smooth": 0.75}, 0.01).smooth == pytest.approx(0.0075)
+    rng = np.random.default_rng(5)
+    d = rng.normal(size=(300, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    x = d * (0.05 + rng.uniform(-2e-3, 3e-3, (300, 1)))
+    phi, n = ico.signed_distance(x)
+    assert np.abs(phi - (np.linalg.norm(x, axis=1) - 0.05)).max() < 5e-5
+    assert np.abs(np.linalg.norm(n, axis=1) - 1.0).max() < 0.02
+    H = ico.normal_gradient(x)
+    h = 1e-7
+    for i in range(3):
+        e = np.zeros(3)
+        e[i] = h
+        (pp, np_), (pm, nm) = ico.signed_distance(x + e), ico.signed_distance(x - e)
+        assert np.abs((pp - pm) / (2 * h) - n[:, i]).max() < 1e-6
+        assert np.abs((np_ - nm) / (2 * h) - H[:, :, i]).max() < 1e-5 * np.abs(H).max()
+    # far points keep the triangles' distance; a support under 2.5 facet radii or an open surface is refused
+    far = np.array([[0.0, 0.0, 0.2]])
+    assert 0.15 - ico.radius - 1e-9 <= ico.signed_distance(far)[0][0] <= 0.15 + 1e-9  # its lower bound far out
+    with pytest.raises(ValueError, match="facet radii"):
+        SurfaceObstacle(path, scale=5.0, scene_length=0.01, smooth=0.001)
+    with pytest.raises(MeshError, match="closed"):
+        SurfaceObstacle(_write(tmp_path / "plate.obj", *_grid_plate(4)), scene_length=0.01, side="front", smooth=0.1)
+
+
+def test_a_sheet_node_in_a_concave_valley_of_the_facets_feels_a_continuous_force(tmp_path):
+    # two facets meeting at a concave 20 deg crease (a V-shaped trough): the triangles' distance jumps its normal at
+    # the bisecting plane, the smooth surface's does not
+    V = np.array([[-0.02, -0.02, 0.0], [-0.02, 0.02, 0.0], [0.0, -0.02, -0.0035], [0.0, 0.02, -0.0035],
+                  [0.02, -0.02, 0.0], [0.02, 0.02, 0.0], [0.0, 0.0, -0.05]])
+    F = np.array([[0, 2, 1], [1, 2, 3], [2, 4, 3], [3, 4, 5], [0, 6, 2], [2, 6, 4], [1, 3, 6], [3, 5, 6],
+                  [0, 1, 6], [4, 6, 5]])
+    path = _write(tmp_path / "trough.obj", V, F)
+    sharp, smooth = (SurfaceObstacle(path, units="m", **k) for k in ({}, {"smooth": 0.09}))
+    x = np.stack([np.linspace(-1e-4, 1e-4, 201), np.zeros(201), np.full(201, -0.0030)], axis=1)
+    jump = lambda ob: np.abs(np.diff(ob.signed_distance(x)[1][:, 0])).max()  # noqa: E731
+    assert jump(sharp) > 0.3 and jump(smooth) < 1e-3

@@ -120,7 +120,7 @@ def signed_in_sets(x, surface, ik, dk, moved, consts, hessian, phi, normal, H, o
     or unproven with a held set (the caller seeks its set again, or searches every triangle within ``r + R``); 2
     beyond the band inside a closed surface's box (the caller's winding number); 3 a held set's point beyond the
     band by its bound alone (``dk_0 - moved - R >= band``), left untested: the caller evaluates it with its nearest
-    centroid now as its set (:data:`rftstatic.contact.obstacles.surface_mesh.FAR`)."""
+    centroid now as its set (:data:`rftstatic.contact.obstacles.surface_query.FAR`)."""
     V, T, centroid, nf, ne, nv, edge_of, edges, rim_edge, rim_vertex = surface
     R, band, half, mode = consts[0], consts[1], consts[2], int(consts[3])
     n, K = ik.shape

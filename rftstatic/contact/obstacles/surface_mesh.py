@@ -22,9 +22,9 @@ nodes rest over facet edges, where the clamped tangent converges linearly.
 
 The signed distance and its derivatives are those of :mod:`.surface_geometry`, exact for the points
 within ``band`` of the surface. The closest triangle is sought among each point's nearest triangle centroids
-(a ``cKDTree`` of them, built once: :data:`WIDER` with the compiled kernel of :mod:`.surface_kernels`,
-:data:`NEAREST` with its numpy twin), kept between calls for the same number of points (a static obstacle's
-triangles never move: :data:`HELD_SETS`); the nearest of them is the nearest of all when every other centroid
+(a ``cKDTree`` of them, built once: :data:`~.surface_query.WIDER` with the compiled kernel of :mod:`.surface_kernels`,
+:data:`~.surface_query.NEAREST` with its numpy twin), kept between calls for the same number of points (a static obstacle's
+triangles never move: :data:`~.surface_query.HELD_SETS`); the nearest of them is the nearest of all when every other centroid
 lies farther than its distance plus ``R`` (the largest centroid-to-corner radius; the centroid distances where
 the set was found minus how far the point moved since), else the set is sought again where the point is, and
 a point still unproven searches every triangle whose centroid lies within its distance plus ``R``. A point
@@ -55,6 +55,7 @@ import numpy as np
 from rftstatic.compiled import numba_available
 from rftstatic.contact.obstacles.base import NUMBER, NUMBERS, Obstacle, SceneKey, SharpFeatures, _as_points
 from rftstatic.contact.obstacles.registry import register
+from rftstatic.contact.obstacles.surface_query import HELD_SETS, NEAREST, WIDER, WIDEST
 from rftstatic.contact.obstacles.surface_geometry import (EDGE, FACE, VERTEX, closest_on_triangles, merge_nodes,
                                                           plan_hull, polygon_area_centre, pseudo_normals, rotation,
                                                           sharp_edges, winding_number)
@@ -70,34 +71,6 @@ BAND = 0.25
 SIZE_RANGE = (1e-6, 1e4)
 """Sizes [m] (bounding-box diagonal after scale and units) a mesh obstacle may have: a scale that makes it
 smaller or larger is a mistake (its triangles would be degenerate, or its coordinates overflow)."""
-
-NEAREST = 12
-"""Triangle centroids each point's nearest triangle is sought among by the numpy twin (then proven, or searched
-wider)."""
-
-WIDER = 64
-"""Triangle centroids each point's nearest triangle is sought among by the compiled twin, nearest first: it
-stops at the first that cannot be nearer (a point on the surface tests a few), and a point several triangles
-off the surface (the sheet hanging beside a finely tessellated body) is still proven among them, without the
-search of every triangle within its distance plus ``R``."""
-
-WIDEST = 512
-"""The most centroids a compiled candidate set grows to: where fresh sets of :data:`WIDER` fail to prove the
-nearest triangle for more than a quarter of the points sought again (slivers along a rounded edge: the nearest
-centroids all lie within a few millimetres), the next calls use sets twice as large."""
-
-FAR = "dk_0 - moved - R >= band"
-"""A point whose held candidate set bounds its distance beyond the band (its set's nearest centroid, less how far it
-moved since, less ``R``) needs only that bound: it is evaluated with its nearest centroid now as its set (a k-d
-tree query of one centroid) rather than its held set tested, failing its proof and sought again with ``K``
-centroids; its value then no longer depends on which set it held. On sphere-mesh with the level-4 icosphere the
-all-node evaluations of the candidate list's refreshes re-sought ~700 far nodes each: 2.5 of the query's 4.8 s."""
-
-HELD_SETS = 8
-"""Candidate sets kept between calls, one per number of points asked about (the sheet's nodes, its edge
-midpoints, the feature contact's points ...): a static obstacle's triangles never move, so a point that moved
-less than its margin keeps its set (:meth:`SurfaceObstacle._candidates`) and Newton's iterations skip the
-k-d tree."""
 
 HESSIAN_CAP = 0.5
 """The rounded surface's curvature ``1 / d`` is taken at ``d = HESSIAN_CAP * rounding`` where the point lies
@@ -144,6 +117,9 @@ class SurfaceObstacle(Obstacle):
         "side": SceneKey("side", length=False, kinds=(str,),
                          help='open mesh: "front" (solid behind the side its normals face) or "back"'),
         "thickness": SceneKey("thickness", kinds=NUMBER, help="open mesh: two-sided shell of this thickness"),
+        "smooth": SceneKey("smooth", kinds=NUMBER,
+                           help="closed mesh: the smooth implicit (IMLS) surface of its facets, of this support radius "
+                                "(at least 2.5 facet radii; default 0: the triangles)"),
         "rounding": SceneKey("rounding", kinds=NUMBER,
                              help="closed or one-sided mesh: the solid grown by a ball of this radius (a smooth contact "
                                   "surface, an exact contact tangent; default 0)"),
@@ -152,8 +128,8 @@ class SurfaceObstacle(Obstacle):
     }
 
     def __init__(self, path, units=None, scale=1.0, rotate=(0.0, 0.0, 0.0), translate=(0.0, 0.0, 0.0),
-                 side=None, thickness=None, feature_angle=FEATURE_ANGLE, rounding=0.0, *, scene_length=1.0,
-                 base_dir=None):
+                 side=None, thickness=None, feature_angle=FEATURE_ANGLE, rounding=0.0, smooth=0.0, *,
+                 scene_length=1.0, base_dir=None):
         from rftstatic.errors import MeshError
         from rftstatic.mesh.surface import check_triangles, read_triangles
 
@@ -169,7 +145,7 @@ class SurfaceObstacle(Obstacle):
         self.side = side
         self.thickness = None if thickness is None else float(thickness)
         self.feature_angle = float(feature_angle)
-        self.rounding = float(rounding)
+        self.rounding, self.smooth = float(rounding), float(smooth)
         self.scene_length = float(scene_length)
         if side not in (None, "front", "back"):
             raise ValueError(f'side must be "front" or "back", got {side!r}')
@@ -179,6 +155,8 @@ class SurfaceObstacle(Obstacle):
             raise ValueError("thickness and side are exclusive: a shell of a thickness has two sides; give one")
         if not (np.isfinite(self.rounding) and self.rounding >= 0):
             raise ValueError(f"rounding must be a finite length >= 0, got {rounding!r}")
+        if not (np.isfinite(self.smooth) and self.smooth >= 0):
+            raise ValueError(f"smooth must be a finite length >= 0, got {smooth!r}")
         if self.rounding > 0 and self.thickness is not None:
             raise ValueError("rounding and thickness are exclusive: a shell is rounded by half its thickness; give one")
         if not (0.0 < self.feature_angle < 180.0):
@@ -224,6 +202,15 @@ class SurfaceObstacle(Obstacle):
         self.boundary_vertex = np.zeros(len(V), bool)
         self.boundary_vertex[self.edges[boundary_edge].ravel()] = True
         self._build_search()
+        if self.smooth:
+            from rftstatic.contact.obstacles.surface_smooth import MIN_SUPPORT, SmoothSurface
+
+            if not self.closed:
+                raise MeshError(f"{self.path}: smooth needs a closed surface (a solid); this one is open: leave it out")
+            if self.smooth < MIN_SUPPORT * self.radius:
+                raise ValueError(f"smooth = {smooth!r} is below {MIN_SUPPORT:g} facet radii of {self.path.name} "
+                                 f"({MIN_SUPPORT * self.radius:.3g} m): give at least that (in the scene's lengths)")
+            self._smooth = SmoothSurface(V, tri, self.smooth)
         self._features()
 
     # --- geometry ---------------------------------------------------------------------------------
@@ -353,9 +340,18 @@ class SurfaceObstacle(Obstacle):
     def _evaluate(self, x, hessian):
         x = _as_points(x)
         if self.compiled:
-            return self._evaluate_compiled(x, hessian)
-        q, kind, gid, exact, lower = self._closest(x)
-        return self._signed(x, q, kind, gid, exact & (lower < self.band), lower, hessian)
+            phi, normal, H = self._evaluate_compiled(x, hessian)
+        else:
+            q, kind, gid, exact, lower = self._closest(x)
+            phi, normal, H = self._signed(x, q, kind, gid, exact & (lower < self.band), lower, hessian)
+        if self.smooth:  # the IMLS surface within half its support of the triangles (.surface_smooth)
+            near = np.flatnonzero(np.abs(phi + self.offset) < 0.5 * self.smooth)
+            if near.size:
+                ps, gs, Hs, _ = self._smooth.evaluate(x[near], hessian)
+                phi[near], normal[near] = ps - self.offset, gs
+                if hessian:
+                    H[near] = Hs
+        return phi, normal, H
 
     def _evaluate_compiled(self, x, hessian):
         from rftstatic.contact.obstacles.surface_query import evaluate_compiled
@@ -441,9 +437,9 @@ class SurfaceObstacle(Obstacle):
 
     @property
     def psd_tangent(self) -> bool:
-        """The penalty clamps the contact tangent (PSD) where the distance's curvature is unbounded (sharp edges,
-        no rounding); a rounded surface's curvature is at most ``1 / rounding``: its tangent stays exact."""
-        return self.rounding == 0.0
+        """The penalty clamps the contact tangent (PSD) where the distance's curvature is unbounded (sharp edges, no
+        rounding or smoothing); a rounded or smooth surface's curvature is bounded: its tangent stays exact."""
+        return self.rounding == 0.0 and self.smooth == 0.0
 
     def bounding_box(self):
         half = self.offset
@@ -460,6 +456,8 @@ class SurfaceObstacle(Obstacle):
             out["thickness"] = self.thickness
         if self.rounding > 0:
             out["rounding"] = self.rounding
+        if self.smooth > 0:
+            out["smooth"] = self.smooth
         return out
 
     def as_dict(self):

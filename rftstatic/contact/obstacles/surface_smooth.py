@@ -1,0 +1,154 @@
+"""A smooth contact surface for a triangle-mesh obstacle: the implicit moving-least-squares (IMLS) surface of its
+facets (Shen, O'Brien & Shewchuk 2004; Kolluri 2008), for a body that is smooth but given as triangles.
+
+The signed distance to a triangle surface has a crease wherever the surface is concave: outside a concave facet
+edge the nearest point jumps from one facet to the other across the bisecting plane, so the contact normal jumps by
+the edge's dihedral angle. A node resting in such a valley feels a force that no position balances (the penalty's
+``k A phi n`` jumps by ``k A phi`` times the angle), and Newton cannot converge there. The IMLS surface blends the
+facets' planes with smooth weights:
+
+    phi(x) = S / W,   S = sum_i w_i (x - p_i) . n_i,   W = sum_i w_i,   w_i = A_i psi(|x - p_i| / h)        (S1)
+
+with ``p_i``, ``n_i``, ``A_i`` the centroid, unit outward normal and area of facet ``i``, ``h`` the support radius and
+``psi(q) = (1 - q)^4 (4 q + 1)`` for ``q < 1`` (Wendland's C2 kernel, 0 beyond). Its derivatives, with ``d_i = (x -
+p_i) . n_i``, ``u_i`` the unit vector from ``p_i`` to ``x`` and ``r_i`` the distance:
+
+    grad phi = (sum_i (w_i n_i + d_i grad w_i) - phi grad W) / W                                          (S2)
+    hess phi = (sum_i (d_i hess w_i + grad w_i n_i^T + n_i grad w_i^T) - phi hess W
+                - grad phi grad W^T - grad W grad phi^T) / W                                               (S3)
+    grad w_i = A_i psi'(q) / h u_i,   hess w_i = A_i (psi''(q) / h^2 u_i u_i^T + psi'(q) / (h r_i) (I - u_i u_i^T))
+
+(``psi'(q) / q = -20 (1 - q)^3`` stays finite at ``r_i = 0``). ``phi`` is C2 wherever ``W > 0``: a plane is
+reproduced exactly, and on a surface of curvature ``kappa`` the zero set lies outside the facets by about
+``kappa <r^2> / 2`` over the support (the weighted mean square distance of the facet centroids): a support of
+about three facets keeps this within the facets' own sagitta on a finely tessellated body. ``|grad phi|`` is 1 on
+a plane and near 1 elsewhere; the penalty uses ``grad phi`` itself (force = gradient of the energy).
+
+A point is evaluated here when some facet centroid lies within ``h`` of it; the caller
+(:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle` with ``smooth``) takes the facets' own signed
+distance for the points farther than ``h / 2`` from the triangles, where no contact acts (it requires ``h`` of at
+least :data:`MIN_SUPPORT` facet radii, so every point within ``h / 2`` of the triangles has a centroid within ``h``).
+"""
+
+from __future__ import annotations
+
+from itertools import chain
+
+import numpy as np
+
+from rftstatic.compiled import numba_available
+
+__all__ = ["MIN_SUPPORT", "SmoothSurface"]
+
+MIN_SUPPORT = 2.5
+"""Smallest support radius ``h``, in the largest facet's centroid-to-corner radii ``R``: a point within ``h / 2`` of
+the triangles lies within ``h / 2 + R < h`` of some facet's centroid."""
+
+SKIN = 0.25
+"""Neighbour lists are gathered within ``(1 + SKIN) h`` and kept for a set of points while none has moved more than
+``SKIN h / 2`` since (the kernel skips the facets beyond ``h``)."""
+
+
+def _imls(x, p, nrm, area, h, start, nbr, hessian, phi, grad, H, W_out):
+    """(S1)-(S3) at the points ``x (n, 3)`` over their neighbour facets ``nbr[start[k]:start[k + 1]]``."""
+    for k in range(x.shape[0]):
+        W = 0.0
+        S = 0.0
+        gW = np.zeros(3)
+        gS = np.zeros(3)
+        hW = np.zeros((3, 3))
+        hS = np.zeros((3, 3))
+        for j in range(start[k], start[k + 1]):
+            i = nbr[j]
+            v = x[k] - p[i]
+            r = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            q = r / h
+            if q >= 1.0:
+                continue
+            om = 1.0 - q
+            w = area[i] * om ** 4 * (4.0 * q + 1.0)
+            d = v[0] * nrm[i, 0] + v[1] * nrm[i, 1] + v[2] * nrm[i, 2]
+            W += w
+            S += w * d
+            # grad w = A psi'(q) / h u = A (psi'(q) / q) v / h^2, psi'(q) / q = -20 (1 - q)^3
+            c1 = area[i] * (-20.0) * om ** 3 / (h * h)
+            for a in range(3):
+                gW[a] += c1 * v[a]
+                gS[a] += c1 * v[a] * d + w * nrm[i, a]
+            if hessian:
+                # hess w = grad (c1 v) = c1 I + (dc1 / dr) v v^T / r, dc1 / dr = 60 A (1 - q)^2 / h^3 (v v^T / r -> 0)
+                c2 = area[i] * 60.0 * om * om / (h * h * h * r) if r > 0.0 else 0.0
+                for a in range(3):
+                    for b in range(3):
+                        hw = c2 * v[a] * v[b] + (c1 if a == b else 0.0)
+                        hW[a, b] += hw
+                        hS[a, b] += hw * d + c1 * (v[a] * nrm[i, b] + nrm[i, a] * v[b])
+        W_out[k] = W
+        if W <= 0.0:
+            phi[k] = 0.0
+            continue
+        f = S / W
+        phi[k] = f
+        for a in range(3):
+            grad[k, a] = (gS[a] - f * gW[a]) / W
+        if hessian:
+            for a in range(3):
+                for b in range(3):
+                    H[k, a, b] = (hS[a, b] - f * hW[a, b] - grad[k, a] * gW[b] - gW[a] * grad[k, b]) / W
+
+
+_KERNEL = []
+
+
+def _kernel():
+    """:func:`_imls`, compiled by numba (cached) when it is installed."""
+    if not _KERNEL:
+        if numba_available():
+            import numba
+
+            _KERNEL.append(numba.njit(cache=True, nogil=True)(_imls))
+        else:
+            _KERNEL.append(_imls)
+    return _KERNEL[0]
+
+
+class SmoothSurface:
+    """The IMLS surface (S1) of the facets of a closed, outward-wound triangle surface ``V (m, 3)`` [m], ``T (t, 3)``
+    with support radius ``h`` [m] (module docstring)."""
+
+    def __init__(self, V: np.ndarray, T: np.ndarray, h: float):
+        from scipy.spatial import cKDTree
+
+        a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
+        cross = np.cross(b - a, c - a)
+        twice = np.linalg.norm(cross, axis=1)
+        self.p = np.ascontiguousarray((a + b + c) / 3.0)
+        self.n = np.ascontiguousarray(cross / twice[:, None])
+        self.area = np.ascontiguousarray(0.5 * twice)
+        self.h = float(h)
+        self.tree = cKDTree(self.p)
+        self._held = {}  # len(x) -> (x_ref, start, nbr)
+
+    def _neighbours(self, x):
+        held = self._held.get(len(x))
+        if held is not None and np.max(np.linalg.norm(x - held[0], axis=1), initial=0.0) < 0.5 * SKIN * self.h:
+            return held[1], held[2]
+        lists = self.tree.query_ball_point(x, (1.0 + SKIN) * self.h)
+        counts = np.fromiter(map(len, lists), np.int64, len(lists))
+        start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        nbr = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
+        if len(self._held) >= 8 and len(x) not in self._held:
+            self._held.pop(next(iter(self._held)))
+        self._held[len(x)] = (x.copy(), start, nbr)
+        return start, nbr
+
+    def evaluate(self, x: np.ndarray, hessian: bool = False):
+        """``(phi (n,) [m], grad (n, 3) [-], H (n, 3, 3) [1/m] or None, W (n,))`` of (S1)-(S3) at ``x (n, 3)`` [m];
+        ``W = 0`` where no facet's support reaches (``phi``, ``grad`` 0 there)."""
+        x = np.ascontiguousarray(x, dtype=float)
+        start, nbr = self._neighbours(x)
+        n = len(x)
+        phi, grad, W = np.zeros(n), np.zeros((n, 3)), np.zeros(n)
+        H = np.zeros((n, 3, 3) if hessian else (1, 3, 3))
+        _kernel()(x, self.p, self.n, self.area, self.h, start, nbr, hessian, phi, grad, H, W)
+        return phi, grad, (H if hessian else None), W
