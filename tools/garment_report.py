@@ -1,6 +1,6 @@
 """Write validation/garments.md: garments sewn from panels on the dress form, measured by independent checks.
 
-    python tools/garment_report.py [--out validation] [--a-line-h 1.45 1.1] [--circle-h 1.48 1.1] [--dress-h 2 1.45]
+    python tools/garment_report.py [--out validation] [--a-line-h 1.45 1.1] [--circle-h 1.48 1.1] [--dress-h 1.45 1.1]
 
 Every number comes from a whole-process run made here (``python -m rftstatic case SCENE --set garment.h=H``), one
 after the other: each scene on its own mesh (the whole ``case`` command, figures and all, timed: the issue's time
@@ -153,7 +153,7 @@ def main(argv=None):
     ap.add_argument("--out", default=str(ROOT / "validation"))
     ap.add_argument("--a-line-h", type=float, nargs="+", default=[1.45, 1.1])
     ap.add_argument("--circle-h", type=float, nargs="+", default=[1.48, 1.1])
-    ap.add_argument("--dress-h", type=float, nargs="+", default=[2.0, 1.45])
+    ap.add_argument("--dress-h", type=float, nargs="+", default=[1.45, 1.1])
     ap.add_argument("--work", default="/tmp/garment-report")
     ap.add_argument("--reuse", action="store_true", help="reuse finished runs in --work (module docstring)")
     ap.add_argument("--timeout", type=float, default=TIMEOUT, help="longest run [s]")

@@ -99,10 +99,10 @@ features, total energy 0.130 -> 1.12 J in 0.3 s undamped, against 0.130 -> 0.128
 FORM_TESSELLATION = {"sections": 160, "around": 128}
 """The contact surface's rings and points per ring (:meth:`rftstatic.garment.body.DressForm.surface`): facets of
 about 0.5 cm, so that the smooth surface's support (:data:`SMOOTH`) stays small against the form's curvature."""
-SMOOTH = 3.0
+SMOOTH = 2.5
 """Support radius of the contact surface's smooth implicit surface (``smooth`` of
 :class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle`, :mod:`rftstatic.contact.obstacles.surface_smooth`)
-in facet radii of :data:`FORM_TESSELLATION` [-]. The triangles' own distance has a crease at every concave facet
+in facet radii of :data:`FORM_TESSELLATION` [-] (the least the smooth surface takes). The triangles' own distance has a crease at every concave facet
 edge (the waist's profile, the neck's fillet), where the contact normal jumps: a node resting in such a valley keeps
 a force that no position balances, and Newton stalled on the garment meshes of 1.5 cm (the dress at 1.45 cm held a
 neckline node on a jump of 1e-3 N, 30 times the tolerance); the smooth surface has none and an exact tangent."""

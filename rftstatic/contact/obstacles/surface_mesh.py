@@ -207,7 +207,7 @@ class SurfaceObstacle(Obstacle):
 
             if not self.closed:
                 raise MeshError(f"{self.path}: smooth needs a closed surface (a solid); this one is open: leave it out")
-            if self.smooth < MIN_SUPPORT * self.radius:
+            if self.smooth < MIN_SUPPORT * self.radius * (1.0 - 1e-6):
                 raise ValueError(f"smooth = {smooth!r} is below {MIN_SUPPORT:g} facet radii of {self.path.name} "
                                  f"({MIN_SUPPORT * self.radius:.3g} m): give at least that (in the scene's lengths)")
             self._smooth = SmoothSurface(V, tri, self.smooth)
@@ -339,19 +339,17 @@ class SurfaceObstacle(Obstacle):
 
     def _evaluate(self, x, hessian):
         x = _as_points(x)
+        if self.smooth:  # the IMLS surface wherever a facet's support reaches
+            from rftstatic.contact.obstacles.surface_smooth import evaluate_smooth
+
+            return evaluate_smooth(self, x, hessian)
+        return self._evaluate_faceted(x, hessian)
+
+    def _evaluate_faceted(self, x, hessian):
         if self.compiled:
-            phi, normal, H = self._evaluate_compiled(x, hessian)
-        else:
-            q, kind, gid, exact, lower = self._closest(x)
-            phi, normal, H = self._signed(x, q, kind, gid, exact & (lower < self.band), lower, hessian)
-        if self.smooth:  # the IMLS surface within half its support of the triangles (.surface_smooth)
-            near = np.flatnonzero(np.abs(phi + self.offset) < 0.5 * self.smooth)
-            if near.size:
-                ps, gs, Hs, _ = self._smooth.evaluate(x[near], hessian)
-                phi[near], normal[near] = ps - self.offset, gs
-                if hessian:
-                    H[near] = Hs
-        return phi, normal, H
+            return self._evaluate_compiled(x, hessian)
+        q, kind, gid, exact, lower = self._closest(x)
+        return self._signed(x, q, kind, gid, exact & (lower < self.band), lower, hessian)
 
     def _evaluate_compiled(self, x, hessian):
         from rftstatic.contact.obstacles.surface_query import evaluate_compiled

@@ -24,10 +24,11 @@ reproduced exactly, and on a surface of curvature ``kappa`` the zero set lies ou
 about three facets keeps this within the facets' own sagitta on a finely tessellated body. ``|grad phi|`` is 1 on
 a plane and near 1 elsewhere; the penalty uses ``grad phi`` itself (force = gradient of the energy).
 
-A point is evaluated here when some facet centroid lies within ``h`` of it; the caller
-(:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle` with ``smooth``) takes the facets' own signed
-distance for the points farther than ``h / 2`` from the triangles, where no contact acts (it requires ``h`` of at
-least :data:`MIN_SUPPORT` facet radii, so every point within ``h / 2`` of the triangles has a centroid within ``h``).
+The caller (:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle` with ``smooth``) takes (S1) wherever
+some facet centroid lies within ``h`` (``W > 0``) and the triangles' own signed distance beyond, about ``h`` from the
+surface, where no contact acts (the two agree there to about the bias above); it requires ``h`` of at least
+:data:`MIN_SUPPORT` facet radii, so every point within ``h / 2`` of the triangles has a centroid within ``h``. The
+triangles' exact distance, the costly part of a faceted body's query, is then needed only far from it.
 """
 
 from __future__ import annotations
@@ -38,13 +39,13 @@ import numpy as np
 
 from rftstatic.compiled import numba_available
 
-__all__ = ["MIN_SUPPORT", "SmoothSurface"]
+__all__ = ["MIN_SUPPORT", "SmoothSurface", "evaluate_smooth"]
 
 MIN_SUPPORT = 2.5
 """Smallest support radius ``h``, in the largest facet's centroid-to-corner radii ``R``: a point within ``h / 2`` of
 the triangles lies within ``h / 2 + R < h`` of some facet's centroid."""
 
-SKIN = 0.25
+SKIN = 0.1
 """Neighbour lists are gathered within ``(1 + SKIN) h`` and kept for a set of points while none has moved more than
 ``SKIN h / 2`` since (the kernel skips the facets beyond ``h``)."""
 
@@ -152,3 +153,21 @@ class SmoothSurface:
         H = np.zeros((n, 3, 3) if hessian else (1, 3, 3))
         _kernel()(x, self.p, self.n, self.area, self.h, start, nbr, hessian, phi, grad, H, W)
         return phi, grad, (H if hessian else None), W
+
+
+def evaluate_smooth(ob, x: np.ndarray, hessian: bool):
+    """``(phi (n,) [m], normal (n, 3), H (n, 3, 3) or None)`` of a smooth surface obstacle ``ob``
+    (:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle` with ``smooth``) at ``x (n, 3)`` [m]: (S1)-(S3)
+    less its offset wherever a facet's support reaches; beyond (``h`` or more from every centroid) the nearest
+    centroid's distance less ``R`` less the offset, signed by the side of that facet's plane the point lies on (a
+    bound of the distance, as the faceted query's far points have: no contact acts there; Hessian 0)."""
+    phi, normal, H, W = ob._smooth.evaluate(x, hessian)
+    phi = phi - ob.offset
+    far = np.flatnonzero(W <= 0.0)
+    if far.size:
+        d, k = ob._ctree.query(x[far], k=1)
+        away = x[far] - ob.centroid[k]
+        side = np.where(np.einsum("pi,pi->p", away, ob._smooth.n[k]) < 0.0, -1.0, 1.0)
+        phi[far] = side * (d - ob.radius) - ob.offset
+        normal[far] = side[:, None] * away / np.maximum(d, 1e-300)[:, None]
+    return phi, normal, H
