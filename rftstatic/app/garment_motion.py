@@ -84,17 +84,18 @@ def _drape_scene(scene):
     return type(scene)(data, scene.path, scene.name, scene.overrides)
 
 
-def moving_scene(scene, body_obj: Path, given: dict, opts: GarmentMotionOptions):
-    """The ``dynamic`` scene of stage 2: the form's contact surface ``body_obj`` (an OBJ in metres) as a mesh
-    obstacle with the friction and the keyframes; no supports, no static solver; ``[dynamics]`` from ``[motion]``
-    (``given``: its values in scene units)."""
+def moving_scene(scene, body_obj: Path, given: dict, opts: GarmentMotionOptions, smooth: float = 0.0):
+    """The ``dynamic`` scene of stage 2: the form's contact surface ``body_obj`` (an OBJ in metres, its smooth
+    surface's support ``smooth`` in scene lengths: the drape's ``garment.contact_smoothing``) as a mesh obstacle with
+    the friction and the keyframes; no supports, no static solver; ``[dynamics]`` from ``[motion]`` (``given``: its
+    values in scene units)."""
     data = copy.deepcopy(scene.data)
     for key in ("garment", "solver", "supports", "motion"):
         data.pop(key, None)
     body = data.pop("body")
     data["analysis"] = "dynamic"
     data["obstacles"] = [{"type": "mesh", "path": str(Path(body_obj).resolve()), "units": "m",
-                          "smooth": garment.form_smoothing(garment.dress_form(scene)) / scene.units.length,
+                          "smooth": smooth,
                           "feature_angle": garment.BODY_FEATURE_ANGLE, "friction": opts.friction,
                           "motion": body["motion"]}]
     t_end = given["t_end"]
@@ -134,6 +135,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False):
     opts, given = motion_options(scene)
     stage = _stage(scene, out, opts, given)
     drape = garment.run(_drape_scene(scene), out / DRAPE, progress=progress, figures=figures)
+    stage = moving_scene(scene, out / DRAPE / "body-m.obj", given, opts, drape.summary["garment"]["contact_smoothing"])
     model, extras = build_model(stage, mesh=drape.model.mesh, contact="penalty", start_check=False)
     summary, explicit = dynamic._run(stage, model, extras, out, progress=progress, figures=figures, resume=resume,
                                      U0=drape.U)
