@@ -8,12 +8,18 @@ entries of :data:`SEARCHED` marked ``search: 1``; the second (branch h-lit) adde
 and :data:`SKIRT_SEARCHED`, and its every query, with what came back, is the CSV read by :func:`search_log`
 (``data/drape_search_2026-12-04.csv``, described in SOURCES.md).
 
-The page corpus keeps each stored page from its beginning: a query that names a table's content returns the
-page's opening (title, authors, abstract, at most the first lines of the introduction), never the table. No
-fabric table of any of these studies was within reach, so **no fabric row (mechanical data with a measured DC)
-could be entered** (:data:`MEASURED_ROWS` is empty) and **no skirt row** (:data:`SKIRT_ROWS` is empty); the
-report validation/measured_drape.md says so. A row entered later must pass :func:`check_row` (the fields of
-:data:`ROW_FIELDS`), and its table's text must be copied into the package's data folder.
+The page corpus keeps only the first passages of a stored page (its opening, for some pages the next
+passage): a query that names a table's content returns the title, authors, abstract or the introduction's
+start, never a results table. No fabric table of any of these studies was within reach, so **no fabric row
+(mechanical data with a measured DC, read in its source) could be entered** (:data:`MEASURED_ROWS` is empty) and
+**no skirt row** (:data:`SKIRT_ROWS` is empty); the report validation/measured_drape.md says so. A row entered
+later must pass :func:`check_row` (the fields of :data:`ROW_FIELDS`), and its table's text must be copied into
+the package's data folder.
+
+One table came second-hand: a public repository transcribes four fabrics of Matsudaira et al. (2015) (KES B,
+2HB, W, T, drape coefficient and node count). They are :data:`SECONDARY_ROWS`, kept apart from the measured rows,
+copied unchanged with their source lines (``data/matsudaira2015_as_transcribed.csv``, :func:`secondary_table`);
+the tester's specimen and disc diameters are not in the transcription.
 
 What the readable openings do give are qualitative findings (paraphrased, not quoted), which the report
 checks as trends of the simulation (:data:`TRENDS`). Nothing here is entered from memory: every statement
@@ -201,6 +207,27 @@ SEARCHED = (
      "says": "typical DC and node-count ranges stated without a source or a named fabric: not a measurement, "
              "not used",
      "table_within_reach": False, "search": 2},
+    {"citation": "Matsudaira, M., Masuda, T., Wada, M. & Yokura, H. (2015), Shape factor of flared skirts compared "
+                 "with that of circular fabrics, J. Textile Eng. 61(6), 69-73, doi:10.4188/jte.61.69",
+     "found_at": "not the paper: a transcription of its Tables 1 and 2 in the public repository "
+                 "github.com/antonbj3/3fold-motion-engine (commit 72e280a), src/motion_engine/cloth/r6_setup.py and "
+                 "data/cloth/bending_and_drape_reference.json (read_file)",
+     "readable": "the transcription: KES B and 2HB, W, T, DC and node count of four fabrics (A, B, C, F); the "
+                 "paper itself (J-STAGE) is not stored here",
+     "says": "four fabrics with KES bending data and a measured drape coefficient and node count "
+             "(SECONDARY_ROWS); the transcription names Table 1 (KES) and Table 2 (drape), gives one B per "
+             "fabric (no warp / weft split), leaves out the shear G it says the table carries, and does not "
+             "give the drape tester's specimen and disc diameters",
+     "table_within_reach": False, "search": 2},
+    {"citation": "Memon, H., Chaklie, E.B., Yesuf, H.M. & Zhu, C. (2021), Study on effect of leather rigidity and "
+                 "thickness on drapability of sheep garment leather, Materials 14(16), 4553, "
+                 "doi:10.3390/ma14164553",
+     "found_at": "https://mdpi.com/1996-1944/14/16/4553 (and a mirror); https://ebusca.uv.mx/Record/"
+                 "pubmed-8398511/Details",
+     "readable": "abstract and the introduction's first paragraph (the page's first two passages)",
+     "says": "four sheep garment leathers: flexural rigidity 9.2 to 22 and thickness 0.64 to 0.96 (units not in "
+             "the part returned), mean DC 47.35 to 69.9 %; no per-sample values in reach",
+     "table_within_reach": False, "search": 2},
 )
 """Every source looked at for issue 35 (module docstring); ``search`` says which of the two searches found it."""
 
@@ -243,6 +270,28 @@ SKIRT_SEARCHED = (
      "says": "a relationship from KES properties to particle-model inputs, fitted on circular specimens, tried "
              "on simulations of apparel; no garment against Cusick numbers in the part returned",
      "table_within_reach": False, "search": 2},
+    {"citation": "Matsudaira, M., Masuda, T., Wada, M. & Yokura, H. (2015), Shape factor of flared skirts compared "
+                 "with that of circular fabrics, J. Textile Eng. 61(6), 69-73, doi:10.4188/jte.61.69",
+     "found_at": "the paper is not stored here; its fabrics' KES data and drape, as a third party transcribed "
+                 "them, are SECONDARY_ROWS",
+     "readable": "the title (in the transcription's citation); no skirt value",
+     "says": "by its title, the study that issue 37 asks for (flared skirts against the same fabrics' circular "
+             "drape); its skirt numbers were not reached",
+     "table_within_reach": False, "search": 2},
+    {"citation": "Flared skirts made by two flat-pattern methods and by draping (koreascience.or.kr, "
+                 "JAKO200823659446695; authors not in the part returned)",
+     "found_at": "https://koreascience.or.kr/article/JAKO200823659446695.view?orgId=ksci",
+     "readable": "the abstract",
+     "says": "the draped-pattern skirt has more uniform nodes than the flat-pattern skirts; a lining reduces "
+             "the node count of the flat-pattern skirts; no fabric drape values",
+     "table_within_reach": False, "search": 2},
+    {"citation": "Local deformation of flared skirts of four fabrics (J-STAGE, senshoshi 57(10); Japanese; "
+                 "authors not in the part returned)",
+     "found_at": "https://www.jstage.jst.go.jp/browse/senshoshi/57/10/_contents/-char/ja",
+     "readable": "the abstract (Japanese)",
+     "says": "sheeting, broadcloth, satin crepe and cupra skirts after two weeks: local deformation correlates "
+             "with the fabrics' bending and shear properties (p < 0.01); no drape-tester reading",
+     "table_within_reach": False, "search": 2},
 )
 """Every source looked at for issue 37 (a flared skirt's folds against the same fabric's Cusick drape)."""
 
@@ -271,6 +320,28 @@ MEASURED_ROWS: tuple = ()
 SKIRT_ROWS: tuple = ()
 """Fabrics with a measured flared-skirt fold count and the same fabric's Cusick DC or nodes: none could be
 read (:data:`SKIRT_SEARCHED`)."""
+
+
+SECONDARY_FILE = "matsudaira2015_as_transcribed.csv"
+"""In ``rftstatic/references/data``: the four rows of :data:`SECONDARY_ROWS` as the transcription gives them,
+with its source lines (:func:`secondary_table`)."""
+
+SECONDARY_ROWS = (
+    {"fabric": "A", "name": "cotton broad", "kes_B": 0.118, "kes_2HB": 0.124, "kes_W": 12.38, "kes_T": 0.497,
+     "dc_percent": 82.9, "nodes": 2},
+    {"fabric": "B", "name": "wool tropical", "kes_B": 0.067, "kes_2HB": 0.033, "kes_W": 16.29, "kes_T": 0.407,
+     "dc_percent": 49.8, "nodes": 5},
+    {"fabric": "C", "name": "polyester tropical", "kes_B": 0.077, "kes_2HB": 0.029, "kes_W": 11.65,
+     "kes_T": 0.340, "dc_percent": 50.7, "nodes": 5},
+    {"fabric": "F", "name": "polyester faille", "kes_B": 0.019, "kes_2HB": 0.007, "kes_W": 10.43, "kes_T": 0.226,
+     "dc_percent": 28.3, "nodes": 7},
+)
+"""Matsudaira et al. (2015), Tables 1 and 2, **as a third party transcribed them** (github.com/antonbj3/3fold-
+motion-engine, commit 72e280a, src/motion_engine/cloth/r6_setup.py), not read in the paper: KES-FB2 bending
+rigidity B [gf cm^2/cm] (one value per fabric, so warp = weft here) and hysteresis 2HB [gf cm/cm], weight W
+[mg/cm^2], thickness T [mm], drape coefficient [%] and node count. Unknown from it: the drape tester's specimen
+and disc diameters, B's warp / weft split, the shear G. Not :data:`MEASURED_ROWS`: a row there must be read in
+the source; these are kept apart so that a report can show them as what they are."""
 
 
 def check_row(row: dict) -> None:
@@ -323,6 +394,13 @@ def search_log() -> list[dict]:
         raise ValueError(f"{SEARCH_LOG_FILE}: columns = {reader.fieldnames}, expected {list(SEARCH_LOG_COLUMNS)}")
     return list(reader)
 
+
+
+def secondary_table() -> list[dict]:
+    """The rows of :data:`SECONDARY_FILE` (its ``#`` lines are the source), values as text exactly as copied."""
+    text = resources.files("rftstatic.references").joinpath("data", SECONDARY_FILE).read_text(encoding="utf-8")
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
+    return list(csv.DictReader(io.StringIO("\n".join(lines))))
 
 TRENDS = {
     "dc_rises_with_bending_length": (

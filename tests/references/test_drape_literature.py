@@ -8,11 +8,13 @@ second search's log names every source that search added.
 
 import copy
 import math
+import re
 
 import pytest
 
 from rftstatic.references import drape_literature as lit
 
+HOST = re.compile(r"(?:https?://)?((?:[a-z0-9-]+\.)+[a-z]{2,})/")
 ENTRY_KEYS = {"citation", "found_at", "readable", "says", "table_within_reach", "search"}
 
 
@@ -92,7 +94,25 @@ def test_search_log_is_complete_and_names_every_source_the_second_search_added()
     for e in lit.SEARCHED + lit.SKIRT_SEARCHED:
         if e["search"] != 2:
             continue
-        first = e["found_at"].split(";")[0].split(" ")[0]
-        host_and_path = first.split("://", 1)[-1].removeprefix("www.")
-        key = host_and_path.split("/")[0]
-        assert key in returned, (e["citation"], key)
+        hosts = {h.removeprefix("www.") for h in HOST.findall(e["found_at"])}
+        assert hosts or "not stored" in e["found_at"], e["citation"]
+        for host in hosts:
+            assert host in returned, (e["citation"], host)
+
+
+def test_secondary_rows_are_the_copied_transcription_and_stay_apart_from_measured_rows():
+    table = {r["id"]: r for r in lit.secondary_table()}
+    assert set(table) == {r["fabric"] for r in lit.SECONDARY_ROWS}
+    columns = {"kes_B": "B_gf*cm^2/cm", "kes_2HB": "2HB_gf*cm/cm", "kes_W": "W_mg/cm^2", "kes_T": "T_mm",
+               "dc_percent": "DC_pub_%"}
+    for row in lit.SECONDARY_ROWS:
+        copied = table[row["fabric"]]
+        assert row["name"] == copied["name"].lower()
+        for key, column in columns.items():
+            assert row[key] == float(copied[column]), (row["fabric"], key)
+        assert row["nodes"] == int(copied["nodes_pub"])
+        assert 0.0 < row["dc_percent"] < 100.0 and row["nodes"] >= 0
+        assert min(row[k] for k in ("kes_B", "kes_2HB", "kes_W", "kes_T")) > 0.0
+    source = next(e for e in lit.SEARCHED if e["citation"].startswith("Matsudaira"))
+    assert not source["table_within_reach"], "a transcription is not the paper's table"
+    assert all(r.get("citation") != source["citation"] for r in lit.MEASURED_ROWS)
