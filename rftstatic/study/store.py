@@ -39,6 +39,10 @@ def point_key(scene) -> str:
     return hashlib.sha1(text.encode()).hexdigest()[:16]
 
 
+TEXT_COLUMNS = ("key", "worker", "folder")
+"""Columns of ``results.csv`` read back as text, never decoded (a hex key can read as a number)."""
+
+
 def encode(value) -> str:
     """A cell of ``results.csv``: empty for None, JSON for lists, ``repr`` precision for floats."""
     if value is None:
@@ -94,8 +98,8 @@ class Store:
                 for name in reader.fieldnames or []:
                     if name not in self.columns:  # a column of an earlier run (another measure): kept
                         self.columns.insert(len(self.columns) - len(FIXED_LAST), name)
-                for row in reader:
-                    self.rows[row["key"]] = {k: decode(v) for k, v in row.items()}
+                for row in reader:  # the key is hex text: "55159628e9139277" must not decode to a float (inf)
+                    self.rows[row["key"]] = {k: v if k in TEXT_COLUMNS else decode(v) for k, v in row.items()}
 
     def recover(self, keys) -> int:
         """Rows of points among ``keys`` that finished (``point.json`` in their folder) but are not in

@@ -93,6 +93,18 @@ def test_store_rewrites_the_table_and_recovers_rows_from_point_folders(tmp_path)
     assert "c" * 16 in store.Store(tmp_path, []).rows
 
 
+def test_store_reads_a_key_that_looks_like_a_number_as_text(tmp_path):
+    """A hex key of digits around an 'e' parses as a float (55159628e9139277 -> inf): read back as text."""
+    key = "55159628e9139277"
+    store.Store(tmp_path, ["probes.tip.z"]).add({"key": key, "status": "ok", "probes.tip.z": -1.5,
+                                                 "folder": "points/" + key, "worker": "1e3"})
+    again = store.Store(tmp_path, ["probes.tip.z"])
+    assert list(again.rows) == [key] and again.rows[key]["key"] == key
+    assert again.rows[key]["worker"] == "1e3" and again.rows[key]["probes.tip.z"] == -1.5
+    again.write()
+    assert next(iter(store.Store(tmp_path, []).rows.values()))["key"] == key
+
+
 def test_point_key_follows_the_resolved_scene():
     a = store.point_key(api.load_scene("strip", ["material.B_warp=0.083"]))
     assert a == store.point_key(api.load_scene("strip", ["material.B_warp=0.083"]))
