@@ -100,3 +100,21 @@ def test_held_by_contacts_sweeps_are_admissible_and_do_not_overshoot():
     np.testing.assert_allclose(capped[:, 0], [1.5, -1.5], rtol=1e-9)
     one = held_by_contacts(r[:1], [(np.array([[0]]), np.array([[1.0]]), normal, np.array([0.5]))])
     np.testing.assert_allclose(one, [[1.5, 0.0, 0.5]], rtol=1e-12)
+
+
+@pytest.mark.parametrize("slope", [0.4, 0.49, 0.6])
+def test_a_stack_on_a_frictional_floor_is_held_through_both_contacts(slope):
+    """Two free nodes of weight 1 (normal), one on the other (a pair, mu_s 0.5, lambda 1) and the lower on a floor
+    (mu_s 0.5, lambda 2), both pulled by ``slope`` along x: held (below 1e-3 of the load) while slope <= mu_s, since
+    the upper's load goes through the pair into the floor; above, each keeps slope - mu_s exactly. The floor alone
+    (the rest test before) holds only the lower node."""
+    n = np.array([[0.0, 0.0, 1.0]])
+    r = np.array([[slope, 0.0, 0.0], [slope, 0.0, 0.0]])
+    pair = (np.array([[0, 1]]), np.array([[1.0, -1.0]]), n, np.array([0.5]))
+    floor = (np.array([[1]]), np.array([[1.0]]), n, np.array([1.0]))
+    held = held_by_contacts(r, [pair, floor])
+    if slope <= 0.5:
+        assert np.abs(held).max() < 1e-3 * slope
+    else:
+        np.testing.assert_allclose(held[:, 0], slope - 0.5, rtol=1e-3)
+    np.testing.assert_allclose(held_by_contacts(r, [floor])[:, 0], [slope, max(slope - 1.0, 0.0)], atol=1e-12)
