@@ -47,7 +47,8 @@ limit by far), and they need no history: a relaxation resumed from its checkpoin
 handovers anchor the lag at the relaxed state (:func:`anchored_lag`). A relaxation from rest first seats the
 sheet on the penalty (:func:`seated`): a sheet laid at ``phi = 0`` on a plane starts where the penalty pushes with
 about 1000 x its weight and is thrown clear of the obstacle (4 cm on the 10 cm incline test), and in the air
-nothing holds it against the downhill weight.
+nothing holds it against the downhill weight. Its rest test measures the out-of-balance force less what static
+friction can hold, on the obstacles and between layers in self-contact together (:func:`held_by_contacts`, H1-H2).
 """
 
 from __future__ import annotations
