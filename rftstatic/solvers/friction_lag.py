@@ -12,7 +12,7 @@ import logging
 import numpy as np
 
 from rftstatic.contact.friction import anchored_lag, commit, initial_lag
-from rftstatic.contact.self_contact.friction import commit_pairs, empty_pairs_lag
+from rftstatic.contact.self_contact.friction import anchored_pairs_lag, commit_pairs, empty_pairs_lag
 from rftstatic.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
@@ -72,8 +72,9 @@ def anchor(model, state, U) -> None:
     law, slaw = law_of(model), self_law_of(model)
     if law is not None:
         state.contact_history[KEY] = anchored_lag(law, model.contact, model.positions(U))
-    if slaw is not None:  # the relaxation is frictionless between layers: their lag starts again at Newton's commit
-        state.contact_history[SELF_KEY] = empty_pairs_lag(slaw)
+    if slaw is not None:  # the pairs' impulses held the layers where they rest: anchored there likewise
+        state.contact_history[SELF_KEY] = anchored_pairs_lag(slaw, model.self_contact, model.positions(U),
+                                                             state.self_pairs)
     link(model, state, U)  # the tangent of the stability check before the handover sees the anchored lag
 
 

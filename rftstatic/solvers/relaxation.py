@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rftstatic.contact.friction import held_residual, seated
+from rftstatic.contact.friction import held_by_contacts, obstacle_holds, seated
+from rftstatic.contact.self_contact.friction import pair_holds
 from rftstatic.element.explicit_force import BACKENDS
 from rftstatic.errors import ParameterError
 from rftstatic.model.state import State
@@ -107,7 +108,9 @@ def relax_steps(model, state: State, options: RelaxOptions, *, given_velocity: b
     (default s = 100 as in §6) lengthens the stable step by sqrt(s); the load is not scaled, so the resting
     state is the static equilibrium. With Coulomb friction on the penalty contact the explicit steps apply its
     impulses (:func:`rftstatic.contact.friction.penalty_impulses`), and a relaxation from rest starts with the sheet
-    seated on the penalty (:func:`rftstatic.contact.friction.seated`).
+    seated on the penalty (:func:`rftstatic.contact.friction.seated`); between layers in self-contact, the pairs'
+    (:func:`rftstatic.contact.self_contact.friction.pair_impulses`). The rest test then measures what friction does
+    not hold (:func:`_held_rest`).
 
     Parameters
     ----------
@@ -143,21 +146,31 @@ run tests as the uninterrupted one did (its history holds the frictionless measu
 
 
 def _held_rest(model, state, at_rest: AtRest, P, mass_scale):
-    """The rest test of a relaxation: ``at_rest`` itself, or with Coulomb friction on the penalty contact, one that
-    measures what the friction does not hold: the kinetic energy of the velocities its impulses left (the motion's
-    peak counts the sample's own, impulse-free, so a sheet released from rest has moved before it can rest) and the
-    out-of-balance force with the static friction's reaction taken off
-    (:func:`rftstatic.contact.friction.held_residual`)."""
+    """The rest test of a relaxation: ``at_rest`` itself, or with Coulomb friction (on the penalty contact, between
+    the layers in self-contact), one that measures what the friction does not hold: the kinetic energy of the
+    velocities its impulses left (the motion's peak counts the sample's own, impulse-free, so a sheet released from
+    rest has moved before it can rest) and the out-of-balance force with a reaction the static friction of the
+    obstacle contacts and of the layers' pairs can give taken off (:func:`rftstatic.contact.friction.held_by_contacts`,
+    H1-H2; :func:`rftstatic.contact.friction.obstacle_holds`,
+    :func:`rftstatic.contact.self_contact.friction.pair_holds`)."""
     law = getattr(model.contact, "friction", None)
-    if law is None:
+    sc = getattr(model, "self_contact", None)
+    self_law = getattr(sc, "friction", None) if sc is not None else None
+    if law is None and self_law is None:
         return at_rest
     mass = lumped_mass(model, mass_scale)
+    mobile = model.free.any(axis=1)
     peaks = state.route.setdefault(FRICTION_REST, {"kinetic": at_rest.peak_kinetic, "residual": 0.0})
     at_rest.peak_kinetic, at_rest.peak_residual = peaks["kinetic"], peaks["residual"]
 
     def test(st, sample):
         r = -model.residual(st.U, 1.0, candidates=st.candidates, pairs=st.self_pairs, slip=st.bending_slip)
-        r = held_residual(law, model.contact, model.positions(st.U), np.where(model.free, r - model.load + P, 0.0))
+        x = model.positions(st.U)
+        holds = [] if law is None else [obstacle_holds(law, model.contact, x)]
+        if self_law is not None:
+            holds.append(pair_holds(self_law, sc, x, st.self_pairs))
+        r = held_by_contacts(np.where(model.free, r - model.load + P, 0.0), holds, mobile)
+        r = np.where(model.free, r, 0.0)
         at_rest.peak_kinetic = max(at_rest.peak_kinetic, sample["kinetic"])
         kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, st.V, st.V))
         done = at_rest(st, dict(sample, kinetic=kinetic, residual=float(np.linalg.norm(r))))

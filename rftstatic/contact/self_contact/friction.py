@@ -36,7 +36,8 @@ from rftstatic.contact.friction import TRAIL, FrictionLaw, _mollifier
 from rftstatic.contact.self_contact.distance import edge_edge, point_triangle
 from rftstatic.contact.self_contact.near_pairs import NearPairCache
 
-__all__ = ["empty_pairs_lag", "pair_friction_terms", "commit_pairs", "with_friction", "pair_impulses"]
+__all__ = ["empty_pairs_lag", "pair_friction_terms", "commit_pairs", "with_friction", "pair_impulses", "pair_holds",
+           "anchored_pairs_lag"]
 
 
 def empty_pairs_lag(law: FrictionLaw) -> dict:
@@ -205,3 +206,20 @@ def pair_impulses(law: FrictionLaw, sc, x: np.ndarray, v: np.ndarray, minv: np.n
     np.add.at(v, nodes.ravel(), dv.reshape(-1, 3))
     m = np.where(minv > 0, 1.0 / np.maximum(minv, 1e-300), 0.0)
     return 0.5 * float(np.sum(m * (before * before - v * v)))
+
+
+def pair_holds(law: FrictionLaw, sc, x: np.ndarray, cache=None):
+    """The self-contact pairs closer than the thickness at ``x (N, 3)`` [m] (pair cache ``cache``) as
+    :func:`rftstatic.contact.friction.held_by_contacts` takes them: ``nodes (P, 4)``, the closest points'
+    coefficients ``w (P, 4)``, normal ``(P, 3)`` and the largest static friction force ``mu_s lambda (P,)`` [N]
+    each can transmit between its two layers (what :func:`pair_impulses` holds still): the rest test of a
+    relaxation with friction between layers."""
+    nodes, _, w, normal, lam = _active_pairs(sc, x, cache)
+    return nodes, w, normal, law.mu_static[0] * lam
+
+
+def anchored_pairs_lag(law: FrictionLaw, sc, x: np.ndarray, cache=None) -> dict:
+    """The lag between layers of a sheet at rest at ``x (N, 3)`` [m] (a relaxed state handed to Newton, which
+    :func:`pair_impulses` held there): every pair closer than the thickness anchored where it is (sticking, static
+    coefficient), with its normal force at ``x`` (:func:`commit_pairs` from no lag)."""
+    return commit_pairs(law, sc, empty_pairs_lag(law), x, cache)[0]
