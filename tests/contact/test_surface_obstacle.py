@@ -124,6 +124,16 @@ def test_penalty_and_feature_pairs_force_is_the_energy_gradient_and_tangent_psd(
     assert np.linalg.eigvalsh(K).min() >= -1e-8 * np.abs(K).max()
 
 
+def _assert_tangent_blocks_are_force_gradients(pc, x, cs, h=1e-9):
+    """Each node's (3, 3) tangent block of the penalty ``pc`` at ``x`` against central differences of its force."""
+    for n in range(len(x)):
+        for i in range(3):
+            e = np.zeros_like(x)
+            e[n, i] = h
+            fd = (pc.evaluate(x + e).force[n] - pc.evaluate(x - e).force[n]) / (2 * h)
+            assert np.allclose(fd, cs.tangent_blocks[n, :, i], rtol=1e-5, atol=1e-6 * np.abs(cs.tangent_blocks).max())
+
+
 def test_tangent_is_the_force_gradient_on_faces(ico):
     # points pressed 0.2 mm into the middle of the icosphere's upper faces, or 0.05 mm above them (within the
     # onset): face regions, where the PSD tangent is the exact one
@@ -133,13 +143,7 @@ def test_tangent_is_the_force_gradient_on_faces(ico):
     pc = PenaltyContact([ico], np.full(len(x), 1e-4), 1e7, smoothing=1e-4)
     cs = pc.evaluate(x)
     assert np.all(cs.energy > 0) and np.abs(cs.tangent_blocks).max() > 0
-    h = 1e-9
-    for n in range(len(x)):
-        for i in range(3):
-            e = np.zeros_like(x)
-            e[n, i] = h
-            fd = (pc.evaluate(x + e).force[n] - pc.evaluate(x - e).force[n]) / (2 * h)
-            assert np.allclose(fd, cs.tangent_blocks[n, :, i], rtol=1e-5, atol=1e-6 * np.abs(cs.tangent_blocks).max())
+    _assert_tangent_blocks_are_force_gradients(pc, x, cs)
 
 
 def test_independent_crossing_check(tmp_path):
@@ -351,13 +355,7 @@ def test_a_rounded_surface_is_the_box_grown_by_a_ball_with_an_exact_penalty_tang
     pc = PenaltyContact([box], np.full(len(x), 1e-4), 1e7, smoothing=1e-4)
     cs = pc.evaluate(x)
     assert np.linalg.eigvalsh(cs.tangent_blocks).min() < 0  # the exact tangent softens along the rounded edges
-    h = 1e-9
-    for k in range(len(x)):
-        for i in range(3):
-            e = np.zeros_like(x)
-            e[k, i] = h
-            fd = (pc.evaluate(x + e).force[k] - pc.evaluate(x - e).force[k]) / (2 * h)
-            assert np.allclose(fd, cs.tangent_blocks[k, :, i], rtol=1e-5, atol=1e-6 * np.abs(cs.tangent_blocks).max())
+    _assert_tangent_blocks_are_force_gradients(pc, x, cs)
     # the compiled query (an icosphere of 320 triangles) rounds alike
     ipath = _write(tmp_path / "ico.obj", *_icosphere(2))
     ico, iplain = (SurfaceObstacle(ipath, scale=5.0, scene_length=0.01, rounding=rr) for rr in (r, 0.0))
