@@ -4,9 +4,13 @@
 import os
 from functools import cache
 
-PARALLEL_MIN_ELEMENTS = 4000
-"""Smallest mesh whose explicit internal force is spread over threads: below it, waking the threads
-costs more than the work."""
+PARALLEL_MIN_ELEMENTS = 1000
+"""Smallest mesh whose explicit internal force is spread over threads (a :class:`ThreadTuner` then keeps the
+faster of one and all). Measured (2 cores, one process alternating blocks of 25 calls, the fastest call, the same
+force bits; load 5-7; validation/bench_profile.md, fourth round): RFT6 force kernel, 1 / 2 threads,
+cusick-30 3,840 elements 0.592 / 0.295 ms, hang-20 3,200 0.491 / 0.237 ms, pedestal-square-20 2,048
+0.401 / 0.241 ms, cusick-30 at 9 x 96 1,536 0.238 / 0.178 ms, sphere-30 at 17 x 17 512 0.137 / 0.117 ms
+(was 4,000: cusick-30's kernel ran on one thread)."""
 
 
 STATIC_COMPILED_MIN_ELEMENTS = 3000
