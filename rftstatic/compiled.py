@@ -4,13 +4,13 @@
 import os
 from functools import cache
 
-PARALLEL_MIN_ELEMENTS = 1000
-"""Smallest mesh whose explicit internal force is spread over threads (a :class:`ThreadTuner` then keeps the
-faster of one and all). Measured (2 cores, one process alternating blocks of 25 calls, the fastest call, the same
-force bits; load 5-7; validation/bench_profile.md, fourth round): RFT6 force kernel, 1 / 2 threads,
-cusick-30 3,840 elements 0.592 / 0.295 ms, hang-20 3,200 0.491 / 0.237 ms, pedestal-square-20 2,048
-0.401 / 0.241 ms, cusick-30 at 9 x 96 1,536 0.238 / 0.178 ms, sphere-30 at 17 x 17 512 0.137 / 0.117 ms
-(was 4,000: cusick-30's kernel ran on one thread)."""
+PARALLEL_MIN_ELEMENTS = 4000
+"""Smallest mesh whose explicit internal force is spread over threads. The kernel alone pays on two threads far
+below it (``python -m rftstatic.bench.explicit --threads SCENE``, the fastest of 1,000 calls each at load 5-7, the
+same force bits: cusick-30's 3,840 elements 0.59 -> 0.30 ms, 2,048 elements 0.40 -> 0.24 ms), but the whole run
+does not on a busy machine: cusick-30 (whole process, eight before / after pairs at load 4-6, three variants of
+the tuner) took 5-49 % longer (median 9 %) with 1,000 here (validation/bench_profile.md, fourth round). On an idle machine ``RFTSTATIC_THREADS``
+= 2 asks for both cores."""
 
 
 STATIC_COMPILED_MIN_ELEMENTS = 3000

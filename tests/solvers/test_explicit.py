@@ -302,17 +302,3 @@ def test_threads_from_the_environment(monkeypatch):
         force_threads(10)
     monkeypatch.delenv("RFTSTATIC_THREADS")
     assert force_threads(10) == 1  # a small mesh: one thread
-
-
-def test_threads_from_the_mesh_size(monkeypatch):
-    """All cores (and the tuner) from PARALLEL_MIN_ELEMENTS on: cusick-30's 3,840 elements run on two threads
-    of a 2-core machine (measured 0.59 -> 0.30 ms a call), a mesh just below the limit on one."""
-    numba = pytest.importorskip("numba")
-    from rftstatic.compiled import PARALLEL_MIN_ELEMENTS, force_threads
-
-    monkeypatch.delenv("RFTSTATIC_THREADS", raising=False)
-    cores = max(1, int(numba.config.NUMBA_NUM_THREADS))
-    assert PARALLEL_MIN_ELEMENTS <= 3840
-    assert force_threads(3840) == cores
-    assert force_threads(PARALLEL_MIN_ELEMENTS) == cores
-    assert force_threads(PARALLEL_MIN_ELEMENTS - 1) == 1
