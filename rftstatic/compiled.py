@@ -92,9 +92,11 @@ def fixed_threads() -> int | None:
     return n
 
 
-BUSY_LOAD = 1.0
+BUSY_LOAD = 2.0
 """Load average above the thread count at which :class:`ThreadTuner` takes one thread (other jobs' runnable
-threads; this run's own threads count up to the thread count)."""
+threads; this run's own threads count up to the thread count). sphere-30, whole process (``bench scenes``), two
+tuned threads against ``RFTSTATIC_THREADS=1``: at load 2.9-3.1 23.8 against 33.3 s (two pay), at 4.4-6.2 40.1,
+41.3, 48.9, 49.4 against 32.7, 25.5, 46.3, 40.7 s (one pays); 2 on 2 cores: one thread above a load of 4."""
 
 
 def busy(threads: int) -> bool:
@@ -116,11 +118,9 @@ class ThreadTuner:
     every :attr:`hold` calls it times :attr:`probe` calls with each setting and keeps the faster
     until the next check. The kernels' sums do not depend on the thread count, only their speed.
 
-    A busy machine (1-minute load average above ``most`` + :data:`BUSY_LOAD`, so runnable threads of other
+    A busy machine (1-minute load average above ``most`` + :data:`BUSY_LOAD`: runnable threads of other
     jobs besides this run's own) gets one thread at every check whatever the probe said: the probe times the
-    kernel alone, not what its waiting second thread costs the rest of the step. Measured on sphere-30
-    (7,200 elements, ``bench scenes``, whole process, load 4.4-6.2): the tuned default 40.1, 41.3, 48.9,
-    49.4 s against 32.7, 25.5, 46.3, 40.7 s with ``RFTSTATIC_THREADS=1`` in the pairs run one after the other.
+    kernel alone, not what its waiting second thread costs the rest of the step (measured: :data:`BUSY_LOAD`).
     An idle machine (load below that) is tuned as before.
     """
 
