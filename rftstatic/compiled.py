@@ -5,8 +5,12 @@ import os
 from functools import cache
 
 PARALLEL_MIN_ELEMENTS = 4000
-"""Smallest mesh whose explicit internal force is spread over threads: below it, waking the threads
-costs more than the work."""
+"""Smallest mesh whose explicit internal force is spread over threads. The kernel alone pays on two threads far
+below it (``python -m rftstatic.bench.explicit --threads SCENE``, the fastest of 1,000 calls each at load 5-7, the
+same force bits: cusick-30's 3,840 elements 0.59 -> 0.30 ms, 2,048 elements 0.40 -> 0.24 ms), but the whole run
+does not on a busy machine: cusick-30 (whole process, eight before / after pairs at load 4-6, three variants of
+the tuner) took 5-49 % longer (median 9 %) with 1,000 here (validation/bench_profile.md, fourth round). On an idle machine ``RFTSTATIC_THREADS``
+= 2 asks for both cores."""
 
 
 STATIC_COMPILED_MIN_ELEMENTS = 3000
@@ -88,6 +92,22 @@ def fixed_threads() -> int | None:
     return n
 
 
+BUSY_LOAD = 2.0
+"""Load average above the thread count at which :class:`ThreadTuner` takes one thread (other jobs' runnable
+threads; this run's own threads count up to the thread count). sphere-30, whole process (``bench scenes``), two
+tuned threads against ``RFTSTATIC_THREADS=1``: at load 2.9-3.1 23.8 against 33.3 s (two pay), at 4.4-6.2 40.1,
+41.3, 48.9, 49.4 against 32.7, 25.5, 46.3, 40.7 s (one pays); 2 on 2 cores: one thread above a load of 4."""
+
+
+def busy(threads: int) -> bool:
+    """Whether the machine's 1-minute load average exceeds ``threads`` + :data:`BUSY_LOAD` (False where the
+    system has no load average)."""
+    try:
+        return os.getloadavg()[0] > threads + BUSY_LOAD
+    except OSError:
+        return False
+
+
 class ThreadTuner:
     """Picks, and keeps picking, the faster of one thread and ``most`` threads for a repeated call.
 
@@ -97,6 +117,11 @@ class ThreadTuner:
     So the explicit loop measures:
     every :attr:`hold` calls it times :attr:`probe` calls with each setting and keeps the faster
     until the next check. The kernels' sums do not depend on the thread count, only their speed.
+
+    A busy machine (1-minute load average above ``most`` + :data:`BUSY_LOAD`: runnable threads of other
+    jobs besides this run's own) gets one thread at every check whatever the probe said: the probe times the
+    kernel alone, not what its waiting second thread costs the rest of the step (measured: :data:`BUSY_LOAD`).
+    An idle machine (load below that) is tuned as before.
     """
 
     probe = 10
@@ -123,6 +148,7 @@ class ThreadTuner:
         if k < 2 * self.probe:
             self._times[threads] += seconds
             if k == 2 * self.probe - 1:
-                self.threads = 1 if self._times[1] <= self._times[self.most] else self.most
+                faster = 1 if self._times[1] <= self._times[self.most] else self.most
+                self.threads = 1 if busy(self.most) else faster
                 self._times = {1: 0.0, self.most: 0.0}
         self.calls += 1

@@ -269,9 +269,13 @@ def test_numpy_and_numba_runs_agree():
     assert np.abs(a.U - b.U).max() <= 1e-12 * np.abs(a.U).max()
 
 
-def test_thread_tuner_keeps_the_faster_setting():
+def test_thread_tuner_keeps_the_faster_setting(monkeypatch):
     """Every hold + 2 probe calls the tuner times both settings and keeps the faster one."""
+    import os
+
     from rftstatic.compiled import ThreadTuner
+
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.5, 0.5, 0.5))  # an idle machine
 
     tuner = ThreadTuner(most=2)
     cost = {1: 3.6e-3, 2: 6.5e-3}  # the other core busy: one thread is faster
@@ -289,6 +293,34 @@ def test_thread_tuner_keeps_the_faster_setting():
     assert used[:tuner.probe] == [1] * tuner.probe and used[tuner.probe:2 * tuner.probe] == [2] * tuner.probe
     assert set(used[2 * tuner.probe:]) == {1}
     cost = {1: 3.6e-3, 2: 2.4e-3}  # the machine is idle again: back to two threads after the next check
+    assert set(run(period)[2 * tuner.probe:]) == {2}
+
+
+def test_thread_tuner_takes_one_thread_on_a_busy_machine(monkeypatch):
+    """Above the thread count + BUSY_LOAD of load average the check keeps one thread even when the probe found
+    two faster (it times the kernel alone); below it the probe decides, as on an idle machine."""
+    import os
+
+    from rftstatic.compiled import BUSY_LOAD, ThreadTuner
+
+    load = [0.5]
+    monkeypatch.setattr(os, "getloadavg", lambda: (load[0], load[0], load[0]))
+    tuner = ThreadTuner(most=2)
+    cost = {1: 3.6e-3, 2: 2.4e-3}  # the kernel alone: two threads faster
+
+    def run(calls):
+        used = []
+        for _ in range(calls):
+            t = tuner.before()
+            tuner.after(t, cost[t])
+            used.append(t)
+        return used
+
+    period = 2 * tuner.probe + tuner.hold
+    assert set(run(period)[2 * tuner.probe:]) == {2}  # idle: the probe decides
+    load[0] = 2 + BUSY_LOAD + 0.5  # other jobs' threads besides this run's two
+    assert set(run(period)[2 * tuner.probe:]) == {1}
+    load[0] = 2 + BUSY_LOAD - 0.5
     assert set(run(period)[2 * tuner.probe:]) == {2}
 
 
