@@ -3,28 +3,18 @@ the analytic sphere it approximates."""
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def _run(args, out):
-    t = time.perf_counter()
-    p = subprocess.run([sys.executable, "-m", "rftstatic", "case", *args, "--no-figures", "--out", str(out)],
-                       capture_output=True, text=True, cwd=ROOT)
-    wall = time.perf_counter() - t
-    s = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else {}
-    return p.returncode, s, wall
-
-
-def sphere_cost_rows(tmp, rounds=2):
+def sphere_cost_rows(tmp, case, rounds=2):
     """sphere-30 at 33 x 33 on the analytic sphere and on the level-4 icosphere (5,120 triangles, written by
     tools/icosphere.py and given to ``cases/sphere-mesh.toml`` by its absolute path; the same smoothing 0.07), whole
-    processes back to back, ``rounds`` times: rows, the ratio of the smaller walls and the DC's relative difference."""
+    processes back to back by ``case`` (friction_report's: ``(args, out) -> (exit, summary, wall, error)``), ``rounds``
+    times: rows, the ratio of the smaller walls and the DC's relative difference."""
     ico = Path(tmp).resolve() / "icosphere-4.obj"
     subprocess.run([sys.executable, "tools/icosphere.py", "4", str(ico)], check=True, cwd=ROOT, capture_output=True)
     runs = {"analytic": ["sphere-30", "--set", "mesh.nodes=[33,33]", "--set", "contact.smoothing=0.07"],
@@ -32,7 +22,7 @@ def sphere_cost_rows(tmp, rounds=2):
     walls, rows, dc = {k: [] for k in runs}, [], {}
     for r in range(rounds):
         for name, args in runs.items():
-            rc, s, wall = _run(args, tmp / f"sphere-{r}-{name.split()[0]}")
+            rc, s, wall, _ = case(args, tmp / f"sphere-{r}-{name.split()[0]}")
             walls[name].append(wall)
             d = s.get("drape") or {}
             dc[name] = d.get("drape_coefficient_percent", float("nan"))

@@ -260,13 +260,6 @@ def close(scene, data, mesh, pairs, *, progress=True, start_check=True):
                        alpha=CLOSING_DAMPING, progress=progress)
 
 
-def form_smoothing(form: DressForm, clearance: float) -> float:
-    """Support radius [m] of the smooth contact surface of the form grown by ``clearance`` [m] (:data:`SMOOTH` facet
-    radii)."""
-    P, T = form.surface(clearance=clearance, **FORM_TESSELLATION)
-    return SMOOTH * float(np.max(np.linalg.norm(P[T] - P[T].mean(axis=1, keepdims=True), axis=2)))
-
-
 def contact_surface(form: DressForm, path, mesh, unit: float) -> dict:
     """Write the form's contact surface for the garment ``mesh`` (placed) to ``path`` (an OBJ in metres) and return
     its mesh-obstacle table (``smooth`` in scene lengths, ``unit`` [m] each): the form grown by the
@@ -274,8 +267,9 @@ def contact_surface(form: DressForm, path, mesh, unit: float) -> dict:
     garment's top, tessellated finely (:data:`FORM_TESSELLATION`), its smooth implicit surface (:data:`SMOOTH`);
     ``clearance`` and ``smooth_m`` [m] added for the summary."""
     clearance = CLEARANCE * form.chord_clearance(float(mesh.element_size.mean()), float(mesh.X3[:, 2].max()))
-    smooth = form_smoothing(form, clearance)
-    form.write_obj(path, clearance=clearance, **FORM_TESSELLATION)
+    P, T = form.surface(clearance=clearance, **FORM_TESSELLATION)
+    smooth = SMOOTH * float(np.max(np.linalg.norm(P[T] - P[T].mean(axis=1, keepdims=True), axis=2)))  # facet radii
+    write_obj(path, P, T, header="dress form grown by the contact clearance, metres (rftstatic.app.garment)")
     return {"type": "mesh", "path": str(Path(path).resolve()), "units": "m", "smooth": smooth / unit,
             "feature_angle": BODY_FEATURE_ANGLE, "clearance": clearance, "smooth_m": smooth}
 

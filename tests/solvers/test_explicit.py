@@ -269,6 +269,16 @@ def test_numpy_and_numba_runs_agree():
     assert np.abs(a.U - b.U).max() <= 1e-12 * np.abs(a.U).max()
 
 
+def _tuned(tuner, cost, calls):
+    """The threads ``tuner`` chooses over ``calls`` kernel calls that each take ``cost[threads]`` [s]."""
+    used = []
+    for _ in range(calls):
+        t = tuner.before()
+        tuner.after(t, cost[t])
+        used.append(t)
+    return used
+
+
 def test_thread_tuner_keeps_the_faster_setting(monkeypatch):
     """Every hold + 2 probe calls the tuner times both settings and keeps the faster one."""
     import os
@@ -281,12 +291,7 @@ def test_thread_tuner_keeps_the_faster_setting(monkeypatch):
     cost = {1: 3.6e-3, 2: 6.5e-3}  # the other core busy: one thread is faster
 
     def run(calls):
-        used = []
-        for _ in range(calls):
-            t = tuner.before()
-            tuner.after(t, cost[t])
-            used.append(t)
-        return used
+        return _tuned(tuner, cost, calls)
 
     period = 2 * tuner.probe + tuner.hold
     used = run(period)
@@ -309,12 +314,7 @@ def test_thread_tuner_takes_one_thread_on_a_busy_machine(monkeypatch):
     cost = {1: 3.6e-3, 2: 2.4e-3}  # the kernel alone: two threads faster
 
     def run(calls):
-        used = []
-        for _ in range(calls):
-            t = tuner.before()
-            tuner.after(t, cost[t])
-            used.append(t)
-        return used
+        return _tuned(tuner, cost, calls)
 
     period = 2 * tuner.probe + tuner.hold
     assert set(run(period)[2 * tuner.probe:]) == {2}  # idle: the probe decides
