@@ -393,6 +393,19 @@ def test_the_smooth_surface_is_c2_near_the_sphere_and_its_derivatives_are_exact(
     # far points keep the triangles' distance; a support under 2.5 facet radii or an open surface is refused
     far = np.array([[0.0, 0.0, 0.2]])
     assert 0.15 - ico.radius - 1e-9 <= ico.signed_distance(far)[0][0] <= 0.15 + 1e-9  # its lower bound far out
+    # far points (outside, deep inside) keep their held nearest centroid while they move under FAR_SLACK of its
+    # distance: within twice their motion m of a fresh query, on the right side; one moved onto the surface is exact
+    far = np.concatenate([d[:40] * 0.1, d[40:80] * 0.02])
+    held = ico.signed_distance(far)[0]
+    m = np.r_[np.full(40, 0.004), np.full(40, 0.002)]  # under FAR_SLACK of their distance to the centroids
+    moved = far + m[:, None] * d[80:160]
+    fresh = SurfaceObstacle(path, scale=5.0, scene_length=0.01, smooth=0.0075).signed_distance(moved)[0]
+    now = ico.signed_distance(moved)[0]
+    assert np.all(np.sign(now) == np.sign(held)) and np.all(now[:40] > 0) and np.all(now[40:] < 0)
+    assert np.all((now - fresh) * np.sign(now) >= -1e-12) and np.all(np.abs(now - fresh) <= 2 * m)
+    moved[0] = d[0] * 0.0501
+    assert ico.signed_distance(moved)[0][0] == pytest.approx(
+        SurfaceObstacle(path, scale=5.0, scene_length=0.01, smooth=0.0075).signed_distance(moved[:1])[0][0], abs=1e-12)
     with pytest.raises(ValueError, match="facet radii"):
         SurfaceObstacle(path, scale=5.0, scene_length=0.01, smooth=0.001)
     with pytest.raises(MeshError, match="closed"):
@@ -411,3 +424,24 @@ def test_a_sheet_node_in_a_concave_valley_of_the_facets_feels_a_continuous_force
     x = np.stack([np.linspace(-1e-4, 1e-4, 201), np.zeros(201), np.full(201, -0.0030)], axis=1)
     jump = lambda ob: np.abs(np.diff(ob.signed_distance(x)[1][:, 0])).max()  # noqa: E731
     assert jump(sharp) > 0.3 and jump(smooth) < 1e-3
+
+
+@pytest.mark.parametrize("cells", [128, 3])
+def test_the_smooth_surface_grid_finds_every_facet_in_the_support(tmp_path, monkeypatch, cells):
+    # (S1) from the cell grid against the sum over all facets (numpy), cells of h and cells far larger than h
+    from rftstatic.contact.obstacles import surface_smooth
+
+    monkeypatch.setattr(surface_smooth, "GRID_CELLS", cells)
+    V, T = _icosphere(3)
+    surface = surface_smooth.SmoothSurface(0.05 * V, T, 0.012)
+    rng = np.random.default_rng(2)
+    x = rng.uniform(-0.07, 0.07, (400, 3))
+    phi, _, _, W = surface.evaluate(x)
+    r = np.linalg.norm(x[:, None] - surface.p[None], axis=2)
+    q = np.minimum(r / surface.h, 1.0)
+    w = surface.area * (1.0 - q) ** 4 * (4.0 * q + 1.0)
+    d = np.einsum("pfi,fi->pf", x[:, None] - surface.p[None], surface.n)
+    assert np.allclose(W, w.sum(axis=1), rtol=1e-12, atol=1e-300)
+    near = W > 0
+    assert 50 < near.sum() < 400
+    assert np.allclose(phi[near], (w * d).sum(axis=1)[near] / W[near], rtol=1e-10, atol=1e-15)

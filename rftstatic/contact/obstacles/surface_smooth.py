@@ -33,8 +33,6 @@ triangles' exact distance, the costly part of a faceted body's query, is then ne
 
 from __future__ import annotations
 
-from itertools import chain
-
 import numpy as np
 
 from rftstatic.compiled import numba_available
@@ -45,45 +43,66 @@ MIN_SUPPORT = 2.5
 """Smallest support radius ``h``, in the largest facet's centroid-to-corner radii ``R``: a point within ``h / 2`` of
 the triangles lies within ``h / 2 + R < h`` of some facet's centroid."""
 
-SKIN = 0.1
-"""Neighbour lists are gathered within ``(1 + SKIN) h`` and kept for a set of points while none has moved more than
-``SKIN h / 2`` since (the kernel skips the facets beyond ``h``)."""
+GRID_CELLS = 128
+"""The facet grid's cells along the surface's longest side at most (cells are ``max(h, extent / GRID_CELLS)``)."""
+
+FAR_SLACK = 0.1
+"""A far point's nearest centroid is looked up again once it has moved this fraction of its distance to it."""
 
 
-def _imls(x, p, nrm, area, h, start, nbr, hessian, phi, grad, H, W_out):
-    """(S1)-(S3) at the points ``x (n, 3)`` over their neighbour facets ``nbr[start[k]:start[k + 1]]``."""
+def _imls(x, p, nrm, area, h, grid, order, cell_start, hessian, phi, grad, H, W_out):
+    """(S1)-(S3) at the points ``x (n, 3)``: the facets ``order[cell_start[c]:cell_start[c + 1]]`` of the cells ``c``
+    around each point's cell (``grid = (lo_x, lo_y, lo_z, size, nx, ny, nz)``, cells of ``size >= h``, x fastest)."""
+    lo0, lo1, lo2, size = grid[0], grid[1], grid[2], grid[3]
+    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
+    v = np.zeros(3)
+    gW = np.zeros(3)
+    gS = np.zeros(3)
+    hW = np.zeros((3, 3))
+    hS = np.zeros((3, 3))
     for k in range(x.shape[0]):
         W = 0.0
         S = 0.0
-        gW = np.zeros(3)
-        gS = np.zeros(3)
-        hW = np.zeros((3, 3))
-        hS = np.zeros((3, 3))
-        for j in range(start[k], start[k + 1]):
-            i = nbr[j]
-            v = x[k] - p[i]
-            r = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
-            q = r / h
-            if q >= 1.0:
-                continue
-            om = 1.0 - q
-            w = area[i] * om ** 4 * (4.0 * q + 1.0)
-            d = v[0] * nrm[i, 0] + v[1] * nrm[i, 1] + v[2] * nrm[i, 2]
-            W += w
-            S += w * d
-            # grad w = A psi'(q) / h u = A (psi'(q) / q) v / h^2, psi'(q) / q = -20 (1 - q)^3
-            c1 = area[i] * (-20.0) * om ** 3 / (h * h)
-            for a in range(3):
-                gW[a] += c1 * v[a]
-                gS[a] += c1 * v[a] * d + w * nrm[i, a]
-            if hessian:
-                # hess w = grad (c1 v) = c1 I + (dc1 / dr) v v^T / r, dc1 / dr = 60 A (1 - q)^2 / h^3 (v v^T / r -> 0)
-                c2 = area[i] * 60.0 * om * om / (h * h * h * r) if r > 0.0 else 0.0
-                for a in range(3):
-                    for b in range(3):
-                        hw = c2 * v[a] * v[b] + (c1 if a == b else 0.0)
-                        hW[a, b] += hw
-                        hS[a, b] += hw * d + c1 * (v[a] * nrm[i, b] + nrm[i, a] * v[b])
+        gW[:] = 0.0
+        gS[:] = 0.0
+        hW[:, :] = 0.0
+        hS[:, :] = 0.0
+        cx = int(np.floor((x[k, 0] - lo0) / size))
+        cy = int(np.floor((x[k, 1] - lo1) / size))
+        cz = int(np.floor((x[k, 2] - lo2) / size))
+        for iz in range(max(cz - 1, 0), min(cz + 2, nz)):
+            for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
+                x0, x1 = max(cx - 1, 0), min(cx + 1, nx - 1)
+                if x0 > x1:
+                    continue
+                row = (iz * ny + iy) * nx
+                for j in range(cell_start[row + x0], cell_start[row + x1 + 1]):
+                    i = order[j]
+                    for a in range(3):
+                        v[a] = x[k, a] - p[i, a]
+                    r = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+                    q = r / h
+                    if q >= 1.0:
+                        continue
+                    om = 1.0 - q
+                    w = area[i] * om ** 4 * (4.0 * q + 1.0)
+                    d = v[0] * nrm[i, 0] + v[1] * nrm[i, 1] + v[2] * nrm[i, 2]
+                    W += w
+                    S += w * d
+                    # grad w = A psi'(q) / h u = A (psi'(q) / q) v / h^2, psi'(q) / q = -20 (1 - q)^3
+                    c1 = area[i] * (-20.0) * om ** 3 / (h * h)
+                    for a in range(3):
+                        gW[a] += c1 * v[a]
+                        gS[a] += c1 * v[a] * d + w * nrm[i, a]
+                    if hessian:
+                        # hess w = grad (c1 v) = c1 I + (dc1 / dr) v v^T / r,
+                        # dc1 / dr = 60 A (1 - q)^2 / h^3 (v v^T / r -> 0)
+                        c2 = area[i] * 60.0 * om * om / (h * h * h * r) if r > 0.0 else 0.0
+                        for a in range(3):
+                            for b in range(3):
+                                hw = c2 * v[a] * v[b] + (c1 if a == b else 0.0)
+                                hW[a, b] += hw
+                                hS[a, b] += hw * d + c1 * (v[a] * nrm[i, b] + nrm[i, a] * v[b])
         W_out[k] = W
         if W <= 0.0:
             phi[k] = 0.0
@@ -115,7 +134,9 @@ def _kernel():
 
 class SmoothSurface:
     """The IMLS surface (S1) of the facets of a closed, outward-wound triangle surface ``V (m, 3)`` [m], ``T (t, 3)``
-    with support radius ``h`` [m] (module docstring)."""
+    with support radius ``h`` [m] (module docstring). The facets are binned in a grid of cells of at least ``h``
+    (:data:`GRID_CELLS` along the longest side at most), so a point's facets within ``h`` lie in its own and the 26
+    cells around it."""
 
     def __init__(self, V: np.ndarray, T: np.ndarray, h: float):
         from scipy.spatial import cKDTree
@@ -127,47 +148,65 @@ class SmoothSurface:
         self.n = np.ascontiguousarray(cross / twice[:, None])
         self.area = np.ascontiguousarray(0.5 * twice)
         self.h = float(h)
+        lo, hi = self.p.min(axis=0), self.p.max(axis=0)
+        size = max(self.h, float(np.max(hi - lo)) / GRID_CELLS)
+        dims = np.floor((hi - lo) / size).astype(np.int64) + 1
+        cx, cy, cz = np.floor((self.p - lo) / size).astype(np.int64).T
+        cx, cy, cz = np.minimum(cx, dims[0] - 1), np.minimum(cy, dims[1] - 1), np.minimum(cz, dims[2] - 1)
+        cell = (cz * dims[1] + cy) * dims[0] + cx
+        self.order = np.argsort(cell, kind="stable").astype(np.int64)
+        self.cell_start = np.searchsorted(cell[self.order], np.arange(int(np.prod(dims)) + 1)).astype(np.int64)
+        self.grid = np.array([*lo, size, *dims], dtype=float)
         self.tree = cKDTree(self.p)
-        self._held = {}  # len(x) -> (x_ref, start, nbr)
+        self._far = {}  # len(x) -> (x_ref, slack^2, facet): the held nearest centroids of far points (nearest_far)
 
-    def _neighbours(self, x):
-        held = self._held.get(len(x))
-        if held is not None and np.max(np.linalg.norm(x - held[0], axis=1), initial=0.0) < 0.5 * SKIN * self.h:
-            return held[1], held[2]
-        lists = self.tree.query_ball_point(x, (1.0 + SKIN) * self.h)
-        counts = np.fromiter(map(len, lists), np.int64, len(lists))
-        start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-        nbr = np.fromiter(chain.from_iterable(lists), np.int64, int(counts.sum()))
-        if len(self._held) >= 8 and len(x) not in self._held:
-            self._held.pop(next(iter(self._held)))
-        self._held[len(x)] = (x.copy(), start, nbr)
-        return start, nbr
+    def nearest_far(self, x: np.ndarray, far: np.ndarray) -> np.ndarray:
+        """The facet ``(f,)`` whose centroid stands for the nearest one of each point ``x[far]`` that no facet's
+        support reaches (``W = 0``): the nearest when last asked for that point, kept while the point has moved
+        less than :data:`FAR_SLACK` of that distance ``d0`` (so the distance to it exceeds the nearest one's by at
+        most ``2 FAR_SLACK d0``: a far point's value is an estimate, no contact acts there), else found again."""
+        held = self._far.get(len(x))
+        if held is None:
+            held = (np.zeros_like(x), np.full(len(x), -1.0), np.full(len(x), -1, np.int64))
+            if len(self._far) >= 8:
+                self._far.pop(next(iter(self._far)))
+            self._far[len(x)] = held
+        x_ref, slack2, facet = held
+        d = x[far] - x_ref[far]
+        ask = far[np.einsum("pi,pi->p", d, d) >= slack2[far]]
+        if ask.size:
+            d0, facet[ask] = self.tree.query(x[ask], k=1)
+            x_ref[ask], slack2[ask] = x[ask], (FAR_SLACK * d0) ** 2
+        return facet[far]
 
     def evaluate(self, x: np.ndarray, hessian: bool = False):
         """``(phi (n,) [m], grad (n, 3) [-], H (n, 3, 3) [1/m] or None, W (n,))`` of (S1)-(S3) at ``x (n, 3)`` [m];
         ``W = 0`` where no facet's support reaches (``phi``, ``grad`` 0 there)."""
         x = np.ascontiguousarray(x, dtype=float)
-        start, nbr = self._neighbours(x)
         n = len(x)
         phi, grad, W = np.zeros(n), np.zeros((n, 3)), np.zeros(n)
         H = np.zeros((n, 3, 3) if hessian else (1, 3, 3))
-        _kernel()(x, self.p, self.n, self.area, self.h, start, nbr, hessian, phi, grad, H, W)
+        _kernel()(x, self.p, self.n, self.area, self.h, self.grid, self.order, self.cell_start, hessian,
+                  phi, grad, H, W)
         return phi, grad, (H if hessian else None), W
 
 
 def evaluate_smooth(ob, x: np.ndarray, hessian: bool):
     """``(phi (n,) [m], normal (n, 3), H (n, 3, 3) or None)`` of a smooth surface obstacle ``ob``
     (:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle` with ``smooth``) at ``x (n, 3)`` [m]: (S1)-(S3)
-    less its offset wherever a facet's support reaches; beyond (``h`` or more from every centroid) the nearest
-    centroid's distance less ``R`` less the offset, signed by the side of that facet's plane the point lies on (a
-    bound of the distance, as the faceted query's far points have: no contact acts there; Hessian 0)."""
+    less its offset wherever a facet's support reaches; beyond (``h`` or more from every centroid) the distance to
+    the nearest centroid (as held by :meth:`SmoothSurface.nearest_far`) less ``R`` less the
+    offset, signed by the side of that facet's plane the point lies on (an estimate of the distance, as the faceted
+    query's far points have: no contact acts there; Hessian 0)."""
     phi, normal, H, W = ob._smooth.evaluate(x, hessian)
     phi = phi - ob.offset
     far = np.flatnonzero(W <= 0.0)
     if far.size:
-        d, k = ob._ctree.query(x[far], k=1)
-        away = x[far] - ob.centroid[k]
-        side = np.where(np.einsum("pi,pi->p", away, ob._smooth.n[k]) < 0.0, -1.0, 1.0)
+        surface = ob._smooth
+        k = surface.nearest_far(x, far)
+        away = x[far] - surface.p[k]
+        d = np.sqrt(np.einsum("pi,pi->p", away, away))
+        side = np.where(np.einsum("pi,pi->p", away, surface.n[k]) < 0.0, -1.0, 1.0)
         phi[far] = side * (d - ob.radius) - ob.offset
         normal[far] = side[:, None] * away / np.maximum(d, 1e-300)[:, None]
     return phi, normal, H
