@@ -26,7 +26,7 @@ def contact_friction(scene: Scene, c, n_obstacles: int, mesh):
         return None
     if np.any(mu_k > mu_s):
         raise scene.error("contact.friction_kinetic", f"the kinetic coefficient {mu_k.max():g} exceeds the static "
-                          f"one {mu_s.min():g}; give friction_kinetic <= friction_static")
+                          f"one {mu_s.min():g} (contact.friction_static); give friction_kinetic <= friction_static")
     if scene.analysis not in ("static", "dynamic"):
         given = [f"contact.{k} = {getattr(c, k)!r}" for k in ("friction", "friction_static", "friction_kinetic")
                  if getattr(c, k)]  # the keys that gave the friction, so the message names the one set

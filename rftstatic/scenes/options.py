@@ -9,6 +9,7 @@ raises :class:`~rftstatic.errors.SceneError` naming the file, the key and the va
 
 from __future__ import annotations
 
+import logging
 from contextlib import contextmanager
 from dataclasses import replace
 
@@ -21,6 +22,10 @@ from rftstatic.scenes.contact_options import ContactOptions
 from rftstatic.scenes.dynamics_options import DYNAMICS_DEFAULTS, DynamicsOptions
 from rftstatic.scenes.run_options import SOLVER_GROUPS, CantileverOptions, RunOptions
 from rftstatic.solvers.options import IncrementOptions, NewtonOptions, RouteOptions, StaticOptions
+
+log = logging.getLogger(__name__)
+
+_UNREAD_WARNED = set()  # scene files whose unread [dynamics] table has been named (static_options)
 
 
 @contextmanager
@@ -48,7 +53,14 @@ def _solver_table(scene) -> dict:
 
 def static_options(scene, *, progress=True) -> StaticOptions:
     """The scene's ``[solver]`` table as :class:`StaticOptions` (lengths in SI [m]); the app's keys (mesh
-    sequence, seeds, membrane switch) are :func:`run_options`'."""
+    sequence, seeds, membrane switch) are :func:`run_options`'. A ``[dynamics]`` table, which no static drape reads
+    (a scene switched from ``relax`` keeps its own), is named in a warning."""
+    if "dynamics" in scene.data and scene.analysis not in DYNAMICS_DEFAULTS and scene.path not in _UNREAD_WARNED:
+        _UNREAD_WARNED.add(scene.path)
+        log.warning("%s: [dynamics] is not read by a static drape (the static route's dynamic relaxation plans its "
+                    "own damping and time from the sheet, rftstatic.solvers.static; a garment-motion scene's explicit "
+                    'run is set by [motion]): it is ignored; remove it, or use analysis = "dynamic" or "relax"',
+                    scene.path)
     table = _solver_table(scene)
     with scene_keys(scene):
         return StaticOptions(newton=NewtonOptions(**table[NewtonOptions]),

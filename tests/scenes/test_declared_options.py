@@ -216,3 +216,12 @@ def test_a_contact_penalty_is_auto_or_a_stiffness_in_the_scenes_units():
 def test_an_undeclared_unit_is_a_programming_error():
     with pytest.raises(TypeError, match='option unit "furlong"'):
         option(1.0, "a distance", unit="furlong")
+
+
+
+def test_a_static_drape_names_a_dynamics_table_it_does_not_read(tmp_path, caplog):
+    from rftstatic.cli import main
+
+    with caplog.at_level("WARNING", logger="rftstatic.scenes.options"):
+        assert main(["case", "strip", "--no-figures", "--out", str(tmp_path / "run"), "--set", "dynamics.alpha=3"]) == 0
+    assert "strip.toml: [dynamics] is not read by a static drape" in caplog.text and "remove it" in caplog.text
