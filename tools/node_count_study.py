@@ -7,7 +7,7 @@ DC mean and range over the seeds, the node counts of the fold counter as the run
 (:func:`rftstatic.post.measures.boundary.fold_count`), the same outlines counted with a threshold from the hem's depth
 (``--depth-fraction``: a crest counts when its prominence is at least that fraction of r_max - r_min of its own
 outline, the nodes a lab sees in the shadow), the hem depth, the energies (total, and the membrane's share of the
-elastic energy) and the wall time.
+elastic energy), how many specimens ended on a stable minimum (the exact tangent factorises) and the solve time.
 
 Usage::
 
@@ -17,7 +17,7 @@ Usage::
 Groups (``--group``; all by default): ``base`` (the wool with its bending rigidities x 0.25, 1, 4), ``membrane``
 (in-plane shear and tensile rigidity scaled down to and below KES-typical values), ``anisotropy`` (B_warp / B_weft at
 fixed sqrt(B_warp B_weft) and fixed B_twist), ``mesh`` (sector counts that 8 does not divide), ``hysteresis``
-(bending hysteresis 2HB), ``isotropic`` (an isotropic sheet: no 4-fold anisotropy in bending or membrane).
+(bending hysteresis 2HB), ``route`` (the stiff wools on the quasi-static release and on the load steps), ``isotropic`` (an isotropic sheet: no 4-fold anisotropy in bending or membrane).
 """
 
 from __future__ import annotations
@@ -108,6 +108,21 @@ GROUPS = {
         ("isotropic sheet, C = 2 C_shear of the wool, B x 1", _isotropic(1.0, 2 * WOOL["C_shear"])),
         ("isotropic sheet, C = 2 C_shear of the wool, B x 4", _isotropic(4.0, 2 * WOOL["C_shear"])),
     ],
+    "route": [
+        ("wool B x 2, release", _bending(2.0) + ["solver.start=release"]),
+        ("wool B x 4, release", _bending(4.0) + ["solver.start=release"]),
+        ("wool B x 2, load steps", _bending(2.0) + ["solver.start=load-steps"]),
+        ("wool B x 4, load steps", _bending(4.0) + ["solver.start=load-steps"]),
+        ("wool B x 2", _bending(2.0)),
+        ("wool B x 0.5", _bending(0.5)),
+        ("wool B x 0.5, load steps", _bending(0.5) + ["solver.start=load-steps"]),
+        ("wool B x 4, C_shear x 0.1, load steps", _bending(4.0) + _scaled(("C_shear",), 0.1)
+         + ["solver.start=load-steps"]),
+        ("wool B x 4, lift 0.3 element sizes", _bending(4.0) + ["solver.perturbation=0.3"]),
+        ("wool B x 4, release, first lowering step 1 element size", _bending(4.0) + ["solver.start=release",
+                                                                                  "solver.release_step=1.0"]),
+        ("wool B x 4, load steps, 13 x 150 sectors", _bending(4.0) + ["solver.start=load-steps", "mesh.nodes=[13, 150]"]),
+    ],
     "mesh": [
         ("wool, 13 x 150 sectors", ["mesh.nodes=[13, 150]"]),
         ("wool, 13 x 162 sectors", ["mesh.nodes=[13, 162]"]),
@@ -172,7 +187,7 @@ def table(rows: list, fractions: list) -> str:
     """Markdown rows, one per variant (the order of ``rows``)."""
     head = ("| variant | seeds | DC [%] mean (range) | nodes (counter) | nodes mean | "
             + " | ".join(f"nodes, prominence >= {f:g} depth" for f in fractions)
-            + " | hem depth [cm] mean | energy [mJ] (range) | membrane / elastic | solve [s] per seed |")
+            + " | hem depth [cm] mean | energy [mJ] (range) | membrane / elastic | stable | solve [s] per seed |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     by = {}
     for row in rows:
@@ -181,7 +196,7 @@ def table(rows: list, fractions: list) -> str:
         ok = [r for r in rs if r["status"] == "ok"]
         bad = [f"seed {r['seed']}: {r['status']}" for r in rs if r["status"] != "ok"]
         if not ok:
-            lines.append(f"| {label} | {len(rs)} | {'; '.join(bad)} |" + " |" * (8 + len(fractions)))
+            lines.append(f"| {label} | {len(rs)} | {'; '.join(bad)} |" + " |" * (9 + len(fractions)))
             continue
         dc = np.array([r["dc"] for r in ok])
         en = np.array([r["energy_mJ"] for r in ok])
@@ -193,7 +208,7 @@ def table(rows: list, fractions: list) -> str:
         lines.append(f"| {label}{note} | {len(ok)} | {dc.mean():.2f} ({dc.min():.2f}-{dc.max():.2f}) | "
                      f"{', '.join(map(str, folds))} | {np.mean(folds):.2f} | " + " | ".join(dcounts)
                      + f" | {np.mean([r['hem_depth'] for r in ok]):.2f} | {en.mean():.4f} ({en.min():.4f} .. "
-                     f"{en.max():.4f}) | {share:.3f} | {solve:.0f} |")
+                     f"{en.max():.4f}) | {share:.3f} | {sum(bool(r['stable']) for r in ok)}/{len(ok)} | {solve:.0f} |")
     return "\n".join(lines)
 
 
