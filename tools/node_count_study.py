@@ -13,6 +13,7 @@ Usage::
 
     PYTHONPATH=$PWD python tools/node_count_study.py [--group G ...] [--seeds 3] [--jobs 2] [--out DIR]
         [--json FILE] [--plot FILE.png --plot-variants NAME ...]
+    PYTHONPATH=$PWD python tools/node_count_study.py --plot-only FILE.png --plot-variants NAME ...
 
 Groups (``--group``; all by default): ``base`` (the wool with its bending rigidities x 0.25, 1, 4), ``membrane``
 (in-plane shear and tensile rigidity scaled down to and below KES-typical values), ``anisotropy`` (B_warp / B_weft at
@@ -116,6 +117,7 @@ GROUPS = {
         ("wool B x 2", _bending(2.0)),
         ("wool B x 0.5", _bending(0.5)),
         ("wool B x 0.5, load steps", _bending(0.5) + ["solver.start=load-steps"]),
+        ("wool B x 0.5, release", _bending(0.5) + ["solver.start=release"]),
         ("wool B x 4, C_shear x 0.1, load steps", _bending(4.0) + _scaled(("C_shear",), 0.1)
          + ["solver.start=load-steps"]),
         ("wool B x 4, lift 0.3 element sizes", _bending(4.0) + ["solver.perturbation=0.3"]),
@@ -222,9 +224,13 @@ def plot(rows: list, labels: list, path: str) -> None:
     from rftstatic.post.measures.boundary import _prominent_peaks
 
     pick = [next(r for r in rows if r["label"] == lb and r["status"] == "ok") for lb in labels]
-    fig, axes = plt.subplots(1, len(pick), figsize=(4 * len(pick), 4.3), squeeze=False)
+    cols = min(len(pick), 4)
+    rows_n = -(-len(pick) // cols)
+    fig, axes = plt.subplots(rows_n, cols, figsize=(3.4 * cols, 3.7 * rows_n), squeeze=False)
+    for ax in axes.ravel()[len(pick):]:
+        ax.set_axis_off()
     th = np.radians(np.arange(360.0))
-    for ax, row in zip(axes[0], pick):
+    for ax, row in zip(axes.ravel(), pick):
         r = np.asarray(row["r"])
         ax.fill(r * np.cos(th), r * np.sin(th), color="0.15")
         ax.add_patch(plt.Circle((0, 0), 9.0, color="0.6"))
@@ -253,9 +259,15 @@ def main() -> None:
     p.add_argument("--depth-fraction", type=float, action="append")
     p.add_argument("--plot")
     p.add_argument("--plot-variants", nargs="*", default=[])
+    p.add_argument("--plot-only", help="only draw the outlines of seed 1 of --plot-variants into this file")
     args = p.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.plot_only:
+        sets = {label: s for g in GROUPS.values() for label, s in g}
+        plot([run_one(args.scene, label, sets[label], 1, out) for label in args.plot_variants], args.plot_variants,
+             args.plot_only)
+        return
     groups = args.group or list(GROUPS)
     jobs = [(g, label, sets, k) for g in groups for label, sets in GROUPS[g] for k in range(1, args.seeds + 1)]
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
