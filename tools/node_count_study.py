@@ -18,7 +18,9 @@ Usage::
 Groups (``--group``; all by default): ``base`` (the wool with its bending rigidities x 0.25, 1, 4), ``membrane``
 (in-plane shear and tensile rigidity scaled down to and below KES-typical values), ``anisotropy`` (B_warp / B_weft at
 fixed sqrt(B_warp B_weft) and fixed B_twist), ``mesh`` (sector counts that 8 does not divide), ``hysteresis``
-(bending hysteresis 2HB), ``route`` (the stiff wools on the quasi-static release and on the load steps), ``isotropic`` (an isotropic sheet: no 4-fold anisotropy in bending or membrane).
+(bending hysteresis 2HB), ``route`` (the stiff wools on the quasi-static release and on the load steps),
+``imperfection`` (the release from a 4-fold lift), ``isotropic`` (an isotropic sheet: no 4-fold anisotropy in bending
+or membrane).
 """
 
 from __future__ import annotations
@@ -123,7 +125,16 @@ GROUPS = {
         ("wool B x 4, lift 0.3 element sizes", _bending(4.0) + ["solver.perturbation=0.3"]),
         ("wool B x 4, release, first lowering step 1 element size", _bending(4.0) + ["solver.start=release",
                                                                                   "solver.release_step=1.0"]),
-        ("wool B x 4, load steps, 13 x 150 sectors", _bending(4.0) + ["solver.start=load-steps", "mesh.nodes=[13, 150]"]),
+        ("wool B x 4, load steps, 13 x 150 sectors",
+         _bending(4.0) + ["solver.start=load-steps", "mesh.nodes=[13, 150]"]),
+    ],
+    "imperfection": [
+        ("wool B x 4, release, 4-fold lift 0.3", _bending(4.0) + ["solver.start=release", "solver.perturbation=0.3",
+                                                              "solver.perturbation_folds=4"]),
+        ("wool B x 4, release, 4-fold lift 1", _bending(4.0) + ["solver.start=release", "solver.perturbation=1.0",
+                                                            "solver.perturbation_folds=4"]),
+        ("wool, release, 4-fold lift 1", ["solver.start=release", "solver.perturbation=1.0",
+                                          "solver.perturbation_folds=4"]),
     ],
     "mesh": [
         ("wool, 13 x 150 sectors", ["mesh.nodes=[13, 150]"]),

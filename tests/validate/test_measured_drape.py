@@ -39,8 +39,9 @@ def test_the_hand_written_node_count_section_is_carried_over_a_regeneration(monk
     disk up to the next heading, placed before the route's scope; absent file or section: no section."""
     report = tmp_path / "measured_drape.md"
     assert md.carried_section(report) is None
-    report.write_text("# T\n\n## Trends\n\nold rows\n\n## " + md.NODES_HEADING + "\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n"
-                      "Conclusion.\n\n## Route and scope\n\nold scope\n", encoding="utf-8")
+    report.write_text("# T\n\n## Trends\n\nold rows\n\n## " + md.NODES_HEADING
+                      + "\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\nConclusion.\n\n## Route and scope\n\nold scope\n",
+                      encoding="utf-8")
     assert md.carried_section(report) == "| a | b |\n|---|---|\n| 1 | 2 |\n\nConclusion."
     assert md.carried_section(report, "Missing") is None
     monkeypatch.setattr(md, "plan", lambda quick: {"wool B x 0.5": ("cusick-30", ["wool B x 0.5"])})
