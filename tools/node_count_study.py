@@ -14,6 +14,7 @@ Usage::
     PYTHONPATH=$PWD python tools/node_count_study.py [--group G ...] [--seeds 3] [--jobs 2] [--out DIR]
         [--json FILE] [--plot FILE.png --plot-variants NAME ...]
     PYTHONPATH=$PWD python tools/node_count_study.py --plot-only FILE.png --plot-variants NAME ...
+    PYTHONPATH=$PWD python tools/node_count_study.py --probe-release FACTOR
 
 Groups (``--group``; all by default): ``base`` (the wool with its bending rigidities x 0.25, 1, 4), ``membrane``
 (in-plane shear and tensile rigidity scaled down to and below KES-typical values), ``anisotropy`` (B_warp / B_weft at
@@ -259,6 +260,33 @@ def plot(rows: list, labels: list, path: str) -> None:
     fig.savefig(path, dpi=90)
 
 
+def probe_release(factor: float, scene_name: str = "cusick-30") -> None:
+    """Print the fold count, hem depth [cm] and hem drop [cm] at every pause of the release route of the wool with
+    its bending rigidities x ``factor`` (seed 1): where the route chooses its count."""
+    from rftstatic import api
+    from rftstatic.post.measures.boundary import boundary_loop, fold_count
+    from rftstatic.scenes.build import build_model
+    from rftstatic.scenes.options import static_options
+    from rftstatic.solvers.drive import drive
+    from rftstatic.solvers.newton import start_state
+    from rftstatic.solvers.static import static_route
+
+    scene = api.load_scene(scene_name, _bending(factor) + ["solver.start=release", "solver.seed=1"])
+    model, _ = build_model(scene)
+    opts = static_options(scene, progress=False)
+    state = start_state(model, opts.newton.linear_solver)
+    u = scene.units.length
+
+    def on_pause(pause):
+        x = model.positions(state.U) / u
+        prof = fold_count(x, boundary_loop(model.mesh.tri, x))
+        print(f"{pause.what}: nodes {prof.count}, hem depth {prof.r.max() - prof.r.min():.3f}, "
+              f"hem drop {-x[:, 2].min():.3f}", flush=True)
+
+    res = drive(static_route(model, state, opts), on_pause)
+    print(f"converged {res.converged}, stable {res.stable}")
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--scene", default="cusick-30")
@@ -271,9 +299,14 @@ def main() -> None:
     p.add_argument("--plot")
     p.add_argument("--plot-variants", nargs="*", default=[])
     p.add_argument("--plot-only", help="only draw the outlines of seed 1 of --plot-variants into this file")
+    p.add_argument("--probe-release", type=float, metavar="FACTOR",
+                   help="only print the fold count along the release route of the wool with B x FACTOR")
     args = p.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.probe_release is not None:
+        probe_release(args.probe_release, args.scene)
+        return
     if args.plot_only:
         sets = {label: s for g in GROUPS.values() for label, s in g}
         plot([run_one(args.scene, label, sets[label], 1, out) for label in args.plot_variants], args.plot_variants,
