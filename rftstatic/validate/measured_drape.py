@@ -282,6 +282,24 @@ SCOPE = ("Measured with the current Cusick route (cases/cusick-*.toml: dynamic r
          "the k2 of Feng et al.'s data set) and shear hysteresis (KES 2HG, 2HG5).")
 
 
+NODES_HEADING = "Why the node count does not follow the fabric"
+"""A section written by hand from ``tools/node_count_study.py`` (issue 35, item 3): its runs take about an hour, so the
+report does not solve them; a regeneration carries the section over from the report it replaces."""
+
+
+def carried_section(report: Path, heading: str = NODES_HEADING) -> str | None:
+    """The text of the ``## heading`` section of the Markdown ``report`` (up to the next ``## ``), or None when the
+    file or the section is missing."""
+    if not report.exists():
+        return None
+    lines = report.read_text(encoding="utf-8").splitlines()
+    if f"## {heading}" not in lines:
+        return None
+    start = lines.index(f"## {heading}") + 1
+    end = next((i for i in range(start, len(lines)) if lines[i].startswith("## ")), len(lines))
+    return "\n".join(lines[start:end]).strip("\n") or None
+
+
 def run(quick: bool = False, *, out=None) -> BenchmarkResult:
     result = BenchmarkResult(
         name="measured_drape", title="Cusick drape: measured fabrics (none readable), trends, bending hysteresis",
@@ -296,6 +314,11 @@ def run(quick: bool = False, *, out=None) -> BenchmarkResult:
     failed = _trends(result, runs, quick)
     if not quick:
         _hysteresis(result, runs)
+    from rftstatic.validate import default_out
+
+    nodes = carried_section(Path(out or default_out()) / "measured_drape.md")
+    if nodes is not None:
+        result.sections.append((NODES_HEADING, nodes))
     result.sections.append(("Route and scope", SCOPE))
     result.passed = not failed
     result.notes.append("trend checks failed: " + ", ".join(failed) if failed else "every trend check holds")

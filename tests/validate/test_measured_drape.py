@@ -32,3 +32,21 @@ def test_a_dc_that_falls_with_the_bending_length_fails_the_report(monkeypatch, s
     result = md.run(True)
     assert result.passed is passes
     assert ("dc_rises_with_bending_length" in result.notes[0]) is not passes
+
+
+def test_the_hand_written_node_count_section_is_carried_over_a_regeneration(monkeypatch, tmp_path):
+    """The section of tools/node_count_study.py's runs survives ``validate measured_drape``: taken from the report on
+    disk up to the next heading, placed before the route's scope; absent file or section: no section."""
+    report = tmp_path / "measured_drape.md"
+    assert md.carried_section(report) is None
+    report.write_text("# T\n\n## Trends\n\nold rows\n\n## " + md.NODES_HEADING
+                      + "\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\nConclusion.\n\n## Route and scope\n\nold scope\n",
+                      encoding="utf-8")
+    assert md.carried_section(report) == "| a | b |\n|---|---|\n| 1 | 2 |\n\nConclusion."
+    assert md.carried_section(report, "Missing") is None
+    monkeypatch.setattr(md, "plan", lambda quick: {"wool B x 0.5": ("cusick-30", ["wool B x 0.5"])})
+    monkeypatch.setattr(md, "run_row", lambda scene, sets: _summary(1.2, 40.0, 10))
+    headings = [h for h, _ in md.run(True, out=tmp_path).sections]
+    assert headings.index(md.NODES_HEADING) == headings.index("Route and scope") - 1
+    headings = [h for h, _ in md.run(True, out=tmp_path / "elsewhere").sections]
+    assert md.NODES_HEADING not in headings
