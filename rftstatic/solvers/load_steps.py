@@ -149,8 +149,9 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
             # displacement iteration before cutting back, which would unload the drape; its mixed try is short
             whole_from_state = from_state and not result.load_steps and lam_next >= 1.0
             short = whole_from_state and iteration_fallback and mixed and not fallback and continuing is None
+            reach = FROM_STATE_REACH * float(model.mesh.element_size.mean()) if short else None
             nt = newton(model, start, lam_next, _short_mixed(opts.newton) if short else opts.newton, state, max_step,
-                        scheme="displacement" if fallback else None)
+                        scheme="displacement" if fallback else None, reach=reach)
             continuing = None
             result.iterations += nt.iterations
             if (not nt.converged and nt.scheme == "mixed" and iteration_fallback
@@ -258,6 +259,19 @@ displacement iteration follows if it fails (instead of ``2 x`` :data:`~rftstatic
 at full load). Measured from the relaxation route's first relaxed state: cusick-30 converges in 9 mixed
 iterations (49 displacement iterations); sphere-30, pedestal-round-50 and pedestal-square-80 wander (|r| 0.3 N
 after 20 on sphere-30) and then converge by the displacement iteration, so the 8 more cost 8 factorisations."""
+
+
+FROM_STATE_REACH = 0.5
+"""Reach of the short mixed try from a given state, in mean element sizes [-]: the try gives up before its first
+step when that step would move a node farther, or when the exact tangent there is indefinite
+(:func:`~rftstatic.solvers.mixed.mixed_iterations`), and the displacement iteration (line search) starts at
+once. Measured at the relaxation route's first handover (issue 34, validation/bench_profile.md, h-speed5): the
+first Newton step moves a node 0.19 h on cusick-30 (the mixed iteration converges in 9), 1.09 h on
+pedestal-round-50 and 8.0 h on pedestal-square-80 (indefinite there, and on sphere-30), where the 12 mixed
+iterations wander (|r| 2e-4 -> 1.3 N at the first step on pedestal-round-50, about 22 factorisations) and the
+displacement iteration restarts from the relaxed state. Along a Newton step from that state Pi follows the
+quadratic model to about 1.5 times a step of 0.07 h and departs from it beyond (the membrane's strain is quadratic
+in the step)."""
 
 
 def _short_mixed(newton_opts):

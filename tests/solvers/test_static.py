@@ -296,3 +296,33 @@ def test_the_mixed_try_from_a_given_state_is_short_when_the_displacement_iterati
     with pytest.raises(static.ConvergenceError):
         load_steps.solve_load_steps(mod, U0=U0, options=opts.replace(max_continuations=0), iteration_fallback=False)
     assert calls == [("mixed", 30)]
+
+
+def test_the_short_mixed_try_from_a_given_state_has_a_reach(monkeypatch):
+    """The short mixed try gets the reach FROM_STATE_REACH x the mean element size (it gives up before a longer
+    first step); the displacement iteration after it, and a mixed iteration without that fallback, get none."""
+    from rftstatic.solvers import load_steps
+    from rftstatic.solvers.iteration import Iteration
+
+    mod = strip_model(11, 3)
+    opts = static.StaticOptions.from_keys(progress=False, relax_fallback=False, max_iterations=30).from_state()
+    U0 = np.zeros((mod.mesh.n_nodes, 3))
+    calls = []
+    real = load_steps.newton
+
+    def recorded(model, U, lam, newton_opts, state, max_step, *, scheme=None, reach=None, **kw):
+        used = scheme or newton_opts.iteration
+        calls.append((used, reach))
+        if used == "mixed":
+            return Iteration(False, U, 1, np.inf, "forced", scheme="mixed")
+        return real(model, U, lam, newton_opts, state, max_step, scheme=scheme, reach=reach, **kw)
+
+    monkeypatch.setattr(load_steps, "newton", recorded)
+    assert load_steps.solve_load_steps(mod, U0=U0, options=opts).converged
+    h = float(mod.mesh.element_size.mean())
+    assert calls[0] == ("mixed", pytest.approx(load_steps.FROM_STATE_REACH * h, rel=1e-15))
+    assert calls[1] == ("displacement", None)
+    calls.clear()
+    with pytest.raises(static.ConvergenceError):
+        load_steps.solve_load_steps(mod, U0=U0, options=opts.replace(max_continuations=0), iteration_fallback=False)
+    assert calls == [("mixed", None)]
