@@ -123,9 +123,10 @@ class LineSearch:
 
     def _trust_region(self, Pi0, Pi, alpha, slope, cap, curvature) -> None:
         """Levenberg-Marquardt damping as a trust region (More's update): the ratio of the actual to the
-        predicted energy decrease of a fresh Newton step decides; a step the line search had to shorten (a
-        near-singular or indefinite direction: a sheet balanced on a sphere, a fold forming) damps the next
-        one, good steps undo it, so the final iterations are pure Newton."""
+        predicted energy decrease of a fresh Newton step decides; a step the line search had to shorten below
+        :data:`SHORT_STEP` of its length (a near-singular or indefinite direction: a sheet balanced on a sphere, a
+        fold forming) damps the next one, one it took at that length or longer leaves the damping as it is, good
+        full steps undo it, so the final iterations are pure Newton."""
         mu = self.damping.mu
         predicted = -(slope + 0.5 * cap * cap * curvature)
         actual = Pi0 - Pi
@@ -134,9 +135,9 @@ class LineSearch:
             rho = 1.0  # below what the energy resolves: the residual decides convergence
         else:
             rho = actual / predicted if (alpha == 1.0 and predicted > 0) else 0.0
-        if alpha < 1.0 or rho < 0.25:
+        if alpha < SHORT_STEP or (alpha == 1.0 and rho < 0.25):
             mu = max(4.0 * mu, 1e-6)
-        elif rho > 0.75:
+        elif alpha == 1.0 and rho > 0.75:
             mu = mu / 3.0 if mu > 1e-9 else 0.0
         self.damping.mu = mu
 
@@ -210,6 +211,13 @@ def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_tr
             alpha *= 0.1
     return None, None
 
+
+SHORT_STEP = 0.5
+"""Share of a fresh Newton step [-] below which a step the line search shortened damps the next direction
+(:meth:`LineSearch._trust_region`). Every shortened step damped it before (x 4, at least 1e-6 of the mean tangent
+diagonal); with the refined line search (:func:`lowest_near`), from the relaxed states of issue 34
+(validation/bench_profile.md, h-speed5): pedestal-round-50 92 Newton iterations and 102 factorisations (101, 112
+when every shortened step damps), pedestal-square-80 141 and 133 (148, 147); the same equilibria."""
 
 LINE_REFINE_FACTOR = 2.0 ** 0.5
 """Ratio of two trial step lengths of :func:`lowest_near` [-]."""
