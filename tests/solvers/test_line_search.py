@@ -86,3 +86,30 @@ def test_a_non_finite_trial_ends_the_refinement():
     a, parts = lowest_near(parts_at, 0.25, parts_at(0.25))
     assert a == 0.25 or a < 0.25  # the longer trial was NaN: it went shorter (or stayed)
     assert np.isfinite(parts["total"]) and parts["total"] <= model.pi(0.25)
+
+
+def _damping_after(mu, alpha, actual, predicted=1.0):
+    """The damping after a step of length ``alpha`` [-] that lowered Pi by ``actual`` [J], the quadratic model
+    of the full step predicting ``predicted`` [J] (slope -2 predicted, curvature 2 predicted: -(s + c/2))."""
+    from rftstatic.solvers.displacement import Damping, LineSearch
+
+    search = object.__new__(LineSearch)
+    search.damping, search.work0 = Damping(), 1.0
+    search.damping.mu = mu
+    search._trust_region(0.0, -actual, alpha, -2.0 * predicted, 1.0, 2.0 * predicted)
+    return search.damping.mu
+
+
+def test_only_a_step_shortened_below_short_step_damps_the_next_direction():
+    from rftstatic.solvers.displacement import SHORT_STEP
+
+    assert 0.0 < SHORT_STEP < 1.0
+    assert _damping_after(1e-5, 0.9 * SHORT_STEP, 0.1) == pytest.approx(4e-5)
+    assert _damping_after(0.0, 0.9 * SHORT_STEP, 0.1) == pytest.approx(1e-6)
+    assert _damping_after(1e-5, SHORT_STEP, 0.1) == 1e-5  # refined to half its length or more: as it was
+    assert _damping_after(1e-5, 0.99, 0.1) == 1e-5
+    # full steps: More's ratio of the actual to the predicted decrease
+    assert _damping_after(1e-5, 1.0, 0.1) == pytest.approx(4e-5)  # rho = 0.1
+    assert _damping_after(1e-5, 1.0, 0.5) == 1e-5  # rho = 0.5
+    assert _damping_after(3e-5, 1.0, 0.9) == pytest.approx(1e-5)  # rho = 0.9
+    assert _damping_after(1e-10, 1.0, 0.9) == 0.0
