@@ -216,8 +216,8 @@ SHORT_STEP = 0.5
 """Share of a fresh Newton step [-] below which a step the line search shortened damps the next direction
 (:meth:`LineSearch._trust_region`). Every shortened step damped it before (x 4, at least 1e-6 of the mean tangent
 diagonal); with the refined line search (:func:`lowest_near`), from the relaxed states of issue 34
-(validation/bench_profile.md, h-speed5): pedestal-round-50 92 Newton iterations and 102 factorisations (101, 112
-when every shortened step damps), pedestal-square-80 141 and 133 (148, 147); the same equilibria."""
+(validation/bench_profile.md, h-speed5): pedestal-round-50 89 Newton iterations and 105 factorisations (101, 112
+when every shortened step damps), pedestal-square-80 140 and 143 (148, 147); the same equilibria."""
 
 LINE_REFINE_FACTOR = 2.0 ** 0.5
 """Ratio of two trial step lengths of :func:`lowest_near` [-]."""
