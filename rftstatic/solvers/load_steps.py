@@ -151,7 +151,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
             short = whole_from_state and iteration_fallback and mixed and not fallback and continuing is None
             reach = FROM_STATE_REACH * float(model.mesh.element_size.mean()) if short else None
             nt = newton(model, start, lam_next, _short_mixed(opts.newton) if short else opts.newton, state, max_step,
-                        scheme="displacement" if fallback else None, reach=reach)
+                        scheme="displacement" if fallback else None, reach=reach, refine=whole_from_state)
             continuing = None
             result.iterations += nt.iterations
             if (not nt.converged and nt.scheme == "mixed" and iteration_fallback
@@ -159,7 +159,8 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                 result.retries += 1
                 log.info("load factor %.6g: %s (|r| = %.3e); retrying with displacement iterations",
                          lam_next, nt.reason, nt.residual)
-                nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement")
+                nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement",
+                            refine=whole_from_state)
                 result.iterations += nt.iterations
             if nt.converged and friction_lag.active(model):  # the lagged friction settles here
                 nt, its = friction_lag.settle(model, state, nt, lam_next, lambda V: newton(

@@ -1,5 +1,6 @@
 """The displacement iteration's line search (rftstatic.solvers.displacement.line_search): Armijo backtracking on
-the energy, a shortened step refined to the lowest energy near it (lowest_near)."""
+the energy; on the walk from a given state (``refine``) a shortened step refined to the lowest energy near it
+(lowest_near) and the damping raised only after a step shortened below SHORT_STEP."""
 
 from types import SimpleNamespace
 
@@ -34,9 +35,9 @@ STATE = SimpleNamespace(candidates=None, self_pairs=None, bending_slip=None, loa
 OPTS = SimpleNamespace(line_search=True)
 
 
-def _search(model):
+def _search(model, refine=True):
     U, step = np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0]])
-    return line_search(model, U, step, 1.0, 0.0, -1.0, OPTS, STATE, scale=1.0)
+    return line_search(model, U, step, 1.0, 0.0, -1.0, OPTS, STATE, scale=1.0, refine=refine)
 
 
 def test_a_full_step_that_passes_is_taken_as_it_is():
@@ -58,6 +59,13 @@ def test_a_shortened_step_lands_within_the_refine_factor_of_the_minimum(c4):
     assert parts["total"] == pytest.approx(model.pi(alpha), rel=1e-15)
     assert parts["total"] <= model.pi(armijo)
     assert len(calls) - calls.index(armijo) - 1 <= 2 * 4  # at most LINE_REFINE_TRIALS each way
+
+
+def test_without_refine_the_first_armijo_point_stands():
+    model = LineModel(0.5, 20.0)
+    alpha, parts = _search(model, refine=False)
+    assert alpha == model.calls[-1] < 1.0 and parts["total"] == pytest.approx(model.pi(alpha), rel=1e-15)
+    assert not model.minimiser() / LINE_REFINE_FACTOR <= alpha  # refined, it lands near the minimiser (above)
 
 
 def test_lowest_near_never_rises_and_stays_below_the_full_step():
@@ -88,13 +96,13 @@ def test_a_non_finite_trial_ends_the_refinement():
     assert np.isfinite(parts["total"]) and parts["total"] <= model.pi(0.25)
 
 
-def _damping_after(mu, alpha, actual, predicted=1.0):
+def _damping_after(mu, alpha, actual, predicted=1.0, refine=True):
     """The damping after a step of length ``alpha`` [-] that lowered Pi by ``actual`` [J], the quadratic model
     of the full step predicting ``predicted`` [J] (slope -2 predicted, curvature 2 predicted: -(s + c/2))."""
     from rftstatic.solvers.displacement import Damping, LineSearch
 
     search = object.__new__(LineSearch)
-    search.damping, search.work0 = Damping(), 1.0
+    search.damping, search.work0, search.refine = Damping(), 1.0, refine
     search.damping.mu = mu
     search._trust_region(0.0, -actual, alpha, -2.0 * predicted, 1.0, 2.0 * predicted)
     return search.damping.mu
@@ -108,6 +116,7 @@ def test_only_a_step_shortened_below_short_step_damps_the_next_direction():
     assert _damping_after(0.0, 0.9 * SHORT_STEP, 0.1) == pytest.approx(1e-6)
     assert _damping_after(1e-5, SHORT_STEP, 0.1) == 1e-5  # refined to half its length or more: as it was
     assert _damping_after(1e-5, 0.99, 0.1) == 1e-5
+    assert _damping_after(1e-5, 0.99, 0.1, refine=False) == pytest.approx(4e-5)  # off the valley walk: every one
     # full steps: More's ratio of the actual to the predicted decrease
     assert _damping_after(1e-5, 1.0, 0.1) == pytest.approx(4e-5)  # rho = 0.1
     assert _damping_after(1e-5, 1.0, 0.5) == 1e-5  # rho = 0.5

@@ -326,3 +326,25 @@ def test_the_short_mixed_try_from_a_given_state_has_a_reach(monkeypatch):
     with pytest.raises(static.ConvergenceError):
         load_steps.solve_load_steps(mod, U0=U0, options=opts.replace(max_continuations=0), iteration_fallback=False)
     assert calls == [("mixed", None)]
+
+
+def test_only_the_whole_load_from_a_given_state_refines_its_line_search(monkeypatch):
+    """The displacement iteration refines its shortened steps (``refine``) on the whole load from a given state, not
+    on the load-scaled path from the flat sheet."""
+    from rftstatic.solvers import load_steps
+
+    mod = strip_model(11, 3)
+    opts = static.StaticOptions.from_keys(progress=False, relax_fallback=False, iteration="displacement")
+    calls = []
+    real = load_steps.newton
+
+    def recorded(*args, refine=False, **kw):
+        calls.append(refine)
+        return real(*args, refine=refine, **kw)
+
+    monkeypatch.setattr(load_steps, "newton", recorded)
+    flat = load_steps.solve_load_steps(mod, options=opts)
+    assert flat.converged and len(flat.load_steps) > 1 and not any(calls)
+    calls.clear()
+    again = load_steps.solve_load_steps(mod, U0=flat.U, options=opts.from_state())
+    assert again.converged and calls and all(calls)
