@@ -156,12 +156,12 @@ def displacement_iterations(model, U, lam, opts, state, max_step, refine: bool =
     """Newton on the displacements alone from ``U`` at load factor ``lam`` (module docstring), with the
     :class:`~rftstatic.solvers.options.NewtonOptions` ``opts`` and the solve's State ``state``.
 
-    ``refine``: the walk along a flat valley from a given state at full load (a relaxed drape,
-    :mod:`rftstatic.solvers.load_steps`): a step the line search shortened is refined to the lowest energy near it
-    (:func:`lowest_near`) and damps the next direction only below :data:`SHORT_STEP`. Not on the load-scaled path
-    from the flat sheet, where the greedier steps measured worse (pedestal-round-50-unstructured, h = 2.86 cm: its
-    first increment, at a load factor of 1e-5, no longer converged and the route fell back to the relaxation and
-    another equilibrium)."""
+    ``refine``: the walk along a flat valley from a relaxed drape at full load (``relaxed`` of
+    :func:`rftstatic.solvers.load_steps.load_steps`): a step the line search shortened is refined to the lowest
+    energy near it (:func:`lowest_near`) and damps the next direction only below :data:`SHORT_STEP`. Not on the
+    load-scaled path from the flat sheet, where the greedier steps measured worse (pedestal-round-50-unstructured,
+    h = 2.86 cm: its first increment, at a load factor of 1e-5, no longer converged and the route fell back to the
+    relaxation and another equilibrium)."""
     test = Criteria(model, lam, opts, U)
     # the final increment converges to the tight tolerance and may need longer
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
