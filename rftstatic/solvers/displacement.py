@@ -5,7 +5,8 @@
   factorisation while the residual falls fast (modified Newton), or on large meshes the step by CG on the
   exact tangent preconditioned with the last factorisation (:mod:`~rftstatic.solvers.krylov`);
 - globalisation (:class:`LineSearch`): the step cap ``max_step`` and the self-contact bound, an Armijo
-  backtracking line search on the total potential energy Pi, and Levenberg-Marquardt damping of the next
+  backtracking line search on the total potential energy Pi (from a given state, a shortened step refined to the
+  lowest energy near it, :func:`lowest_near`), and Levenberg-Marquardt damping of the next
   direction as a trust region (More's update of the ratio of actual to predicted decrease);
 - the convergence test :class:`~rftstatic.solvers.iteration.Criteria`.
 """
@@ -78,11 +79,13 @@ class DisplacementDirection:
 class LineSearch:
     """The displacement iteration's globalisation (module docstring): capped, self-contact-bounded step,
     Armijo backtracking on Pi, trust-region update of the damping. ``energies`` holds Pi after every step
-    (:meth:`progress`); the first step sets the energy scale of the convergence test."""
+    (:meth:`progress`); the first step sets the energy scale of the convergence test. ``refine``: the walk along
+    a flat valley from a given state (:func:`displacement_iterations`)."""
 
-    def __init__(self, model, opts, state, damping: Damping, test: Criteria, max_step: float, start: Iterate):
+    def __init__(self, model, opts, state, damping: Damping, test: Criteria, max_step: float, start: Iterate,
+                 refine: bool = False):
         self.model, self.opts, self.state, self.damping, self.test = model, opts, state, damping, test
-        self.max_step = max_step
+        self.max_step, self.refine = max_step, refine
         self.free = model.free.ravel()
         self.energies = [start.energy]
         self.work0 = None
@@ -93,7 +96,8 @@ class LineSearch:
         step, frac = self_contact_limited(model, x.U, step, state)
         cap *= frac
         slope = float(x.r @ step.ravel()[free])
-        alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, state, x.energy_scale)
+        alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, state, x.energy_scale,
+                                   refine=self.refine)
         if alpha is None:
             raise StepFailure("line search found no decrease of the energy")
         U = x.U + alpha * step
@@ -123,8 +127,9 @@ class LineSearch:
     def _trust_region(self, Pi0, Pi, alpha, slope, cap, curvature) -> None:
         """Levenberg-Marquardt damping as a trust region (More's update): the ratio of the actual to the
         predicted energy decrease of a fresh Newton step decides; a step the line search had to shorten (a
-        near-singular or indefinite direction: a sheet balanced on a sphere, a fold forming) damps the next
-        one, good steps undo it, so the final iterations are pure Newton."""
+        near-singular or indefinite direction: a sheet balanced on a sphere, a fold forming) damps the next one
+        (with ``refine``, only below :data:`SHORT_STEP` of its length: one it took at that length or longer leaves
+        the damping as it is), good full steps undo it, so the final iterations are pure Newton."""
         mu = self.damping.mu
         predicted = -(slope + 0.5 * cap * cap * curvature)
         actual = Pi0 - Pi
@@ -133,9 +138,9 @@ class LineSearch:
             rho = 1.0  # below what the energy resolves: the residual decides convergence
         else:
             rho = actual / predicted if (alpha == 1.0 and predicted > 0) else 0.0
-        if alpha < 1.0 or rho < 0.25:
+        if alpha < (SHORT_STEP if self.refine else 1.0) or (alpha == 1.0 and rho < 0.25):
             mu = max(4.0 * mu, 1e-6)
-        elif rho > 0.75:
+        elif alpha == 1.0 and rho > 0.75:
             mu = mu / 3.0 if mu > 1e-9 else 0.0
         self.damping.mu = mu
 
@@ -147,9 +152,16 @@ class LineSearch:
         return drop / max(self.work0 or 0.0, abs(x.lam * float(np.einsum("ni,ni->", self.test.P, x.U))), 1e-300)
 
 
-def displacement_iterations(model, U, lam, opts, state, max_step) -> Iteration:
+def displacement_iterations(model, U, lam, opts, state, max_step, refine: bool = False) -> Iteration:
     """Newton on the displacements alone from ``U`` at load factor ``lam`` (module docstring), with the
-    :class:`~rftstatic.solvers.options.NewtonOptions` ``opts`` and the solve's State ``state``."""
+    :class:`~rftstatic.solvers.options.NewtonOptions` ``opts`` and the solve's State ``state``.
+
+    ``refine``: the walk along a flat valley from a relaxed drape at full load (``relaxed`` of
+    :func:`rftstatic.solvers.load_steps.load_steps`): a step the line search shortened is refined to the lowest
+    energy near it (:func:`lowest_near`) and damps the next direction only below :data:`SHORT_STEP`. Not on the
+    load-scaled path from the flat sheet, where the greedier steps measured worse (pedestal-round-50-unstructured,
+    h = 2.86 cm: its first increment, at a load factor of 1e-5, no longer converged and the route fell back to the
+    relaxation and another equilibrium)."""
     test = Criteria(model, lam, opts, U)
     # the final increment converges to the tight tolerance and may need longer
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
@@ -163,7 +175,7 @@ def displacement_iterations(model, U, lam, opts, state, max_step) -> Iteration:
         return Iteration(False, U, 0, x.rnorm, "non-finite residual")
     damping = Damping()
     find = DisplacementDirection(model, opts, state, damping, x)
-    search = LineSearch(model, opts, state, damping, test, max_step, x)
+    search = LineSearch(model, opts, state, damping, test, max_step, x, refine)
     out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, state.solver), direction=find,
                       globalise=search, max_iterations=max_iterations)
     x = out.x
@@ -174,11 +186,12 @@ def displacement_iterations(model, U, lam, opts, state, max_step) -> Iteration:
                      else 0.0, history=out.history)
 
 
-def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_trials=12):
+def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_trials=12, refine=False):
     """Armijo backtracking on Pi along ``step (N, 3)`` [m] from ``U`` with energy ``Pi0`` [J] and slope
     ``r . step`` [J]: ``(alpha, parts)``, ``parts`` the energies (:meth:`~rftstatic.model.model.Model.energies`)
     at ``U + alpha step``; ``(None, None)`` when no trial lowers the energy. ``scale`` [J]: :func:`energy_scale`
-    of the energies at ``U`` (computed when None)."""
+    of the energies at ``U`` (computed when None). A full step that passes is taken as it is; with ``refine``, a
+    shorter Armijo point is refined to the lowest energy near it (:func:`lowest_near`)."""
     def parts_at(alpha):
         return model.energies(U + alpha * step, lam, candidates=state.candidates, pairs=state.self_pairs,
                               slip=state.bending_slip, branches=state.load_branches)
@@ -198,7 +211,7 @@ def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_tr
         parts = parts_at(alpha)
         Pi = parts["total"]
         if np.isfinite(Pi) and Pi <= Pi0 + 1e-4 * alpha * slope + roundoff:
-            return alpha, parts
+            return (alpha, parts) if alpha == 1.0 or not refine else lowest_near(parts_at, alpha, parts)
         # minimiser of the quadratic through Pi0, slope and Pi(alpha), safeguarded
         if np.isfinite(Pi):
             denom = 2.0 * (Pi - Pi0 - slope * alpha)
@@ -207,6 +220,56 @@ def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_tr
         else:
             alpha *= 0.1
     return None, None
+
+
+SHORT_STEP = 0.5
+"""Share of a fresh Newton step [-] below which a step the line search shortened damps the next direction
+(:meth:`LineSearch._trust_region`). Every shortened step damped it before (x 4, at least 1e-6 of the mean tangent
+diagonal); with the refined line search (:func:`lowest_near`), from the relaxed states of issue 34
+(validation/bench_profile.md, h-speed5): pedestal-round-50 89 Newton iterations and 105 factorisations (101, 112
+when every shortened step damps), pedestal-square-80 140 and 143 (148, 147); the same equilibria."""
+
+LINE_REFINE_FACTOR = 2.0 ** 0.5
+"""Ratio of two trial step lengths of :func:`lowest_near` [-]."""
+
+LINE_REFINE_TRIALS = 4
+"""Most trials of :func:`lowest_near` in each direction (longer, then shorter)."""
+
+
+def lowest_near(parts_at, alpha: float, parts: dict, factor: float = LINE_REFINE_FACTOR,
+                trials: int = LINE_REFINE_TRIALS) -> tuple[float, dict]:
+    """The step length of lowest energy near the Armijo point ``alpha < 1`` of a backtracking: ``(alpha, parts)``.
+
+    From ``alpha`` (energies ``parts``), the trial length is multiplied by ``factor`` (longer, below the full
+    step, which failed) while the energy falls, up to ``trials`` times; if the first longer trial does not lower
+    it, divided by ``factor`` the same way. The result is within a factor ``factor`` of a minimum of Pi along
+    the line (where Pi has one minimum between the trials and they did not run out) and never higher than at
+    ``alpha``. ``parts_at(a)``: the energies (:meth:`~rftstatic.model.model.Model.energies`, key ``"total"`` [J])
+    at the step length ``a``.
+
+    Why: the backtracking stops at the first length that passes Armijo's test, often far from the minimum
+    along the line. On the static drapes' flat valleys (validation/bench_profile.md, issue 34, h-speed5) Pi
+    along a Newton step is far from quadratic beyond about the full step (the membrane's strain is quadratic in
+    the step), and the backtracking's quadratic interpolation undershoots: from pedestal-round-50's relaxed
+    state the refined length was 1.4-4 times the Armijo point's in 21 of 24 refinements, and the displacement
+    iteration took 101 Newton iterations and 112 factorisations (116 and 128 without); from
+    pedestal-square-80's, 148 and 147 (165 and 157), at 2-3 energy evaluations per refinement, the same
+    equilibria (energy to 1e-15 relative).
+    """
+    best_alpha, best = alpha, parts
+    for f in (factor, 1.0 / factor):
+        trial, moved = best_alpha * f, False
+        for _ in range(trials):
+            if not trial < 1.0:
+                break
+            p = parts_at(trial)
+            if not (np.isfinite(p["total"]) and p["total"] < best["total"]):
+                break
+            best_alpha, best, moved = trial, p, True
+            trial *= f
+        if moved:
+            break
+    return best_alpha, best
 
 
 def energy_scale(parts: dict) -> float:

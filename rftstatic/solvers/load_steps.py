@@ -64,16 +64,19 @@ LOAD_STEPS = "load-steps"
 
 
 def solve_load_steps(model, *, U0=None, options: StaticOptions | None = None, callback=None,
-                     state: State | None = None, iteration_fallback: bool = True) -> StaticResult:
+                     state: State | None = None, iteration_fallback: bool = True,
+                     relaxed: bool = False) -> StaticResult:
     """The load-scaled Newton iteration of :func:`solve_static` (module docstring): :func:`load_steps` run to its
     end. ``state``: the solve's :class:`~rftstatic.model.state.State`, shared with its other phases (default
     :func:`~rftstatic.solvers.newton.start_state`)."""
     opts = options or StaticOptions()
     state = state if state is not None else start_state(model, opts.newton.linear_solver)
-    return finish(load_steps(model, state, opts, U0=U0, callback=callback, iteration_fallback=iteration_fallback))
+    return finish(load_steps(model, state, opts, U0=U0, callback=callback, iteration_fallback=iteration_fallback,
+                             relaxed=relaxed))
 
 
-def load_steps(model, state: State, opts: StaticOptions, *, U0=None, callback=None, iteration_fallback: bool = True):
+def load_steps(model, state: State, opts: StaticOptions, *, U0=None, callback=None, iteration_fallback: bool = True,
+               relaxed: bool = False):
     """The load steps as a route (:mod:`rftstatic.solvers.drive`): from ``U0`` (default the flat sheet, perturbed
     if asked) or from the :class:`LoadPath` saved in ``state.route`` (then as the uninterrupted solve went on),
     pausing after every converged increment (the last one final); returns the :class:`StaticResult`.
@@ -81,15 +84,18 @@ def load_steps(model, state: State, opts: StaticOptions, *, U0=None, callback=No
     ``callback``: ``callback(lam, U)`` after every converged increment. ``iteration_fallback``: an increment the
     mixed iteration cannot converge and that cannot be cut back (or has failed twice) is tried with the
     displacement iteration; off for the relaxation route's intermediate handovers, where the relaxation goes on
-    instead.
+    instead. ``relaxed``: ``U0`` is a relaxed drape (the relaxation route's handovers,
+    :mod:`rftstatic.solvers.static`): on its whole load the short mixed try has a reach (:data:`FROM_STATE_REACH`)
+    and the displacement iteration refines its line search (``refine`` of
+    :func:`~rftstatic.solvers.displacement.displacement_iterations`), both measured there only.
     """
     try:
-        return (yield from _load_steps(model, state, opts, U0, callback, iteration_fallback))
+        return (yield from _load_steps(model, state, opts, U0, callback, iteration_fallback, relaxed))
     finally:
         state.route.pop(LOAD_STEPS, None)
 
 
-def _load_steps(model, state, opts, U0, callback, iteration_fallback):
+def _load_steps(model, state, opts, U0, callback, iteration_fallback, relaxed):
     t0 = time.perf_counter()
     n = model.mesh.n_nodes
     resume = state.route.get(LOAD_STEPS)
@@ -149,8 +155,10 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
             # displacement iteration before cutting back, which would unload the drape; its mixed try is short
             whole_from_state = from_state and not result.load_steps and lam_next >= 1.0
             short = whole_from_state and iteration_fallback and mixed and not fallback and continuing is None
+            valley = whole_from_state and relaxed  # a relaxed drape: the handover's walk along its flat valley
+            reach = FROM_STATE_REACH * float(model.mesh.element_size.mean()) if short and relaxed else None
             nt = newton(model, start, lam_next, _short_mixed(opts.newton) if short else opts.newton, state, max_step,
-                        scheme="displacement" if fallback else None)
+                        scheme="displacement" if fallback else None, reach=reach, refine=valley)
             continuing = None
             result.iterations += nt.iterations
             if (not nt.converged and nt.scheme == "mixed" and iteration_fallback
@@ -158,7 +166,8 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback):
                 result.retries += 1
                 log.info("load factor %.6g: %s (|r| = %.3e); retrying with displacement iterations",
                          lam_next, nt.reason, nt.residual)
-                nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement")
+                nt = newton(model, start, lam_next, opts.newton, state, max_step, scheme="displacement",
+                            refine=valley)
                 result.iterations += nt.iterations
             if nt.converged and friction_lag.active(model):  # the lagged friction settles here
                 nt, its = friction_lag.settle(model, state, nt, lam_next, lambda V: newton(
@@ -258,6 +267,20 @@ displacement iteration follows if it fails (instead of ``2 x`` :data:`~rftstatic
 at full load). Measured from the relaxation route's first relaxed state: cusick-30 converges in 9 mixed
 iterations (49 displacement iterations); sphere-30, pedestal-round-50 and pedestal-square-80 wander (|r| 0.3 N
 after 20 on sphere-30) and then converge by the displacement iteration, so the 8 more cost 8 factorisations."""
+
+
+FROM_STATE_REACH = 0.5
+"""Reach of the short mixed try from a relaxed drape (``relaxed`` of :func:`load_steps`), in mean element sizes
+[-]: the try gives up before its first step when that step would move a node farther, or when the exact tangent
+there is indefinite
+(:func:`~rftstatic.solvers.mixed.mixed_iterations`), and the displacement iteration (line search) starts at
+once. Measured at the relaxation route's first handover (issue 34, validation/bench_profile.md, h-speed5): the
+first Newton step moves a node 0.19 h on cusick-30 (the mixed iteration converges in 9), 1.09 h on
+pedestal-round-50 and 8.0 h on pedestal-square-80 (indefinite there, and on sphere-30), where the 12 mixed
+iterations wander (|r| 2e-4 -> 1.3 N at the first step on pedestal-round-50, about 22 factorisations) and the
+displacement iteration restarts from the relaxed state. Along a Newton step from that state Pi follows the
+quadratic model to about 1.5 times a step of 0.07 h and departs from it beyond (the membrane's strain is quadratic
+in the step)."""
 
 
 def _short_mixed(newton_opts):

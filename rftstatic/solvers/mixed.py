@@ -15,7 +15,7 @@ not converged by 12 wanders (RFT6 at C/B = 1e8 from a secant start went on for 3
 a smaller increment is the better remedy."""
 
 
-def mixed_iterations(model, U, lam, opts, state, max_step, stress) -> Iteration:
+def mixed_iterations(model, U, lam, opts, state, max_step, stress, reach=None) -> Iteration:
     """MIP Newton (Magisano, Leonetti & Garcea, CMAME 313, 2017): Newton on the Hellinger-Reissner form
     of Eq. 15 with the membrane stress of every element an unknown of its own, condensed element by
     element. The step solves ``K(U, S) d = -r(U)`` with the ordinary residual r and the ordinary tangent
@@ -32,6 +32,12 @@ def mixed_iterations(model, U, lam, opts, state, max_step, stress) -> Iteration:
     monotonically, so there is no energy line search; only the step cap ``max_step`` applies. An
     iteration that fails returns to the load steps (:mod:`rftstatic.solvers.load_steps`), which cut the
     increment back and, after repeated failures, try the displacement iteration.
+
+    ``reach`` [m] (None: none): give up at the first iteration when its tangent is not the exact one (indefinite)
+    or its step would move a node farther than ``reach`` (:class:`MixedDirection`), before taking that step: a
+    start so far from the equilibrium that the quadratic model does not hold over the step, where the
+    step without a line search only wanders (the short try from a relaxed drape,
+    :data:`~rftstatic.solvers.load_steps.FROM_STATE_REACH`).
     """
     test = Criteria(model, lam, opts, U)
     budget = min(opts.max_iterations, MIXED_ITERATIONS)
@@ -43,7 +49,7 @@ def mixed_iterations(model, U, lam, opts, state, max_step, stress) -> Iteration:
     x = Iterate(U, lam, r, float(np.linalg.norm(r)), stress=S)
     if not np.isfinite(x.rnorm):
         return Iteration(False, U, 0, x.rnorm, "non-finite residual", scheme="mixed")
-    find = MixedDirection(model, opts, state)
+    find = MixedDirection(model, opts, state, reach)
     out = newton_loop(x, test=lambda it: test.met(it.U, it.r, it.work, state.solver), direction=find,
                       globalise=CappedStep(model, state, test, max_step), max_iterations=max_iterations)
     x = out.x
@@ -59,10 +65,12 @@ def mixed_iterations(model, U, lam, opts, state, max_step, stress) -> Iteration:
 class MixedDirection:
     """The MIP direction: the safeguarded Newton direction whose geometric stiffness takes the carried stress
     (:func:`~rftstatic.solvers.iteration.direction` with ``stress``); ``stable``: the last tangent was the
-    exact one and positive definite (None when the solver cannot tell)."""
+    exact one and positive definite (None when the solver cannot tell). ``reach`` [m]: the first direction
+    fails (:class:`~rftstatic.solvers.loop.StepFailure`) unless it comes from the exact tangent and moves no
+    node farther than that (None: no test)."""
 
-    def __init__(self, model, opts, state):
-        self.model, self.opts, self.state = model, opts, state
+    def __init__(self, model, opts, state, reach=None):
+        self.model, self.opts, self.state, self.reach = model, opts, state, reach
         self.stable = None
 
     def __call__(self, x: Iterate) -> Direction:
@@ -71,6 +79,13 @@ class MixedDirection:
         except LinearSolveError as exc:
             raise StepFailure(f"linear solve failed ({exc})") from None
         self.stable = mode == "exact" if self.state.solver.detects_indefinite else None
+        if self.reach is not None:
+            reach, self.reach = self.reach, None  # the first direction only
+            move = float(np.linalg.norm(capped_step(self.model, d, np.inf)[0], axis=1).max())
+            if mode != "exact" or not move <= reach:
+                why = f"its tangent is not positive definite ({mode})" if mode != "exact" else (
+                    f"its step moves a node {move:.3g} m, beyond the reach {reach:.3g} m")
+                raise StepFailure(f"the first mixed step was not taken: {why}")
         return Direction(d, mode)
 
 

@@ -106,18 +106,21 @@ def start_state(model, linear_solver: str = "auto") -> State:
     return state
 
 
-def newton(model, U, lam, opts, state, max_step, *, stress=None, scheme=None) -> Iteration:
+def newton(model, U, lam, opts, state, max_step, *, stress=None, scheme=None, reach=None,
+           refine=False) -> Iteration:
     """Newton iterations at fixed load factor ``lam`` from ``U`` (not modified), with the options ``opts``
     (:class:`~rftstatic.solvers.options.NewtonOptions`).
 
     ``scheme``: ``"mixed"`` (MIP Newton, :func:`~rftstatic.solvers.mixed.mixed_iterations`) or ``"displacement"``
     (:func:`~rftstatic.solvers.displacement.displacement_iterations`); default ``opts.iteration``. ``stress (E, 3)`` [N/m]: the
-    mixed membrane stress at ``U`` (default ``D^m eps(U)``).
+    mixed membrane stress at ``U`` (default ``D^m eps(U)``). ``reach`` [m]: the mixed iteration gives up at once when
+    its first step would move a node farther, or its first tangent is indefinite (None: it does not). ``refine``: the
+    displacement iteration's walk from a given state (:func:`~rftstatic.solvers.displacement.displacement_iterations`).
     """
     scheme = scheme or opts.iteration
     if scheme == "mixed" and model.with_membrane:
-        return mixed_iterations(model, U, lam, opts, state, max_step, stress)
-    return displacement_iterations(model, U, lam, opts, state, max_step)
+        return mixed_iterations(model, U, lam, opts, state, max_step, stress, reach)
+    return displacement_iterations(model, U, lam, opts, state, max_step, refine)
 
 def close_record(model, result: StaticResult, state: State, t0: float, error: ConvergenceError | None = None,
                  counts=None) -> StaticResult:

@@ -357,7 +357,7 @@ def _relax_route(model, opts, callback, state, first):
                        if first_try else basin if long_try else short)
             history = state.bending_slip, state.dissipated  # committed by a converged Newton
             res = solve_load_steps(model, U0=route.U, options=options, callback=callback, state=state,
-                                   iteration_fallback=final or long_try or first_try)
+                                   iteration_fallback=final or long_try or first_try, relaxed=True)
             if first_try:  # kept only if a stable minimum (which the final stability check then knows)
                 if not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
                                           slip=state.bending_slip, candidates=state.candidates):

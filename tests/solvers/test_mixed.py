@@ -116,3 +116,20 @@ def test_increments_grow_when_convergence_is_fast():
             assert b["increment"] > a["increment"]
     assert all(s["scheme"] == "mixed" for s in steps)
     assert res.factorisations >= res.iterations
+
+
+def test_the_reach_stops_the_mixed_iteration_before_a_long_first_step():
+    """``reach`` [m]: a first step that would move a node farther is not taken (one iteration, the start kept,
+    the reason named); one within it runs on exactly as without the test."""
+    model = strip_model(21, 5)
+    res = static.solve_static(model, options=static.StaticOptions(progress=False))
+    start = res.U.copy()
+    start[:, 2] *= 0.99
+    opts = NewtonOptions(iteration="mixed")
+    first = newton(model, start, 1.0, opts, start_state(model), max_step=1.0, scheme="mixed")
+    move = float(np.linalg.norm(first.U - start, axis=1).max())  # at least the first step's largest move
+    short = newton(model, start, 1.0, opts, start_state(model), max_step=1.0, scheme="mixed", reach=1e-6 * move)
+    assert not short.converged and short.iterations == 1 and np.array_equal(short.U, start)
+    assert "first mixed step was not taken" in short.reason and "beyond the reach" in short.reason
+    wide = newton(model, start, 1.0, opts, start_state(model), max_step=1.0, scheme="mixed", reach=1e3 * move)
+    assert wide.converged and wide.iterations == first.iterations and np.array_equal(wide.U, first.U)

@@ -296,3 +296,62 @@ def test_the_mixed_try_from_a_given_state_is_short_when_the_displacement_iterati
     with pytest.raises(static.ConvergenceError):
         load_steps.solve_load_steps(mod, U0=U0, options=opts.replace(max_continuations=0), iteration_fallback=False)
     assert calls == [("mixed", 30)]
+
+
+def test_the_short_mixed_try_from_a_given_state_has_a_reach(monkeypatch):
+    """The short mixed try from a relaxed drape gets the reach FROM_STATE_REACH x the mean element size (it gives
+    up before a longer first step); the displacement iteration after it, a mixed iteration without that fallback
+    and the short try from another given state (a transferred level) get none."""
+    from rftstatic.solvers import load_steps
+    from rftstatic.solvers.iteration import Iteration
+
+    mod = strip_model(11, 3)
+    opts = static.StaticOptions.from_keys(progress=False, relax_fallback=False, max_iterations=30).from_state()
+    U0 = np.zeros((mod.mesh.n_nodes, 3))
+    calls = []
+    real = load_steps.newton
+
+    def recorded(model, U, lam, newton_opts, state, max_step, *, scheme=None, reach=None, **kw):
+        used = scheme or newton_opts.iteration
+        calls.append((used, reach))
+        if used == "mixed":
+            return Iteration(False, U, 1, np.inf, "forced", scheme="mixed")
+        return real(model, U, lam, newton_opts, state, max_step, scheme=scheme, reach=reach, **kw)
+
+    monkeypatch.setattr(load_steps, "newton", recorded)
+    assert load_steps.solve_load_steps(mod, U0=U0, options=opts, relaxed=True).converged
+    h = float(mod.mesh.element_size.mean())
+    assert calls[0] == ("mixed", pytest.approx(load_steps.FROM_STATE_REACH * h, rel=1e-15))
+    assert calls[1] == ("displacement", None)
+    calls.clear()
+    with pytest.raises(static.ConvergenceError):
+        load_steps.solve_load_steps(mod, U0=U0, options=opts.replace(max_continuations=0), iteration_fallback=False)
+    assert calls == [("mixed", None)]
+    calls.clear()
+    assert load_steps.solve_load_steps(mod, U0=U0, options=opts).converged
+    assert calls[0] == ("mixed", None)
+
+
+def test_only_the_whole_load_from_a_given_state_refines_its_line_search(monkeypatch):
+    """The displacement iteration refines its shortened steps (``refine``) on the whole load from a relaxed drape,
+    not on the load-scaled path from the flat sheet nor from another given state."""
+    from rftstatic.solvers import load_steps
+
+    mod = strip_model(11, 3)
+    opts = static.StaticOptions.from_keys(progress=False, relax_fallback=False, iteration="displacement")
+    calls = []
+    real = load_steps.newton
+
+    def recorded(*args, refine=False, **kw):
+        calls.append(refine)
+        return real(*args, refine=refine, **kw)
+
+    monkeypatch.setattr(load_steps, "newton", recorded)
+    flat = load_steps.solve_load_steps(mod, options=opts)
+    assert flat.converged and len(flat.load_steps) > 1 and not any(calls)
+    calls.clear()
+    again = load_steps.solve_load_steps(mod, U0=flat.U, options=opts.from_state(), relaxed=True)
+    assert again.converged and calls and all(calls)
+    calls.clear()
+    assert load_steps.solve_load_steps(mod, U0=flat.U, options=opts.from_state()).converged
+    assert calls and not any(calls)
