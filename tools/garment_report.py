@@ -150,7 +150,8 @@ def _cusick_section(circle, cusick) -> list:
     lines.append(f"| cusick-30 | {s['drape']['fold_count']} | {s['drape']['drape_coefficient']:.4f} (Cusick DC) | "
                  f"{wall:.0f} |")
     lines += [f"| skirt-circle h = {h:g} cm | {r['garment']['hem_folds']} | {r['garment']['hem_drape_coefficient']:.4f} "
-              f"(hem shadow over flat area) | {w:.0f} |" for h, code, w, r, err, _ in circle if r is not None]
+              f"(hem shadow over flat area) | {_wall(w, figures)} |" for h, code, w, r, err, figures in circle
+              if r is not None]
     return lines
 
 
