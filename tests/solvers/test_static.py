@@ -8,6 +8,7 @@ from rftstatic.bench.problems import strip_model
 from rftstatic.references import plates
 from rftstatic.references.elastica import heavy_elastica
 from rftstatic.solvers import perturbation, static
+from rftstatic.solvers.options import HANDOVER_KINETIC
 from rftstatic.validate.plates import plate_coefficient
 
 
@@ -129,7 +130,7 @@ def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
     assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
     # the record says by which test the relaxation stopped: the first segment at |r| < |P|, later ones tighter
     first = b.relax["handovers"][0]["rest_test"]
-    assert first == {"criterion": "kinetic+force", "tol_kinetic": 1e-4, "tol_force": 1.0}
+    assert first == {"criterion": "kinetic+force", "tol_kinetic": HANDOVER_KINETIC, "tol_force": 1.0}
     assert b.relax["rest_test"]["tol_force"] <= first["tol_force"]
 
 
