@@ -424,7 +424,7 @@ def _relax_segment(model, opts, plan, route, fail, state, t0):
     seg = _segment_state(model, state, route)
     saved = seg.route.get(EXPLICIT)
     span = max(min(route.span, plan.max_time - route.t_used), plan.min_span)
-    first = opts.route.handover_kinetic if route.tol_force >= 1.0 else 1e-4  # the first handover's rest, then 1e-4
+    first = friction_lag.handover_kinetic(model, opts.route.handover_kinetic) if route.tol_force >= 1.0 else 1e-4
     rest = RestCriterion(tol_kinetic=first, tol_force=route.tol_force)
     try:
         rel = yield from relax_steps(model, seg, RelaxOptions(

@@ -130,7 +130,7 @@ def test_dynamic_relaxation_start_reaches_the_newton_equilibrium():
     assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
     # the record says by which test the relaxation stopped: the first segment at |r| < |P|, later ones tighter
     first = b.relax["handovers"][0]["rest_test"]
-    assert first == {"criterion": "kinetic+force", "tol_kinetic": HANDOVER_KINETIC, "tol_force": 1.0}
+    assert first == {"criterion": "kinetic+force", "tol_kinetic": HANDOVER_KINETIC, "tol_force": 1.0}  # frictionless
     assert b.relax["rest_test"]["tol_force"] <= first["tol_force"]
 
 
