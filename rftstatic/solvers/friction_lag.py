@@ -78,6 +78,18 @@ def anchor(model, state, U) -> None:
     link(model, state, U)  # the tangent of the stability check before the handover sees the anchored lag
 
 
+def handover_kinetic(model, given: float | None) -> float:
+    """The kinetic energy / its peak at which the relaxation route first hands over to Newton: ``given``
+    (``solver.handover_kinetic``), else :data:`~rftstatic.solvers.options.HANDOVER_KINETIC` without friction and
+    :data:`~rftstatic.solvers.options.HANDOVER_KINETIC_FRICTION` with it (:func:`anchor` sets the stick anchors
+    there)."""
+    from rftstatic.solvers.options import HANDOVER_KINETIC, HANDOVER_KINETIC_FRICTION
+
+    if given is not None:
+        return float(given)
+    return HANDOVER_KINETIC if law_of(model) is None and self_law_of(model) is None else HANDOVER_KINETIC_FRICTION
+
+
 def predict(model, state, lam_to: float) -> None:
     """Scale the normal forces committed at load factor ``lag["lam"]`` to the solve at ``lam_to`` (the forces a
     growing load presses with: lagged unscaled, a sheet held at one load factor would slide at the next before

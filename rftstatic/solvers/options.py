@@ -93,6 +93,20 @@ class IncrementOptions:
                                  f"{self.min_increment:g}, {self.initial_increment:g}, {self.max_increment:g}")
 
 
+
+HANDOVER_KINETIC = 1e-2
+"""Default ``solver.handover_kinetic`` without friction (:func:`rftstatic.solvers.friction_lag.handover_kinetic`).
+Measured 2026-12-04 (main at 090f6ea, load 1.5-2, one run each, the same equilibria to 1e-14 in energy): against
+1e-4, cusick-30 7.3 against 14.9 s (7,801 explicit steps and 66 Newton iterations against 13,701 and 9),
+pedestal-round-50 37.2 against 49.2 s, pedestal-square-80 63.7 against 73.7 s, sphere-30 23.6 against 23.9 s:
+Newton walks the last of the valley faster than the damped motion creeps down it. A garment's flat ring is still
+folding at 1e-2 (skirt-circle 182 s against 134 s): the garment scenes keep 1e-4."""
+
+HANDOVER_KINETIC_FRICTION = 1e-4
+"""Default ``solver.handover_kinetic`` with Coulomb friction: the stick anchors are set where the relaxation hands
+over, so it waits until the sliding has died down (a layer resting on another below its friction angle moved 5.2e-5 m
+by an earlier handover at 1e-2, 1.5e-6 m at 1e-4; tests/contact/self_contact/test_self_friction_relax.py)."""
+
 @dataclass(frozen=True, kw_only=True)
 class RouteOptions:
     """How the static solve starts and where it falls back (scene keys ``solver.<name>``)."""
@@ -113,6 +127,11 @@ class RouteOptions:
                               low=0, high=1000)
     guide_weight: float = option(0.0, "relative amplitude of that modulation (it keeps the weight downward)",
                                  low=0.0, high=1.0, open_high=True)
+    handover_kinetic: float | None = option(None, "relax route: the relaxation first hands over to Newton when the "
+                                            "kinetic energy has fallen to this fraction of its peak (and the "
+                                            "out-of-balance force below the weight; later handovers wait for 1e-4; "
+                                            "auto: 1e-2, 1e-4 with Coulomb friction)", kind="float", low=0.0,
+                                            high=1.0, open_low=True, open_high=True)
 
     def __post_init__(self):
         check(self, SECTION)

@@ -420,12 +420,12 @@ def _start_route(model, opts, plan, first) -> RelaxRoute:
 
 
 def _relax_segment(model, opts, plan, route, fail, state, t0):
-    """One relaxation segment from ``route`` (or going on with the segment saved in ``state``): the route then
-    stands at its end (``"handover"``), a final pause."""
+    """One relaxation segment from ``route`` (or the one saved in ``state``); then a final pause at ``"handover"``."""
     seg = _segment_state(model, state, route)
     saved = seg.route.get(EXPLICIT)
     span = max(min(route.span, plan.max_time - route.t_used), plan.min_span)
-    rest = RestCriterion(tol_kinetic=1e-4, tol_force=route.tol_force)
+    first = friction_lag.handover_kinetic(model, opts.route.handover_kinetic) if route.tol_force >= 1.0 else 1e-4
+    rest = RestCriterion(tol_kinetic=first, tol_force=route.tol_force)
     try:
         rel = yield from relax_steps(model, seg, RelaxOptions(
             mass_scale=plan.mass_scale, alpha=plan.alpha, rest=rest,

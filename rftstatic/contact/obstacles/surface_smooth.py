@@ -50,10 +50,11 @@ FAR_SLACK = 0.1
 """A far point's nearest centroid is looked up again once it has moved this fraction of its distance to it."""
 
 
-def _imls(x, p, nrm, area, h, grid, order, cell_start, hessian, phi, grad, H, W_out):
+def _imls(x, p, nrm, area, grid, order, cell_start, hessian, phi, grad, H, W_out):
     """(S1)-(S3) at the points ``x (n, 3)``: the facets ``order[cell_start[c]:cell_start[c + 1]]`` of the cells ``c``
-    around each point's cell (``grid = (lo_x, lo_y, lo_z, size, nx, ny, nz)``, cells of ``size >= h``, x fastest)."""
-    lo0, lo1, lo2, size = grid[0], grid[1], grid[2], grid[3]
+    around each point's cell (``grid = (lo_x, lo_y, lo_z, size, nx, ny, nz, h)``: cells of ``size >= h``, x fastest,
+    and the support radius ``h``)."""
+    lo0, lo1, lo2, size, h = grid[0], grid[1], grid[2], grid[3], grid[7]
     nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
     v = np.zeros(3)
     gW = np.zeros(3)
@@ -156,7 +157,7 @@ class SmoothSurface:
         cell = (cz * dims[1] + cy) * dims[0] + cx
         self.order = np.argsort(cell, kind="stable").astype(np.int64)
         self.cell_start = np.searchsorted(cell[self.order], np.arange(int(np.prod(dims)) + 1)).astype(np.int64)
-        self.grid = np.array([*lo, size, *dims], dtype=float)
+        self.grid = np.array([*lo, size, *dims, self.h], dtype=float)
         self.tree = cKDTree(self.p)
         self._far = {}  # len(x) -> (x_ref, slack^2, facet): the held nearest centroids of far points (nearest_far)
 
@@ -186,8 +187,7 @@ class SmoothSurface:
         n = len(x)
         phi, grad, W = np.zeros(n), np.zeros((n, 3)), np.zeros(n)
         H = np.zeros((n, 3, 3) if hessian else (1, 3, 3))
-        _kernel()(x, self.p, self.n, self.area, self.h, self.grid, self.order, self.cell_start, hessian,
-                  phi, grad, H, W)
+        _kernel()(x, self.p, self.n, self.area, self.grid, self.order, self.cell_start, hessian, phi, grad, H, W)
         return phi, grad, (H if hessian else None), W
 
 
