@@ -61,8 +61,8 @@ def _wall(wall, figures) -> str:
 
 def _table(rows) -> list:
     """The measures of each run of one scene, a markdown table."""
-    out = ["| h [cm] | exit | mean element [cm] | converged | stable | Newton its | largest gap start / merged [cm] | "
-           "closing [s sim, steps, s wall] | body crossings | smallest distance to form [cm] | clearance [cm] | "
+    out = ["| h [cm] | exit | mean element [cm] | converged | stable | Newton its (last try) | "
+           "largest gap start / merged [cm] | closing [s sim, steps, s wall] | body crossings | smallest distance to form [cm] | clearance [cm] | "
            "self crossings | hem DC | hem folds | nodes | static solve [s] | wall [s] |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for h, code, wall, s, err, figures in rows:
