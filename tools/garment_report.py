@@ -1,6 +1,6 @@
 """Write validation/garments.md: garments sewn from panels on the dress form, measured by independent checks.
 
-    python tools/garment_report.py [--out validation] [--a-line-h 1.45 1.1] [--circle-h 1.48 1.1] [--dress-h 1.45 1.1]
+    python tools/garment_report.py [--out validation] [--a-line-h 1.45 1.1] [--circle-h 1.48 1.1] [--dress-h 1.1 0.9]
 
 Every number comes from a whole-process run made here (``python -m rftstatic case SCENE --set garment.h=H``), one
 after the other: each scene on its own mesh (the whole ``case`` command, figures and all, timed: the issue's time
@@ -26,8 +26,10 @@ ROOT = Path(__file__).resolve().parent.parent
 
 REUSE = False
 """``--reuse``: take a run folder that already holds a finished run's summary.json instead of running it again
-(its whole-process wall time, not stored there, is then not shown), waiting up to ``--timeout`` for one under way
-in another process (its ``.partial`` folder)."""
+(its whole-process wall time as this tool measured it, from :data:`WALL_FILE`; not shown for a run made by hand),
+waiting up to ``--timeout`` for one under way in another process (its ``.partial`` folder)."""
+WALL_FILE = "report-wall.json"
+"""The whole-process wall time [s] of a run this tool made, kept in its folder so that ``--reuse`` can show it."""
 TIMEOUT = 900.0
 """Longest whole-process run [s] (``--timeout``); a run stopped there is a row with exit ``timeout``."""
 
@@ -40,7 +42,9 @@ def _run(scene, h, out, figures, sets=()):
     if REUSE and partial.is_dir() and not (out / "summary.json").is_file():
         return "timeout", time.perf_counter() - t, None, [f"still running in another process after {TIMEOUT:.0f} s"]
     if REUSE and (out / "summary.json").is_file():
-        return 0, float("nan"), json.loads((out / "summary.json").read_text()), []
+        timed = out / WALL_FILE  # the whole-process time this tool measured for that run, if it did
+        wall = json.loads(timed.read_text())["wall_s"] if timed.is_file() else float("nan")
+        return 0, wall, json.loads((out / "summary.json").read_text()), []
     t = time.perf_counter()
     try:
         p = subprocess.run([sys.executable, "-m", "rftstatic", "case", scene, "--set", f"garment.h={h}", "--out",
@@ -50,6 +54,8 @@ def _run(scene, h, out, figures, sets=()):
         return "timeout", time.perf_counter() - t, None, [f"stopped after {TIMEOUT:.0f} s (--timeout)"]
     wall = time.perf_counter() - t
     summary = json.loads((out / "summary.json").read_text()) if p.returncode == 0 else None
+    if summary is not None:
+        (out / WALL_FILE).write_text(json.dumps({"wall_s": wall, "figures": figures}))
     return p.returncode, wall, summary, (p.stdout + p.stderr).strip().splitlines()[-1:] if p.returncode else []
 
 
@@ -161,7 +167,7 @@ def main(argv=None):
     ap.add_argument("--out", default=str(ROOT / "validation"))
     ap.add_argument("--a-line-h", type=float, nargs="+", default=[1.45, 1.1])
     ap.add_argument("--circle-h", type=float, nargs="+", default=[1.48, 1.1])
-    ap.add_argument("--dress-h", type=float, nargs="+", default=[1.45, 1.1])
+    ap.add_argument("--dress-h", type=float, nargs="+", default=[1.1, 0.9])
     ap.add_argument("--work", default="/tmp/garment-report")
     ap.add_argument("--reuse", action="store_true", help="reuse finished runs in --work (module docstring)")
     ap.add_argument("--timeout", type=float, default=TIMEOUT, help="longest run (or wait for one under way) [s]")
