@@ -210,7 +210,7 @@ class SurfaceObstacle(Obstacle):
             if self.smooth < MIN_SUPPORT * self.radius * (1.0 - 1e-6):
                 raise ValueError(f"smooth = {smooth!r} is below {MIN_SUPPORT:g} facet radii of {self.path.name} "
                                  f"({MIN_SUPPORT * self.radius:.3g} m): give at least that (in the scene's lengths)")
-            self._smooth = SmoothSurface(V, tri, self.smooth)
+            self._smooth = SmoothSurface(V, tri, self.smooth, tree=self._ctree)  # the same centroids
         self._features()
 
     # --- geometry ---------------------------------------------------------------------------------

@@ -137,9 +137,10 @@ class SmoothSurface:
     """The IMLS surface (S1) of the facets of a closed, outward-wound triangle surface ``V (m, 3)`` [m], ``T (t, 3)``
     with support radius ``h`` [m] (module docstring). The facets are binned in a grid of cells of at least ``h``
     (:data:`GRID_CELLS` along the longest side at most), so a point's facets within ``h`` lie in its own and the 26
-    cells around it."""
+    cells around it. ``tree``: a k-d tree of the facet centroids in facet order (the obstacle's own), else one is
+    built."""
 
-    def __init__(self, V: np.ndarray, T: np.ndarray, h: float):
+    def __init__(self, V: np.ndarray, T: np.ndarray, h: float, tree=None):
         from scipy.spatial import cKDTree
 
         a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
@@ -158,7 +159,7 @@ class SmoothSurface:
         self.order = np.argsort(cell, kind="stable").astype(np.int64)
         self.cell_start = np.searchsorted(cell[self.order], np.arange(int(np.prod(dims)) + 1)).astype(np.int64)
         self.grid = np.array([*lo, size, *dims, self.h], dtype=float)
-        self.tree = cKDTree(self.p)
+        self.tree = cKDTree(self.p) if tree is None else tree
         self._far = {}  # len(x) -> (x_ref, slack^2, facet): the held nearest centroids of far points (nearest_far)
 
     def nearest_far(self, x: np.ndarray, far: np.ndarray) -> np.ndarray:
@@ -195,9 +196,9 @@ def evaluate_smooth(ob, x: np.ndarray, hessian: bool):
     """``(phi (n,) [m], normal (n, 3), H (n, 3, 3) or None)`` of a smooth surface obstacle ``ob``
     (:class:`~rftstatic.contact.obstacles.surface_mesh.SurfaceObstacle` with ``smooth``) at ``x (n, 3)`` [m]: (S1)-(S3)
     less its offset wherever a facet's support reaches; beyond (``h`` or more from every centroid) the distance to
-    the nearest centroid (as held by :meth:`SmoothSurface.nearest_far`) less ``R`` less the
-    offset, signed by the side of that facet's plane the point lies on (an estimate of the distance, as the faceted
-    query's far points have: no contact acts there; Hessian 0)."""
+    the nearest centroid (as held by :meth:`SmoothSurface.nearest_far`) less ``R`` less the offset, signed by the
+    side of that facet's plane the point lies on (an estimate of the distance, as the faceted query's far points
+    have: no contact acts there; Hessian 0)."""
     phi, normal, H, W = ob._smooth.evaluate(x, hessian)
     phi = phi - ob.offset
     far = np.flatnonzero(W <= 0.0)
