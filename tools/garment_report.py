@@ -1,13 +1,15 @@
 """Write validation/garments.md: garments sewn from panels on the dress form, measured by independent checks.
 
     python tools/garment_report.py [--out validation] [--a-line-h 1.45 1.1] [--circle-h 1.48 1.1] [--dress-h 1.1 0.9]
+                                   [--carry-h 0.8] [--work DIR] [--reuse] [--timeout S]
 
 Every number comes from a whole-process run made here (``python -m rftstatic case SCENE --set garment.h=H``), one
 after the other: each scene on its own mesh (the whole ``case`` command, figures and all, timed: the issue's time
 limits) and on a finer one (``--no-figures``): convergence and stability, the seams (largest gap at the start and at
 the merge), the independent crossing check of the garment against the form itself (``body.obj``, not the contact
 surface) and against itself, the hem's drape coefficient and fold count on each mesh (the fold count against the
-finer mesh), and the cost of each stage (closing levels, static solve).
+finer mesh), and the cost of each stage (closing levels, static solve). The circle skirt's drapes are also carried
+between its meshes (and to ``--carry-h``) and solved there (:func:`_carried`): which drapes each mesh holds.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -127,9 +131,91 @@ def _verdict(name, done) -> list:
     f0, f1 = s0["garment"]["hem_folds"], s1["garment"]["hem_folds"]
     d0, d1 = s0["garment"]["hem_drape_coefficient"], s1["garment"]["hem_drape_coefficient"]
     m0 = s0["garment"]["mean_element_size"]
+    differ = ("the routes' drapes differ: each mesh's drape carried to the others below"
+              if name in CARRIED else "not converged")
     return [f"- {name}: mean element {m0:.2f} cm ({'<=' if m0 <= 1.5 else '>'} 1.5 cm); hem folds {f0} at h = {h0:g} "
-            f"cm against {f1} at h = {h1:g} cm ({'the same' if f0 == f1 else 'not converged'}); hem DC {d0:.4f} "
+            f"cm against {f1} at h = {h1:g} cm ({'the same' if f0 == f1 else differ}); hem DC {d0:.4f} "
             f"against {d1:.4f} ({abs(d0 - d1) / d1 * 100:.1f} % apart)."]
+
+
+CARRIED = ("skirt-circle",)
+"""Scenes whose drapes are carried between the report's meshes (:func:`_carried`): those whose fold counts differ."""
+
+
+def _carried(scene, runs, work, extra=()) -> list:
+    """Each finished run of ``scene`` carried to the other mesh sizes of its table and to the sizes ``extra`` (no run
+    of their own) and solved there by Newton (:func:`rftstatic.app.garment_carry.carry_drape`; kept as JSON in
+    ``work`` for ``--reuse``): rows ``(source h, target h, table)``."""
+    from rftstatic import api
+    from rftstatic.app.garment_carry import carry_drape
+
+    done = [r[0] for r in runs if r[3] is not None]
+    rows = []
+    for hs in done:
+        for hd in [*done, *extra]:
+            if hs == hd:
+                continue
+            name = work / f"carry-{scene}-{hs:g}-to-{hd:g}"
+            kept = name.with_suffix(".json")
+            if REUSE and kept.is_file():
+                table = json.loads(kept.read_text())
+            else:
+                table = carry_drape(api.load_scene(scene), work / f"{scene}-{hs:g}", hs, out=name, h=hd)
+                kept.write_text(json.dumps(table, indent=1))
+            rows.append((hs, hd, table))
+            print(f"{scene} carried {hs:g} -> {hd:g}: {table['hem_folds']} folds, {table['wall_time_s']:.0f} s",
+                  flush=True)
+    return rows
+
+
+def _carry_section(scene, runs, carried) -> tuple[list, list]:
+    """The drapes of ``scene`` found on each mesh, each also solved on the other meshes: (section lines, verdict)."""
+    lines = [f"## The {scene} drapes on each mesh", "",
+             "Which of several near-equal stable drapes the route finds depends on the fall from the flat start, so the "
+             "fold counts of two meshes' own runs mix the mesh with the route. Here each mesh's drape is also carried to "
+             "the other mesh through the flat pattern and solved there by Newton at full load "
+             "(`rftstatic.app.garment_carry.carry_drape`): a drape that is a stable minimum with the same folds on "
+             "both meshes is resolved by both; the energies of two drapes on one mesh say which is lower there.", "",
+             "| mesh h [cm] | drape found by the route on | converged | stable | hem folds | hem DC | total energy "
+             "[gf cm] | Newton its | wall [s] |", "|---|---|---|---|---|---|---|---|---|"]
+    best, rows = {}, []
+    for h, code, wall, s, err, figures in runs:
+        if s is None:
+            continue
+        e = s["energies"]["total"]
+        rows.append((-h, 0, f"| {h:g} | {h:g} (its own run) | {s['converged']} | {s['stable_minimum']} | "
+                     f"{s['garment']['hem_folds']} | {s['garment']['hem_drape_coefficient']:.4f} | {e:.3f} | "
+                     f"{s['newton_iterations']} | {_wall(wall, figures)} |"))
+        best.setdefault(h, []).append((e, s["garment"]["hem_folds"], s["stable_minimum"]))
+    for hs, hd, t in carried:
+        e = t["energies"]["total"]
+        rows.append((-hd, -hs, f"| {hd:g} | {hs:g} (carried: {t['nodes']} nodes) | {t['converged']} | "
+                     f"{t['stable_minimum']} | {t['hem_folds']} | {t['hem_drape_coefficient']:.4f} | {e:.3f} | "
+                     f"{t['newton_iterations']} | {t['wall_time_s']:.0f} |"))
+        best.setdefault(hd, []).append((e, t["hem_folds"], t["stable_minimum"] and t["converged"]))
+    lines += [r[2] for r in sorted(rows)]
+    verdict = []
+    own = {h: (s["garment"]["hem_folds"], s["garment"]["hem_drape_coefficient"]) for h, _, _, s, *_ in runs
+           if s is not None}
+    for hs, (folds, dc) in own.items():  # each drape on every mesh: its folds, and its DC's convergence
+        on = sorted([(hs, folds, dc)] + [(hd, t["hem_folds"], t["hem_drape_coefficient"]) for h0, hd, t in carried
+                                         if h0 == hs], reverse=True)
+        text = (f"the drape of the {hs:g} cm run ({folds} folds) has " + ", ".join(f"{f} folds, DC {d:.4f} at "
+                f"{h:g} cm" for h, f, d in on))
+        if len(on) >= 3:
+            (h0, _, d0), (h1, _, d1), (h2, _, d2) = on[-3:]
+            if (d0 - d1) * (d1 - d2) > 0 and abs(d1 - d2) > 0:
+                rate = np.log(abs(d0 - d1) / abs(d1 - d2)) / np.log(h0 / h1)
+                text += f" (the DC's observed rate {rate:.2f} over the last three meshes)"
+        verdict.append(text)
+    for h, rows in sorted(best.items(), reverse=True):
+        held = sorted({f for _, f, ok in rows if ok})
+        low = min((r for r in rows if r[2]), default=None)
+        spread = max(r[0] for r in rows) - min(r[0] for r in rows)
+        verdict.append(f"on the {h:g} cm mesh stable drapes of {' and '.join(map(str, held))} folds"
+                       + (f", the lowest in energy {low[1]} folds ({spread:.3g} gf cm apart, "
+                          f"{spread / abs(low[0]):.1e} relative)" if low is not None and len(rows) > 1 else ""))
+    return lines, [f"- {scene}'s drapes carried between the meshes: " + "; ".join(verdict) + "."]
 
 
 def _run_cusick(out):
@@ -168,6 +254,8 @@ def main(argv=None):
     ap.add_argument("--a-line-h", type=float, nargs="+", default=[1.45, 1.1])
     ap.add_argument("--circle-h", type=float, nargs="+", default=[1.48, 1.1])
     ap.add_argument("--dress-h", type=float, nargs="+", default=[1.1, 0.9])
+    ap.add_argument("--carry-h", type=float, nargs="*", default=[0.8],
+                    help="further meshes [cm] the circle skirt's drapes are carried to (no run of their own)")
     ap.add_argument("--work", default="/tmp/garment-report")
     ap.add_argument("--reuse", action="store_true", help="reuse finished runs in --work (module docstring)")
     ap.add_argument("--timeout", type=float, default=TIMEOUT, help="longest run (or wait for one under way) [s]")
@@ -224,6 +312,10 @@ def main(argv=None):
     verdict = []
     for scene, *_ in SCENES:
         verdict += _verdict(scene, [r for r in results[scene] if r[3] is not None])
+    for scene in CARRIED:
+        section, said = _carry_section(scene, results[scene], _carried(scene, results[scene], work, a.carry_h))
+        lines += ["", *section]
+        verdict += said
     done = [r for rows in results.values() for r in rows if r[3] is not None]
     stable = all(r[3]["converged"] and r[3]["stable_minimum"] for r in done)
     verdict += [

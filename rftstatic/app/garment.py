@@ -206,6 +206,20 @@ def _hem(mesh, x) -> np.ndarray:
     return nodes[label[nodes] == lowest]
 
 
+def hem_folds(mesh, x) -> int | None:
+    """The hem's folds of the garment ``mesh`` at positions ``x (N, 3)`` [m]: the node count of its outer boundary
+    seen from above, about the form's axis (as a Cusick specimen's); None when it does not surround the axis."""
+    try:
+        return fold_count(x, boundary_loop(mesh.tri, x), (0.0, 0.0)).count
+    except ValueError:
+        return None
+
+
+def garment_h(scene) -> float:
+    """The scene's ``garment.h`` [scene length]: the garment's target element size."""
+    return _size(scene, "garment.h")
+
+
 def _garment_measures(scene, model, U, pmesh, hem, closing) -> dict:
     """The ``garment`` table of the summary (scene units; module docstring)."""
     u = scene.units.length
@@ -217,10 +231,7 @@ def _garment_measures(scene, model, U, pmesh, hem, closing) -> dict:
     if closing is not None:
         sewing = {"largest_seam_gap": closing.largest_gap / u, "largest_seam_gap_start": closing.largest_gap_start / u,
                   "closing_time": closing.time, "closing_steps": closing.steps, "closing_wall_time": closing.wall_time}
-    try:  # the hem's folds: the outer boundary seen from above, about the form's axis (as a Cusick specimen's)
-        folds = fold_count(x, boundary_loop(model.mesh.tri, x), (0.0, 0.0)).count
-    except ValueError:  # the hem does not surround the axis in plan view
-        folds = None
+    folds = hem_folds(model.mesh, x)
     return {"pattern": Path(pmesh.pattern.source).name, "panels": len(pmesh.meshes), "hem_folds": folds,
             "seams": len(pmesh.pattern.seams), **sewing, "hem_nodes": int(len(hem)),
             "nodes_sewn": int(model.mesh.info.get("sewn_from_nodes", model.mesh.n_nodes) - model.mesh.n_nodes),
