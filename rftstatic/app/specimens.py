@@ -17,6 +17,7 @@ import time
 import numpy as np
 
 from rftstatic.app.levels import solve_levels
+from rftstatic.app.starts import keep_lower
 from rftstatic.errors import ConvergenceError
 from rftstatic.io.summary import drape_summary
 from rftstatic.scenes.options import run_options
@@ -25,26 +26,35 @@ from rftstatic.solvers.static import solve_static
 log = logging.getLogger(__name__)
 
 
-def seeded_specimens(scene, model, extras, opts, first: dict, n: int, first_energy: float | None = None) -> dict:
+def seeded_specimens(scene, model, extras, opts, first: dict, n: int, first_energy: float | None = None,
+                     compare: str | None = None) -> dict:
     """Solve ``model`` from ``n - 1`` further seeds after ``opts.route.seed`` and summarise all ``n`` drapes.
 
     ``first``: the drape summary of the run's own solve (seed ``opts.route.seed``), ``first_energy`` its total
     potential energy (scene units). A seed whose solve does not converge is listed (``converged: false``) and left
     out of the statistics. ``lowest_energy``: the specimen whose drape has the lowest total potential energy, the
     best minimum found of the one model (the drapes of a drape test are several stable equilibria, §6.2).
+    ``compare``: every further specimen is also solved from that start and keeps the lower stable minimum
+    (:func:`rftstatic.app.starts.keep_lower`; its row names the ``start`` kept).
     """
     rows = [{"seed": opts.route.seed, "converged": True, **_row(first), "energy": first_energy}]
     levels = run_options(scene).levels
     for k in range(1, n):
         t0 = time.perf_counter()
+        start = None
         seeded = opts.replace(seed=opts.route.seed + k, progress=False)
         try:
             res = solve_levels(scene, model, seeded) if levels > 1 else solve_static(model, options=seeded)
             ok = bool(res.converged)
+            if ok and compare is not None:
+                res, kept = keep_lower(scene, model, seeded, res, compare, lambda U: {})
+                start = kept["kept"]
         except ConvergenceError as exc:
             log.warning("seed %d: %s", seeded.route.seed, exc)
             res, ok = exc.result, False
         row = {"seed": seeded.route.seed, "converged": ok, "wall_time_s": time.perf_counter() - t0}
+        if compare is not None:
+            row["start"] = start if ok else None
         if ok:
             row.update(_row(drape_summary(scene, model, extras, res.U)), stable_minimum=res.stable,
                        energy=res.energies.get("total", np.nan) / scene.units.energy)

@@ -29,7 +29,8 @@ from rftstatic.io.summary import (drape_summary, obstacle_crossing_summary, prob
                                   self_intersection_summary, summary_header)
 from rftstatic.scenes.build import build_model
 from rftstatic.app.specimens import seeded_specimens
-from rftstatic.scenes.options import run_options, seed_count, static_options
+from rftstatic.app.starts import keep_lower
+from rftstatic.scenes.options import compare_start, run_options, seed_count, static_options
 from rftstatic.solvers.drive import drive
 from rftstatic.solvers.newton import start_state
 from rftstatic.solvers.static import static_route
@@ -59,6 +60,11 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     build_time = time.perf_counter() - t0
     opts = static_options(scene, progress=progress)
     seeds = seed_count(scene)
+    other = compare_start(scene)
+    if other is not None and model.bending_friction is not None:
+        raise scene.error("solver.compare", f"{other!r}: a drape with bending hysteresis depends on its route (the "
+                          "friction's history), so two routes' energies do not tell which drape a specimen keeps; "
+                          "remove solver.compare or the kes_2HB keys")
     path = out / CHECKPOINT
     remove_stale(path)
     resumed = None
@@ -84,12 +90,20 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         error, result = exc, exc.result
         if result is None:
             raise
+    starts = None
+    if other is not None and error is None:
+        result, starts = keep_lower(scene, model, opts, result, other, _measures(scene, model, extras),
+                                    wall=result.wall_time)
     summary = static_summary(scene, model, extras, result, build_time)
+    if starts is not None:
+        summary["starts"] = starts
     if model.bending_friction is not None and state is not None:  # bending hysteresis: what the route dissipated
         summary["bending_hysteresis"] = hysteresis_summary(scene, model, state, result.U)
     if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
         summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds,
-                                            first_energy=summary["energies"].get("total"))
+                                            first_energy=summary["energies"].get("total"), compare=other)
+        if starts is not None:
+            summary["seeds"]["specimens"][0]["start"] = starts["kept"]
     summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or resumed else None, "writes": saver.writes,
                              "write_time_s": saver.write_time, "resumed_from": resumed}
     write_outputs(scene, model, extras, result.U, out, summary, figures=figures)
@@ -97,6 +111,17 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         raise error
     remove_levels(out)
     return RunResult(to_jsonable(summary), model, result.U, extras, out)
+
+
+def _measures(scene, model, extras):
+    """``U -> dict``: a drape's DC and fold count for the compared starts' table (empty without a drape)."""
+    def measures(U):
+        if model.contact is None and extras.get("disc") is None:
+            return {}
+        d = drape_summary(scene, model, extras, U)
+        return {k: d.get(k) for k in ("drape_coefficient_percent", "fold_count")}
+
+    return measures
 
 
 def hysteresis_summary(scene, model, state, U) -> dict:

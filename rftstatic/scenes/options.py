@@ -136,6 +136,20 @@ def seed_count(scene) -> int:
     return n
 
 
+def compare_start(scene) -> str | None:
+    """``solver.compare``: the second start a static drape is solved from (:mod:`rftstatic.app.starts`), checked;
+    None for ``"none"``."""
+    other = declared_run_options(scene).compare
+    if other == "none":
+        return None
+    if scene.analysis != "static":
+        raise scene.error("solver.compare", f"{other!r}: a second start is run by the static analysis only")
+    if other == static_options(scene).route.start:  # e.g. a scene with compare = "load-steps" run --set start=...
+        log.warning("%s: solver.compare = %r is the scene's own solver.start: nothing to compare", scene.path, other)
+        return None
+    return other
+
+
 def cantilever_options(scene) -> CantileverOptions:
     """The scene's ``[cantilever]`` table checked (:class:`~rftstatic.scenes.run_options.CantileverOptions`), the
     angle in radians."""

@@ -37,6 +37,9 @@ class RunOptions:
     seeds: int = option(1, "static drape: run this many seeded starts (seed, seed + 1, ...), as a lab tests several "
                         "specimens; the summary reports their mean, range and fold counts", low=1, high=MAX_SEEDS)
     membrane: bool = option(True, "false: a linear Kirchhoff plate (bending only, no membrane)")
+    compare: str = option("none", "static drape: also solve it from this start (a solver.start value) and keep the "
+                          "stable minimum of lower energy (rftstatic.app.starts); none: the scene's route only",
+                          choices=("none", "load-steps", "relax", "release"))
 
     def __post_init__(self):
         check(self, "solver")

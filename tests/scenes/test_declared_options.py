@@ -42,7 +42,7 @@ def test_the_groups_are_split_by_concern_and_none_is_over_fifteen_fields():
     assert {"rtol", "tangent", "step_solver"} <= {n for n, _, _ in declared(NewtonOptions)}
     assert {"initial_increment", "continuation"} <= {n for n, _, _ in declared(IncrementOptions)}
     assert {"start", "seed", "perturbation"} <= {n for n, _, _ in declared(RouteOptions)}
-    assert {"levels", "seeds", "membrane"} == {n for n, _, _ in declared(RunOptions)} - {"level_membrane"}
+    assert {"levels", "seeds", "membrane", "compare"} == {n for n, _, _ in declared(RunOptions)} - {"level_membrane"}
 
 
 @pytest.mark.parametrize("section, cls, name, spec, default",
