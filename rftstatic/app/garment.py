@@ -111,11 +111,31 @@ CLOSING_DAMPING = 8.0
 (2 sqrt(g / 0.5 m) = 8.9 /s)."""
 
 
+def _sized(scene, body: dict) -> dict:
+    """``[body]`` with the measurements of its ``size`` (:func:`rftstatic.references.body_sizes.size_chart`, converted
+    to scene units) under the keys it does not give."""
+    from rftstatic.references.body_sizes import size_chart
+
+    size = body.get("size")
+    chart = size_chart()
+    if isinstance(size, bool) or not isinstance(size, (int, float)) or size not in chart:
+        raise scene.error("body.size", f"{size!r}: not a size of the chart (the bust girth in cm: "
+                          f"{', '.join(map(str, chart))}; rftstatic.references.body_sizes), or give the measurements")
+    cm = 0.01 / scene.units.length
+    row = {k: v * cm for k, v in chart[int(size)].items() if k in BODY_KEYS}
+    row.update({k: v for k, v in chart[int(size)].items() if k in DEPTH_KEYS})
+    return {**row, **{k: v for k, v in body.items() if k != "size"}}
+
+
 def dress_form(scene) -> DressForm:
-    """The scene's ``[body]`` as a :class:`~rftstatic.garment.body.DressForm` (lengths in metres)."""
+    """The scene's ``[body]`` as a :class:`~rftstatic.garment.body.DressForm` (lengths in metres): its measurements,
+    or a ``size`` of the chart (:mod:`rftstatic.references.body_sizes`) with any measurement given overriding."""
     body = scene.get("body")
     if not isinstance(body, dict) or body.get("kind", "dress-form") != "dress-form":
-        raise scene.error("body", 'a garment scene needs [body] with kind = "dress-form" and its measurements')
+        raise scene.error("body", 'a garment scene needs [body] with kind = "dress-form" and its measurements '
+                          "(or a size)")
+    if "size" in body:
+        body = _sized(scene, body)
     u = scene.units.length
     args = {k: float(body[k]) * u for k in BODY_KEYS if k in body}
     args.update({k: float(body[k]) for k in DEPTH_KEYS if k in body})

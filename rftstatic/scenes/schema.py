@@ -177,6 +177,8 @@ SCHEMA = {
                                "the closed shape is carried to the garment mesh (rftstatic.garment.sewing)")},
                 "the garment of analysis = \"garment\" (rftstatic.app.garment)"),
     "body": ({"kind": (str, "dress-form (rftstatic.garment.body.DressForm)"),
+              "size": (NUM, "a size of the chart, by bust girth in cm (rftstatic.references.body_sizes; ANSUR II "
+                       "medians): the measurements not given"),
               **{k: (NUM, "dress form measurement [length]") for k in
                  ("bust_girth", "waist_girth", "hip_girth", "bust_height", "waist_height", "hip_height",
                   "shoulder_breadth", "shoulder_height", "neck_girth", "neck_height", "neck_length",
