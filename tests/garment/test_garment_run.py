@@ -67,3 +67,14 @@ def test_the_garmentcode_json_skirt_is_the_toml_skirt(tmp_path):
     np.testing.assert_allclose(ma.element_X, mb.element_X, atol=1e-12)
     np.testing.assert_array_equal(ma.tri, mb.tri)
     np.testing.assert_array_equal(seam_pairs(pa), seam_pairs(pb))
+
+
+@pytest.mark.slow
+def test_the_dress_drapes_on_a_chart_size(tmp_path):
+    # the ANSUR II size 84 (rftstatic.references.body_sizes) in place of the scene's measurements
+    out = tmp_path / "out"
+    assert main(["case", "dress", "--out", str(out), "--no-figures", "--set", "garment.h=2.5",
+                 "--set", "garment.closing_h=5", "--set",
+                 'body={kind="dress-form", size=84, neck_length=6.0, bottom_height=62.0}']) == 0
+    summary = _check_dressed(out, load_scene("dress").path.parent / "patterns" / "dress-shift.toml", 0.025)
+    assert summary["garment"]["panels"] == 4
