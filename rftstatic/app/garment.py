@@ -313,6 +313,16 @@ def _with_body(data, body) -> dict:
     return data
 
 
+def static_data(scene, body) -> dict:
+    """The garment scene's table as a ``static`` drape's: without ``[garment]`` and ``[body]``, the form's contact
+    surface ``body`` (:func:`contact_surface`) a mesh obstacle."""
+    data = copy.deepcopy(scene.data)
+    data.pop("garment")
+    data.pop("body")
+    data["analysis"] = "static"
+    return _with_body(data, body)
+
+
 def _closing_levels(scene, data, out, form, pmesh, mesh, pairs, *, progress=True):
     """The closing (stage 1 of :mod:`rftstatic.garment.sewing`), on a coarser mesh first when ``garment.closing_h``
     is larger than ``garment.h``: ``(mesh, closing, levels)``, the garment's panel mesh (placed at the carried
@@ -375,11 +385,7 @@ def run(scene, out: Path, *, progress=True, figures=True):
     # the contact surface [m]: the form grown by the sag of the garment's mean edge (body.obj: the form itself)
     table = contact_surface(form, out / "body-m.obj", mesh, u)
     clearance = table["clearance"]
-    data = copy.deepcopy(scene.data)
-    data.pop("garment")
-    data.pop("body")
-    data["analysis"] = "static"
-    data = _with_body(data, table)
+    data = static_data(scene, table)
     pairs = seam_pairs(pmesh)
     closing, corner_uv, levels = None, mesh.tri, []
     if len(pairs):

@@ -17,7 +17,6 @@ mesh. Lengths in scene units in the returned table.
 
 from __future__ import annotations
 
-import copy
 import time
 from pathlib import Path
 
@@ -67,15 +66,11 @@ def carry_drape(scene, source: str | Path, source_h: float, *, out: str | Path, 
     x = carry_closed(src_pmesh, x_panels, pmesh)
     pairs = seam_pairs(pmesh)
     if len(pairs):  # the reference: the placed panels merged at their seams' midpoints (U's origin only)
-        mesh, node_of = sew(mesh, pairs, mesh.X3, where=Path(pmesh.pattern.source).name)
-        count = np.bincount(node_of, minlength=mesh.n_nodes)[:, None]
-        x = np.stack([np.bincount(node_of, x[:, i], minlength=mesh.n_nodes) for i in range(3)], axis=1) / count
+        where = Path(pmesh.pattern.source).name
+        x = sew(mesh, pairs, x, where=where)[0].X3  # the carried panels merged the same way
+        mesh, _ = sew(mesh, pairs, mesh.X3, where=where)
     table = G.contact_surface(G.dress_form(scene), out / "body-m.obj", mesh, u)
-    data = copy.deepcopy(scene.data)
-    data.pop("garment")
-    data.pop("body")
-    data["analysis"] = "static"
-    solved = type(scene)(G._with_body(data, table), scene.path, scene.name, scene.overrides)
+    solved = type(scene)(G.static_data(scene, table), scene.path, scene.name, scene.overrides)
     model, _ = build_model(solved, mesh=mesh, start_check=False)
     U0 = x - model.X3
     folds0 = G.hem_folds(model.mesh, x)
