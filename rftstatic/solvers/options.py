@@ -132,6 +132,10 @@ class RouteOptions:
                                             "out-of-balance force below the weight; later handovers wait for 1e-4; "
                                             "auto: 1e-2, 1e-4 with Coulomb friction)", kind="float", low=0.0,
                                             high=1.0, open_low=True, open_high=True)
+    relax_damping: str = option("viscous", "relax route: how the relaxation damps the motion: viscous (mass damping "
+                                "critical for the pendulum mode), fire (FIRE velocity mixing and resets) or kinetic "
+                                "(velocities zeroed at each peak of the kinetic energy); with Coulomb friction always "
+                                "viscous", choices=("viscous", "fire", "kinetic"))
 
     def __post_init__(self):
         check(self, SECTION)
