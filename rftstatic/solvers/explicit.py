@@ -171,8 +171,9 @@ def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(
         loop.resume(dt, saved)
     sample_every = max(1, n_steps // 2000) if o.sample_every is None else o.sample_every
     state.route[EXPLICIT] = loop.position(n_steps, estimate, {
-        "t_end": o.t_end, "alpha": o.alpha, "damping": o.damping, "mass_scale": o.mass_scale, "sample_every": int(sample_every),
-        "energy_check": o.energy_check, "energy_tol": o.energy_tol, "rest_tol": o.rest_tol, "safety": o.safety,
+        "t_end": o.t_end, "alpha": o.alpha, "damping": o.damping, "mass_scale": o.mass_scale,
+        "sample_every": int(sample_every), "energy_check": o.energy_check, "energy_tol": o.energy_tol,
+        "rest_tol": o.rest_tol, "safety": o.safety,
         "frame_times": loop.frame_times, "probe_nodes": probes, "backend": loop.kernel.backend})
     check = _EnergyCheck(model, estimate, mass_scale=o.mass_scale, alpha=o.alpha, safety=o.safety, tol=o.energy_tol,
                          enabled=o.energy_check)
