@@ -46,8 +46,12 @@ from rftstatic.errors import ParameterError
 
 __all__ = ["DAMPINGS", "DampingLaw", "make_law"]
 
-DAMPINGS = ("viscous", "fire", "kinetic")
-"""The damping laws of an explicit run: mass damping ``alpha`` (Eq. 27, the default), FIRE, kinetic damping."""
+DAMPINGS = ("viscous", "fire", "kinetic", "viscous-fire")
+"""The damping laws of an explicit run: mass damping ``alpha`` (Eq. 27, the default), FIRE, kinetic damping, and
+the mass damping until the kinetic energy has fallen to :data:`HANDOFF` of its peak, FIRE after."""
+
+HANDOFF = 0.1
+"""Kinetic energy / its peak [-] at which ``"viscous-fire"`` hands the motion from the mass damping to FIRE."""
 
 
 @dataclass(frozen=True)
@@ -60,25 +64,37 @@ class DampingLaw:
     a_start : FIRE's mixing factor after a reset [-], in (0, 1) (FIRE 2.0: 0.25; Bitzek et al.: 0.1)
     f_alpha : FIRE's factor on the mixing factor per step of positive power after the delay [-], in (0, 1]
     delay : FIRE's steps of positive power before the mixing factor decays [-] (N_delay, FIRE 2.0: 20)
+    after : the law takes over from the mass damping ``alpha`` once the kinetic energy of a sample has fallen to this
+        fraction of its peak [-], in [0, 1) (0: from the start)
     """
 
     name: str
     a_start: float = 0.1
     f_alpha: float = 0.99
     delay: int = 5
+    after: float = 0.0
 
     def __post_init__(self):
-        if self.name not in DAMPINGS[1:]:
-            raise ParameterError("damping", f'"{self.name}" is no velocity law; use one of {", ".join(DAMPINGS[1:])}')
+        if self.name not in DAMPINGS[1:3]:
+            raise ParameterError("damping", f'"{self.name}" is no velocity law; use one of {", ".join(DAMPINGS[1:3])}')
         if not 0.0 < self.a_start < 1.0:
             raise ParameterError("a_start", f"must lie in (0, 1), got {self.a_start!r}")
+        if not 0.0 <= self.after < 1.0:
+            raise ParameterError("after", f"must lie in [0, 1), got {self.after!r}")
         if not 0.0 < self.f_alpha <= 1.0:
             raise ParameterError("f_alpha", f"must lie in (0, 1], got {self.f_alpha!r}")
 
     def begin(self, acc: dict) -> dict:
         """The law's state in the run's records ``acc`` (new, or the one a resumed run saved)."""
         return acc.setdefault("law", {"a": self.a_start, "positive": 0, "resets": 0, "kin": [0.0, 0.0],
-                                      "swing": 0.0, "last_swing": 0.0})
+                                      "swing": 0.0, "last_swing": 0.0, "on": self.after == 0.0})
+
+    def switch(self, s: dict, kinetic: float) -> None:
+        """Take over from the mass damping when a sample's kinetic energy ``kinetic`` [J] has fallen to ``after``
+        of the samples' peak."""
+        s["peak"] = max(s.get("peak", 0.0), kinetic)
+        if kinetic <= self.after * s["peak"] and s["peak"] > 0.0:
+            s["on"] = True
 
     def __call__(self, s: dict, U, V, Vnew, g, mass, free, dt) -> float:
         """Apply the law at step n: ``V`` = v_(n-1/2), ``Vnew`` = v_(n+1/2) of the undamped update (in place),
@@ -143,4 +159,6 @@ def make_law(damping: str) -> DampingLaw | None:
     """The velocity law of ``damping`` (one of :data:`DAMPINGS`); None for viscous damping (the loop's own)."""
     if damping not in DAMPINGS:
         raise ParameterError("damping", f'"{damping}" is unknown; use one of {", ".join(DAMPINGS)}')
+    if damping == "viscous-fire":
+        return DampingLaw("fire", after=HANDOFF)
     return None if damping == "viscous" else DampingLaw(damping)

@@ -293,7 +293,6 @@ class _Loop:
         check_every = min(sample_every, 50)
         Ufix = U.copy()
         fixed_any = bool((~free).any())
-        damp = 1.0 - self.alpha * dt
         Vnew = np.empty_like(V)
         step = state.step
         stopped = False
@@ -313,23 +312,27 @@ class _Loop:
             # Eq. 20-21, with the damping force lagged half a step
             np.subtract(P, f, out=f)
             f *= minv
-            np.multiply(V, damp, out=Vnew)
+            law = self.law if self.law is not None and self.law.begin(acc)["on"] else None
+            alpha = 0.0 if law is not None else self.alpha  # a velocity law takes over from the mass damping
+            np.multiply(V, 1.0 - alpha * dt, out=Vnew)
             f *= dt
             Vnew += f
-            if self.alpha:
-                acc["damping"] += self.alpha * dt * float(np.einsum("n,ni,ni->", mass, V, Vnew))
-            if self.law is not None:  # FIRE or kinetic damping (rftstatic.solvers.damping)
-                acc["damping"] += self.law(self.law.begin(acc), U, V, Vnew, f, mass, free, dt)
+            if alpha:
+                acc["damping"] += alpha * dt * float(np.einsum("n,ni,ni->", mass, V, Vnew))
+            if law is not None:  # FIRE or kinetic damping (rftstatic.solvers.damping)
+                acc["damping"] += law(law.begin(acc), U, V, Vnew, f, mass, free, dt)
             if checked:
                 rec = _sample(t, U, V, Vnew, W, P, f, dt, mass, minv, free, acc)
                 check(rec, step, dt, acc)
+                if self.law is not None and law is None:
+                    self.law.switch(self.law.begin(acc), rec["kinetic"])
                 if sample:
                     self._record(rec, U)
                     bar.update(t, f"KE {rec['kinetic']:.3g} J")
                     if callback is not None:
                         state.U, state.V, state.t, state.step = U, V, t, step
-                        stopped = bool(callback(state, rec if self.law is None else dict(
-                            rec, kinetic=self.law.rest_kinetic(self.law.begin(acc), rec["kinetic"]))))
+                        stopped = bool(callback(state, rec if law is None else dict(
+                            rec, kinetic=law.rest_kinetic(law.begin(acc), rec["kinetic"]))))
             V, Vnew = Vnew, V
             if self.drive is not None:
                 np.copyto(V, self.drive, where=~free)

@@ -84,7 +84,7 @@ class ExplicitOptions:
             _number("dt", self.dt)
         _number("alpha", self.alpha, strict=False)
         make_law(self.damping)
-        if self.damping != DAMPINGS[0] and self.alpha != 0:
+        if self.damping in DAMPINGS[1:3] and self.alpha != 0:
             raise ParameterError("alpha", f"must be 0 with damping = {self.damping!r} (its velocity law damps the "
                                  f"motion), got {self.alpha!r}")
         _number("mass_scale", self.mass_scale)

@@ -134,8 +134,9 @@ class RouteOptions:
                                             high=1.0, open_low=True, open_high=True)
     relax_damping: str = option("viscous", "relax route: how the relaxation damps the motion: viscous (mass damping "
                                 "critical for the pendulum mode), fire (FIRE velocity mixing and resets) or kinetic "
-                                "(velocities zeroed at each peak of the kinetic energy); with Coulomb friction always "
-                                "viscous", choices=("viscous", "fire", "kinetic"))
+                                "(velocities zeroed at each peak of the kinetic energy) or viscous-fire (viscous until the kinetic "
+                                "energy has fallen to 0.1 of its peak, FIRE after); with Coulomb friction always "
+                                "viscous", choices=("viscous", "fire", "kinetic", "viscous-fire"))
 
     def __post_init__(self):
         check(self, SECTION)

@@ -87,7 +87,7 @@ class RelaxOptions:
 
     def explicit(self, *, given_velocity: bool) -> ExplicitOptions:
         """The explicit run of the relaxation: from a given half-step velocity, or consistent from rest."""
-        alpha = self.alpha if self.damping == DAMPINGS[0] else 0.0
+        alpha = 0.0 if self.damping in DAMPINGS[1:3] else self.alpha
         return ExplicitOptions(t_end=self.max_time, dt=self.dt, alpha=alpha, damping=self.damping,
                                mass_scale=self.mass_scale,
                                start="given" if given_velocity else "consistent", sample_every=self.sample_every,
