@@ -102,3 +102,49 @@ def test_rest_test_sees_the_last_swing():
     assert law.rest_kinetic(s, 1e-9) == 5.0  # the swing before the reset still counts
     law._reset(s)
     assert law.rest_kinetic(s, 1e-9) == pytest.approx(1e-9)
+
+
+@pytest.mark.parametrize("damping", ["fire", "kinetic", "viscous-fire"])
+def test_relax_route_with_a_velocity_law_reaches_the_newton_equilibrium(damping):
+    """solver.relax_damping on the static route (strip, one equilibrium): the load steps' Newton solution within
+    1e-6, the route's record names the law, and a guided first stage runs under it too."""
+    from rftstatic.bench.problems import strip_model
+    from rftstatic.solvers import static
+
+    mod = strip_model(11, 3)
+    a = static.solve_static(mod, options=static.StaticOptions(progress=False))
+    b = static.solve_static(mod, options=static.StaticOptions.from_keys(
+        progress=False, start="relax", relax_damping=damping, guide_folds=3, guide_weight=0.5, seed=2))
+    assert b.route == "relax+newton" and b.relax["damping"] == damping and b.relax["guide"]["steps"] > 0
+    assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
+
+
+def test_viscous_fire_hands_over_when_the_motion_has_died_down():
+    """viscous-fire: the mass damping alone (the viscous run step for step) until a sample's kinetic energy has
+    fallen to 0.1 of the peak, FIRE after."""
+    model = strip()
+    opts = dict(t_end=3.0, mass_scale=100.0, alpha=2 * _w1() / 10.0, sample_every=5, progress=False)
+    viscous = run_explicit(model, ExplicitOptions(**opts))
+    mixed = run_explicit(model, ExplicitOptions(damping="viscous-fire", **opts))
+    kin = viscous.history["kinetic"]
+    peak = np.maximum.accumulate(kin)
+    below = np.flatnonzero((kin <= 0.1 * peak) & (peak > 0))
+    assert below.size and below[0] > 10
+    first = below[0]  # the sample at which FIRE takes over (it acts from the step after)
+    for k in ("kinetic", "potential", "total"):
+        np.testing.assert_array_equal(mixed.history[k][: first + 1], viscous.history[k][: first + 1])
+    assert not np.array_equal(mixed.history["kinetic"][first + 2:], viscous.history["kinetic"][first + 2:])
+    with pytest.raises(ParameterError, match="after.*must lie in"):
+        DampingLaw("fire", after=1.0)
+
+
+def test_friction_relaxes_with_viscous_damping(monkeypatch):
+    """With Coulomb friction the relaxation keeps the mass damping (its rest test measures the impulses' leftover
+    velocities): the route's plan takes the law only without friction."""
+    from rftstatic.bench.problems import strip_model
+    from rftstatic.solvers import friction_lag, static
+
+    mod = strip_model(11, 3)
+    assert static._relax_plan(mod, None, "fire").damping == "fire"
+    monkeypatch.setattr(friction_lag, "active", lambda model: True)
+    assert static._relax_plan(mod, None, "fire").damping == "viscous"
