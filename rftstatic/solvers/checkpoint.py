@@ -388,7 +388,8 @@ def load_explicit_state(path, model, obstacles=(), *, progress: bool = True):
     position = state.route[EXPLICIT]
     o = position["options"]
     options = ExplicitOptions(t_end=float(o["t_end"]), dt=float(position["dt"]), alpha=float(o["alpha"]),
-                              mass_scale=float(o["mass_scale"]), sample_every=int(o["sample_every"]),
+                              damping=str(o.get("damping", "viscous")), mass_scale=float(o["mass_scale"]),
+                              sample_every=int(o["sample_every"]),
                               energy_check=bool(o["energy_check"]), energy_tol=float(o["energy_tol"]),
                               rest_tol=float(o["rest_tol"]), safety=float(o["safety"]), backend=str(o["backend"]),
                               progress=progress)

@@ -54,6 +54,7 @@ from rftstatic.element.explicit_force import ForceKernel
 from rftstatic.errors import InstabilityError, ParameterError
 from rftstatic.model.state import State
 from rftstatic.progress import Progress
+from rftstatic.solvers.damping import make_law
 from rftstatic.solvers.drive import Pause, finish
 from rftstatic.solvers.explicit_options import ExplicitOptions
 from rftstatic.solvers.rest import RestCriterion
@@ -152,7 +153,8 @@ def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(
     if probes.size and (probes.min() < 0 or probes.max() >= N):
         raise ValueError(f"probe nodes must lie in 0..{N - 1}, got min {probes.min()}, max {probes.max()}")
     loop = _Loop(model, obstacles, mass_scale=o.mass_scale, alpha=o.alpha, load=load, backend=o.backend,
-                 probes=probes, frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()), friction=friction)
+                 probes=probes, frame_times=np.sort(np.asarray(frame_times, dtype=float).ravel()), friction=friction,
+                 law=make_law(o.damping))
     saved = state.route.get(EXPLICIT)
     if saved is None:
         state.V *= model.free
@@ -169,8 +171,9 @@ def explicit_steps(model, state: State, options: ExplicitOptions, *, obstacles=(
         loop.resume(dt, saved)
     sample_every = max(1, n_steps // 2000) if o.sample_every is None else o.sample_every
     state.route[EXPLICIT] = loop.position(n_steps, estimate, {
-        "t_end": o.t_end, "alpha": o.alpha, "mass_scale": o.mass_scale, "sample_every": int(sample_every),
-        "energy_check": o.energy_check, "energy_tol": o.energy_tol, "rest_tol": o.rest_tol, "safety": o.safety,
+        "t_end": o.t_end, "alpha": o.alpha, "damping": o.damping, "mass_scale": o.mass_scale,
+        "sample_every": int(sample_every), "energy_check": o.energy_check, "energy_tol": o.energy_tol,
+        "rest_tol": o.rest_tol, "safety": o.safety,
         "frame_times": loop.frame_times, "probe_nodes": probes, "backend": loop.kernel.backend})
     check = _EnergyCheck(model, estimate, mass_scale=o.mass_scale, alpha=o.alpha, safety=o.safety, tol=o.energy_tol,
                          enabled=o.energy_check)
@@ -197,8 +200,9 @@ class _Loop:
     """The central-difference loop of :func:`run_explicit` (Eq. 20-22) and its bookkeeping: energy
     accumulators, history samples, probe records and frames. The solve's state is a :class:`State`."""
 
-    def __init__(self, model, obstacles, *, mass_scale, alpha, load, backend, probes, frame_times, friction=None):
-        self.model, self.obstacles, self.alpha, self.friction = model, obstacles, alpha, friction
+    def __init__(self, model, obstacles, *, mass_scale, alpha, load, backend, probes, frame_times, friction=None,
+                 law=None):
+        self.model, self.obstacles, self.alpha, self.friction, self.law = model, obstacles, alpha, friction, law
         self.free = model.free
         self.mass = lumped_mass(model, mass_scale)
         self.kernel = ForceKernel(model, backend=backend)
@@ -289,7 +293,6 @@ class _Loop:
         check_every = min(sample_every, 50)
         Ufix = U.copy()
         fixed_any = bool((~free).any())
-        damp = 1.0 - self.alpha * dt
         Vnew = np.empty_like(V)
         step = state.step
         stopped = False
@@ -309,20 +312,27 @@ class _Loop:
             # Eq. 20-21, with the damping force lagged half a step
             np.subtract(P, f, out=f)
             f *= minv
-            np.multiply(V, damp, out=Vnew)
+            law = self.law if self.law is not None and self.law.begin(acc)["on"] else None
+            alpha = 0.0 if law is not None else self.alpha  # a velocity law takes over from the mass damping
+            np.multiply(V, 1.0 - alpha * dt, out=Vnew)
             f *= dt
             Vnew += f
-            if self.alpha:
-                acc["damping"] += self.alpha * dt * float(np.einsum("n,ni,ni->", mass, V, Vnew))
+            if alpha:
+                acc["damping"] += alpha * dt * float(np.einsum("n,ni,ni->", mass, V, Vnew))
+            if law is not None:  # FIRE or kinetic damping (rftstatic.solvers.damping)
+                acc["damping"] += law(law.begin(acc), U, V, Vnew, f, mass, free, dt)
             if checked:
                 rec = _sample(t, U, V, Vnew, W, P, f, dt, mass, minv, free, acc)
                 check(rec, step, dt, acc)
+                if self.law is not None and law is None:
+                    self.law.switch(self.law.begin(acc), rec["kinetic"])
                 if sample:
                     self._record(rec, U)
                     bar.update(t, f"KE {rec['kinetic']:.3g} J")
                     if callback is not None:
                         state.U, state.V, state.t, state.step = U, V, t, step
-                        stopped = bool(callback(state, rec))
+                        stopped = bool(callback(state, rec if law is None else dict(
+                            rec, kinetic=law.rest_kinetic(law.begin(acc), rec["kinetic"]))))
             V, Vnew = Vnew, V
             if self.drive is not None:
                 np.copyto(V, self.drive, where=~free)

@@ -8,6 +8,7 @@ import numpy as np
 
 from rftstatic.element.explicit_force import BACKENDS
 from rftstatic.errors import ParameterError
+from rftstatic.solvers.damping import DAMPINGS, make_law
 from rftstatic.solvers.step_plan import MAX_STEPS_KEY
 from rftstatic.solvers.timestep import SAFETY
 
@@ -42,7 +43,9 @@ class ExplicitOptions:
     t_end : end time [s], > 0; the step is shortened slightly so that a whole number of steps ends there
     dt : step [s]; None: ``safety`` x the critical step (:func:`~rftstatic.solvers.step_plan.plan_steps`); a
         step above the stable estimate runs with a logged warning
-    alpha : mass damping factor [1/s], >= 0 (§4.6 uses 5)
+    alpha : mass damping factor [1/s], >= 0 (§4.6 uses 5); 0 with a velocity law (``damping``)
+    damping : ``"viscous"`` (the mass damping ``alpha``), ``"fire"`` or ``"kinetic"``: a velocity law of
+        :mod:`rftstatic.solvers.damping` (FIRE, kinetic damping) on the undamped motion
     mass_scale : mass-scaling factor s [-], > 0 (§6 uses 100); the load is not scaled
     start : ``"consistent"`` (v_(-1/2) = V0 - a_0 dt/2) or ``"given"`` (v_(-1/2) = V0)
     sample_every : steps between history samples [-] (None: about 2000 samples per run)
@@ -62,6 +65,7 @@ class ExplicitOptions:
     t_end: float
     dt: float | None = None
     alpha: float = 0.0
+    damping: str = DAMPINGS[0]
     mass_scale: float = 1.0
     start: str = STARTS[0]
     sample_every: int | None = None
@@ -79,6 +83,10 @@ class ExplicitOptions:
         if self.dt is not None:
             _number("dt", self.dt)
         _number("alpha", self.alpha, strict=False)
+        make_law(self.damping)
+        if self.damping in DAMPINGS[1:3] and self.alpha != 0:
+            raise ParameterError("alpha", f"must be 0 with damping = {self.damping!r} (its velocity law damps the "
+                                 f"motion), got {self.alpha!r}")
         _number("mass_scale", self.mass_scale)
         if self.start not in STARTS:
             raise ParameterError("start", f'"{self.start}" is unknown; use one of {", ".join(STARTS)}')

@@ -132,6 +132,11 @@ class RouteOptions:
                                             "out-of-balance force below the weight; later handovers wait for 1e-4; "
                                             "auto: 1e-2, 1e-4 with Coulomb friction)", kind="float", low=0.0,
                                             high=1.0, open_low=True, open_high=True)
+    relax_damping: str = option("viscous", "relax route: how the relaxation damps the motion: viscous (mass damping "
+                                "critical for the pendulum mode), fire (FIRE velocity mixing and resets) or kinetic "
+                                "(velocities zeroed at each peak of the kinetic energy) or viscous-fire (viscous until the kinetic "
+                                "energy has fallen to 0.1 of its peak, FIRE after); with Coulomb friction always "
+                                "viscous", choices=("viscous", "fire", "kinetic", "viscous-fire"))
 
     def __post_init__(self):
         check(self, SECTION)

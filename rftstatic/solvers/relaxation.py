@@ -16,6 +16,7 @@ from rftstatic.contact.self_contact.friction import pair_holds
 from rftstatic.element.explicit_force import BACKENDS
 from rftstatic.errors import ParameterError
 from rftstatic.model.state import State
+from rftstatic.solvers.damping import DAMPINGS
 from rftstatic.solvers.drive import finish
 from rftstatic.solvers.explicit import EXPLICIT, ExplicitResult, explicit_steps
 from rftstatic.solvers.explicit_options import ExplicitOptions
@@ -61,6 +62,8 @@ class RelaxOptions:
     max_steps : refuse a relaxation of more explicit steps than this, or whose stable step collapsed
         (:class:`~rftstatic.errors.StepLimitError`, before the first step); None: the explicit solver's limit
     max_steps_name : the option that sets ``max_steps``, named in that refusal
+    damping : ``"viscous"`` (the mass damping ``alpha``) or a velocity law of :mod:`rftstatic.solvers.damping`
+        (``"fire"``, ``"kinetic"``) on the undamped motion; ``alpha`` then only sets the time scale of the caller
     """
 
     alpha: float
@@ -73,6 +76,7 @@ class RelaxOptions:
     backend: str = BACKENDS[0]
     max_steps: int | None = None
     max_steps_name: str = MAX_STEPS_KEY
+    damping: str = DAMPINGS[0]
 
     def __post_init__(self):
         if not (isinstance(self.max_time, (int, float)) and self.max_time > 0):
@@ -83,7 +87,9 @@ class RelaxOptions:
 
     def explicit(self, *, given_velocity: bool) -> ExplicitOptions:
         """The explicit run of the relaxation: from a given half-step velocity, or consistent from rest."""
-        return ExplicitOptions(t_end=self.max_time, dt=self.dt, alpha=self.alpha, mass_scale=self.mass_scale,
+        alpha = 0.0 if self.damping in DAMPINGS[1:3] else self.alpha
+        return ExplicitOptions(t_end=self.max_time, dt=self.dt, alpha=alpha, damping=self.damping,
+                               mass_scale=self.mass_scale,
                                start="given" if given_velocity else "consistent", sample_every=self.sample_every,
                                progress=self.progress, backend=self.backend, max_steps=self.max_steps,
                                max_steps_name=self.max_steps_name)

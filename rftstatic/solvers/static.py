@@ -128,13 +128,13 @@ so a gap of 0.05 d under the automatic stiffness opens to about d/2 after two ra
 
 
 def _stiffen_self_contact(model, result, opts, state):
-    """Continuation on the self-contact stiffness (as IPC adapts its barrier stiffness): while the
-    converged state has a pair closer than :data:`SELF_CONTACT_MIN_GAP` times the thickness d (folds pinched harder than the automatic
-    stiffness's design load, ten times the sheet's weight), raise the stiffness and converge again from
-    that state (its steps bounded by the collision test, so no pair crosses on the way). The raised
-    stiffness is the solve's State's (``state.self_contact_scale``; the model's law stays as built):
-    ``result.self_contact_stiffenings`` counts the raises, ``result.self_contact_scale`` is the factor
-    the equilibrium holds with (its summary reports the stiffness)."""
+    """Continuation on the self-contact stiffness (as IPC adapts its barrier stiffness): while the converged state
+    has a pair closer than :data:`SELF_CONTACT_MIN_GAP` times the thickness d (folds pinched harder than the
+    automatic stiffness's design load, ten times the sheet's weight), raise the stiffness and converge again from
+    that state (its steps bounded by the collision test, so no pair crosses on the way). The raised stiffness is the
+    solve's State's (``state.self_contact_scale``; the model's law stays as built):
+    ``result.self_contact_stiffenings`` counts the raises, ``result.self_contact_scale`` is the factor the
+    equilibrium holds with (its summary reports the stiffness)."""
     sc = model.self_contact
     if sc is None or not result.converged:
         return result
@@ -240,20 +240,20 @@ class RelaxRoute:
 
 @dataclass(frozen=True)
 class _RelaxPlan:
-    """The fixed numbers of one model's relaxation route: mass scale [-], damping [1/s], the longest
-    relaxation, the segment between two tangent checks and the shortest segment [s]."""
+    """One model's relaxation route: mass scale, damping [1/s] (a time scale under the law ``damping``), times [s]."""
 
     mass_scale: float
     alpha: float
     max_time: float
     chunk: float
     min_span: float
+    damping: str = "viscous"
 
 
-def _relax_plan(model, first) -> _RelaxPlan:
-    """The relaxation's damping, critical for the pendulum mode of the drape, and its time limits;
-    ConvergenceError when the sheet has no mass to move (a weightless material), when its stable step
-    collapsed or when it would need more than :data:`MAX_RELAX_STEPS` explicit steps."""
+def _relax_plan(model, first, damping: str = "viscous") -> _RelaxPlan:
+    """The relaxation's damping, critical for the drape's pendulum mode, or the law ``damping`` (viscous with friction:
+    its rest test measures the impulses' leftover velocities), and time limits; ConvergenceError when the sheet has no
+    mass (weightless), its stable step collapsed or it would need over :data:`MAX_RELAX_STEPS` explicit steps."""
 
     def refuse(text):
         return ConvergenceError(text, None) if first is None else ConvergenceError(f"{first}; {text}", first.result)
@@ -278,8 +278,8 @@ def _relax_plan(model, first) -> _RelaxPlan:
                      "flat sheet, no explicit steps) or solver.continuation = \"arc-length\"; or a coarser mesh, or "
                      "a smaller membrane stiffness, which lengthen the stable step")
     # settling folds on fine meshes (31 x 240 rings) take longer
-    return _RelaxPlan(mass_scale=mass_scale, alpha=alpha, max_time=max_time * RELAX_TIME_ALLOWANCE,
-                      chunk=4.0 / alpha, min_span=10 * est.dt)
+    return _RelaxPlan(mass_scale=mass_scale, alpha=alpha, max_time=max_time * RELAX_TIME_ALLOWANCE, chunk=4.0 / alpha,
+                      min_span=10 * est.dt, damping="viscous" if friction_lag.active(model) else damping)
 
 
 def _relax_then_newton(model, opts, callback, state, *, first=None):
@@ -312,7 +312,7 @@ def _relax_route(model, opts, callback, state, first):
     t0 = time.perf_counter()
     route = state.route.get(RELAX_ROUTE)
     first = route.first if route is not None else first
-    plan = _relax_plan(model, first)
+    plan = _relax_plan(model, first, opts.route.relax_damping)
     if route is None:
         route = state.route[RELAX_ROUTE] = _start_route(model, opts, plan, first)
         if first is not None:
@@ -413,8 +413,8 @@ def _start_route(model, opts, plan, first) -> RelaxRoute:
         seed = opts.route.seed
         U = np.zeros((model.mesh.n_nodes, 3))
         U[:, 2] = start_perturbation(model.mesh, opts.route) * model.free[:, 2]
-    info = {"mass_scale": plan.mass_scale, "alpha_per_s": plan.alpha, "time_s": 0.0, "steps": 0, "handovers": [],
-            "after_failure": None if first is None else str(first)}  # the first stop: motion died down, |r| < |P|
+    info = {"mass_scale": plan.mass_scale, "alpha_per_s": plan.alpha, "damping": plan.damping, "time_s": 0.0,
+            "steps": 0, "handovers": [], "after_failure": None if first is None else str(first)}
     return RelaxRoute(phase="start", U=U, V=None, t_used=0.0, peak=0.0, tol_force=1.0, span=plan.max_time,
                       at_rest=False, seed=seed, info=info, first=first)
 
@@ -428,7 +428,7 @@ def _relax_segment(model, opts, plan, route, fail, state, t0):
     rest = RestCriterion(tol_kinetic=first, tol_force=route.tol_force)
     try:
         rel = yield from relax_steps(model, seg, RelaxOptions(
-            mass_scale=plan.mass_scale, alpha=plan.alpha, rest=rest,
+            mass_scale=plan.mass_scale, alpha=plan.alpha, rest=rest, damping=plan.damping,
             max_time=span if saved is None else float(saved["options"]["t_end"]), progress=opts.progress,
             max_steps=RELAX_SEGMENT_STEPS, max_steps_name="the relaxation route's segment limit"),
             given_velocity=route.V is not None, peak_kinetic=route.peak)
@@ -462,7 +462,7 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     seg = _segment_state(model, state, route)
     try:
         rel = yield from relax_steps(model, seg, RelaxOptions(
-            mass_scale=plan.mass_scale, alpha=plan.alpha, rest=RestCriterion(tol_kinetic=1e-4, tol_force=1.0),
+            mass_scale=plan.mass_scale, alpha=plan.alpha, rest=RestCriterion(1e-4, tol_force=1.0), damping=plan.damping,
             max_time=GUIDE_DAMPING_TIMES / plan.alpha, progress=opts.progress, max_steps=RELAX_SEGMENT_STEPS,
             max_steps_name="the relaxation route's segment limit"), given_velocity=route.V is not None, load=guided)
     except InstabilityError as exc:

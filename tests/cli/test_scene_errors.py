@@ -29,6 +29,7 @@ def _assert_input_error(code, err, key, fragment):
     (["material.E=1e6"], "material.E", "does not apply next to preset"),
     # a mesh too big to build: was a MemoryError (an internal error) or a run that never ends
     (["mesh.nodes=[100000000,1000000]"], "mesh.nodes", "more than 2,000,000"),
+    (["solver.relax_damping=firee"], "solver.relax_damping", 'is not one of viscous, fire, kinetic, viscous-fire (did'),
 ])
 def test_strip_mutations_are_input_errors(capsys, tmp_path, sets, key, fragment):
     _assert_input_error(*_run(capsys, tmp_path, "strip", sets), key, fragment)
