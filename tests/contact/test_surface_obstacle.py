@@ -445,3 +445,27 @@ def test_the_smooth_surface_grid_finds_every_facet_in_the_support(tmp_path, monk
     near = W > 0
     assert 50 < near.sum() < 400
     assert np.allclose(phi[near], (w * d).sum(axis=1)[near] / W[near], rtol=1e-10, atol=1e-15)
+
+
+def test_the_smooth_surface_gives_the_same_bits_on_any_number_of_threads(monkeypatch):
+    # the threaded kernel splits the points into blocks; each point's sums are the serial kernel's
+    numba = pytest.importorskip("numba")
+    from rftstatic.contact.obstacles import surface_smooth
+
+    if surface_smooth._kernels()["parallel"] is None or numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("needs numba and two threads")
+    monkeypatch.setattr(surface_smooth, "PARALLEL_MIN_POINTS", 1)
+    V, T = _icosphere(3)
+    surface = surface_smooth.SmoothSurface(0.05 * V, T, 0.012)
+    x = np.random.default_rng(3).uniform(-0.07, 0.07, (301, 3))
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        serial = surface.evaluate(x, hessian=True)
+        numba.set_num_threads(2)
+        threaded = surface.evaluate(x, hessian=True)
+    finally:
+        numba.set_num_threads(before)
+    assert (serial[3] > 0).sum() > 50
+    for a, b in zip(serial, threaded):
+        assert np.array_equal(a, b)

@@ -50,10 +50,23 @@ FAR_SLACK = 0.1
 """A far point's nearest centroid is looked up again once it has moved this fraction of its distance to it."""
 
 
-def _imls(x, p, nrm, area, grid, order, cell_start, hessian, phi, grad, H, W_out):
-    """(S1)-(S3) at the points ``x (n, 3)``: the facets ``order[cell_start[c]:cell_start[c + 1]]`` of the cells ``c``
-    around each point's cell (``grid = (lo_x, lo_y, lo_z, size, nx, ny, nz, h)``: cells of ``size >= h``, x fastest,
-    and the support radius ``h``)."""
+prange = range
+"""Loop over point blocks in :func:`_imls_blocks`; ``numba.prange`` in its threaded compiled twin."""
+
+PARALLEL_MIN_POINTS = 2000
+"""Fewest points for which :meth:`SmoothSurface.evaluate` runs its point blocks on numba's threads (as many blocks
+as ``numba.get_num_threads()``, which the explicit force's thread tuner sets); each point's sums are the same in
+either kernel, so the results do not depend on it."""
+
+
+def _imls(x, facets, hessian, out, start, stop):
+    """(S1)-(S3) at the points ``x[start:stop]`` of ``x (n, 3)`` into ``out = (phi (n,), grad (n, 3), H (n, 3, 3) or
+    (1, 3, 3) without ``hessian``, W (n,))``. ``facets = (p, nrm, area, grid, order, cell_start)``: centroids, unit
+    normals, areas, and the facets ``order[cell_start[c]:cell_start[c + 1]]`` of the cells ``c`` around each point's
+    cell (``grid = (lo_x, lo_y, lo_z, size, nx, ny, nz, h)``: cells of ``size >= h``, x fastest, and the support
+    radius ``h``)."""
+    p, nrm, area, grid, order, cell_start = facets
+    phi, grad, H, W_out = out
     lo0, lo1, lo2, size, h = grid[0], grid[1], grid[2], grid[3], grid[7]
     nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
     v = np.zeros(3)
@@ -61,7 +74,7 @@ def _imls(x, p, nrm, area, grid, order, cell_start, hessian, phi, grad, H, W_out
     gS = np.zeros(3)
     hW = np.zeros((3, 3))
     hS = np.zeros((3, 3))
-    for k in range(x.shape[0]):
+    for k in range(start, stop):
         W = 0.0
         S = 0.0
         gW[:] = 0.0
@@ -118,19 +131,35 @@ def _imls(x, p, nrm, area, grid, order, cell_start, hessian, phi, grad, H, W_out
                     H[k, a, b] = (hS[a, b] - f * hW[a, b] - grad[k, a] * gW[b] - gW[a] * grad[k, b]) / W
 
 
-_KERNEL = []
+def _imls_blocks(x, facets, hessian, out, blocks):
+    """:func:`_imls` over ``blocks`` contiguous blocks of the points ``x (n, 3)``, one block per loop pass."""
+    n = x.shape[0]
+    for b in prange(blocks):
+        _imls(x, facets, hessian, out, b * n // blocks, (b + 1) * n // blocks)
 
 
-def _kernel():
-    """:func:`_imls`, compiled by numba (cached) when it is installed."""
-    if not _KERNEL:
+_KERNELS = {}
+
+
+def _kernels():
+    """``{"serial": kernel, "parallel": kernel or None}``: :func:`_imls_blocks` compiled by numba (cached; the
+    threaded twin with ``prange`` as ``numba.prange``) when it is installed, else the Python function alone."""
+    if not _KERNELS:
         if numba_available():
+            import types
+
             import numba
 
-            _KERNEL.append(numba.njit(cache=True, nogil=True)(_imls))
+            scope = dict(globals())
+            scope["_imls"] = numba.njit(cache=True, nogil=True)(_imls)
+            for name, options in (("serial", {}), ("parallel", {"parallel": True})):
+                own = dict(scope, prange=numba.prange)
+                copy = types.FunctionType(_imls_blocks.__code__, own, "_imls_blocks")
+                copy.__qualname__ = "_imls_blocks_" + name  # numba's cache entry is named after it
+                _KERNELS[name] = numba.njit(cache=True, nogil=True, **options)(copy)
         else:
-            _KERNEL.append(_imls)
-    return _KERNEL[0]
+            _KERNELS.update(serial=_imls_blocks, parallel=None)
+    return _KERNELS
 
 
 class SmoothSurface:
@@ -188,7 +217,13 @@ class SmoothSurface:
         n = len(x)
         phi, grad, W = np.zeros(n), np.zeros((n, 3)), np.zeros(n)
         H = np.zeros((n, 3, 3) if hessian else (1, 3, 3))
-        _kernel()(x, self.p, self.n, self.area, self.grid, self.order, self.cell_start, hessian, phi, grad, H, W)
+        kernels, blocks = _kernels(), 1
+        if kernels["parallel"] is not None and n >= PARALLEL_MIN_POINTS:
+            import numba
+
+            blocks = numba.get_num_threads()
+        kernel = kernels["parallel"] if blocks > 1 else kernels["serial"]
+        kernel(x, (self.p, self.n, self.area, self.grid, self.order, self.cell_start), hessian, (phi, grad, H, W), blocks)
         return phi, grad, (H if hessian else None), W
 
 

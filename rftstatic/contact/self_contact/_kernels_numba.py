@@ -8,7 +8,8 @@ global names resolve to the compiled twins, so the loops call the compiled per-p
 :func:`.geometry.select_one` (``a if c else b``). Each loop inlines only functions of its own file, the
 one numba's cache is keyed on (its source hash), so that an edit of that file recompiles the loop.
 The key holds no compile options: after changing the ``njit`` options here, delete the index files
-``__pycache__/<module>.*.nbi`` of the three modules, or the old machine code is loaded again. Serial: the machines share their cores, and the loops are short next to the solver's. Imported only
+``__pycache__/<module>.*.nbi`` of the three modules, or the old machine code is loaded again. Serial: the machines share their cores, and the loops are short next to the solver's (the broad phase's join alone
+runs ranges of its boxes on threads for a large sheet, :func:`.broad_phase._join_on_threads`). Imported only
 when numba is installed and chosen (:func:`rftstatic.contact.self_contact.distance.compiled_for`).
 """
 

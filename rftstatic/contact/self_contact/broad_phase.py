@@ -202,8 +202,33 @@ def _find_pairs_compiled(prims, x0, radius, x1):
         entries = int(np.prod(c[b][1] - c[b][0] + 1, axis=1).sum())
         dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries, 1 << 16)
         cl = cell_list(c[b][0], c[b][1], dims, dense)
-        out.append(join(c[a][0], c[a][1], *box[a], na, c[b][0], *box[b], nb_, *cl, dims, dense, same))
+        args = (c[a][0], c[a][1], *box[a], na, c[b][0], *box[b], nb_, *cl, dims, dense, same)
+        out.append(_join_on_threads(join, args, len(na)))
     return Pairs(out[0], out[1])
+
+
+JOIN_THREADS_FROM = 4000
+"""Fewest boxes ``a`` for which the compiled join runs its ranges of ``a`` on threads (as many as numba's,
+``numba.get_num_threads()``, which the explicit force's thread tuner sets); the pairs come out the same."""
+
+_POOL = []
+
+
+def _join_on_threads(join, args, n):
+    """``join(*args, a0, a1)`` over ``0 <= a < n``, in contiguous ranges on threads for a large ``n`` (the kernel
+    holds no GIL), the ranges' pairs concatenated in order (so sorted as one call's)."""
+    import numba
+
+    threads = numba.get_num_threads() if n >= JOIN_THREADS_FROM else 1
+    if threads < 2:
+        return join(*args, 0, n)
+    if not _POOL or _POOL[0][0] < threads:
+        from concurrent.futures import ThreadPoolExecutor
+
+        _POOL[:] = [(threads, ThreadPoolExecutor(threads, thread_name_prefix="rftstatic-join"))]
+    cuts = [n * k // threads for k in range(threads + 1)]
+    parts = _POOL[0][1].map(lambda k: join(*args, cuts[k], cuts[k + 1]), range(threads))
+    return np.concatenate(list(parts))
 
 
 def _find_pairs_numpy(prims, x0, radius, x1):

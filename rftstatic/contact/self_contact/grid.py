@@ -97,16 +97,17 @@ def _grow(out, n):
     return bigger
 
 
-def join(c0a, c1a, lo_a, hi_a, nodes_a, c0b, lo_b, hi_b, nodes_b, ukey, start, members, dims, dense, same):
-    """Pairs ``(a, b) (Q, 2)``, sorted, of boxes ``a`` (cell ranges ``c0a, c1a``, bounds ``lo_a, hi_a``,
+def join(c0a, c1a, lo_a, hi_a, nodes_a, c0b, lo_b, hi_b, nodes_b, ukey, start, members, dims, dense, same,
+         a0, a1):
+    """Pairs ``(a, b) (Q, 2)``, sorted, of boxes ``a0 <= a < a1`` (cell ranges ``c0a, c1a``, bounds ``lo_a, hi_a``,
     nodes ``nodes_a (A, m)``) and ``b`` (the :func:`cell_list` of ``c0b``; bounds, ``nodes_b (B, n)``)
     that overlap and share no node; ``same``: both are one kind, only ``a < b``. Compiled only (its numpy
     path is :func:`.broad_phase._join`): a numba kernel on flat arrays, the exception to the rule of at
-    most 12 parameters."""
-    out = np.empty((4 * c0a.shape[0] + 16, 2), dtype=np.int64)
+    most 12 parameters; it holds no GIL, so ranges of ``a`` can run on threads."""
+    out = np.empty((4 * (a1 - a0) + 16, 2), dtype=np.int64)
     found = np.empty(64, dtype=np.int64)
     n = 0
-    for a in range(c0a.shape[0]):
+    for a in range(a0, a1):
         nf = 0
         for iz in range(c0a[a, 2], c1a[a, 2] + 1):
             for iy in range(c0a[a, 1], c1a[a, 1] + 1):

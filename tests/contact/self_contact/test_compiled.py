@@ -64,9 +64,16 @@ def test_additive_ccd_agrees(random_pairs, monkeypatch, kind, size):
     assert c == a and e == pytest.approx(a, rel=1e-12)
 
 
-def test_broad_phase_agrees_on_a_folded_crumpled_sheet(monkeypatch):
-    from rftstatic.bench.self_contact import crumpled, smooth_step
+@pytest.mark.parametrize("threads", [1, 2])
+def test_broad_phase_agrees_on_a_folded_crumpled_sheet(monkeypatch, threads):
+    # threads: the compiled join over ranges of boxes on two threads gives the same sorted pairs
+    import numba
 
+    from rftstatic.bench.self_contact import crumpled, smooth_step
+    from rftstatic.contact.self_contact import broad_phase
+
+    monkeypatch.setattr(broad_phase, "JOIN_THREADS_FROM", 1)
+    monkeypatch.setattr(numba, "get_num_threads", lambda: threads)
     mesh, X = crumpled(31)
     X[X[:, 0] > 0.4, 2] += 0.004
     prims = SheetPrimitives.of_mesh(mesh)
