@@ -72,7 +72,7 @@ from rftstatic.post.measures.boundary import boundary_loop, fold_count
 from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
 from rftstatic.post.measures.shadow import shadow_area
 
-__all__ = ["run", "dressed_mesh", "dress_form", "write_obj", "read_obj_uv", "BODY_KEYS"]
+__all__ = ["run", "resume_scene", "dressed_mesh", "dress_form", "write_obj", "read_obj_uv", "BODY_KEYS"]
 
 log = logging.getLogger(__name__)
 
@@ -374,9 +374,11 @@ def _level_row(scene, h, mesh, closing) -> dict:
             "time": closing.time, "steps": closing.steps, "wall_time": closing.wall_time}
 
 
-def run(scene, out: Path, *, progress=True, figures=True):
+def run(scene, out: Path, *, progress=True, figures=True, resume=False):
     """Dress the scene's form with its garment (module docstring); write the outputs; return the
-    :class:`~rftstatic.app.result.RunResult` (its summary with the ``garment`` measures)."""
+    :class:`~rftstatic.app.result.RunResult` (its summary with the ``garment`` measures). ``resume``: the static
+    solve continues from ``out/checkpoint.npz`` (:func:`rftstatic.app.static.run`); the mesh, the contact surface
+    and the seams' closing before it are made again (they are the same for the same scene)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     u = scene.units.length
@@ -403,7 +405,7 @@ def run(scene, out: Path, *, progress=True, figures=True):
     solved = type(scene)(data, scene.path, scene.name, scene.overrides)
     # the start is checked against the form itself above: the contact surface, grown by the clearance, is cut by
     # the garment's flat triangles between their nodes by up to their sag (which the clearance is for)
-    result = static.run(solved, out, progress=progress, figures=figures, mesh=mesh, start_check=False)
+    result = static.run(solved, out, progress=progress, figures=figures, resume=resume, mesh=mesh, start_check=False)
     model, U = result.model, result.U
     hem = _hem(model.mesh, model.positions(U))
     garment = _garment_measures(scene, model, U, pmesh, hem, closing)
@@ -425,3 +427,9 @@ def run(scene, out: Path, *, progress=True, figures=True):
     result.summary = summary
     log.info("garment: hem drape coefficient %.3f, %d hem nodes", garment["hem_drape_coefficient"], len(hem))
     return result
+
+
+def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
+    """Continue the garment run of ``scene`` from ``out_dir/checkpoint.npz`` (``case NAME --resume``): the sewing
+    is done again, the static solve goes on from its checkpoint (:func:`run`)."""
+    return run(scene, Path(out_dir), progress=progress, figures=figures, resume=True).summary

@@ -57,11 +57,29 @@ def static_fingerprint(model) -> str:
     load, material, element) and the penalty contact (obstacles, stiffness, smoothing) and potential loads."""
     h = hashlib.sha1(model_fingerprint(model).encode())
     c = model.contact
-    contact = None if c is None else {"obstacles": [ob.as_dict() for ob in c.obstacles], "stiffness": c.stiffness,
-                                      "smoothing": c.smoothing}
+    contact = None if c is None else {"obstacles": [_by_content(ob.as_dict()) for ob in c.obstacles],
+                                      "stiffness": c.stiffness, "smoothing": c.smoothing}
     h.update(json.dumps([contact, [type(t).__name__ for t in model.load_terms]], sort_keys=True,
                         default=plain).encode())
     return h.hexdigest()
+
+
+def _by_content(spec: dict) -> dict:
+    """An obstacle's ``spec`` with its mesh files (``path``, ``paths``) named by the SHA-1 of their bytes: a run
+    continued in another folder (a finished run's, after its ``.partial`` folder was published) reads the same
+    surface from another path."""
+    def digest(name):
+        try:
+            return hashlib.sha1(Path(name).read_bytes()).hexdigest()
+        except (OSError, TypeError):
+            return name
+
+    out = dict(spec)
+    if isinstance(out.get("path"), str):
+        out["path"] = digest(out["path"])
+    if isinstance(out.get("paths"), (list, tuple)):
+        out["paths"] = [digest(p) for p in out["paths"]]
+    return out
 
 
 def options_spec(options) -> dict:

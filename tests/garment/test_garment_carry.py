@@ -49,3 +49,8 @@ def test_a_coarse_circle_skirt_drape_is_held_on_a_finer_mesh(tmp_path):
     table = carry_drape(load_scene("skirt-circle"), out, 6.0, out=tmp_path / "carry", h=5.0)
     assert table["converged"] and table["stable_minimum"]
     assert table["folds_carried"] == own["garment"]["hem_folds"] == table["hem_folds"]
+    # --resume continues a garment run from its checkpoint (here the converged state: the same drape at once)
+    assert main(["case", "skirt-circle", "--out", str(out), "--no-figures", "--set", "garment.h=6", "--resume"]) == 0
+    again = json.loads((out / "summary.json").read_text())
+    assert again["garment"]["hem_folds"] == own["garment"]["hem_folds"] and again["converged"]
+    assert again["energies"]["total"] == pytest.approx(own["energies"]["total"], rel=1e-9)
