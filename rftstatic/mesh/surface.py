@@ -30,8 +30,13 @@ DEGENERATE_AREA = 1e-14
 """A triangle is degenerate when its area is below this fraction of the squared bounding-box diagonal."""
 
 
+_READ = {}
+"""The last files :func:`read_triangles` read, by (path, size, modification time, quads): a run reads its body
+mesh for the solve, the crossing check, the figures and the view (0.5 s per read of the dress form's OBJ)."""
+
+
 def read_triangles(path, *, quads: str = "refuse") -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """Read a triangle surface with meshio.
+    """Read a triangle surface with meshio (a file read before and unchanged since: from memory, as copies).
 
     Parameters
     ----------
@@ -49,6 +54,26 @@ def read_triangles(path, *, quads: str = "refuse") -> tuple[np.ndarray, np.ndarr
     MeshError
         An unreadable or empty file, no triangles, other cells, node indices out of range, NaN or inf.
     """
+    import os
+
+    try:
+        stat = os.stat(path)
+        key = (os.path.realpath(path), stat.st_size, stat.st_mtime_ns, quads)
+    except OSError:
+        key = None
+    if key in _READ:
+        P, tri, notes = _READ[key]
+        return P.copy(), tri.copy(), list(notes)
+    P, tri, notes = _read_triangles(path, quads)
+    if key is not None:
+        if len(_READ) >= 4:
+            _READ.pop(next(iter(_READ)))
+        _READ[key] = (P.copy(), tri.copy(), list(notes))
+    return P, tri, notes
+
+
+def _read_triangles(path, quads):
+    """:func:`read_triangles` from the file."""
     import meshio
 
     try:
