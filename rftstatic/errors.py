@@ -55,6 +55,12 @@ class ConvergenceError(RuntimeError):
         self.result = result
 
 
+class FallError(RuntimeError):
+    """A dynamic relaxation whose sheet falls away: nothing holds it
+    (:data:`rftstatic.solvers.relaxation.FALL_DIAGONALS`); the static route turns it into a
+    :class:`ConvergenceError`."""
+
+
 class InstabilityError(RuntimeError):
     """The explicit run became unstable; attributes ``t``, ``step``, ``dt`` and ``suggested_dt`` [s]."""
 

@@ -14,7 +14,7 @@ import numpy as np
 from rftstatic.contact.friction import held_by_contacts, obstacle_holds, seated
 from rftstatic.contact.self_contact.friction import pair_holds
 from rftstatic.element.explicit_force import BACKENDS
-from rftstatic.errors import ParameterError
+from rftstatic.errors import FallError, ParameterError
 from rftstatic.model.state import State
 from rftstatic.solvers.damping import DAMPINGS
 from rftstatic.solvers.drive import finish
@@ -25,6 +25,12 @@ from rftstatic.solvers.step_plan import MAX_STEPS_KEY
 from rftstatic.solvers.timestep import lumped_mass
 
 log = logging.getLogger(__name__)
+
+FALL_DIAGONALS = 3.0
+"""A relaxation stops with a :class:`~rftstatic.errors.FallError` once the sheet's mass centre has moved this many
+of its reference diagonals along the load from the reference (:func:`_fall_guard`): a drape hangs within about
+one diagonal of where it was placed, so a sheet that far away is falling with nothing to hold it (a garment slid
+off its form: a limp circle skirt, fabric F of validation/garments.md, went 14 m down in the 177 s of its route)."""
 
 @dataclass
 class RelaxResult:
@@ -136,8 +142,9 @@ def relax_steps(model, state: State, options: RelaxOptions, *, given_velocity: b
         at_rest.resume_from(saved["history"])
     elif not given_velocity and getattr(model.contact, "friction", None) is not None:  # thrown off, it would slide
         state.U += (seated(model.contact, model.positions(state.U), P) - model.positions(state.U)) * model.free
+    rest = _fall_guard(model, _held_rest(model, state, at_rest, P, options.mass_scale), P)
     run = yield from explicit_steps(model, state, options.explicit(given_velocity=given_velocity), obstacles=obstacles,
-                                    load=load, callback=_held_rest(model, state, at_rest, P, options.mass_scale))
+                                    load=load, callback=rest)
     state.route.pop(FRICTION_REST, None)
     if not run.stopped:  # the caller decides what follows (the static route relaxes on or hands over)
         log.info("dynamic relaxation not at rest after %.4g s (%d steps): kinetic %.3e J, |r| %.3e N",
@@ -149,6 +156,32 @@ def relax_steps(model, state: State, options: RelaxOptions, *, given_velocity: b
 FRICTION_REST = "relax-friction-rest"
 """Key in ``State.route`` of the peaks of a frictional relaxation's rest test (:func:`_held_rest`), so that a resumed
 run tests as the uninterrupted one did (its history holds the frictionless measures)."""
+
+
+def _fall_guard(model, test, P):
+    """The rest test ``test`` of a relaxation under the load ``P (N, 3)`` [N], which first raises a
+    :class:`~rftstatic.errors.FallError` at a sample where the sheet's mass centre lies more than
+    :data:`FALL_DIAGONALS` reference diagonals from the reference along the load's resultant (a sheet with no
+    resultant load is not tested)."""
+    resultant = np.where(model.free, P, 0.0).sum(axis=0)
+    size = float(np.linalg.norm(resultant))
+    if not size > 0.0:
+        return test
+    down = resultant / size
+    share = model.mesh.node_area / model.mesh.node_area.sum()
+    X = model.X3
+    limit = FALL_DIAGONALS * float(np.linalg.norm(X.max(axis=0) - X.min(axis=0)))
+
+    def guarded(st, sample):
+        drop = float(share @ (st.U @ down))
+        if drop > limit:
+            raise FallError(f"the sheet fell: its mass centre is {drop:.3g} m from where it was placed, along the "
+                            f"load (more than {FALL_DIAGONALS:g} of its diagonals, {limit:.3g} m), after {st.t:.3g} s: "
+                            "nothing holds it. Check the supports and obstacles; a garment slid off its form: give it "
+                            "friction ([contact] friction, e.g. 0.3) or a pattern that fits the body closer")
+        return test(st, sample)
+
+    return guarded
 
 
 def _held_rest(model, state, at_rest: AtRest, P, mass_scale):

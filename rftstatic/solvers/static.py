@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rftstatic.errors import ConvergenceError, InstabilityError, ParameterError, StepLimitError
+from rftstatic.errors import ConvergenceError, FallError, InstabilityError, ParameterError, StepLimitError
 from rftstatic.model.state import State
 from rftstatic.solvers import friction_lag
 from rftstatic.solvers.checkpoint import as_state
@@ -432,8 +432,8 @@ def _relax_segment(model, opts, plan, route, fail, state, t0):
             max_time=span if saved is None else float(saved["options"]["t_end"]), progress=opts.progress,
             max_steps=RELAX_SEGMENT_STEPS, max_steps_name="the relaxation route's segment limit"),
             given_velocity=route.V is not None, peak_kinetic=route.peak)
-    except InstabilityError as exc:
-        raise fail(f"dynamic relaxation became unstable ({exc})") from None
+    except (InstabilityError, FallError) as exc:
+        raise fail(str(exc) if isinstance(exc, FallError) else f"dynamic relaxation became unstable ({exc})") from None
     except StepLimitError as exc:  # the stable step at this state collapsed (a stretched start)
         raise fail(f"dynamic relaxation cannot go on from t = {route.t_used:.3g} s: {exc}") from None
     del state.route[SEGMENT]

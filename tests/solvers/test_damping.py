@@ -148,3 +148,19 @@ def test_friction_relaxes_with_viscous_damping(monkeypatch):
     assert static._relax_plan(mod, None, "fire").damping == "fire"
     monkeypatch.setattr(friction_lag, "active", lambda model: True)
     assert static._relax_plan(mod, None, "fire").damping == "viscous"
+
+
+def test_a_sheet_that_nothing_holds_stops_as_a_fall():
+    """The wool strip with no support under its weight: the relaxation stops with a FallError once its mass centre
+    is FALL_DIAGONALS reference diagonals below the reference (instead of relaxing to its time limit); the
+    clamped strip (test_velocity_law_relaxes_to_the_static_solution) is at rest within a diagonal."""
+    from rftstatic.errors import FallError
+    from rftstatic.model.model import Model
+    from rftstatic.solvers.relaxation import FALL_DIAGONALS
+
+    held = strip()
+    free = Model(held.mesh, WOOL, element="RFT6", load=held.load)
+    with pytest.raises(FallError, match="the sheet fell") as info:
+        _relax(free, "viscous")
+    diagonal = float(np.linalg.norm(np.ptp(held.X3, axis=0)))
+    assert f"{FALL_DIAGONALS * diagonal:.3g} m" in str(info.value)
