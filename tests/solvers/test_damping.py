@@ -142,12 +142,13 @@ def test_friction_relaxes_with_viscous_damping(monkeypatch):
     """With Coulomb friction the relaxation keeps the mass damping (its rest test measures the impulses' leftover
     velocities): the route's plan takes the law only without friction."""
     from rftstatic.bench.problems import strip_model
-    from rftstatic.solvers import friction_lag, static
+    from rftstatic.solvers import friction_lag
+    from rftstatic.solvers.relax_plan import relax_plan
 
     mod = strip_model(11, 3)
-    assert static._relax_plan(mod, None, "fire").damping == "fire"
+    assert relax_plan(mod, None, "fire").damping == "fire"
     monkeypatch.setattr(friction_lag, "active", lambda model: True)
-    assert static._relax_plan(mod, None, "fire").damping == "viscous"
+    assert relax_plan(mod, None, "fire").damping == "viscous"
 
 
 def test_a_sheet_that_nothing_holds_stops_as_a_fall():
@@ -164,3 +165,23 @@ def test_a_sheet_that_nothing_holds_stops_as_a_fall():
         _relax(free, "viscous")
     diagonal = float(np.linalg.norm(np.ptp(held.X3, axis=0)))
     assert f"{FALL_DIAGONALS * diagonal:.3g} m" in str(info.value)
+
+
+def test_a_relaxation_segment_that_goes_unstable_runs_again_with_a_shorter_step(monkeypatch):
+    """The explicit step taken 3 x the stable one (a stiffness the estimate leaves out): the route's segment goes
+    unstable, runs again from its start with the step the explicit run names (twice: 1.5 x, then 0.75 x the stable
+    step), and ends at the load steps' Newton solution; the cuts are in the route's record."""
+    from dataclasses import replace
+
+    from rftstatic.bench.problems import strip_model
+    from rftstatic.solvers import static, step_plan
+
+    real = step_plan.stable_time_step
+    monkeypatch.setattr(step_plan, "stable_time_step", lambda *a, **k: replace(real(*a, **k), dt=3 * real(*a, **k).dt))
+    mod = strip_model(11, 3)
+    a = static.solve_static(mod, options=static.StaticOptions(progress=False))
+    b = static.solve_static(mod, options=static.StaticOptions.from_keys(progress=False, start="relax"))
+    cuts = b.relax["step_cuts"]
+    assert len(cuts) == 2 and cuts[1]["new_dt_s"] == pytest.approx(0.25 * cuts[0]["dt_s"])
+    assert b.relax["dt_s"] == cuts[1]["new_dt_s"]
+    assert np.abs(a.U - b.U).max() < 1e-6 * np.abs(a.U).max()
