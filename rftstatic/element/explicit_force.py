@@ -77,6 +77,7 @@ class ForceKernel:
         self._bend_energy = 0.0 if self._bend_offset is None else 0.5 * float(np.einsum("ni,ni->", self.X3,
                                                                                           self._bend_offset))
         self.threads = 1
+        self.hinges = getattr(model, "hinges", None)
         self.bending_friction = getattr(model, "bending_friction", None)
         if self.bending_friction is not None:  # the bending friction's scatter
             self._patch_dofs = (3 * self.bending_friction.nodes[..., None] + np.arange(3)).ravel()
@@ -147,6 +148,10 @@ class ForceKernel:
             Wf, fe, _ = self.bending_friction.evaluate(Ub, self.X3 + U, held)
             f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
             W += Wf if energy else 0.0
+        if self.hinges is not None:
+            x = self.X3 + U
+            f += self.hinges.force(x)
+            W += self.hinges.energy(x) if energy else 0.0
         for term in self.load_terms:  # potential loads at load factor 1 (the explicit loads act in full)
             x = self.X3 + U
             f += term.force(x)

@@ -8,7 +8,8 @@ The quadratic fit of Eq. 2, ``w = c1 + c2 x + c3 y + c4 x^2/2 + c5 y^2/2 + c6 xy
 local coordinates centred on the element and scaled by its size so that C (Eq. 2) stays well
 conditioned; L, the lower half of C^-1, maps the six nodal values to (w_xx, w_yy, 2 w_xy) (Eq. 3).
 
-Where an edge a-b of element c-a-b has no neighbour, the missing patch node is an *image node* at
+Where an edge a-b of element c-a-b has no neighbour (or is a fold edge, :mod:`rftstatic.mesh.folds`, where the
+crease's hinge carries the bending across, :mod:`rftstatic.element.hinge`), the missing patch node is an *image node* at
 X_img = X_a + X_b - X_c (Fig. 4b) whose displacement is a fixed combination of real nodes:
   - free edge:    U_img = U_a + U_b - U_c  (linear across the edge: no moment across it);
   - clamped edge: U_img = U_c              (mirror: zero slope), when both a and b are clamped.
@@ -83,7 +84,7 @@ def build_patches(mesh: TriMesh, *, clamped_nodes=None, check=True) -> Patches:
     """
     tri = mesh.tri
     topo = mesh.topology
-    has_opp = ~topo.is_boundary
+    has_opp = ~topo.is_boundary & ~mesh.fold_mask  # a fold edge ends the patch (rftstatic.mesh.folds)
     nb = np.maximum(topo.neighbour, 0)
     opp_real = tri[nb, np.maximum(topo.neighbour_vertex, 0)]  # (E, 3)
     # image node coordinates X_a + X_b - X_c for edge k (a, b = the other two vertices, c = vertex k)

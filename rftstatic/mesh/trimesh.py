@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from rftstatic.errors import MeshError
+from rftstatic.mesh.folds import FoldLines, fold_edge_mask
 from rftstatic.mesh.topology import EdgeTopology, edge_topology
 
 PATTERNS = ("right", "left", "alternate", "union-jack")
@@ -50,6 +51,8 @@ class TriMesh:
     placed : (N, 3) reference positions in space [m] that displacements are measured from, with
         ``element_X``: the panels as placed around the body, or a sewn garment's state where a stage starts
         (:attr:`X3`). None: ``(X, z0)``
+    folds : creased edges (:class:`rftstatic.mesh.folds.FoldLines`): the RF patches end there and hinges hold
+        the crease (:mod:`rftstatic.element.hinge`); None: the sheet is smooth across every interior edge
     """
 
     X: np.ndarray
@@ -59,6 +62,7 @@ class TriMesh:
     info: dict = field(default_factory=dict)
     element_X: np.ndarray | None = None
     placed: np.ndarray | None = None
+    folds: FoldLines | None = None
 
     def __post_init__(self):
         X = np.ascontiguousarray(self.X, dtype=float)
@@ -99,6 +103,8 @@ class TriMesh:
         object.__setattr__(self, "X", X)
         object.__setattr__(self, "tri", tri)
         self.topology  # noqa: B018 -- validates the edge structure now (non-manifold edges)
+        if self.folds is not None:
+            self.fold_mask  # noqa: B018 -- every fold edge an interior edge of the mesh
 
     def _check_sewn(self, X, tri):
         """Shapes and values of ``element_X`` and ``placed`` (given together)."""
@@ -113,6 +119,11 @@ class TriMesh:
             raise MeshError("element_X or placed contains non-finite coordinates")
         object.__setattr__(self, "element_X", ex)
         object.__setattr__(self, "placed", pl)
+
+    @cached_property
+    def fold_mask(self) -> np.ndarray:
+        """(E, 3) bool: local edge k of element e is a fold edge (:attr:`folds`)."""
+        return fold_edge_mask(self.topology, self.folds, self.n_nodes)
 
     @cached_property
     def chart_is_flat(self) -> bool:

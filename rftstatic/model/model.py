@@ -7,7 +7,9 @@ contact term. Its methods evaluate, for a displacement field ``U (N, 3)`` [m] an
 
     Pi(U) = E_b + E_m + E_c + E_s - lam P . U,
 
-``E_s`` the self-contact energy (:class:`rftstatic.contact.self_contact.law.SelfContact`, optional); with bending
+E_b holds the hinges of the mesh's creases (``mesh.folds``, attribute ``hinges``:
+:class:`rftstatic.element.hinge.FoldHinges`), ``E_s`` is the self-contact energy
+(:class:`rftstatic.contact.self_contact.law.SelfContact`, optional); with bending
 hysteresis (``material.hysteresis``, attribute ``friction``: :class:`rftstatic.element.hysteresis.BendingFriction`)
 E_b also holds the friction's incremental potential at the committed slip (``State.bending_slip``, keyword ``slip``),
 
@@ -27,6 +29,7 @@ import numpy as np
 
 from rftstatic.compiled import choose_kernels
 from rftstatic.element.curvature import curvature_norm
+from rftstatic.element.hinge import fold_hinges
 from rftstatic.element.hysteresis import bending_friction
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
@@ -155,6 +158,7 @@ class Model(Frozen):
         self.free = ~self.fixed
         self.patches = build_patches(mesh, clamped_nodes=self.supports.clamped)
         self.Kb = bending_stiffness(mesh, self.patches, material.Db)
+        self.hinges = fold_hinges(mesh, material.Db)  # the creases of mesh.folds (rftstatic.element.hinge), or None
         self.membrane = membrane_operator(element, mesh, self.patches)
         h = material.hysteresis
         self.bending_friction = (None if h is None or h.M0_warp == h.M0_weft == 0.0 else bending_friction(
@@ -180,7 +184,7 @@ class Model(Frozen):
     # --- constant structures, built on first use ------------------------------------------------
     @cached_property
     def plan(self) -> AssemblyPlan:
-        couplings = [t.couplings() for t in self.load_terms if hasattr(t, "couplings")]
+        couplings = [t.couplings() for t in (*self.load_terms, self.hinges) if hasattr(t, "couplings")]
         return AssemblyPlan(self.patches.nodes, self.mesh.n_nodes, self.free,
                             couplings=np.concatenate(couplings) if couplings else None)
 
@@ -231,6 +235,8 @@ class Model(Frozen):
         Eb = 0.5 * float(np.einsum("ni,ni->", Ub, self.Kb @ Ub))
         if self.bending_friction is not None:
             Eb += self._friction(U, slip)[0]
+        if self.hinges is not None:
+            Eb += self.hinges.energy(self.positions(U))
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
         Es = (self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).energy
@@ -273,6 +279,8 @@ class Model(Frozen):
         f = self.Kb @ self.bending_displacement(U)
         if self.bending_friction is not None:
             f += scatter_forces(self.patches.nodes, self._friction(U, slip)[1], self.mesh.n_nodes)
+        if self.hinges is not None:
+            f += self.hinges.force(self.positions(U))
         if self.with_membrane:
             fe = self.membrane.element_forces(U, self.material.Dm, backend=self.membrane_backend)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
@@ -310,6 +318,10 @@ class Model(Frozen):
             _, fe, ke = self._friction(U, slip, tangent=True, psd=psd)
             f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
             data += scatter_matrices(self._patch_map, ke, plan.nnz)
+        if self.hinges is not None:
+            f += self.hinges.force(x)
+            rows, cols, blocks = self.hinges.tangent_blocks(x, psd=psd)
+            data += scatter_matrices(plan.positions(rows, cols), blocks, plan.nnz)
         if self.with_membrane:
             fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress,
                                              backend=self.membrane_backend)
