@@ -36,7 +36,9 @@ by a ``fixed`` ``[[supports]]`` component at one waist node.
 
 Measures added to ``summary.json`` (``garment``): the pattern's panels and seams, the largest seam gap at the
 start of the closing and when the seams were merged, the closing's simulated time, explicit steps and wall time,
-the nodes removed by merging, hem nodes (the lowest boundary loop), the hem's folds (the node count of
+the nodes removed by merging, hem nodes (the lowest boundary loop of the garment without the panels turned back at
+``fold`` seams, so a turned-up hem's crease), the creases' distance from their rest angle (``crease_edges``,
+``crease_off_rest_mean_deg``, ``crease_off_rest_max_deg``: :mod:`rftstatic.element.hinge`), the hem's folds (the node count of
 :func:`rftstatic.post.measures.boundary.fold_count` on the outline seen from above, about the form's axis, as for a
 Cusick specimen), the hem's drape coefficient
 ``A_shadow / A_flat``: the area of the draped skirt's vertical projection (:func:`rftstatic.post.measures.shadow.shadow_area`,
@@ -64,10 +66,11 @@ from rftstatic.app import static
 from rftstatic.contact.obstacles.surface_mesh import SurfaceObstacle
 from rftstatic.garment.body import DressForm
 from rftstatic.garment.meshing import check_placement, mesh_pattern, place
-from rftstatic.garment.sewing import (SEAM_STIFFNESS, ClosingResult, carry_closed, close_seams, panel_mesh, seam_pairs,
-                                     sew)
+from rftstatic.garment.sewing import (SEAM_STIFFNESS, ClosingResult, carry_closed, close_seams, fold_chains,
+                                     panel_mesh, seam_pairs, sew, turned_back)
 from rftstatic.garment.readers import read_pattern
 from rftstatic.io.files import to_jsonable, write_json, write_vtu
+from rftstatic.mesh.topology import edge_topology
 from rftstatic.post.measures.boundary import boundary_loop, fold_count
 from rftstatic.post.measures.obstacle_crossings import obstacle_crossings
 from rftstatic.post.measures.shadow import shadow_area
@@ -209,14 +212,17 @@ def read_obj_uv(path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     return np.array(v), np.array(vt), np.array(f, dtype=np.int64), np.array(ft, dtype=np.int64)
 
 
-def _hem(mesh, x) -> np.ndarray:
-    """Nodes of the hem of a skirt hanging at positions ``x (N, 3)`` [m]: the boundary loop of ``mesh`` lowest on
-    average."""
+def _hem(tri, x) -> np.ndarray:
+    """Nodes of the hem of a skirt of triangles ``tri (E, 3)`` hanging at positions ``x (N, 3)`` [m]: the boundary
+    loop lowest on average (a folded hem's crease, when ``tri`` leaves out the facing turned back,
+    :func:`rftstatic.garment.sewing.turned_back`)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    boundary = mesh.boundary_edges
-    n = mesh.n_nodes
+    n = len(x)
+    topo = edge_topology(tri, n)
+    e, k = np.nonzero(topo.is_boundary)
+    boundary = np.stack([tri[e, (k + 1) % 3], tri[e, (k + 2) % 3]], axis=1)
     g = coo_matrix((np.ones(len(boundary)), (boundary[:, 0], boundary[:, 1])), shape=(n, n))
     _, label = connected_components(g, directed=False)
     nodes = np.unique(boundary)
@@ -226,11 +232,12 @@ def _hem(mesh, x) -> np.ndarray:
     return nodes[label[nodes] == lowest]
 
 
-def hem_folds(mesh, x) -> int | None:
+def hem_folds(mesh, x, tri=None) -> int | None:
     """The hem's folds of the garment ``mesh`` at positions ``x (N, 3)`` [m]: the node count of its outer boundary
-    seen from above, about the form's axis (as a Cusick specimen's); None when it does not surround the axis."""
+    seen from above, about the form's axis (as a Cusick specimen's); None when it does not surround the axis.
+    ``tri``: the garment's outer triangles (default all; :func:`_hem`)."""
     try:
-        return fold_count(x, boundary_loop(mesh.tri, x), (0.0, 0.0)).count
+        return fold_count(x, boundary_loop(mesh.tri if tri is None else tri, x), (0.0, 0.0)).count
     except ValueError:
         return None
 
@@ -240,7 +247,7 @@ def garment_h(scene) -> float:
     return _size(scene, "garment.h")
 
 
-def _garment_measures(scene, model, U, pmesh, hem, closing) -> dict:
+def _garment_measures(scene, model, U, pmesh, hem, closing, outer) -> dict:
     """The ``garment`` table of the summary (scene units; module docstring)."""
     u = scene.units.length
     x = model.positions(U)
@@ -251,13 +258,18 @@ def _garment_measures(scene, model, U, pmesh, hem, closing) -> dict:
     if closing is not None:
         sewing = {"largest_seam_gap": closing.largest_gap / u, "largest_seam_gap_start": closing.largest_gap_start / u,
                   "closing_time": closing.time, "closing_steps": closing.steps, "closing_wall_time": closing.wall_time}
-    folds = hem_folds(model.mesh, x)
+    folds = hem_folds(model.mesh, x, outer)
+    creases = {}
+    if model.hinges is not None:  # fold seams: how far the creases sit from their rest angle
+        off = np.degrees(np.abs(model.hinges.excess(x)))
+        creases = {"crease_edges": len(model.hinges), "crease_off_rest_mean_deg": float(off.mean()),
+                   "crease_off_rest_max_deg": float(off.max())}
     return {"pattern": Path(pmesh.pattern.source).name, "panels": len(pmesh.meshes), "hem_folds": folds,
             "seams": len(pmesh.pattern.seams), **sewing, "hem_nodes": int(len(hem)),
             "nodes_sewn": int(model.mesh.info.get("sewn_from_nodes", model.mesh.n_nodes) - model.mesh.n_nodes),
             "mean_element_size": float(model.mesh.element_size.mean()) / u, "flat_area": flat / u**2,
             "shadow_area": shadow / u**2, "hem_drape_coefficient": shadow / flat,
-            "hem_lowest": float(x[hem, 2].min()) / u, "hem_highest": float(x[hem, 2].max()) / u}
+            "hem_lowest": float(x[hem, 2].min()) / u, "hem_highest": float(x[hem, 2].max()) / u, **creases}
 
 
 def _closing_scene(scene, data):
@@ -399,7 +411,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False):
                               "or check that the body does not hold them apart (the contact surface lies "
                               f"{clearance / u:.3g} {scene.units.name.split('-')[0]} outside the form at this mesh "
                               "size: a finer garment.h brings it closer)")
-        mesh, _ = sew(mesh, pairs, closing.x, where=Path(pmesh.pattern.source).name)
+        mesh, _ = sew(mesh, pairs, closing.x, where=Path(pmesh.pattern.source).name, folds=fold_chains(pmesh))
     P, T = form.surface()
     _check_off_form(scene, (P, T), mesh, "as placed and sewn")
     solved = type(scene)(data, scene.path, scene.name, scene.overrides)
@@ -407,8 +419,9 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False):
     # the garment's flat triangles between their nodes by up to their sag (which the clearance is for)
     result = static.run(solved, out, progress=progress, figures=figures, resume=resume, mesh=mesh, start_check=False)
     model, U = result.model, result.U
-    hem = _hem(model.mesh, model.positions(U))
-    garment = _garment_measures(scene, model, U, pmesh, hem, closing)
+    outer = model.mesh.tri[~turned_back(pmesh)]  # a hem's facing turned back inside is not the garment's outline
+    hem = _hem(outer, model.positions(U))
+    garment = _garment_measures(scene, model, U, pmesh, hem, closing, outer)
     body = obstacle_crossings(model.positions(U), model.mesh.tri, P, T)
     garment.update({"contact_clearance": clearance / u, "contact_smoothing": table["smooth_m"] / u,
                     "body_crossing_pairs": body["pairs"], "closing_levels": levels,

@@ -174,7 +174,10 @@ class Panel:
 class Seam:
     """Two panel edges joined: edge ``a_edge`` of panel ``a_panel`` and edge ``b_edge`` of ``b_panel``.
 
-    ``orientation`` is one of :data:`ORIENTATIONS`, ``kind`` one of :data:`SEAM_KINDS`.
+    ``orientation`` is one of :data:`ORIENTATIONS`, ``kind`` one of :data:`SEAM_KINDS`. A ``fold`` seam is a crease
+    (a hem: side b is the part turned back, e.g. the hem's facing) with the rest dihedral ``angle`` [deg] across it
+    (180: turned back flat onto side a) and the crease's ``width`` [m] (None: the elements' height at the seam;
+    :mod:`rftstatic.element.hinge`).
     """
 
     a_panel: str
@@ -183,6 +186,8 @@ class Seam:
     b_edge: int
     orientation: str = "reversed"
     kind: str = "sew"
+    angle: float = 180.0
+    width: float | None = None
 
     def label(self):
         return f"{self.a_panel}:{self.a_edge} -- {self.b_panel}:{self.b_edge}"
@@ -320,6 +325,11 @@ def _check_seams(pattern, src):
             raise PatternError(f"{where}: kind {seam.kind!r}; use one of {SEAM_KINDS}")
         if seam.orientation not in ORIENTATIONS:
             raise PatternError(f"{where}: orientation {seam.orientation!r}; use one of {ORIENTATIONS}")
+        if not (isinstance(seam.angle, (int, float)) and 0 < seam.angle <= 180):
+            raise PatternError(f"{where}: fold angle = {seam.angle!r}; give the crease's rest angle in (0, 180] deg "
+                               "(180: turned back flat)")
+        if seam.width is not None and not (isinstance(seam.width, (int, float)) and 0 < seam.width < np.inf):
+            raise PatternError(f"{where}: fold width = {seam.width!r}; give a length > 0 or leave it out")
         lengths = []
         for name, k in ((seam.a_panel, seam.a_edge), (seam.b_panel, seam.b_edge)):
             if name not in index:

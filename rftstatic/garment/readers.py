@@ -48,6 +48,8 @@ TOML form
     b = "back:3"
     orientation = "reversed"          # or "aligned" (default "reversed")
     kind = "sew"                      # "sew", "fold" or "open" (default "sew")
+    angle = 180                       # fold seams: the crease's rest angle [deg] (default 180: turned back)
+    width = 0.5                       # fold seams: the crease's width, in `units` (default: the elements' height)
 
 An arc's ``side`` says on which side of its chord (vertex k -> k+1) the arc's midpoint lies;
 ``large = true`` takes the arc longer than half the circle. A loop of two vertices whose two edges
@@ -212,7 +214,7 @@ def _gc_stitch(spec, k, where):
 _TOP = {"units", "name", "panels", "seams"}
 _PANEL = {"name", "vertices", "holes", "arcs", "grain", "translate", "rotate"}
 _ARC = {"edge", "radius", "side", "large"}
-_SEAM = {"a", "b", "orientation", "kind"}
+_SEAM = {"a", "b", "orientation", "kind", "angle", "width"}
 
 
 def read_toml(path, *, seam_tolerance=SEAM_LENGTH_TOLERANCE):
@@ -236,7 +238,7 @@ def parse_toml(data, *, source="<toml>", seam_tolerance=SEAM_LENGTH_TOLERANCE):
         raise PatternError(f"{source}: units = {units!r}; give one of {', '.join(LENGTH_UNITS)}")
     scale = LENGTH_UNITS[units]
     panels = [_toml_panel(p, k, scale, source) for k, p in enumerate(data.get("panels", []))]
-    seams = [_toml_seam(s, f"{source}: seams[{k}]") for k, s in enumerate(data.get("seams", []))]
+    seams = [_toml_seam(s, f"{source}: seams[{k}]", scale) for k, s in enumerate(data.get("seams", []))]
     return Pattern(panels=panels, seams=seams, units=units, source=source, seam_tolerance=seam_tolerance)
 
 
@@ -281,7 +283,7 @@ def _toml_panel(spec, k, scale, source):
                  rotation=_vector(spec.get("rotate", [0, 0, 0]), where, "rotate"))
 
 
-def _toml_seam(spec, where):
+def _toml_seam(spec, where, scale):
     _unknown(spec, _SEAM, where)
     refs = []
     for key in ("a", "b"):
@@ -290,4 +292,10 @@ def _toml_seam(spec, where):
         if not panel or not edge.strip().isdigit():
             raise PatternError(f"{where}: {key} = {ref!r}; give \"panel:edge\", e.g. \"front:2\"")
         refs += [panel.strip(), int(edge)]
-    return Seam(*refs, orientation=spec.get("orientation", "reversed"), kind=spec.get("kind", "sew"))
+    kind = spec.get("kind", "sew")
+    if kind != "fold" and ("angle" in spec or "width" in spec):
+        raise PatternError(f"{where}: angle and width belong to a fold seam (kind = \"fold\"), not to kind {kind!r}; "
+                           "remove them or make the seam a fold")
+    width = spec.get("width")
+    return Seam(*refs, orientation=spec.get("orientation", "reversed"), kind=kind, angle=spec.get("angle", 180.0),
+                width=None if width is None else float(_number(width, where, "width")) * scale)

@@ -22,21 +22,23 @@ finishes the job. The closing's explicit step is set by the smallest element (me
 so each halving of the element size costs about eight times the explicit steps; the carried start leaves the fine
 mesh only the last millimetres.
 
-Seams of kind ``sew`` are closed and merged; ``open`` seams are left open (a slit); ``fold`` seams (a hem
-turned back, which needs a rest angle of 180 deg across the seam) are refused, naming the seam.
+Seams of kind ``sew`` are closed and merged; ``open`` seams are left open (a slit); ``fold`` seams (a hem turned
+back) are closed and merged as ``sew`` seams, and the merged edges along them become the sewn mesh's creases
+(:class:`rftstatic.mesh.folds.FoldLines`, :func:`fold_chains`): the RF patches end there and a hinge holds each
+at the seam's rest angle (:mod:`rftstatic.element.hinge`), on the side the closed panels turn to (:func:`sew`).
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from rftstatic.garment.pattern import PatternError
 from rftstatic.mesh.trimesh import TriMesh
 
-__all__ = ["panel_mesh", "seam_pairs", "sew", "close_seams", "carry_closed", "ClosingResult", "CLOSING_RUNS",
+__all__ = ["panel_mesh", "seam_pairs", "fold_chains", "turned_back", "sew", "close_seams", "carry_closed", "ClosingResult", "CLOSING_RUNS",
            "SEAM_CLOSED", "SEAM_PULL", "SEAM_STIFFENING", "SEAM_STIFFNESS"]
 
 log = logging.getLogger(__name__)
@@ -97,21 +99,41 @@ def _stem(source) -> str:
 
 
 def seam_pairs(pmesh) -> np.ndarray:
-    """(S, 2) global node pairs of the seams to sew (kind ``sew``; ``open`` left out); :class:`PatternError` for a
-    ``fold`` seam (module docstring). A dart tip pairing a node with itself is left out."""
-    pat = pmesh.pattern
-    out = []
-    for s, pairs in zip(pat.seams, pmesh.seam_pairs):
-        if s.kind == "fold":
-            raise PatternError(f"{pat.source}: the seam {s.a_panel}:{s.a_edge} - {s.b_panel}:{s.b_edge} is a fold "
-                               "(a hem turned back); folds are not sewn yet: give the hem as a panel edge (kind "
-                               "'open') or leave the seam out")
-        if s.kind == "sew":
-            out.append(pairs[pairs[:, 0] != pairs[:, 1]])
+    """(S, 2) global node pairs of the seams to close and merge (kinds ``sew`` and ``fold``; ``open`` left out).
+    A dart tip pairing a node with itself is left out."""
+    out = [pairs[pairs[:, 0] != pairs[:, 1]] for s, pairs in zip(pmesh.pattern.seams, pmesh.seam_pairs)
+           if s.kind in ("sew", "fold")]
     return np.concatenate(out).astype(np.int64) if out else np.zeros((0, 2), np.int64)
 
 
-def sew(mesh: TriMesh, pairs: np.ndarray, x: np.ndarray, *, where: str = "pattern") -> tuple[TriMesh, np.ndarray]:
+@dataclass(frozen=True)
+class FoldChain:
+    """A ``fold`` seam's crease before sewing: ``nodes (n + 1,)`` global panel nodes of its side a in order along
+    the seam, the rest ``angle`` [rad] (magnitude) and the crease ``width`` [m] (NaN: the elements' height), the
+    seam's ``label`` for messages."""
+
+    nodes: np.ndarray
+    angle: float
+    width: float
+    label: str
+
+
+def fold_chains(pmesh) -> list:
+    """The :class:`FoldChain` of every ``fold`` seam of ``pmesh`` (:class:`rftstatic.garment.meshing.PatternMesh`)."""
+    return [FoldChain(pairs[:, 0].astype(np.int64), float(np.radians(s.angle)),
+                      np.nan if s.width is None else float(s.width), s.label())
+            for s, pairs in zip(pmesh.pattern.seams, pmesh.seam_pairs) if s.kind == "fold"]
+
+
+def turned_back(pmesh) -> np.ndarray:
+    """(E,) bool, the elements of the panels turned back at a fold seam (its side b: a hem's facing), which the
+    garment's outer measures (hem, drape coefficient's outline) leave out."""
+    facing = {s.b_panel for s in pmesh.pattern.seams if s.kind == "fold"}
+    return np.repeat([p.name in facing for p in pmesh.pattern.panels], [len(m.tri) for m in pmesh.meshes])
+
+
+def sew(mesh: TriMesh, pairs: np.ndarray, x: np.ndarray, *, where: str = "pattern",
+        folds=()) -> tuple[TriMesh, np.ndarray]:
     """Merge the two sides of every seam into one node (stage 2 of the module docstring).
 
     Parameters
@@ -120,6 +142,9 @@ def sew(mesh: TriMesh, pairs: np.ndarray, x: np.ndarray, *, where: str = "patter
     pairs : (S, 2) node pairs to merge (chains merge into one node: a corner where two seams meet)
     x : (N, 3) positions [m] at the end of the closing; each merged node takes its group's mean
     where : names the pattern in errors
+    folds : the :class:`FoldChain` of the fold seams among ``pairs`` (:func:`fold_chains`): their merged edges
+        become the sewn mesh's creases (``TriMesh.folds``), each at its rest angle on the side the merged
+        positions turn it to (:func:`_creases`)
 
     Returns
     -------
@@ -151,7 +176,52 @@ def sew(mesh: TriMesh, pairs: np.ndarray, x: np.ndarray, *, where: str = "patter
     chart = mesh.X[first[order]]  # each sewn node's first panel node
     sewn = TriMesh(X=chart, tri=tri, name=mesh.name, element_X=mesh.element_X, placed=merged,
                    info={**mesh.info, "sewn_from_nodes": n})
+    if folds:
+        sewn = replace(sewn, folds=_creases(sewn, folds, node_of, where))
     return sewn, node_of
+
+
+FOLD_START_TOLERANCE = 60.0
+"""Largest difference [deg] between a fold seam's dihedral angle as closed and its rest angle (:func:`sew`): the
+panel turned back is placed turned as folded; a fold much further from its rest would be snapped over by its
+hinge, through the cloth around it."""
+
+
+def _creases(sewn: TriMesh, folds, node_of, where):
+    """The :class:`~rftstatic.mesh.folds.FoldLines` of the fold seams ``folds`` on the ``sewn`` mesh: the rest angle
+    of each crease edge signed as the merged positions turn it (the hinge's frame, :func:`rftstatic.element.hinge.
+    fold_hinges`); :class:`PatternError` naming the seam when a fold as closed is more than
+    :data:`FOLD_START_TOLERANCE` from its rest angle."""
+    from rftstatic.element.hinge import fold_hinges
+    from rftstatic.mesh.folds import FoldLines
+
+    edges, angle, width, seam = [], [], [], []
+    for k, f in enumerate(folds):
+        chain = node_of[f.nodes]
+        e = np.stack([chain[:-1], chain[1:]], axis=1)
+        edges.append(e)
+        angle += [f.angle] * len(e)
+        width += [f.width] * len(e)
+        seam += [k] * len(e)
+    edges = np.concatenate(edges)
+    probe = FoldLines(edges, np.asarray(angle), np.asarray(width))
+    hinges = fold_hinges(replace(sewn, folds=probe), np.eye(3))
+    theta = hinges.angles(sewn.X3)
+    n = sewn.n_nodes
+    key = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
+    order = np.argsort(key)
+    a, b = hinges.nodes[:, 0], hinges.nodes[:, 1]
+    at = order[np.searchsorted(key[order], np.minimum(a, b) * n + np.maximum(a, b))]
+    rest = np.where(theta < 0, -1.0, 1.0) * probe.angle[at]
+    off = np.degrees(np.abs(np.abs(theta) - probe.angle[at]))
+    worst = int(np.argmax(off))
+    if off[worst] > FOLD_START_TOLERANCE:
+        f = folds[seam[at[worst]]]
+        raise PatternError(f"{where}: the fold seam {f.label} closed at {np.degrees(abs(theta[worst])):.0f} deg, "
+                           f"{off[worst]:.0f} deg from its rest angle {np.degrees(f.angle):.0f} deg (more than "
+                           f"{FOLD_START_TOLERANCE:g}); place the panel turned back as folded (its side b turned "
+                           "onto side a for a 180 deg hem)")
+    return FoldLines(hinges.nodes[:, :2], rest, probe.width[at])
 
 
 def carry_closed(coarse, x, fine) -> np.ndarray:

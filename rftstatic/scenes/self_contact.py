@@ -46,8 +46,8 @@ def build_self_contact(scene: Scene, mesh, material, kernels: str | None = None)
             raise scene.error(key, f"{shown!r} is not a positive thickness; give a thickness > 0")
     else:
         d, key, shown = contact.self_thickness, "contact.self_thickness", scene.get("contact.self_thickness")
-    edges = mesh.topology.edges
-    smallest = float(np.linalg.norm(mesh.X[edges[:, 1]] - mesh.X[edges[:, 0]], axis=1).min())
+    P = mesh.corners  # each element's own flat shape (a sewn mesh's chart X need not be one)
+    smallest = float(np.linalg.norm(P[:, [1, 2, 0]] - P, axis=2).min())
     h_lower = scene.get("remesh.h_lower") if scene.get("remesh") is not None else None
     if isinstance(h_lower, (int, float)) and d > REMESH_THICKNESS_SHARE * h_lower * u:
         raise scene.error(key, f"{shown!r} is above {REMESH_THICKNESS_SHARE:g} of remesh.h_lower = {h_lower:g} (scene length "

@@ -34,7 +34,7 @@ def test_the_circle_skirt_scene_places_the_ring_flat_at_the_waist():
     assert np.all((mesh.X[inner, 0] / aw) ** 2 + (mesh.X[inner, 1] / bw) ** 2 > 1.0)
     x = mesh.X3.copy()
     x[r > 0.6, 2] -= 0.1  # the hem is the lowest boundary loop
-    hem = _hem(mesh, x)
+    hem = _hem(mesh.tri, x)
     assert np.allclose(np.linalg.norm(mesh.X[hem], axis=1), 0.6114, atol=1e-9)
 
 

@@ -8,7 +8,8 @@ import pytest
 from rftstatic.garment.meshing import mesh_pattern, place
 from rftstatic.garment.pattern import PatternError
 from rftstatic.garment.readers import read_pattern
-from rftstatic.garment.sewing import SEAM_CLOSED, carry_closed, close_seams, panel_mesh, seam_pairs, sew
+from rftstatic.garment.sewing import (FOLD_START_TOLERANCE, SEAM_CLOSED, carry_closed, close_seams, fold_chains,
+                                     panel_mesh, seam_pairs, sew, turned_back)
 from rftstatic.material import preset
 from rftstatic.model.loads import SeamSprings
 from rftstatic.model.model import Model
@@ -118,12 +119,77 @@ def test_sewing_a_triangle_onto_itself_is_an_error(tube):
         sew(mesh, np.array([[t[0], t[1]]]), mesh.X3, where="tube.toml")
 
 
-def test_fold_seams_are_refused_naming_the_seam(tmp_path):
-    path = tmp_path / "fold.toml"
-    path.write_text(TUBE.replace('a = "front:3"', 'kind = "fold"\na = "front:3"'))
-    pmesh = mesh_pattern(read_pattern(path), 0.05)
-    with pytest.raises(PatternError, match="front:3 - back:1 is a fold"):
-        seam_pairs(pmesh)
+# a 20 x 30 cm panel with a 4 cm hem facing turned back behind it (1 cm apart), its hem a fold seam
+HEMMED = """
+units = "cm"
+[[panels]]
+name = "skirt"
+vertices = [[-10, 0], [10, 0], [10, 30], [-10, 30]]
+translate = [0, 0, 8]
+[[panels]]
+name = "facing"
+vertices = [[-10, -4], [10, -4], [10, 0], [-10, 0]]   # drawn below the hem, as cut; turned up behind the skirt
+translate = [0, 0, 7]
+rotate = [180, 0, 0]
+[[seams]]
+a = "skirt:0"
+b = "facing:2"
+kind = "fold"
+"""
+
+
+def _close(pmesh):
+    mesh = panel_mesh(pmesh, place(pmesh))
+    pairs = seam_pairs(pmesh)
+    mat = preset("wool-kang-yu")
+
+    def build(springs):
+        return Model(mesh, mat, element="RFT6", load_terms=(springs,), quiet=True)
+
+    c = close_seams(build, pairs, (), weight=mat.weight * float(mesh.area.sum()),
+                    stiffest=0.5 * min(mat.Dm[0, 0], mat.Dm[1, 1]), t_stage=1.0, alpha=8.0)
+    return mesh, pairs, c, mat
+
+
+def test_a_fold_seam_is_closed_merged_and_becomes_a_crease_turned_back(tmp_path):
+    path = tmp_path / "hem.toml"
+    path.write_text(HEMMED)
+    pmesh = mesh_pattern(read_pattern(path), 0.02)
+    mesh, pairs, c, mat = _close(pmesh)
+    assert c.closed
+    (chain,) = fold_chains(pmesh)
+    sewn, node_of = sew(mesh, pairs, c.x, where="hem.toml", folds=[chain])
+    assert len(sewn.folds) == len(chain.nodes) - 1
+    np.testing.assert_allclose(np.abs(sewn.folds.angle), np.pi)
+    model = Model(sewn, mat, element="RFT6", quiet=True)
+    assert len(model.hinges) == len(sewn.folds)
+    # the closed hem is turned back: its creases within FOLD_START_TOLERANCE of 180 deg
+    assert (np.degrees(np.abs(model.hinges.angles(sewn.X3))) > 180 - FOLD_START_TOLERANCE).all()
+    # the patches end at the crease: no patch of the skirt reaches into the facing
+    facing = turned_back(pmesh)
+    reach = model.patches.nodes[~facing]  # (a missing opposite's slot holds the element's own vertex)
+    facing_only = np.setdiff1d(np.unique(sewn.tri[facing]), np.unique(sewn.tri[~facing]))
+    assert not np.isin(reach, facing_only).any()
+
+
+def test_a_fold_seam_placed_unfolded_is_refused_naming_the_seam(tmp_path):
+    path = tmp_path / "flat.toml"
+    path.write_text(HEMMED.replace("rotate = [180, 0, 0]", "").replace("translate = [0, 0, 7]",
+                                                                      "translate = [0, -1, 8]"))
+    pmesh = mesh_pattern(read_pattern(path), 0.04)
+    mesh, pairs, c, _ = _close(pmesh)
+    with pytest.raises(PatternError, match="fold seam skirt:0 -- facing:2 closed at"):
+        sew(mesh, pairs, c.x, where="flat.toml", folds=fold_chains(pmesh))
+
+
+def test_fold_keys_belong_to_fold_seams(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(TUBE.replace('a = "front:3"', 'angle = 90\na = "front:3"'))
+    with pytest.raises(PatternError, match="angle and width belong to a fold seam"):
+        read_pattern(path)
+    path.write_text(HEMMED.replace('kind = "fold"', 'kind = "fold"\nangle = 270'))
+    with pytest.raises(PatternError, match="fold angle = 270"):
+        read_pattern(path)
 
 
 def test_the_a_line_skirt_pairs_its_side_seams():

@@ -158,7 +158,8 @@ class SelfContact(Frozen):
 
     Parameters
     ----------
-    mesh : the reference :class:`~rftstatic.mesh.trimesh.TriMesh` [m]
+    mesh : the reference :class:`~rftstatic.mesh.trimesh.TriMesh` [m]; no pair of a flat reference may lie closer
+        than ``d``; a sewn mesh's (``element_X``: the closed garment) may, down to the barrier gap
     thickness : ``d`` [m], below half the smallest edge of the mesh
     stiffness : ``k`` [N/m] (:func:`auto_stiffness`), the stiffness at scale 1
     margin : broad-phase margin [m] (default ``max(2 d, h / 4)``, h the mean edge length): pairs are
@@ -207,7 +208,15 @@ class SelfContact(Frozen):
         self.kernels = choose_kernels(len(mesh.tri), self_contact=True, requested=kernels)
         self.compiled = self.kernels == "compiled"
         ref = self.evaluate(X, tangent=False)
-        if ref.n_active:
+        if ref.n_active and getattr(mesh, "element_X", None) is not None:
+            # a sewn mesh's reference is the closed garment, whose layers may rest in contact (a hem's facing on
+            # the skirt, at d / 2 under the design load), but not inside the barrier
+            if ref.min_distance < BARRIER_GAP * thickness:
+                raise ValueError(f"the sewn garment's start has self-contact pairs {ref.min_distance:.6g} m apart, "
+                                 f"inside the barrier gap {BARRIER_GAP:g} x the thickness {thickness:.6g} m: its "
+                                 "layers were pressed together in the closing; place the panels further apart or "
+                                 "use a thinner thickness")
+        elif ref.n_active:
             raise ValueError(f"the flat reference mesh has {ref.n_active} self-contact pairs closer than the "
                              f"thickness {thickness:.6g} m (smallest distance {ref.min_distance:.6g} m, e.g. a "
                              "skinny triangle's height); use a thinner thickness")
