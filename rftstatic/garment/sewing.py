@@ -79,7 +79,8 @@ def panel_mesh(pmesh, placed: np.ndarray, chart: np.ndarray | None = None) -> Tr
     chart : (N, 2) the mesh's ``X`` [m] (a chart to locate nodes, e.g. the plan view); default ``placed[:, :2]``
 
     Returns a :class:`TriMesh` whose ``element_X`` gives every element in its panel's coordinates turned so that
-    the grain line is the x axis (the material's warp).
+    the grain line is the x axis (the material's warp), and whose ``seams`` are the seams to close
+    (:func:`seam_pairs`: the self-contact leaves the two sides of a seam alone).
     """
     tri = np.concatenate([m.tri + pmesh.offsets[p] for p, m in enumerate(pmesh.meshes)])
     corners = []
@@ -89,7 +90,7 @@ def panel_mesh(pmesh, placed: np.ndarray, chart: np.ndarray | None = None) -> Tr
         corners.append(m.X[m.tri] @ R.T)
     X = placed[:, :2] if chart is None else chart
     return TriMesh(X=np.array(X, float), tri=tri, name=f"garment {_stem(pmesh.pattern.source)}",
-                   element_X=np.concatenate(corners), placed=np.array(placed, float))
+                   element_X=np.concatenate(corners), placed=np.array(placed, float), seams=seam_pairs(pmesh))
 
 
 def _stem(source) -> str:

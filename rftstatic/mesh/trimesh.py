@@ -53,6 +53,9 @@ class TriMesh:
         (:attr:`X3`). None: ``(X, z0)``
     folds : creased edges (:class:`rftstatic.mesh.folds.FoldLines`): the RF patches end there and hinges hold
         the crease (:mod:`rftstatic.element.hinge`); None: the sheet is smooth across every interior edge
+    seams : (S, 2) node pairs of seams still open (a garment's panels being sewn, :mod:`rftstatic.garment.sewing`):
+        the self-contact does not act between primitives that will share a node once they are sewn
+        (:class:`rftstatic.contact.self_contact.broad_phase.SheetPrimitives`); None: none
     """
 
     X: np.ndarray
@@ -63,6 +66,7 @@ class TriMesh:
     element_X: np.ndarray | None = None
     placed: np.ndarray | None = None
     folds: FoldLines | None = None
+    seams: np.ndarray | None = None
 
     def __post_init__(self):
         X = np.ascontiguousarray(self.X, dtype=float)
@@ -105,6 +109,11 @@ class TriMesh:
         self.topology  # noqa: B018 -- validates the edge structure now (non-manifold edges)
         if self.folds is not None:
             self.fold_mask  # noqa: B018 -- every fold edge an interior edge of the mesh
+        if self.seams is not None:
+            seams = np.asarray(self.seams, dtype=np.int64).reshape(-1, 2)
+            if len(seams) and (seams.min() < 0 or seams.max() >= len(X)):
+                raise MeshError(f"seams refer to nodes outside 0..{len(X) - 1}")
+            object.__setattr__(self, "seams", seams)
 
     def _check_sewn(self, X, tri):
         """Shapes and values of ``element_X`` and ``placed`` (given together)."""

@@ -239,3 +239,26 @@ def test_the_dress_pattern_pairs_its_four_side_seams_and_two_shoulder_seams():
         else:  # side seams: node k of one side at the height of node k of the other (reversed edges)
             np.testing.assert_allclose(x[pairs[:, 0], 1], x[pairs[:, 1], 1], atol=1e-9)
             assert gap.max() < 0.11
+
+
+def test_the_self_contact_leaves_the_two_sides_of_an_open_seam_alone(tube):
+    from dataclasses import replace
+
+    from rftstatic.contact.self_contact.broad_phase import SheetPrimitives, find_pairs
+    from rftstatic.contact.self_contact.law import SelfContact
+
+    pmesh, mesh = tube
+    assert np.array_equal(mesh.seams, seam_pairs(pmesh))
+    # the panels with their seams all but closed (0.1 mm): each seam node lies on the other panel's edge triangles
+    x = mesh.X3.copy()
+    pairs = seam_pairs(pmesh)
+    x[pairs[:, 1]] = x[pairs[:, 0]] + [0.0, 0.0, 1e-4]
+    closed = replace(mesh, placed=x)
+    bare = replace(closed, seams=None)
+    law = SelfContact(closed, 5e-4, 1.0)  # its start has no pair in contact
+    assert law.evaluate(x, tangent=False).n_active == 0
+    kept = find_pairs(SheetPrimitives.of_mesh(closed), x, 1.0)
+    joined = SheetPrimitives.of_mesh(closed).joined
+    assert not (joined[kept.pt[:, :1]] == joined[closed.tri[kept.pt[:, 1]]]).any()
+    with pytest.raises(ValueError, match="barrier gap"):
+        SelfContact(bare, 5e-4, 1.0)

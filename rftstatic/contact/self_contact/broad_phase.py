@@ -59,16 +59,41 @@ class Pairs:
 
 @dataclass(frozen=True)
 class SheetPrimitives:
-    """The primitives of a triangle mesh: ``tri (T, 3)`` and ``edges (M, 2)`` node indices, ``n_nodes``."""
+    """The primitives of a triangle mesh: ``tri (T, 3)`` and ``edges (M, 2)`` node indices, ``n_nodes``;
+    ``joined (N,)``: the node each node becomes once the mesh's open seams are sewn (a panel mesh being closed,
+    :attr:`rftstatic.mesh.trimesh.TriMesh.seams`), or None. Primitives that will share a node once sewn are no
+    pair: the two sides of a seam meet there, they are not in contact."""
 
     tri: np.ndarray
     edges: np.ndarray
     n_nodes: int
+    joined: np.ndarray | None = None
 
     @classmethod
     def of_mesh(cls, mesh) -> SheetPrimitives:
-        """From a :class:`~rftstatic.mesh.trimesh.TriMesh` (its unique edges)."""
-        return cls(np.asarray(mesh.tri, np.int64), np.asarray(mesh.topology.edges, np.int64), mesh.n_nodes)
+        """From a :class:`~rftstatic.mesh.trimesh.TriMesh` (its unique edges and its open seams)."""
+        seams = getattr(mesh, "seams", None)
+        joined = None
+        if seams is not None and len(seams):
+            from scipy.sparse import coo_matrix
+            from scipy.sparse.csgraph import connected_components
+
+            n = mesh.n_nodes
+            g = coo_matrix((np.ones(len(seams)), (seams[:, 0], seams[:, 1])), shape=(n, n))
+            joined = connected_components(g, directed=False)[1].astype(np.int64)
+        return cls(np.asarray(mesh.tri, np.int64), np.asarray(mesh.topology.edges, np.int64), mesh.n_nodes, joined)
+
+
+def _drop_joined(prims: SheetPrimitives, pairs: Pairs) -> Pairs:
+    """``pairs`` without those whose primitives share a node once the seams are sewn (:class:`SheetPrimitives`)."""
+    j = prims.joined
+    if j is None:
+        return pairs
+    pt, ee = pairs.pt, pairs.ee
+    keep_pt = ~(j[pt[:, :1]] == j[prims.tri[pt[:, 1]]]).any(axis=1)
+    a, b = j[prims.edges[ee[:, 0]]], j[prims.edges[ee[:, 1]]]
+    keep_ee = ~((a[:, :1] == b).any(axis=1) | (a[:, 1:] == b).any(axis=1))
+    return Pairs(pt[keep_pt], ee[keep_ee])
 
 
 def _node_boxes(x0, x1):
@@ -136,7 +161,8 @@ def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.nda
 
     Returns
     -------
-    Pairs, sorted and without duplicates; every pair at distance < ``radius`` is included.
+    Pairs, sorted and without duplicates; every pair at distance < ``radius`` is included, but for those that
+    share a node once the seams are sewn (``prims.joined``).
     """
     x0 = np.asarray(x0, dtype=float)
     if x0.shape != (prims.n_nodes, 3):
@@ -147,8 +173,8 @@ def find_pairs(prims: SheetPrimitives, x0: np.ndarray, radius: float, x1: np.nda
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
     tri, edges = prims.tri, prims.edges
     if distance.compiled_for(len(tri) + len(edges), compiled):
-        return _find_pairs_compiled(prims, x0, radius, x1)
-    return _find_pairs_numpy(prims, x0, radius, x1)
+        return _drop_joined(prims, _find_pairs_compiled(prims, x0, radius, x1))
+    return _drop_joined(prims, _find_pairs_numpy(prims, x0, radius, x1))
 
 
 def _boxes(prims, x0, radius, x1):
@@ -263,7 +289,7 @@ def brute_force_pairs(prims: SheetPrimitives, x0, radius, x1=None) -> Pairs:
     ov = np.all((lo_e[:, None] <= hi_e[None]) & (lo_e[None] <= hi_e[:, None]), axis=2)
     ov &= ~np.any(edges[:, None, :, None] == edges[None, :, None, :], axis=(2, 3))
     ov = np.triu(ov, 1)
-    return Pairs(pt.astype(np.int64), np.argwhere(ov).astype(np.int64))
+    return _drop_joined(prims, Pairs(pt.astype(np.int64), np.argwhere(ov).astype(np.int64)))
 
 
 class PairCache:
