@@ -78,3 +78,24 @@ def test_the_dress_drapes_on_a_chart_size(tmp_path):
                  'body={kind="dress-form", size=84, neck_length=6.0, bottom_height=62.0}']) == 0
     summary = _check_dressed(out, load_scene("dress").path.parent / "patterns" / "dress-shift.toml", 0.025)
     assert summary["garment"]["panels"] == 4
+
+
+@pytest.mark.slow
+def test_the_hemmed_skirt_sews_its_folds_and_drapes_with_the_hem_turned_up(tmp_path):
+    # the A-line skirt with 4 cm facings turned up at fold seams: sewn, creased at 180 deg, draped on the form
+    out = tmp_path / "out"
+    assert main(["case", "skirt-a-line-hem", "--out", str(out), "--no-figures", "--set", "garment.h=3",
+                 "--set", "garment.closing_h=3"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    g = summary["garment"]
+    assert summary["converged"] and summary["stable_minimum"]
+    assert g["body_crossing_pairs"] == 0 and summary["self_intersections"]["pairs"] == 0
+    assert g["largest_seam_gap"] <= SEAM_CLOSED * g["mean_element_size"]
+    pmesh = mesh_pattern(read_pattern(load_scene("skirt-a-line-hem").path.parent / "patterns" /
+                                      "skirt-a-line-hem.toml"), 0.03)
+    hem_edges = sum(len(p) - 1 for s, p in zip(pmesh.pattern.seams, pmesh.seam_pairs) if s.kind == "fold")
+    assert g["crease_edges"] == hem_edges
+    assert g["crease_off_rest_max_deg"] < 45  # the facings lie turned up on the skirt
+    # the hem is the crease: the lowest line of the skirt, below the facings' free edge
+    x, _, tri, _ = read_obj_uv(out / "garment.obj")
+    assert g["hem_lowest"] == pytest.approx(x[:, 2].min(), abs=1e-6)
