@@ -59,6 +59,15 @@ as ``numba.get_num_threads()``, which the explicit force's thread tuner sets); e
 either kernel, so the results do not depend on it."""
 
 
+def _gap(c, lo, size):
+    """Distance [m] along one axis from the coordinate ``c`` to the cell ``[lo, lo + size]`` (0 inside)."""
+    if c < lo:
+        return lo - c
+    if c > lo + size:
+        return c - lo - size
+    return 0.0
+
+
 def _imls(x, facets, hessian, out, start, stop):
     """(S1)-(S3) at the points ``x[start:stop]`` of ``x (n, 3)`` into ``out = (phi (n,), grad (n, 3), H (n, 3, 3) or
     (1, 3, 3) without ``hessian``, W (n,))``. ``facets = (p, nrm, area, grid, order, cell_start)``: centroids, unit
@@ -74,6 +83,8 @@ def _imls(x, facets, hessian, out, start, stop):
     gS = np.zeros(3)
     hW = np.zeros((3, 3))
     hS = np.zeros((3, 3))
+    reach = h * (1.0 + 1e-9) + 1e-9 * size  # a cell farther than this holds no facet within h (CELL_REACH)
+    reach2 = reach * reach
     for k in range(start, stop):
         W = 0.0
         S = 0.0
@@ -85,8 +96,17 @@ def _imls(x, facets, hessian, out, start, stop):
         cy = int(np.floor((x[k, 1] - lo1) / size))
         cz = int(np.floor((x[k, 2] - lo2) / size))
         for iz in range(max(cz - 1, 0), min(cz + 2, nz)):
+            bz = _gap(x[k, 2], lo2 + iz * size, size)
             for iy in range(max(cy - 1, 0), min(cy + 2, ny)):
+                by = _gap(x[k, 1], lo1 + iy * size, size)
+                if bz * bz + by * by >= reach2:
+                    continue
                 x0, x1 = max(cx - 1, 0), min(cx + 1, nx - 1)
+                # the cells of the row within reach (a contiguous run: the gap along x grows away from the point)
+                while x0 <= x1 and bz * bz + by * by + _gap(x[k, 0], lo0 + x0 * size, size) ** 2 >= reach2:
+                    x0 += 1
+                while x1 >= x0 and bz * bz + by * by + _gap(x[k, 0], lo0 + x1 * size, size) ** 2 >= reach2:
+                    x1 -= 1
                 if x0 > x1:
                     continue
                 row = (iz * ny + iy) * nx
@@ -94,7 +114,10 @@ def _imls(x, facets, hessian, out, start, stop):
                     i = order[j]
                     for a in range(3):
                         v[a] = x[k, a] - p[i, a]
-                    r = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+                    r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+                    if r2 >= reach2:  # q > 1 (the test below would skip it): no sqrt
+                        continue
+                    r = np.sqrt(r2)
                     q = r / h
                     if q >= 1.0:
                         continue
@@ -151,7 +174,8 @@ def _kernels():
             import numba
 
             scope = dict(globals())
-            scope["_imls"] = numba.njit(cache=True, nogil=True)(_imls)
+            scope["_gap"] = numba.njit(cache=True, nogil=True, inline="always")(_gap)
+            scope["_imls"] = numba.njit(cache=True, nogil=True)(types.FunctionType(_imls.__code__, scope, "_imls"))
             for name, options in (("serial", {}), ("parallel", {"parallel": True})):
                 own = dict(scope, prange=numba.prange)
                 copy = types.FunctionType(_imls_blocks.__code__, own, "_imls_blocks")

@@ -109,6 +109,8 @@ class StepFilter:
         self.ccd_floor = min(CCD_FLOOR, float(floor)) * sc.thickness
         self.sc, self.minv, self.approach, self.sweeps = sc, np.asarray(minv, float), float(approach), int(sweeps)
         self.eta = sc.min_fraction
+        with np.errstate(divide="ignore"):  # nodal mass per dof [kg], zero on supported dofs (for _kinetic)
+            self._mass = np.where(self.minv > 0, 1.0 / np.where(self.minv > 0, self.minv, 1.0), 0.0)
         self._zeros = None
         self._bound = None  # (cache, its build count, motion at the last full test [m], sum of steps since [m])
 
@@ -192,9 +194,7 @@ class StepFilter:
         return self._zeros
 
     def _kinetic(self, v):
-        with np.errstate(divide="ignore"):
-            mass = np.where(self.minv > 0, 1.0 / np.where(self.minv > 0, self.minv, 1.0), 0.0)
-        return 0.5 * float(np.einsum("ni,ni,ni->", mass, v, v))
+        return 0.5 * float(np.einsum("ni,ni,ni->", self._mass, v, v))
 
     def _impulses(self, x, v, dt, nodes, is_pt, stats):
         """3. Inelastic impulses ``J >= 0`` on the pairs ``nodes (P, 4)`` (module docstring), by active sets:
