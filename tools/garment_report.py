@@ -333,7 +333,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "validation"))
     ap.add_argument("--a-line-h", type=float, nargs="+", default=[1.45, 1.1])
-    ap.add_argument("--hem-h", type=float, nargs="+", default=[1.45, 1.1])
+    ap.add_argument("--hem-h", type=float, nargs="+", default=[3.0, 2.0])
     ap.add_argument("--circle-h", type=float, nargs="+", default=[1.48, 1.1])
     ap.add_argument("--dress-h", type=float, nargs="+", default=[1.1, 0.9])
     ap.add_argument("--carry-h", type=float, nargs="*", default=[0.8],
