@@ -187,18 +187,9 @@ class CholmodSolver:
     (a tie). The analysis is redone when self-contact changes the pattern (8 times in the first 16
     Newton iterations at 201 x 201, 29 factorisations), so the costlier analysis is paid back there too."""
 
-    UNION_GROWTH = 1.02
-    """Largest ratio of the analysed pattern's entries to a tangent's for which that tangent is factorised on the
-    analysis of a pattern holding its own (:meth:`_fits`): self-contact pairs that come and go in Newton's iterations
-    change the pattern (138 analyses in the 364 factorisations of skirt-circle, 23 ms each against 83 ms a
-    factorisation); the union of the patterns met is analysed instead and a tangent whose entries lie in it is
-    factorised there (CHOLMOD takes a subset of the analysed pattern: the same factor as of that pattern with
-    explicit zeros)."""
-
     def __init__(self):
         self._factor = None
         self._pattern = None
-        self._fitted = None  # the last pattern found to lie in the analysed one (:meth:`_fits`)
         self.analyses = 0  # symbolic analyses done (one per sparsity pattern met)
 
     def _same_pattern(self, K) -> bool:
@@ -211,24 +202,6 @@ class CholmodSolver:
         shape, indptr, indices = self._pattern
         return (K.shape == shape and K.indptr.shape == indptr.shape and K.indices.shape == indices.shape
                 and np.array_equal(K.indptr, indptr) and np.array_equal(K.indices, indices))
-
-    def _fits(self, K) -> sp.csr_matrix | None:
-        """None when ``K`` (sorted CSR) can be factorised on the present analysis: its pattern is the analysed one or
-        lies in it; else the pattern to analyse (entries 1): the union of the analysed pattern and ``K``'s, or
-        ``K``'s own once the union would hold more than :data:`UNION_GROWTH` times its entries."""
-        if self._same_pattern(K):
-            return None
-        if self._fitted is not None and _equal_pattern(K, self._fitted):
-            return None
-        own = sp.csr_matrix((np.ones(K.nnz), K.indices, K.indptr), shape=K.shape)
-        if self._pattern is None or K.shape != self._pattern[0]:
-            return own
-        shape, indptr, indices = self._pattern
-        union = (own + sp.csr_matrix((np.ones(len(indices)), indices, indptr), shape=shape)).tocsr()
-        if union.nnz == len(indices):
-            self._fitted = (K.shape, K.indptr.copy(), K.indices.copy())
-            return None
-        return union if union.nnz <= self.UNION_GROWTH * K.nnz else own
 
     @classmethod
     def choose_mode(cls, n: int) -> tuple[str, str]:
@@ -277,16 +250,13 @@ class CholmodSolver:
 
         A = K.T  # CSR of a symmetric matrix = its CSC transpose, no copy
         with SerialOpenMP():
-            pattern = self._fits(K) if self._factor is not None else \
-                sp.csr_matrix((np.ones(K.nnz), K.indices, K.indptr), shape=K.shape)
-            if pattern is not None:
+            if self._factor is None or not self._same_pattern(K):
                 mode, ordering = self.choose_mode(A.shape[0])
                 try:
-                    self._factor = analyze(pattern.T, mode=mode, ordering_method=ordering)
+                    self._factor = analyze(A, mode=mode, ordering_method=ordering)
                 except CholmodError:  # a CHOLMOD built without its Partition module (METIS): no nesdis
-                    self._factor = analyze(pattern.T, mode=mode, ordering_method="default")
-                self._pattern = (pattern.shape, pattern.indptr.copy(), pattern.indices.copy())
-                self._fitted = (K.shape, K.indptr.copy(), K.indices.copy())
+                    self._factor = analyze(A, mode=mode, ordering_method="default")
+                self._pattern = (K.shape, K.indptr.copy(), K.indices.copy())
                 self.analyses += 1
             try:
                 self._factor.cholesky_inplace(A)
@@ -302,13 +272,6 @@ class CholmodSolver:
             raise LinearSolveError("no factorisation to reuse")
         with SerialOpenMP():
             return self._factor(b)
-
-
-def _equal_pattern(K, pattern) -> bool:
-    """Whether the CSR ``K`` has the pattern ``(shape, indptr, indices)``."""
-    shape, indptr, indices = pattern
-    return (K.shape == shape and K.indptr.shape == indptr.shape and K.indices.shape == indices.shape
-            and np.array_equal(K.indptr, indptr) and np.array_equal(K.indices, indices))
 
 
 class ScipySolver:
