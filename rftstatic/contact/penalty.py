@@ -357,13 +357,13 @@ class PenaltyContact(Frozen):
         ``k A_n min(phi, 0) n`` summed over the obstacles; it points into the obstacle, so it is the
         contact term of the residual (the obstacle pushes the sheet with its negative). The explicit
         loop calls this once per step: only the candidates' distances and the slope of the energy
-        density are computed (no energy, gaps or tangent blocks), and only for the candidates that may lie
-        within the onset width (:func:`_within_onset`; beyond it the slope is 0).
+        density are computed (no energy, gaps or tangent blocks), where the distance may be below ``eps``.
         """
         x = _as_points(x, self.n_nodes)
         cand, bound = self._near(x, candidates)
-        if candidates is not None and cand.size and candidates.gaps is not None:
-            cand = cand[_within_onset(candidates.gaps[cand], bound[cand], self.smoothing)]
+        gap0 = getattr(candidates, "gaps", None)  # distances at the refresh; bound = gap0 - the motion since
+        if gap0 is not None and cand.size:  # 2 x motion: room for |grad phi| up to 2 (a smooth surface's: near 1)
+            cand = cand[gap0[cand] - 2.0 * (gap0[cand] - bound[cand]) < self.smoothing]
         force = np.zeros((x.shape[0], 3))
         if cand.size:
             phi, normal = self._distances_of(x[cand], self._offsets(candidates))
@@ -417,15 +417,6 @@ class PenaltyContact(Frozen):
     def active(self, x: np.ndarray) -> np.ndarray:
         """``(N,)`` bool: node penetrates at least one obstacle at ``x (N, 3)`` [m]."""
         return self.gaps(x) < 0.0
-
-
-def _within_onset(gap0, bound, eps) -> np.ndarray:
-    """``(C,)`` bool: the candidates whose distance may be below the onset width ``eps`` [m], from their distances
-    ``gap0`` at the list's refresh and the list's lower bounds ``bound = gap0 - moved`` now (``moved`` [m] the largest
-    motion since, :meth:`~rftstatic.contact.candidates.CandidateList.lookup`): ``gap0 - 2 moved < eps``, room for a
-    distance that changes up to twice as fast as the node moves (a smooth surface's ``|grad phi|`` is near 1, not
-    at most 1); the others have no contact force."""
-    return gap0 - 2.0 * (gap0 - bound) < eps
 
 
 def psd_blocks(blocks: np.ndarray) -> np.ndarray:
