@@ -115,5 +115,10 @@ class CandidateList:
         ``(M, N, 3)`` in every obstacle's body frame."""
         return x if self._poses is None else self._poses.body_frames(x)
 
+    @property
+    def gaps(self) -> np.ndarray | None:
+        """``(N,)`` every point's distance [m] at the last refresh (None before one)."""
+        return self._gap
+
     def __len__(self) -> int:
         return 0 if self._indices is None else len(self._indices)

@@ -357,10 +357,13 @@ class PenaltyContact(Frozen):
         ``k A_n min(phi, 0) n`` summed over the obstacles; it points into the obstacle, so it is the
         contact term of the residual (the obstacle pushes the sheet with its negative). The explicit
         loop calls this once per step: only the candidates' distances and the slope of the energy
-        density are computed (no energy, gaps or tangent blocks).
+        density are computed (no energy, gaps or tangent blocks), where the distance may be below ``eps``.
         """
         x = _as_points(x, self.n_nodes)
-        cand, _ = self._near(x, candidates)
+        cand, bound = self._near(x, candidates)
+        gap0 = getattr(candidates, "gaps", None)  # distances at the refresh; bound = gap0 - the motion since
+        if gap0 is not None and cand.size:  # 2 x motion: room for |grad phi| up to 2 (a smooth surface's: near 1)
+            cand = cand[gap0[cand] - 2.0 * (gap0[cand] - bound[cand]) < self.smoothing]
         force = np.zeros((x.shape[0], 3))
         if cand.size:
             phi, normal = self._distances_of(x[cand], self._offsets(candidates))
