@@ -39,7 +39,8 @@ from rftstatic.garment.pattern import PatternError
 from rftstatic.mesh.trimesh import TriMesh
 
 __all__ = ["panel_mesh", "seam_pairs", "fold_chains", "turned_back", "FoldChain", "FOLD_START_TOLERANCE", "sew",
-           "close_seams", "carry_closed", "ClosingResult", "CLOSING_RUNS", "SEAM_CLOSED", "SEAM_PULL", "SEAM_STIFFENING", "SEAM_STIFFNESS"]
+           "close_seams", "carry_closed", "ClosingResult", "CLOSING_RUNS", "SEAM_CLOSED", "SEAM_PULL",
+           "SEAM_STIFFENING", "SEAM_STIFFNESS"]
 
 log = logging.getLogger(__name__)
 
