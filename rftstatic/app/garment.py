@@ -38,9 +38,9 @@ Measures added to ``summary.json`` (``garment``): the pattern's panels and seams
 start of the closing and when the seams were merged, the closing's simulated time, explicit steps and wall time,
 the nodes removed by merging, hem nodes (the lowest boundary loop of the garment without the panels turned back at
 ``fold`` seams, so a turned-up hem's crease), the creases' distance from their rest angle (``crease_edges``,
-``crease_off_rest_mean_deg``, ``crease_off_rest_max_deg``: :mod:`rftstatic.element.hinge`), the hem's folds (the node count of
-:func:`rftstatic.post.measures.boundary.fold_count` on the outline seen from above, about the form's axis, as for a
-Cusick specimen), the hem's drape coefficient
+``crease_off_rest_mean_deg``, ``crease_off_rest_max_deg``: :mod:`rftstatic.element.hinge`), the hem's folds (the
+node count of :func:`rftstatic.post.measures.boundary.fold_count` on the outline seen from above, about the form's
+axis, as for a Cusick specimen), the hem's drape coefficient
 ``A_shadow / A_flat``: the area of the draped skirt's vertical projection (:func:`rftstatic.post.measures.shadow.shadow_area`,
 the waist opening not counted) over the flat skirt's area (the opening left out too). It is Cusick's
 ``(A_shadow - A_disc) / (A_sheet - A_disc)`` with the waist opening as the disc, when the draped skirt does
