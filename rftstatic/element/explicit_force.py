@@ -149,9 +149,9 @@ class ForceKernel:
             f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
             W += Wf if energy else 0.0
         if self.hinges is not None:
-            x = self.X3 + U
-            f += self.hinges.force(x)
-            W += self.hinges.energy(x) if energy else 0.0
+            Wh, fh = self.hinges.energy_force(self.X3 + U)
+            f += fh
+            W += Wh if energy else 0.0
         for term in self.load_terms:  # potential loads at load factor 1 (the explicit loads act in full)
             x = self.X3 + U
             f += term.force(x)

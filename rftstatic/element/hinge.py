@@ -87,10 +87,13 @@ class FoldHinges:
     nodes : (H, 4) int, the nodes a, b (the fold edge), c, d (the opposite vertices) of every hinge
     rest : (H,) rest angle theta_0 [rad], (H1)
     stiffness : (H,) k of (H2) [N m]
+    fold : (H,) the index of each hinge's edge in the mesh's :class:`~rftstatic.mesh.folds.FoldLines` (set by
+        :func:`fold_hinges`), or None
     """
 
-    def __init__(self, nodes, rest, stiffness):
+    def __init__(self, nodes, rest, stiffness, *, fold=None):
         self.nodes = np.array(nodes, dtype=np.int64).reshape(-1, 4)
+        self.fold = None if fold is None else np.array(fold, dtype=np.int64)
         self.rest = np.broadcast_to(np.asarray(rest, float), (len(self.nodes),)).copy()
         self.stiffness = np.broadcast_to(np.asarray(stiffness, float), (len(self.nodes),)).copy()
         if not (np.isfinite(self.stiffness).all() and (self.stiffness >= 0).all()):
@@ -117,8 +120,17 @@ class FoldHinges:
 
     def force(self, x: np.ndarray) -> np.ndarray:
         """dE/dx ``(N, 3)`` [N]."""
-        g = self.stiffness[:, None, None] * self.excess(x)[:, None, None] * _angle_gradient(x[self.nodes])
-        f = np.zeros_like(x)
+        return self.energy_force(x)[1]
+
+    def energy_force(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """E [J] and dE/dx ``(N, 3)`` [N] from one evaluation of the angles (the explicit step's call)."""
+        t = self.excess(x)
+        g = (self.stiffness * t)[:, None, None] * _angle_gradient(x[self.nodes])
+        return 0.5 * float(self.stiffness @ (t * t)), self._scatter(g, x.shape)
+
+    def _scatter(self, g, shape) -> np.ndarray:
+        """Hinge node forces ``(H, 4, 3)`` summed into ``shape`` (N, 3)."""
+        f = np.zeros(shape)
         np.add.at(f, self.nodes.ravel(), g.reshape(-1, 3))
         return f
 
@@ -141,14 +153,15 @@ class FoldHinges:
             K += (k * t)[:, None, None, None, None] * second
         return (k * t)[:, None, None] * g, K
 
-    def tangent_blocks(self, x: np.ndarray, *, psd: bool = False):
-        """The tangent as ``(rows (16H,), cols (16H,), blocks (16H, 3, 3))`` [N/m] (node-pair blocks)."""
-        _, K = self.element_tangents(x, psd=psd)
+    def force_tangent_blocks(self, x: np.ndarray, *, psd: bool = False):
+        """dE/dx ``(N, 3)`` [N] and the tangent as ``(rows (16H,), cols (16H,), blocks (16H, 3, 3))`` [N/m]
+        (node-pair blocks), from one evaluation."""
+        fe, K = self.element_tangents(x, psd=psd)
         i, j = np.meshgrid(np.arange(4), np.arange(4), indexing="ij")
         rows = self.nodes[:, i.ravel()].ravel()
         cols = self.nodes[:, j.ravel()].ravel()
         blocks = K.transpose(0, 1, 3, 2, 4)[:, i.ravel(), j.ravel()].reshape(-1, 3, 3)
-        return rows, cols, blocks
+        return self._scatter(fe, x.shape), (rows, cols, blocks)
 
     def couplings(self) -> np.ndarray:
         """(6H, 2) the node pairs a hinge couples (c-d lies outside the cut patches: the tangent's structure)."""
@@ -189,4 +202,4 @@ def fold_hinges(mesh, Db) -> FoldHinges | None:
     Bn = np.einsum("hi,ij,hj->h", v, np.asarray(Db, float), v)
     width = folds.width[at]
     width = np.where(np.isfinite(width), width, (mesh.area[e1] + mesh.area[e2]) / length)
-    return FoldHinges(np.stack([a, b, c, d], axis=1), rest, Bn * length / width)
+    return FoldHinges(np.stack([a, b, c, d], axis=1), rest, Bn * length / width, fold=at)

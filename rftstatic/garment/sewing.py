@@ -209,11 +209,7 @@ def _creases(sewn: TriMesh, folds, node_of, where):
     probe = FoldLines(edges, np.asarray(angle), np.asarray(width))
     hinges = fold_hinges(replace(sewn, folds=probe), np.eye(3))
     theta = hinges.angles(sewn.X3)
-    n = sewn.n_nodes
-    key = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
-    order = np.argsort(key)
-    a, b = hinges.nodes[:, 0], hinges.nodes[:, 1]
-    at = order[np.searchsorted(key[order], np.minimum(a, b) * n + np.maximum(a, b))]
+    at = hinges.fold
     rest = np.where(theta < 0, -1.0, 1.0) * probe.angle[at]
     off = np.degrees(np.abs(np.abs(theta) - probe.angle[at]))
     worst = int(np.argmax(off))

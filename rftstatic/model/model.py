@@ -319,8 +319,8 @@ class Model(Frozen):
             f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
             data += scatter_matrices(self._patch_map, ke, plan.nnz)
         if self.hinges is not None:
-            f += self.hinges.force(x)
-            rows, cols, blocks = self.hinges.tangent_blocks(x, psd=psd)
+            fh, (rows, cols, blocks) = self.hinges.force_tangent_blocks(x, psd=psd)
+            f += fh
             data += scatter_matrices(plan.positions(rows, cols), blocks, plan.nnz)
         if self.with_membrane:
             fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress,
