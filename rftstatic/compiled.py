@@ -4,13 +4,15 @@
 import os
 from functools import cache
 
-PARALLEL_MIN_ELEMENTS = 4000
-"""Smallest mesh whose explicit internal force is spread over threads. The kernel alone pays on two threads far
-below it (``python -m rftstatic.bench.explicit --threads SCENE``, the fastest of 1,000 calls each at load 5-7, the
-same force bits: cusick-30's 3,840 elements 0.59 -> 0.30 ms, 2,048 elements 0.40 -> 0.24 ms), but the whole run
-does not on a busy machine: cusick-30 (whole process, eight before / after pairs at load 4-6, three variants of
-the tuner) took 5-49 % longer (median 9 %) with 1,000 here (validation/bench_profile.md, fourth round). On an idle machine ``RFTSTATIC_THREADS``
-= 2 asks for both cores."""
+PARALLEL_MIN_ELEMENTS = 1000
+"""Smallest mesh whose explicit internal force is spread over threads (:class:`ThreadTuner` then keeps the faster
+of one and all, and one on a busy machine: :data:`BUSY_LOAD`). The kernel alone pays on two threads from about a
+thousand elements (``python -m rftstatic.bench.explicit --threads SCENE``, the fastest of 1,000 calls each, the
+same force bits: cusick-30's 3,840 elements 0.59 -> 0.30 ms, 2,048 elements 0.40 -> 0.24 ms, 1,536 0.24 -> 0.18
+ms, 512 0.14 -> 0.12 ms). The whole run: cusick-30 near idle (load average 0.9-1.1 with the run), five pairs one
+after the other, 7.6-8.0 s at the earlier limit of 4,000 (one thread) against 5.4-5.9 s here, the same bits
+(validation/bench_profile.md, "Two threads for the Cusick specimen"); on a machine loaded to 4-6, before the busy
+rule existed, two threads had cost it 5-49 %."""
 
 
 STATIC_COMPILED_MIN_ELEMENTS = 3000
