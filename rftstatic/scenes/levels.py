@@ -32,6 +32,7 @@ import math
 
 from rftstatic.errors import SceneError
 from rftstatic.mesh import trimesh as meshmod
+from rftstatic.scenes.mesh_build import structured_nodes
 from rftstatic.scenes.run_options import MAX_LEVELS
 from rftstatic.scenes.schema import MESH_NODES, Scene, validate
 
@@ -51,7 +52,8 @@ def level_mesh(scene: Scene, k: int) -> dict:
     if k == 0:
         return m
     if kind in LEAST_NODES:
-        a, b = m["nodes"]
+        a, b = m["nodes"] = structured_nodes(scene)  # mesh.locking = "refine": halve the refined mesh
+        m["locking"] = "warn"  # a coarse level is coarser than the finest on purpose (level_membrane)
         a2 = math.ceil((a - 1) / 2 ** k) + 1
         if kind == "rectangle":
             b2 = math.ceil((b - 1) / 2 ** k) + 1

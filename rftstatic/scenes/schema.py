@@ -124,6 +124,8 @@ SCHEMA = {
         "radius": (NUM, "outer radius (polar) or half side (square-polar)"),
         "inner_radius": (NUM, "inner radius of an annulus"),
         "grading": (NUM, "polar: outermost ring spacing / innermost (1: uniform)"),
+        "locking": (str, 'RFT6 membrane locking, (C/B) h^2 > 1e4: "warn" (default) or "refine" (rectangle, polar, '
+                         'square-polar: more nodes until below; rftstatic.scenes.locking)'),
         "path": (str, "mesh file read with meshio (relative to the scene file)"),
         "h": (NUM, "target element size of an unstructured mesh"),
         "z": (NUM, "height of the flat reference plane"),

@@ -218,7 +218,9 @@ range of the second (nodes along y or around) given the first: under :data:`MAX_
 
 
 def tiny_mesh(m: dict, a: int, b: int) -> None:
-    """Make the ``[mesh]`` table ``m`` tiny: ``nodes = [a, b]``, or ``h`` = the sheet's extent / ``a``."""
+    """Make the ``[mesh]`` table ``m`` tiny: ``nodes = [a, b]``, or ``h`` = the sheet's extent / ``a``; coarse on
+    purpose, so not refined against membrane locking (``locking = "refine"`` of the Cusick scenes)."""
+    m.pop("locking", None)
     if m.get("kind", "rectangle") == "unstructured":
         m["h"] = extent(m) / a
     elif "nodes" in m or m.get("kind", "rectangle") in MESH_COUNTS:
