@@ -61,19 +61,20 @@ def check_locking(scene, m: dict, kind: str) -> None:
                           'remove the key (the model then warns)')
 
 
-def refined_nodes(scene, kind: str, given, make_mesh, max_nodes: int) -> list[int]:
-    """``mesh.nodes`` for ``mesh.locking = "refine"``: ``given`` when RFT6 is below
+def refined_nodes(scene, kind: str, given, make_mesh, max_nodes: int):
+    """``(nodes, mesh)``: ``mesh.nodes`` for ``mesh.locking = "refine"``: ``given`` when RFT6 is below
     :data:`~rftstatic.model.model.LOCKING_WARN` on the scene's fabric there (or the element is RFT3), else both
     counts scaled up by ``sqrt(lock / LOCKING_WARN)`` (then 10 % more per try) until the mesh ``make_mesh(nodes)``
-    is below it. A scene error names ``mesh.locking`` when :data:`MAX_TRIES` refinements do not get there or the
+    is below it, and that mesh (built here once). A scene error names ``mesh.locking`` when :data:`MAX_TRIES` refinements do not get there or the
     mesh would have more than ``max_nodes`` nodes (a membrane rigidity far beyond a fabric's)."""
     if scene.get("element", "RFT6") != "RFT6":
-        return list(given)
+        return list(given), make_mesh(given)
     from rftstatic.model.model import LOCKING_WARN, locking_number
     from rftstatic.scenes.material import build_material
 
     material = build_material(scene)
-    nodes, lock = list(given), locking_number(make_mesh(given), material)
+    nodes, mesh = list(given), make_mesh(given)
+    lock = locking_number(mesh, material)
     s = math.sqrt(lock / LOCKING_WARN)
     tries = 0
     while lock > LOCKING_WARN:
@@ -87,10 +88,11 @@ def refined_nodes(scene, kind: str, given, make_mesh, max_nodes: int) -> list[in
                               f"({nodes[0] * nodes[1]:.3g} nodes, more than {max_nodes:,}): check the fabric's "
                               'membrane and bending rigidities ([material]), or use element = "RFT3" or locking = '
                               '"warn"')
-        lock = locking_number(make_mesh(nodes), material)
+        mesh = make_mesh(nodes)
+        lock = locking_number(mesh, material)
         s *= 1.1
         tries += 1
     if nodes != list(given):
         log.info('mesh.locking = "refine": mesh.nodes %s -> %s for (C/B) h^2 <= %.0e on this fabric (%.3g)',
                  list(given), nodes, LOCKING_WARN, lock)
-    return nodes
+    return nodes, mesh

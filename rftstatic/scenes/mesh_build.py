@@ -50,17 +50,22 @@ def _structured(scene, m, kind, nodes, u, z0):
                          grading=m.get("grading", 1.0))
 
 
-def structured_nodes(scene, m: dict | None = None, kind: str | None = None) -> list[int]:
-    """``mesh.nodes`` of the scene's generated (rectangle, polar, square-polar) mesh as built: the given or
-    default counts, refined for the fabric when ``mesh.locking = "refine"`` (:mod:`rftstatic.scenes.locking`)."""
-    m = scene.get("mesh", {}) if m is None else m
-    kind = m.get("kind", "rectangle") if kind is None else kind
-    nodes = list(pair(scene, "mesh.nodes", m.get("nodes", MESH_NODES[kind]), int))
-    if m.get("locking", "warn") == "warn" or "mesh.nodes" in scene.overrides:
-        return nodes
+def _structured_mesh(scene, m: dict, kind: str):
+    """``(nodes, mesh)`` of a generated (rectangle, polar, square-polar) ``[mesh]`` table ``m``: the given or default
+    counts, refined for the fabric when ``mesh.locking = "refine"`` (:mod:`rftstatic.scenes.locking`)."""
     u = scene.units.length
     z0 = m.get("z", 0.0) * u
+    nodes = list(pair(scene, "mesh.nodes", m.get("nodes", MESH_NODES[kind]), int))
+    if m.get("locking", "warn") == "warn" or "mesh.nodes" in scene.overrides:
+        return nodes, _structured(scene, m, kind, nodes, u, z0)
     return refined_nodes(scene, kind, nodes, lambda n: _structured(scene, m, kind, n, u, z0), MAX_MESH_NODES)
+
+
+def structured_nodes(scene) -> list[int]:
+    """``mesh.nodes`` of the scene's generated (rectangle, polar, square-polar) mesh as built (refined for the
+    fabric when ``mesh.locking = "refine"``)."""
+    m = scene.get("mesh", {})
+    return _structured_mesh(scene, m, m.get("kind", "rectangle"))[0]
 
 
 def build_mesh(scene: Scene) -> meshmod.TriMesh:
@@ -79,15 +84,14 @@ def build_mesh(scene: Scene) -> meshmod.TriMesh:
     check_mesh_table(scene, m, kind)
     check_locking(scene, m, kind)
     z0 = m.get("z", 0.0) * u
-    nodes = m.get("nodes") if kind in ("rectangle", "polar", "square-polar") else None
+    nodes = m.get("nodes") if kind in STRUCTURED else None
     if (isinstance(nodes, list) and len(nodes) == 2 and all(isinstance(n, int) for n in nodes)
             and nodes[0] * nodes[1] > MAX_MESH_NODES):
         raise scene.error("mesh.nodes", f"{nodes!r} asks for {nodes[0] * nodes[1]:.3g} nodes, more than "
                           f"{MAX_MESH_NODES:,}; give fewer nodes")
     try:
         if kind in STRUCTURED:
-            nodes = structured_nodes(scene, m, kind)
-            return _structured(scene, m, kind, nodes, u, z0)
+            return _structured_mesh(scene, m, kind)[1]
         if kind == "file":
             if "path" not in m:
                 raise scene.error("mesh.path", "a file mesh needs the path of the mesh file")

@@ -14,7 +14,8 @@ from rftstatic.solvers.relaxation import RELAX_MASS_SCALE
 from rftstatic.solvers.timestep import stable_time_step
 from rftstatic.units import STANDARD_GRAVITY
 
-__all__ = ["MAX_RELAX_STEPS", "RELAX_ATTEMPT_FACTOR", "RELAX_SEGMENT_STEPS", "RELAX_TIME_ALLOWANCE", "RelaxPlan", "relax_plan"]
+__all__ = ["MAX_RELAX_STEPS", "RELAX_ATTEMPT_FACTOR", "RELAX_SEGMENT_STEPS", "RELAX_TIME_ALLOWANCE", "RelaxPlan",
+           "relax_plan"]
 
 MAX_RELAX_STEPS = 200_000
 """Explicit steps of the relaxation's expected need (100 damping times) that the route plans at most: a longer
