@@ -46,7 +46,7 @@ from rftstatic.errors import CheckpointError, InstabilityError, ParameterError
 from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_mesh_series, write_outputs
 from rftstatic.io.summary import (drape_summary, obstacle_crossing_summary, probe_summary, self_contact_summary,
-                                  self_intersection_summary, summary_header)
+                                  self_intersection_summary, summary_header, warn_crossings)
 from rftstatic.optionspec import scene_values
 from rftstatic.remesh.adapt import RemeshRecord, _curvature_figures, refinable_maxima
 from rftstatic.model.state import State
@@ -340,6 +340,7 @@ def summarize(scene, opts, solved) -> dict:
     })
     if model.self_contact is not None:  # the counters of the last mesh's model (each remesh builds its own)
         summary["self_contact"] = self_contact_summary(scene, model, scale=solved.get("self_contact_scale", 1.0))
+    warn_crossings(summary, self_contact=model.self_contact is not None)
     if solved["route"] == "remesh_relax":
         d = solved["dynamics"]
         summary.update(t=solved["t"] / u.time, steps=solved["steps"], skipped_remeshes=solved["skipped"],

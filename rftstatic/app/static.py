@@ -26,7 +26,7 @@ from rftstatic.errors import ConvergenceError
 from rftstatic.io.files import to_jsonable
 from rftstatic.io.results import write_outputs
 from rftstatic.io.summary import (drape_summary, obstacle_crossing_summary, probe_summary, self_contact_summary,
-                                  self_intersection_summary, summary_header)
+                                  self_intersection_summary, summary_header, warn_crossings)
 from rftstatic.scenes.build import build_model
 from rftstatic.app.specimens import seeded_specimens
 from rftstatic.app.starts import keep_lower
@@ -176,13 +176,7 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
         summary["obstacle_crossings"] = crossings
     if model.self_contact is not None:
         summary["self_contact"] = self_contact_summary(scene, model, scale=result.self_contact_scale)
-        crossing = summary["self_intersections"].get("pairs", 0)
-        if crossing:  # the law failed to keep the layers apart: say so beside the converged flag
-            text = (f"{crossing} triangle pairs of the final state cross although self-contact is on: the "
-                    "layers passed through each other, so this equilibrium is not physical; raise "
-                    "contact.self_factor (or refine the mesh at the fold)")
-            log.warning(text)
-            summary["warnings"].append(text)
+    warn_crossings(summary, self_contact=model.self_contact is not None)
     if model.contact is not None:
         x = model.positions(U)
         summary["max_penetration"] = model.contact.max_penetration(x) / u.length
@@ -190,3 +184,4 @@ def static_summary(scene, model, extras, result, build_time) -> dict:
     if model.contact is not None or extras.get("disc") is not None:
         summary["drape"] = drape_summary(scene, model, extras, U)
     return summary
+

@@ -216,3 +216,24 @@ def obstacle_crossing_summary(scene, model, extras, U, poses=None) -> list | Non
                     "deepest_chord": float(min(0.0, ob.signed_distance(mids)[0].min())) / u,
                     "within": r["within"] / u, "tol": r["tol"] / u, "seconds": r["seconds"]})
     return out or None
+
+
+def warn_crossings(summary: dict, *, self_contact: bool) -> None:
+    """Add to ``summary["warnings"]`` (and the log) that the final state crosses itself, when its
+    ``self_intersections`` count pairs: a converged flag beside a sheet that passed through itself is not a
+    physical equilibrium. The fix named depends on ``self_contact`` (on: its stiffness or the mesh; off: turn
+    it on)."""
+    pairs = (summary.get("self_intersections") or {}).get("pairs", 0)
+    if not pairs:
+        return
+    if self_contact:
+        text = (f"{pairs} triangle pairs of the final state cross although self-contact is on: the "
+                "layers passed through each other, so this equilibrium is not physical; raise "
+                "contact.self_factor (or refine the mesh at the fold)")
+    else:
+        text = (f"{pairs} triangle pairs of the final state cross: the sheet passed through itself (this scene has "
+                "no self-contact), so this equilibrium is not physical; set contact.self = true (--set "
+                "contact.self=true), or take a gentler route (solver.start)")
+    log.warning(text)
+    summary.setdefault("warnings", []).append(text)
+
