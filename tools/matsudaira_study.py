@@ -11,6 +11,10 @@ fabric's 2HB; path dependent, so no comparison) on the relaxation and on the loa
 solved again). Prints a Markdown table.
 
     PYTHONPATH=$PWD python tools/matsudaira_study.py [--seeds 3] [--out /tmp/matsudaira-runs]
+
+``--starts``: instead, the lowest-energy drape found per fabric (no hysteresis: energies compare): the relaxation and
+the load steps from the scene's start (seed 1), and the load steps from an n-fold lift of one element size
+(``solver.perturbation_folds = n``, n = 3 ... 8); one row per run and the lowest energy per fabric.
 """
 
 from __future__ import annotations
@@ -28,13 +32,18 @@ VARIANTS = {"compare": ["solver.compare=load-steps"], "relax, 2HB": ["solver.sta
             "load steps, 2HB": ["solver.start=load-steps"]}
 """Route keys of each variant; the 2HB variants add the fabric's bending hysteresis."""
 
+STARTS = {"relax": ["solver.start=relax"], "load steps": ["solver.start=load-steps"],
+          **{f"load steps, {n}-fold lift": ["solver.start=load-steps", "solver.perturbation=1",
+                                            f"solver.perturbation_folds={n}"] for n in range(3, 9)}}
+"""Starts of ``--starts``: the scene's two routes, and the load steps from n-fold lifts of one element size."""
+
 
 def _run(fabric, variant, seed, out: Path) -> dict | None:
     if not (out / "summary.json").is_file():
         keys = [f"kes_B_warp={fabric['B']}", f"kes_B_weft={fabric['B']}", f"kes_W={fabric['W']}", f"kes_T={fabric['T']}"]
         if "2HB" in variant:
             keys += [f"kes_2HB_warp={fabric['2HB']}", f"kes_2HB_weft={fabric['2HB']}"]
-        sets = ["material={" + ", ".join(keys) + "}", f"solver.seed={seed}", *VARIANTS[variant]]
+        sets = ["material={" + ", ".join(keys) + "}", f"solver.seed={seed}", *{**VARIANTS, **STARTS}[variant]]
         t = time.perf_counter()
         p = subprocess.run([sys.executable, "-m", "rftstatic", "case", "cusick-30", "--no-figures", "--out", str(out)]
                            + [a for k in sets for a in ("--set", k)], capture_output=True, text=True)
@@ -54,11 +63,14 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--out", default="/tmp/matsudaira-runs")
+    ap.add_argument("--starts", action="store_true", help="the lowest-energy drape found per fabric (see above)")
     a = ap.parse_args(argv)
     root = Path(a.out)
     fabrics = [{"id": r["id"], "name": r["name"], "B": float(r["B_gf*cm^2/cm"]), "2HB": float(r["2HB_gf*cm/cm"]),
                 "W": float(r["W_mg/cm^2"]), "T": float(r["T_mm"]), "DC": float(r["DC_pub_%"]),
                 "nodes": int(r["nodes_pub"])} for r in secondary_table()]
+    if a.starts:
+        return _starts(fabrics, root)
     lines = ["| fabric | B [gf cm^2/cm], 2HB [gf cm/cm], W [mg/cm^2] | measured DC [%], nodes | variant | DC [%] mean "
              "(seeds) | nodes mean (seeds) | DC error [points] | nodes error | route kept (compare) | stable | wall [s] "
              "per seed |", "|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -79,6 +91,36 @@ def main(argv=None):
                          f"{np.mean([s['wall_s'] for s in runs]):.0f} |")
             print(lines[-1], flush=True)
     print("\n".join(lines))
+
+
+def _starts(fabrics, root: Path) -> None:
+    """Print the ``--starts`` table: every start's drape, and the lowest stable one per fabric."""
+    lines = ["| fabric | measured DC [%], nodes | start | energy [gf cm] | nodes | DC [%] | stable | crossing pairs | "
+             "wall [s] |", "|---|---|---|---|---|---|---|---|---|"]
+    lowest = []
+    for f in fabrics:
+        runs = {}
+        for start in STARTS:
+            s = _run(f, start, 1, root / f"{f['id']}-starts-{start.replace(', ', '-').replace(' ', '_')}")
+            if s is None:
+                continue
+            runs[start] = s
+            lines.append(f"| {f['id']} {f['name']} | {f['DC']:g}, {f['nodes']} | {start} | {s['energies']['total']:.4f} | "
+                         f"{s['drape']['fold_count']} | {s['drape']['drape_coefficient_percent']:.1f} | "
+                         f"{s['stable_minimum']} | {s['self_intersections'].get('pairs')} | {s['wall_s']:.0f} |")
+            print(lines[-1], flush=True)
+        stable = {k: s for k, s in runs.items() if s["stable_minimum"] and not s["self_intersections"].get("pairs")}
+        if stable:
+            k = min(stable, key=lambda k: stable[k]["energies"]["total"])
+            s = stable[k]
+            lowest.append(f"| {f['id']} {f['name']} | {f['DC']:g}, {f['nodes']} | {k} | {s['energies']['total']:.4f} | "
+                          f"{s['drape']['fold_count']} | {s['drape']['drape_coefficient_percent']:.1f} | "
+                          f"{s['drape']['drape_coefficient_percent'] - f['DC']:+.1f} | "
+                          f"{s['drape']['fold_count'] - f['nodes']:+d} |")
+    print("\n".join(lines))
+    print("\n| fabric | measured DC [%], nodes | lowest-energy start | energy [gf cm] | nodes | DC [%] | DC error "
+          "[points] | nodes error |\n|---|---|---|---|---|---|---|---|")
+    print("\n".join(lowest))
 
 
 if __name__ == "__main__":
