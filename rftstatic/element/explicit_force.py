@@ -27,7 +27,8 @@ import time
 import numpy as np
 
 from rftstatic.compiled import ThreadTuner, fixed_threads, force_threads, numba_available
-from rftstatic.element.kernels import element_last, forces_numpy
+from rftstatic.element.kernels import lane_blocks, lane_slots
+from rftstatic.element.kernels_numpy import element_last, forces_numpy
 
 BACKENDS = ("auto", "numpy", "numba")
 
@@ -85,15 +86,14 @@ class ForceKernel:
             self._G_last = element_last(self.G)
             self._dofs = (3 * self.nodes.T[:, None, :] + np.arange(3)[:, None]).ravel()  # scatter of fe (A, 3, E)
             return
-        from rftstatic.element._kernels_numba import internal_force, internal_force_parallel
+        from rftstatic.element._kernels_numba import explicit_kernel
 
-        self._nb = internal_force
-        # node -> element-slot map of the force gather: slots[slot_ptr[n]:slot_ptr[n + 1]] are the
-        # flat indices e * A + a with nodes[e, a] == n, in element order (a node repeated in a patch: each slot)
-        flat = self.nodes.ravel()
-        self._slots = np.argsort(flat, kind="stable").astype(np.int64)
-        self._slot_ptr = np.concatenate([[0], np.cumsum(np.bincount(flat, minlength=N))]).astype(np.int64)
-        self._fe = np.empty((E, A, 3))
+        self._nb = explicit_kernel(Q, A, False)
+        # G, area and the element forces by blocks of elements (the compiled kernel's lanes), and the
+        # node -> element-slot map of the force gather (in element order)
+        self._Gb, self._area_b = lane_blocks(self.G, self.area)
+        self._slot_ptr, self._slots = lane_slots(self.nodes, N)
+        self._fe = np.empty((len(self._Gb), A, 3, self._Gb.shape[-1]))
         self.threads = force_threads(E) if threads is None else max(1, int(threads))
         if self.threads > 1:
             import numba
@@ -103,7 +103,7 @@ class ForceKernel:
             self._run_threads = min(self.threads, int(numba.config.NUMBA_NUM_THREADS))
             tune = threads is None and fixed_threads() is None and self._run_threads > 1
             self._tuner = ThreadTuner(self._run_threads) if tune else None
-            self._nb_parallel = internal_force_parallel
+            self._nb_parallel = explicit_kernel(Q, A, True)
 
     def __call__(self, U: np.ndarray, *, energy: bool = False, candidates=None, pairs=None, slip=None):
         """Internal force ``(N, 3)`` [N]; with ``energy=True`` also the stored energy [J].
@@ -118,8 +118,8 @@ class ForceKernel:
         if self.backend == "numba":
             f = np.empty_like(U)
             Kb = self.Kb
-            args = (Kb.indptr, Kb.indices, Kb.data, self.nodes, self.G, self.area, self._D, self.Dm, U, f, self._fe,
-                    self._slot_ptr, self._slots, self.with_membrane)
+            args = (Kb.indptr, Kb.indices, Kb.data, self.nodes, self._Gb, self._area_b, self._D, self.Dm, U, f,
+                    self._fe, self._slot_ptr, self._slots, self.with_membrane)
             if self.threads > 1:
                 import numba
 
