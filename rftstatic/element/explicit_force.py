@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 from rftstatic.compiled import ThreadTuner, fixed_threads, force_threads, numba_available
-from rftstatic.element.kernels import lane_blocks, lane_slots
+from rftstatic.element.kernels import element_slots, lane_blocks
 from rftstatic.element.kernels_numpy import element_last, forces_numpy
 
 BACKENDS = ("auto", "numpy", "numba")
@@ -89,11 +89,11 @@ class ForceKernel:
         from rftstatic.element._kernels_numba import explicit_kernel
 
         self._nb = explicit_kernel(Q, A, False)
-        # G, area and the element forces by blocks of elements (the compiled kernel's lanes), and the
-        # node -> element-slot map of the force gather (in element order)
+        # G and area by blocks of elements (the compiled kernel's lanes), and the node -> element-slot map of
+        # the force gather (in element order)
         self._Gb, self._area_b = lane_blocks(self.G, self.area)
-        self._slot_ptr, self._slots = lane_slots(self.nodes, N)
-        self._fe = np.empty((len(self._Gb), A, 3, self._Gb.shape[-1]))
+        self._slot_ptr, self._slots = element_slots(self.nodes, N)
+        self._fe = np.empty((E, A, 3))
         self.threads = force_threads(E) if threads is None else max(1, int(threads))
         if self.threads > 1:
             import numba

@@ -308,12 +308,13 @@ def membrane_forces(nodes, G, area, D, Dm, U, fe, start, stop):
 def membrane_force_lanes(nodes, Gb, area, D, Dm, U, fe, start, stop):
     """:func:`membrane_forces` of elements ``start`` to ``stop - 1`` in blocks of :data:`LANES` (the element
     of :data:`_Q`, :data:`_A`): the arithmetic of each element vectorised across the block, the same bits;
-    return their membrane energy [J], summed in element order.
+    fill ``fe[start:stop] (E, A, 3)`` [N] and return their membrane energy [J], summed in element order.
 
-    ``Gb (B, Q, A, 2, LANES)`` [1/m], ``area (B, LANES)`` [m^2] and ``fe (B, A, 3, LANES)`` [N] are laid out
-    by blocks of elements (:func:`lane_blocks`, element ``e`` is lane ``e % LANES`` of block ``e // LANES``;
-    the last block padded); ``nodes (E, A)`` and ``D`` as in :func:`membrane_energies`. A block that
-    ``start`` or ``stop`` cuts is computed whole, and only its lanes in the range are written."""
+    ``Gb (B, Q, A, 2, LANES)`` [1/m] and ``area (B, LANES)`` [m^2] are laid out by blocks of elements
+    (:func:`lane_blocks`: element ``e`` is lane ``e % LANES`` of block ``e // LANES``, the last block padded);
+    ``nodes (E, A)`` and ``D`` as in :func:`membrane_energies`. A block that ``start`` or ``stop`` cuts is
+    computed whole, and only its lanes in the range are written (the forces go out element by element: the
+    nodes' gather in :func:`internal_force` reads one element's slot from one cache line)."""
     E = nodes.shape[0]
     u = _scratch((_A, 3, LANES))
     H = _scratch((_Q, 2, 3, LANES))
@@ -332,7 +333,7 @@ def membrane_force_lanes(nodes, Gb, area, D, Dm, U, fe, start, stop):
             W += strain_energy(area[k, L], S[0, L], S[1, L], S[2, L], S[3, L], S[4, L], S[5, L])
             for a in range(_A):
                 for i in range(3):
-                    fe[k, a, i, L] = fl[a, i, L]
+                    fe[e0 + L, a, i] = fl[a, i, L]
     return W
 
 
@@ -423,18 +424,16 @@ def internal_force(indptr, indices, data, nodes, Gb, area, D, Dm, U, f, fe, slot
     """Fill ``f (N, 3)`` [N] with the internal force at ``U (N, 3)`` [m]; return the stored energy [J].
 
     Bending ``K_b @ U`` over the CSR rows ``indptr, indices, data`` of the scalar K_b [N/m] (Eq. 13),
-    plus the membrane forces of :func:`membrane_force_blocks` (into ``fe (B, A, 3, LANES)``, with ``Gb`` and
+    plus the membrane forces of :func:`membrane_force_blocks` (into ``fe (E, A, 3)``, with ``Gb`` and
     ``area`` laid out by :func:`lane_blocks`), which each node gathers from its element slots
-    ``slots[slot_ptr[n]:slot_ptr[n + 1]]`` (flat indices into ``fe`` of the slot's x component, y and z one and
-    two lanes' strides on, :func:`lane_slots`; in element order): no two threads write one entry, and the sums
-    do not depend on ``chunks``.
+    ``slots[slot_ptr[n]:slot_ptr[n + 1]]`` (flat indices ``e * A + a``, in element order, :func:`element_slots`):
+    no two threads write one entry, and the sums do not depend on ``chunks``.
     """
     N = U.shape[0]
     W = 0.0
     if with_membrane:
         W = membrane_force_blocks(nodes, Gb, area, D, Dm, U, fe, chunks)
-    flat = fe.ravel()
-    step = fe.shape[3]
+    flat = fe.reshape((fe.shape[0] * fe.shape[1], 3))
     for n in prange(N):
         s0 = 0.0
         s1 = 0.0
@@ -449,9 +448,9 @@ def internal_force(indptr, indices, data, nodes, Gb, area, D, Dm, U, f, fe, slot
         if with_membrane:
             for p in range(slot_ptr[n], slot_ptr[n + 1]):
                 k = slots[p]
-                s0 += flat[k]
-                s1 += flat[k + step]
-                s2 += flat[k + 2 * step]
+                s0 += flat[k, 0]
+                s1 += flat[k, 1]
+                s2 += flat[k, 2]
         f[n, 0] = s0
         f[n, 1] = s1
         f[n, 2] = s2
@@ -469,14 +468,11 @@ def lane_blocks(G, area):
     return Gb, np.ascontiguousarray(area[take].reshape(B, LANES))
 
 
-def lane_slots(nodes, N):
+def element_slots(nodes, N):
     """The node -> element-slot map of :func:`internal_force`'s force gather for ``nodes (E, A)`` on ``N`` nodes:
     ``slot_ptr (N + 1,)`` and ``slots``, the slots of node n (``nodes[e, a] == n``, in element order, a node
-    repeated in a patch once each) as flat indices of ``fe[e // LANES, a, 0, e % LANES]`` in the
-    ``(B, A, 3, LANES)`` force blocks."""
+    repeated in a patch once each) as flat indices ``e * A + a``, both int64."""
     flat = nodes.ravel()
-    order = np.argsort(flat, kind="stable")
-    e, a = order // nodes.shape[1], order % nodes.shape[1]
-    slots = ((e // LANES * nodes.shape[1] + a) * 3 * LANES + e % LANES).astype(np.int64)
+    slots = np.argsort(flat, kind="stable").astype(np.int64)
     slot_ptr = np.concatenate([[0], np.cumsum(np.bincount(flat, minlength=N))]).astype(np.int64)
     return slot_ptr, slots
