@@ -27,7 +27,7 @@ from rftstatic.element import kernels
 
 _ELEMENT = ("strain_point_gradients", "green_strain", "averaged_strain", "stress", "membrane_state",
             "strain_energy", "_deformation", "element_force", "positive_part", "element_tangent", "_gather",
-            "strain_increment", "_force_and_tangent", "_gather_offset", "_one")
+            "strain_increment", "_force_and_tangent", "_gather_offset", "_one", "_gather_lanes")
 _LOOPS = ("membrane_energies", "membrane_forces", "membrane_tangents", "membrane_tangents_into",
           "membrane_linearised_strains")
 _EXPLICIT = ("membrane_force_lanes", "membrane_force_blocks", "internal_force")

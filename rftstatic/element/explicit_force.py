@@ -89,9 +89,9 @@ class ForceKernel:
         from rftstatic.element._kernels_numba import explicit_kernel
 
         self._nb = explicit_kernel(Q, A, False)
-        # G and area by blocks of elements (the compiled kernel's lanes), and the node -> element-slot map of
-        # the force gather (in element order)
-        self._Gb, self._area_b = lane_blocks(self.G, self.area)
+        # nodes, G, area and offsets by blocks of elements (the compiled kernel's lanes), and the node ->
+        # element-slot map of the force gather (in element order)
+        self._blocks = lane_blocks(self.nodes, self.G, self.area, self._D)
         self._slot_ptr, self._slots = element_slots(self.nodes, N)
         self._fe = np.empty((E, A, 3))
         self.threads = force_threads(E) if threads is None else max(1, int(threads))
@@ -118,8 +118,8 @@ class ForceKernel:
         if self.backend == "numba":
             f = np.empty_like(U)
             Kb = self.Kb
-            args = (Kb.indptr, Kb.indices, Kb.data, self.nodes, self._Gb, self._area_b, self._D, self.Dm, U, f,
-                    self._fe, self._slot_ptr, self._slots, self.with_membrane)
+            args = (Kb.indptr, Kb.indices, Kb.data, *self._blocks, self.Dm, U, f, self._fe, self._slot_ptr,
+                    self._slots, self.with_membrane)
             if self.threads > 1:
                 import numba
 

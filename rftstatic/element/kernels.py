@@ -305,17 +305,32 @@ def membrane_forces(nodes, G, area, D, Dm, U, fe, start, stop):
     return W
 
 
+def _gather_lanes(U, n, D, k, u):
+    """``u[a, i, L] = U[n[a, L], i]`` (plus ``D[k, a, i, L]`` when ``D`` has rows, :func:`_gather_offset`): the
+    nodal displacements [m] of a block of elements from its nodes ``n (A, LANES)``, lanes innermost (vector
+    gathers)."""
+    for a in range(u.shape[0]):
+        for i in range(3):
+            for L in lanes(u):
+                u[a, i, L] = U[n[a, L], i]
+    if D.shape[0] > 0:
+        for a in range(u.shape[0]):
+            for i in range(3):
+                for L in lanes(u):
+                    u[a, i, L] = u[a, i, L] + D[k, a, i, L]
+
+
 def membrane_force_lanes(nodes, Gb, area, D, Dm, U, fe, start, stop):
     """:func:`membrane_forces` of elements ``start`` to ``stop - 1`` in blocks of :data:`LANES` (the element
     of :data:`_Q`, :data:`_A`): the arithmetic of each element vectorised across the block, the same bits;
     fill ``fe[start:stop] (E, A, 3)`` [N] and return their membrane energy [J], summed in element order.
 
-    ``Gb (B, Q, A, 2, LANES)`` [1/m] and ``area (B, LANES)`` [m^2] are laid out by blocks of elements
-    (:func:`lane_blocks`: element ``e`` is lane ``e % LANES`` of block ``e // LANES``, the last block padded);
-    ``nodes (E, A)`` and ``D`` as in :func:`membrane_energies`. A block that ``start`` or ``stop`` cuts is
-    computed whole, and only its lanes in the range are written (the forces go out element by element: the
-    nodes' gather in :func:`internal_force` reads one element's slot from one cache line)."""
-    E = nodes.shape[0]
+    ``nodes (B, A, LANES)``, ``Gb (B, Q, A, 2, LANES)`` [1/m], ``area (B, LANES)`` [m^2] and ``D (B, A, 3,
+    LANES)`` [m] (or ``(0, A, 3, LANES)``, :func:`_gather_offset`) are laid out by blocks of elements
+    (:func:`lane_blocks`: element ``e`` is lane ``e % LANES`` of block ``e // LANES``, the last block padded).
+    A block that ``start`` or ``stop`` cuts is computed whole, and only its lanes in the range are written
+    (the forces go out element by element: the nodes' gather in :func:`internal_force` reads one element's
+    slot from one cache line)."""
     u = _scratch((_A, 3, LANES))
     H = _scratch((_Q, 2, 3, LANES))
     S = _scratch((6, LANES))
@@ -323,9 +338,7 @@ def membrane_force_lanes(nodes, Gb, area, D, Dm, U, fe, start, stop):
     W = 0.0
     for k in range(start // LANES, (stop + LANES - 1) // LANES):
         e0 = k * LANES
-        for L in range(LANES):
-            e = min(e0 + L, E - 1)
-            _gather_offset(U, nodes[e], D, e, u, L)
+        _gather_lanes(U, nodes[k], D, k, u)
         g = Gb[k]
         membrane_state(g, u, Dm, H, S)
         element_force(g, H, S, area[k], fl)
@@ -339,8 +352,8 @@ def membrane_force_lanes(nodes, Gb, area, D, Dm, U, fe, start, stop):
 
 def membrane_force_blocks(nodes, Gb, area, D, Dm, U, fe, chunks):
     """:func:`membrane_force_lanes` of all elements in ``chunks`` ranges (on threads in the parallel twin;
-    any number of ranges gives the same ``fe``); return the membrane energy [J]."""
-    E = nodes.shape[0]
+    any number of ranges gives the same ``fe (E, A, 3)``); return the membrane energy [J]."""
+    E = fe.shape[0]
     W = 0.0
     for c in prange(chunks):
         W += membrane_force_lanes(nodes, Gb, area, D, Dm, U, fe, c * E // chunks, (c + 1) * E // chunks)
@@ -424,8 +437,8 @@ def internal_force(indptr, indices, data, nodes, Gb, area, D, Dm, U, f, fe, slot
     """Fill ``f (N, 3)`` [N] with the internal force at ``U (N, 3)`` [m]; return the stored energy [J].
 
     Bending ``K_b @ U`` over the CSR rows ``indptr, indices, data`` of the scalar K_b [N/m] (Eq. 13),
-    plus the membrane forces of :func:`membrane_force_blocks` (into ``fe (E, A, 3)``, with ``Gb`` and
-    ``area`` laid out by :func:`lane_blocks`), which each node gathers from its element slots
+    plus the membrane forces of :func:`membrane_force_blocks` (into ``fe (E, A, 3)``, with ``nodes``, ``Gb``,
+    ``area`` and ``D`` laid out by :func:`lane_blocks`), which each node gathers from its element slots
     ``slots[slot_ptr[n]:slot_ptr[n + 1]]`` (flat indices ``e * A + a``, in element order, :func:`element_slots`):
     no two threads write one entry, and the sums do not depend on ``chunks``.
     """
@@ -457,15 +470,22 @@ def internal_force(indptr, indices, data, nodes, Gb, area, D, Dm, U, f, fe, slot
     return W
 
 
-def lane_blocks(G, area):
-    """``G (E, Q, A, 2)`` and ``area (E,)`` laid out by blocks of :data:`LANES` elements for
-    :func:`membrane_force_lanes`: ``(B, Q, A, 2, LANES)`` and ``(B, LANES)``, B = ceil(E / LANES), the last
-    block padded with copies of the last element (computed, never written)."""
+def lane_blocks(nodes, G, area, D):
+    """``nodes (E, A)``, ``G (E, Q, A, 2)``, ``area (E,)`` and the reference offsets ``D (E, A, 3)`` or
+    ``(0, A, 3)`` laid out by blocks of :data:`LANES` elements for :func:`membrane_force_lanes`, the element
+    axis split and its lanes moved last: ``(B, A, LANES)``, ``(B, Q, A, 2, LANES)``, ``(B, LANES)``,
+    ``(B or 0, A, 3, LANES)``; B = ceil(E / LANES), the last block padded with copies of the last element
+    (computed, never written)."""
     E = len(area)
     B = -(-E // LANES)
     take = np.minimum(np.arange(B * LANES), E - 1)
-    Gb = np.ascontiguousarray(np.moveaxis(G[take].reshape((B, LANES) + G.shape[1:]), 1, -1))
-    return Gb, np.ascontiguousarray(area[take].reshape(B, LANES))
+
+    def blocks(x):
+        if len(x) == 0:
+            return np.zeros((0,) + x.shape[1:] + (LANES,))
+        return np.ascontiguousarray(np.moveaxis(x[take].reshape((B, LANES) + x.shape[1:]), 1, -1))
+
+    return blocks(nodes), blocks(G), blocks(area), blocks(D)
 
 
 def element_slots(nodes, N):
