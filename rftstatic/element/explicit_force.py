@@ -10,9 +10,12 @@ Eq. 15, ``f_a = A/Q sum_q F_q S g_qa``), summed into the nodes. A penalty contac
 pair cache only, :meth:`rftstatic.contact.self_contact.law.SelfContact.near_force`).
 
 Two back ends run that code: ``"numba"`` (compiled, one pass over the elements and the CSR rows of
-K_b, :func:`rftstatic.element.kernels.internal_force`) and ``"numpy"`` (the same element kernels
-vectorised over the elements, ``scipy`` for ``K_b @ U``); ``"auto"`` uses numba when it imports. Both
-are tested against :meth:`Model.internal_force`. On large meshes the numba pass runs on all cores:
+K_b, :func:`rftstatic.element.kernels.internal_force`; the elements in blocks of
+:data:`~rftstatic.element.kernels.LANES`, their arithmetic vectorised across a block with the bits of one element
+at a time: cusick-30's 3,840 elements 0.59 -> 0.21 ms a call on one thread, 0.30 -> 0.14 ms on two) and
+``"numpy"`` (the same element kernels vectorised over the elements, ``scipy`` for ``K_b @ U``); ``"auto"`` uses
+numba when it imports. Both are tested against :meth:`Model.internal_force`. On large meshes the numba pass runs
+on all cores:
 blocks of elements write their nodal forces into a private array, and each node then gathers its
 bending row and its element slots (no two threads write one entry; the serial pass does the same
 sums in the same order). A :class:`rftstatic.compiled.ThreadTuner` checks now and then that the
