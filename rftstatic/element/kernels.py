@@ -41,8 +41,9 @@ _TINY = 1e-300
 
 LANES = 16
 """Elements per block of the compiled explicit force (:func:`membrane_force_lanes`): LLVM vectorises each lane
-loop over them (AVX2 / AVX-512). cusick-30's kernel, one thread: 4 lanes 0.40 ms, 8 0.37, 16 0.16, 32 0.17,
-64 0.19 ms a call (0.53 ms one element at a time)."""
+loop over them (AVX-512 on the development machine). cusick-30's membrane loop alone (a first version of
+:func:`membrane_force_lanes`), one thread: 4 lanes 0.40 ms a call, 8 0.37, 16 0.16, 24 0.19, 32 0.17, 64 0.19 ms
+(one element at a time 0.53 ms); the whole kernel with the bending product and the nodes' gather 0.21 ms (0.59)."""
 
 _Q, _A = 3, 6
 """Strain points and nodes of the element of the compiled loops: their scratch arrays (:func:`_scratch`) are
