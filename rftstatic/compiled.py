@@ -14,7 +14,7 @@ same force bits; the kernel vectorised across element blocks, :data:`rftstatic.e
 0.24 -> 0.18, 0.14 -> 0.12 ms). The whole run before the lanes: cusick-30 near idle (load average 0.9-1.1 with
 the run), five pairs one after the other, 7.6-8.0 s at the earlier limit of 4,000 (one thread) against 5.4-5.9 s
 here, the same bits (validation/bench_profile.md, "Two threads for the Cusick specimen"); on a machine loaded to
-4-6, before the busy rule existed, two threads had cost it 5-49 %. With the lanes: 4.1-5.3 s (validation/
+4-6, before the busy rule existed, two threads had cost it 5-49 %. With the lanes: 4.1-5.4 s (validation/
 bench_profile.md, "Explicit kernel, SIMD/layout")."""
 
 
