@@ -8,11 +8,14 @@ PARALLEL_MIN_ELEMENTS = 1000
 """Smallest mesh whose explicit internal force is spread over threads (:class:`ThreadTuner` then keeps the faster
 of one and all, and one on a busy machine: :data:`BUSY_LOAD`). The kernel alone pays on two threads from about a
 thousand elements (``python -m rftstatic.bench.explicit --threads SCENE``, the fastest of 1,000 calls each, the
-same force bits: cusick-30's 3,840 elements 0.59 -> 0.30 ms, 2,048 elements 0.40 -> 0.24 ms, 1,536 0.24 -> 0.18
-ms, 512 0.14 -> 0.12 ms). The whole run: cusick-30 near idle (load average 0.9-1.1 with the run), five pairs one
-after the other, 7.6-8.0 s at the earlier limit of 4,000 (one thread) against 5.4-5.9 s here, the same bits
-(validation/bench_profile.md, "Two threads for the Cusick specimen"); on a machine loaded to 4-6, before the busy
-rule existed, two threads had cost it 5-49 %."""
+same force bits; the kernel vectorised across element blocks, :data:`rftstatic.element.kernels.LANES`, one thread
+-> two: cusick-30's 3,840 elements 0.21-0.24 -> 0.15 ms, 2,048 elements 0.21 -> 0.16 ms, 1,536 0.13 -> 0.10 ms,
+512 0.088 -> 0.083 ms, 384 0.025 -> 0.026 ms; one element at a time they were 0.59 -> 0.30, 0.40 -> 0.24,
+0.24 -> 0.18, 0.14 -> 0.12 ms). The whole run before the lanes: cusick-30 near idle (load average 0.9-1.1 with
+the run), five pairs one after the other, 7.6-8.0 s at the earlier limit of 4,000 (one thread) against 5.4-5.9 s
+here, the same bits (validation/bench_profile.md, "Two threads for the Cusick specimen"); on a machine loaded to
+4-6, before the busy rule existed, two threads had cost it 5-49 %. With the lanes: 4.1-5.4 s (validation/
+bench_profile.md, "Explicit kernel, SIMD/layout")."""
 
 
 STATIC_COMPILED_MIN_ELEMENTS = 3000

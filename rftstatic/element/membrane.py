@@ -24,7 +24,7 @@ from functools import cached_property
 import numpy as np
 
 from rftstatic.compiled import choose_kernels, numba_available
-from rftstatic.element.kernels import (
+from rftstatic.element.kernels_numpy import (
     element_last,
     energies_numpy,
     forces_numpy,

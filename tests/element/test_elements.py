@@ -238,7 +238,7 @@ def test_numpy_tangent_agrees_with_the_compiled_kernel(element, psd, carried):
     pytest.importorskip("numba")
     import rftstatic.element._kernels_numba as compiled
     from rftstatic.bench.problems import strip_model
-    from rftstatic.element import kernels
+    from rftstatic.element import kernels_numpy
 
     model = strip_model(11, 5, element=element)
     op = model.membrane
@@ -246,7 +246,8 @@ def test_numpy_tangent_agrees_with_the_compiled_kernel(element, psd, carried):
     U = 0.05 * rng.normal(size=(model.mesh.n_nodes, 3))
     E, A = op.nodes.shape
     S = rng.normal(size=(E, 3)) if carried else np.zeros((0, 3))
-    fe1, ke1 = kernels.tangents_numpy(op.G_last, op.nodes, op.area, model.material.Dm, U, psd, S if carried else None)
+    fe1, ke1 = kernels_numpy.tangents_numpy(op.G_last, op.nodes, op.area, model.material.Dm, U, psd,
+                                            S if carried else None)
     fe2, ke2 = np.empty((E, A, 3)), np.empty((E, A, 3, A, 3))
     compiled.membrane_tangents(*op._compiled_args, model.material.Dm, U, psd, S, fe2, ke2)
     assert np.abs(ke1 - ke2).max() <= 1e-13 * np.abs(ke2).max() and np.array_equal(fe1, fe2)
