@@ -65,6 +65,11 @@ class BendingHysteresis:
         return {"M0_warp_N": self.M0_warp, "M0_weft_N": self.M0_weft, "stick_ratio": self.ratio}
 
 
+NONLINEAR_FLOOR = 0.2
+"""Default floor of the bending slope under nonlinear bending, a fraction of B [-] (why 0.2:
+:mod:`rftstatic.element.nonlinear_bending`)."""
+
+
 @dataclass(frozen=True)
 class NonlinearBending:
     """Softening bending of a fabric: Feng et al.'s moment ``M = B kappa + k2 kappa |kappa|`` per unit width with
@@ -79,7 +84,7 @@ class NonlinearBending:
 
     k2_warp: float
     k2_weft: float
-    floor: float = 0.2
+    floor: float = NONLINEAR_FLOOR
 
     def __post_init__(self):
         for key in ("k2_warp", "k2_weft"):

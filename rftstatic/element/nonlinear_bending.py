@@ -52,10 +52,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from rftstatic.element.axis_curvature import AxisCurvature, axis_rigidities
+from rftstatic.material import NONLINEAR_FLOOR, voigt_rotation
 
 __all__ = ["FLOOR", "BendingSoftening", "nonlinear_bending", "softening"]
 
-FLOOR = 0.2
+FLOOR = NONLINEAR_FLOOR
 """Default floor phi of the bending slope, a fraction of B [-] (module docstring: the moment stays within
 phi^2 = 4 % of Feng et al.'s law up to the curvature where that law's moment peaks)."""
 
@@ -122,8 +123,6 @@ def nonlinear_bending(patches, area, Db, *, warp_angle, k2, floor=FLOOR) -> Bend
     """The :class:`BendingSoftening` of a mesh's ``patches`` (:class:`rftstatic.element.patch.Patches`) and
     element ``area (E,)`` [m^2], for a fabric of bending matrix ``Db (3, 3)`` in global axes [N m] whose warp lies
     at ``warp_angle`` [rad] from X: ``k2 (2,)`` [N m^2] warp and weft (finite, <= 0), ``floor`` in (0, 1)."""
-    from rftstatic.material import voigt_rotation
-
     T = voigt_rotation(warp_angle)
     k2 = np.asarray(k2, float).reshape(2)
     if not (np.all(np.isfinite(k2)) and np.all(k2 <= 0)) or not 0.0 < floor < 1.0:
