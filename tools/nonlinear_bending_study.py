@@ -54,7 +54,8 @@ def _run(f: dict, r: float, route: str, out: Path) -> dict | None:
         p = subprocess.run([sys.executable, "-m", "rftstatic", "case", "cusick-30", "--no-figures", "--out", str(out)]
                            + [a for k in sets for a in ("--set", k)], capture_output=True, text=True)
         if p.returncode:
-            print(f"{f['id']} r={r} {route}: exit {p.returncode}: {p.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
+            print(f"{f['id']} r={r} {route}: exit {p.returncode}: {p.stderr.strip().splitlines()[-1:]}",
+                  file=sys.stderr)
             return None
         (out / "wall.json").write_text(json.dumps({"wall_s": time.perf_counter() - t}))
     s = json.loads((out / "summary.json").read_text())
@@ -72,9 +73,9 @@ def main(argv=None):
     fabrics = [WOOL] + [{"id": r["id"], "name": r["name"], "B_warp": float(r["B_gf*cm^2/cm"]),
                          "B_weft": float(r["B_gf*cm^2/cm"]), "W": float(r["W_mg/cm^2"]) / 1000, "T": float(r["T_mm"]),
                          "DC": float(r["DC_pub_%"]), "nodes": int(r["nodes_pub"])} for r in secondary_table()]
-    lines = ["| fabric | measured DC [%], nodes | route | k2 kappa / B at 1/c | k2 warp, weft [gf cm^2] | DC [%] | nodes | "
-             "energy [gf cm] | stable | crossing pairs | past kappa_f: share (warp, weft), max kappa / kappa_f | "
-             "wall [s] |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| fabric | measured DC [%], nodes | route | k2 kappa / B at 1/c | k2 warp, weft [gf cm^2] | DC [%] | "
+             "nodes | energy [gf cm] | stable | crossing pairs | past kappa_f: share (warp, weft), max kappa / "
+             "kappa_f | wall [s] |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for f in fabrics:
         measured = "-" if f["DC"] is None else f"{f['DC']:g}, {f['nodes']}"
         for route in ROUTES:

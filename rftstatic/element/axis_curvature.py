@@ -140,7 +140,7 @@ class AxisCurvature:
         Hc = -(nD[:, None, None] * Pm + t[:, :, None] * n[:, None, :] + n[:, :, None] * t[:, None, :]) \
             / (r * r)[:, None, None]
         S = _skew(Ev)
-        nn = -np.einsum("evij,ejk,ewkl->eviwl", S, Hc, S)
+        nn = -np.einsum("evik,ewkl->eviwl", np.einsum("evij,ejk->evik", S, Hc), S)  # [E_v]_x H_c [E_w]_x
         nn -= np.einsum("vw,eil->eviwl", _GAMMA, _skew(h))
         ke[:, 3:, :, 3:, :] += nn
         ke *= A[:, None, None, None, None]

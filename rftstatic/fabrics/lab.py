@@ -72,15 +72,15 @@ theory: turning them into a twisting rigidity would need the plate's compliance 
 repository's law does not follow).
 
 What the model drops (bending hysteresis 2HB and nonlinear bending k2 are options, ``kes_2HB_*`` and ``ctd_k2_*``
-above): the shear hysteresis (KES 2HG, 2HG5), the nonlinear shear curve beyond the small angles where G is measured (0.5-5 deg), the tensile curve's nonlinearity
-(the secant at Fm replaces it: crimp interchange makes the initial modulus far lower, so a drape that
-stretches little is too stiff in tension; drape is insensitive to it while C >> B / h^2), the
-compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measured: Poisson coupling
-(C12 = B12 = 0) and the twisting rigidity, which defaults to ``B_twist = sqrt(B_warp B_weft) / 2`` (the
-orthotropic plate with zero Poisson ratio, M_xy = D (1 - nu)/2 * 2 k_xy; Kang & Yu's wool has 0.37 instead
-of 0.5 of the mean) unless the scene gives ``B_twist``.
-A fabric given by lab data and no preset gets every quantity it lacks (tensile, shear, twist, Poisson) by
-the stated rules of :mod:`rftstatic.fabrics.rules`, each listed in the run's summary (``material.filled``).
+above): the shear hysteresis (KES 2HG, 2HG5), the nonlinear shear curve beyond the small angles where G is measured
+(0.5-5 deg), the tensile curve's nonlinearity (the secant at Fm replaces it: crimp interchange makes the initial
+modulus far lower, so a drape that stretches little is too stiff in tension; drape is insensitive to it while C >> B /
+h^2), the compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measured: Poisson coupling (C12 =
+B12 = 0) and the twisting rigidity, which defaults to ``B_twist = sqrt(B_warp B_weft) / 2`` (the orthotropic plate
+with zero Poisson ratio, M_xy = D (1 - nu)/2 * 2 k_xy; Kang & Yu's wool has 0.37 instead of 0.5 of the mean) unless
+the scene gives ``B_twist``. A fabric given by lab data and no preset gets every quantity it lacks (tensile, shear,
+twist, Poisson) by the stated rules of :mod:`rftstatic.fabrics.rules`, each listed in the run's summary
+(``material.filled``).
 
 Range checks (:data:`RANGES`): a value outside them is almost surely a slip of unit or decimal point.
 What the bounds rest on (searched for through public material on 2026-12-02; nothing entered from memory):
@@ -116,8 +116,8 @@ import math
 from rftstatic.errors import ParameterError
 from rftstatic.units import STANDARD_GRAVITY, unit_system
 
-__all__ = ["K2_RANGE", "LAB_KEYS", "RANGES", "RANGE_EVIDENCE", "QUANTITY_KEYS", "check_ranges", "default_twist", "lab_to_si",
-           "range_source", "sources_of"]
+__all__ = ["K2_RANGE", "LAB_KEYS", "RANGES", "RANGE_EVIDENCE", "QUANTITY_KEYS", "check_ranges", "default_twist",
+           "lab_to_si", "range_source", "sources_of"]
 
 GF = STANDARD_GRAVITY * 1e-3
 """One gram-force [N]."""

@@ -35,11 +35,11 @@ def _rules_text() -> list[str]:
         lines += [f"  {q:8s} {rule.rule}", f"  {'':8s} source: {rule.source}"]
     lines += ["A preset never lends values to lab data: lab keys next to preset are refused. What each rule does to the "
               "Cusick drape coefficient: validation/fabric_rules.md.", "",
-              "Nonlinear (softening) bending, M = B kappa + k2 kappa |kappa| with the slope floored at bending_floor x B "
-              "(rftstatic.element.nonlinear_bending): ctd_k2_warp and ctd_k2_weft (above), or bending_k2_warp and "
-              "bending_k2_weft [force length^2, scene units], both directions or neither, <= 0 (stiffening refused; 0: "
-              "linear); bending_floor in (0, 1), default 0.2; nonlinear_bending = true next to a ctd-* preset takes its "
-              "data row's k2 (opt-in)."]
+              "Nonlinear (softening) bending, M = B kappa + k2 kappa |kappa| with the slope floored at bending_floor x "
+              "B (rftstatic.element.nonlinear_bending): ctd_k2_warp and ctd_k2_weft (above), or bending_k2_warp and "
+              "bending_k2_weft [force length^2, scene units], both directions or neither, <= 0 (stiffening refused; "
+              "0: linear); bending_floor in (0, 1), default 0.2; nonlinear_bending = true next to a ctd-* preset takes "
+              "its data row's k2 (opt-in)."]
     return lines
 
 
