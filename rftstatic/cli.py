@@ -195,6 +195,8 @@ def _command(args) -> int:
             for rule in dict.fromkeys(f["derived_rule"] for f in rows if f["derived_rule"]):
                 print(f"not from the source: {rule}")
             print("sources in full: rftstatic.fabrics.library.FABRICS[name].source")
+            print("nonlinear (softening) bending: the ctd-* presets carry their data row's k2 on request, [material] "
+                  "nonlinear_bending = true (python -m rftstatic fabrics --explain)")
             return 0
         if args.command == "pattern":
             return _pattern(args)

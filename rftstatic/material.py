@@ -65,6 +65,40 @@ class BendingHysteresis:
         return {"M0_warp_N": self.M0_warp, "M0_weft_N": self.M0_weft, "stick_ratio": self.ratio}
 
 
+NONLINEAR_FLOOR = 0.2
+"""Default floor of the bending slope under nonlinear bending, a fraction of B [-] (why 0.2:
+:mod:`rftstatic.element.nonlinear_bending`)."""
+
+
+@dataclass(frozen=True)
+class NonlinearBending:
+    """Softening bending of a fabric: Feng et al.'s moment ``M = B kappa + k2 kappa |kappa|`` per unit width with
+    its slope held at ``floor * B`` or more (:mod:`rftstatic.element.nonlinear_bending`, N1-N3).
+
+    Attributes
+    ----------
+    k2_warp, k2_weft : the quadratic coefficient per direction [N m^2] (moment per width per curvature^2;
+        <= 0: softening; 0: no term in that direction)
+    floor : the least bending slope as a fraction of B [-], in (0, 1) (default 0.2)
+    """
+
+    k2_warp: float
+    k2_weft: float
+    floor: float = NONLINEAR_FLOOR
+
+    def __post_init__(self):
+        for key in ("k2_warp", "k2_weft"):
+            v = getattr(self, key)
+            if isinstance(v, bool) or not (np.isfinite(v) and v <= 0):
+                raise ValueError(f"nonlinear bending {key} must be a finite number <= 0 [N m^2] (softening; a "
+                                 f"stiffening k2 > 0 is refused: rftstatic.element.nonlinear_bending), got {v!r}")
+        if not (np.isfinite(self.floor) and 0.0 < self.floor < 1.0):
+            raise ValueError(f"nonlinear bending floor must be a number in (0, 1), got {self.floor!r}")
+
+    def as_dict(self) -> dict:
+        return {"k2_warp_N_m2": self.k2_warp, "k2_weft_N_m2": self.k2_weft, "floor": self.floor}
+
+
 @dataclass(frozen=True)
 class Material:
     """Membrane and bending rigidities in global axes, and the areal weight.
@@ -76,6 +110,7 @@ class Material:
     weight : areal weight under standard gravity [N/m^2]
     name : label for summaries
     hysteresis : bending hysteresis (:class:`BendingHysteresis`), or None (elastic bending)
+    nonlinear_bending : softening bending (:class:`NonlinearBending`), or None (linear bending)
     """
 
     Dm: np.ndarray
@@ -84,6 +119,7 @@ class Material:
     name: str = "material"
     info: dict = field(default_factory=dict)
     hysteresis: BendingHysteresis | None = None
+    nonlinear_bending: NonlinearBending | None = None
 
     def __post_init__(self):
         for key in ("Dm", "Db"):
@@ -131,6 +167,7 @@ class Material:
             "Db_N_m": self.Db.tolist(),
             "weight_N_per_m2": self.weight,
             **({"bending_hysteresis": self.hysteresis.as_dict()} if self.hysteresis is not None else {}),
+            **({"nonlinear_bending": self.nonlinear_bending.as_dict()} if self.nonlinear_bending is not None else {}),
             **self.info,
         }
 

@@ -52,6 +52,12 @@ class UnitSystem:
         return self.force * self.length
 
     @property
+    def moment_length(self) -> float:
+        """Moment x length (the k2 of nonlinear bending: moment per width per curvature^2) [N m^2 per scene
+        unit]."""
+        return self.force * self.length**2
+
+    @property
     def acceleration(self) -> float:
         return self.length / self.time**2
 

@@ -99,6 +99,8 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         summary["starts"] = starts
     if model.bending_friction is not None and state is not None:  # bending hysteresis: what the route dissipated
         summary["bending_hysteresis"] = hysteresis_summary(scene, model, state, result.U)
+    if model.bending_softening is not None:  # nonlinear bending: how far the drape went along its law
+        summary["nonlinear_bending"] = softening_summary(scene, model, result.U)
     if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
         summary["seeds"] = seeded_specimens(scene, model, extras, opts, summary["drape"], seeds,
                                             first_energy=summary["energies"].get("total"), compare=other)
@@ -132,6 +134,22 @@ def hysteresis_summary(scene, model, state, U) -> dict:
     at_yield = np.abs(moment) >= fr.M0 * (1 - 1e-9)
     return {"dissipated": scene.units.from_si(state.dissipated, "energy"),
             "yielded_share_warp": float(at_yield[:, 0].mean()), "yielded_share_weft": float(at_yield[:, 1].mean())}
+
+
+def softening_summary(scene, model, U) -> dict:
+    """Nonlinear bending at the end of a solve (:mod:`rftstatic.element.nonlinear_bending`): per direction the
+    share of elements past the floor curvature kappa_f (on the floor branch, slope phi B) [-], the largest
+    |kappa_m| [1/length, scene units] and its ratio to kappa_f [-]."""
+    term = model.bending_softening
+    x = model.positions(U)
+    k = np.abs(term.curvature(model.bending_displacement(U), x)[:, :2])
+    kf = term.kappa_floor
+    out = {}
+    for i, d in enumerate(("warp", "weft")):
+        out[f"floor_share_{d}"] = float((k[:, i] > kf[i]).mean())
+        out[f"max_curvature_{d}"] = float(k[:, i].max()) * scene.units.length
+        out[f"max_over_floor_curvature_{d}"] = float(k[:, i].max() / kf[i]) if np.isfinite(kf[i]) else 0.0
+    return out
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:

@@ -60,6 +60,10 @@ class ForceKernel:
         if backend == "auto":
             backend = "numba" if numba_available() else "numpy"
         self.backend = backend
+        # nonlinear bending (rftstatic.element.nonlinear_bending; numpy, added in __call__) and its scatter
+        self.bending_softening = getattr(model, "bending_softening", None)
+        self._soft_dofs = (None if self.bending_softening is None
+                           else (3 * self.bending_softening.nodes[..., None] + np.arange(3)).ravel())
         self.model = model
         self.Kb = model.Kb.tocsr()
         self.Dm = np.ascontiguousarray(model.material.Dm, dtype=float)
@@ -151,6 +155,11 @@ class ForceKernel:
             Wf, fe, _ = self.bending_friction.evaluate(Ub, self.X3 + U, held)
             f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
             W += Wf if energy else 0.0
+        if self.bending_softening is not None:
+            Ub = U if self._bend_offset is None else self.X3 + U
+            Wn, fe, _ = self.bending_softening.evaluate(Ub, self.X3 + U)
+            f += np.bincount(self._soft_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
+            W += Wn if energy else 0.0
         if self.hinges is not None:
             Wh, fh = self.hinges.energy_force(self.X3 + U)
             f += fh

@@ -37,18 +37,12 @@ The elastic moment B kappa stays in the constant K_b of Eq. 13; this module adds
 With K = ratio * B_k (material axes) the loop's turning branch spans a curvature change ``2 M_0 / K``.
 There is no friction in twist (2HB measures bending only).
 
-Derivatives (element force ``(E, 6, 3)`` [N] and tangent ``(E, 6, 3, 6, 3)`` [N/m]):
-with ``w = T^T M_f`` (E, 3), ``l_a = sum_j w_j L[j, a]``, ``D = sum_j w_j d_j``, the unnormalised normal
-``c = (x_1 - x_0) x (x_2 - x_0)``, r = |c|, P = I - n n^T and the vertex edges ``E_v = x_(v+1) - x_(v+2)``
-(so ``dc = sum_v dx_v x E_v``):
-
-    f_a = A (l_a n + [a = 3 + v] E_v x (P D) / r)                                            (H5)
-    K_ab = A (sum_k psi''_k g_k g_k^T + l_a dn/dx_b + (l_b dn/dx_a)^T + d2(D . n)/dx_a dx_b)    (H6)
-
-``g_k = d kappa_m,k / du`` (E, 18), ``dn/dx_v = -(P / r) [E_v]_x``, and, for the fixed vector D,
-``d2(D . n)/dx_v dx_w = -[E_v]_x H_c [E_w]_x - gamma_vw [h]_x`` with ``h = P D / r``,
-``H_c = -(s P + t n^T + n t^T) / r^2`` (s = D . n, t = P D) and ``gamma_01 = gamma_12 = gamma_20 = 1``,
-``gamma_vw = -gamma_wv``. The element tests check (H5) and (H6) by finite differences.
+Derivatives: the friction is a scalar law psi(kappa_m) of the material-axes curvature, so its element forces
+(H5) and tangents (H6) are (A2) and (A3) of :mod:`rftstatic.element.axis_curvature` (the geometry shared with
+the softening of :mod:`rftstatic.element.nonlinear_bending`) with ``M = M_f`` (H2) and ``psi'' = K`` (stick) or 0
+(slip): with ``w = T^T M_f``, ``f_a = A (l_a n + [a = 3 + v] E_v x (P D) / r)`` (H5) and
+``K_ab = A (sum_k psi''_k g_k g_k^T + l_a dn/dx_b + (l_b dn/dx_a)^T + d2(D . n)/dx_a dx_b)`` (H6).
+The element tests check (H5) and (H6) by finite differences.
 """
 
 from __future__ import annotations
@@ -56,6 +50,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from rftstatic.element.axis_curvature import AxisCurvature, axis_rigidities
 
 __all__ = ["BendingFriction", "huber"]
 
@@ -71,110 +67,30 @@ def huber(e, K, M0):
     return psi, m, np.where(stick, K, 0.0) * np.ones_like(e)
 
 
-def _skew(v):
-    """``[v]_x (..., 3, 3)`` with ``[v]_x a = v x a`` for ``v (..., 3)``."""
-    z = np.zeros(v.shape[:-1])
-    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1),
-                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
-
-
-_GAMMA = np.array([[0.0, 1.0, -1.0], [-1.0, 0.0, 1.0], [1.0, -1.0, 0.0]])
-"""gamma_vw of (H6): the second derivative of ``h . c`` is ``-gamma_vw [h]_x`` between vertices v and w."""
-
-
 @dataclass(frozen=True, eq=False)
-class BendingFriction:
+class BendingFriction(AxisCurvature):
     """The friction-moment term of every patch (module docstring), built once per mesh.
 
     Attributes
     ----------
-    nodes : (E, 6) patch nodes (slots 3-5: the element's vertices)
-    L : (E, 3, 6) curvature operator with the image rules folded [1/m^2]
-    area : (E,) element areas [m^2]
-    T : (3, 3) Voigt strain rotation, global -> material axes (kappa_m = T kappa)
+    nodes, L, area, T : the patches' geometry (:class:`rftstatic.element.axis_curvature.AxisCurvature`)
     M0 : (2,) yield moment per unit width, warp and weft [N m/m] (= 2HB / 2, H1)
     K : (2,) stick stiffness per unit width, warp and weft [N m]
     """
 
-    nodes: np.ndarray
-    L: np.ndarray
-    area: np.ndarray
-    T: np.ndarray
     M0: np.ndarray
     K: np.ndarray
-
-    @property
-    def n_elements(self) -> int:
-        return len(self.nodes)
 
     def initial_slip(self) -> np.ndarray:
         """The virgin state: no slip, ``(E, 2)`` [1/m]."""
         return np.zeros((self.n_elements, 2))
-
-    def curvature(self, U, x) -> np.ndarray:
-        """Material-axes curvature ``kappa_m (E, 3)`` [1/m] (warp, weft, 2 x twist) at displacements ``U (N, 3)``
-        [m] and positions ``x (N, 3)`` [m]."""
-        d = np.einsum("eka,eai->eki", self.L, U[self.nodes])
-        n, _, _ = self._normal(x)
-        return np.einsum("eki,ei->ek", d, n) @ self.T.T
-
-    def _normal(self, x):
-        """Unit normal ``n (E, 3)``, ``r = |c| (E,)`` [m^2] and vertex edges ``E_v (E, 3, 3)`` [m] of (H5)."""
-        P = x[self.nodes[:, 3:]]  # (E, 3 vertices, 3)
-        c = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
-        r = np.maximum(np.linalg.norm(c, axis=1), 1e-300)
-        edges = P[:, [1, 2, 0]] - P[:, [2, 0, 1]]  # E_v = x_(v+1) - x_(v+2)
-        return c / r[:, None], r, edges
 
     def evaluate(self, U, x, slip, *, tangent=False, psd=False):
         """Friction energy [J] (the sum of A psi, H3), element forces ``(E, 6, 3)`` [N] (H5) and, with
         ``tangent``, element tangents ``(E, 6, 3, 6, 3)`` [N/m] (H6), at ``U, x (N, 3)`` [m] with the
         committed slip ``slip (E, 2)`` [1/m]. ``psd``: the tangent keeps only its positive semi-definite
         part ``A sum_k psi''_k g_k g_k^T`` (the terms of the turning normal are dropped)."""
-        d = np.einsum("eka,eai->eki", self.L, U[self.nodes])  # (E, 3, 3)
-        n, r, Ev = self._normal(x)
-        km = np.einsum("eki,ei->ek", d, n) @ self.T.T
-        psi, m, dm = huber(km[:, :2] - slip, self.K, self.M0)
-        A = self.area
-        w = m @ self.T[:2]  # (E, 3): T^T M_f
-        ell = np.einsum("ej,eja->ea", w, self.L)  # (E, 6)
-        D = np.einsum("ej,eji->ei", w, d)  # (E, 3)
-        nD = np.einsum("ei,ei->e", n, D)
-        t = D - nD[:, None] * n  # P D
-        h = t / r[:, None]
-        fe = ell[:, :, None] * n[:, None, :]
-        fe[:, 3:] += np.cross(Ev, h[:, None, :])
-        fe *= A[:, None, None]
-        energy = float(np.einsum("e,ek->", A, psi))
-        if not tangent:
-            return energy, fe, None
-        E = self.n_elements
-        # g_k = d kappa_m,k / du (H5 with w = T row k, unit moments)
-        g = np.zeros((E, 2, 6, 3))
-        for k in range(2):
-            lk = np.einsum("j,eja->ea", self.T[k], self.L)
-            Dk = np.einsum("j,eji->ei", self.T[k], d)
-            tk = Dk - np.einsum("ei,ei->e", n, Dk)[:, None] * n
-            g[:, k] = lk[:, :, None] * n[:, None, :]
-            g[:, k, 3:] += np.cross(Ev, (tk / r[:, None])[:, None, :])
-        ke = np.einsum("ek,ekai,ekbj->eaibj", dm, g, g)
-        if psd:
-            return energy, fe, ke * A[:, None, None, None, None]
-        # l_a dn/dx_v and its transpose (H6)
-        Pm = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
-        dn = -np.einsum("eij,evjk->evik", Pm / r[:, None, None], _skew(Ev))  # (E, 3 vertices, 3, 3)
-        cross = np.einsum("ea,evij->eaivj", ell, dn)  # (E, 6, 3, 3, 3): u_a component i, vertex v component j
-        ke[:, :, :, 3:, :] += cross
-        ke[:, 3:, :, :, :] += cross.transpose(0, 3, 4, 1, 2)
-        # d2(D . n) / dx_v dx_w at fixed D
-        Hc = -(nD[:, None, None] * Pm + t[:, :, None] * n[:, None, :] + n[:, :, None] * t[:, None, :]) \
-            / (r * r)[:, None, None]
-        S = _skew(Ev)
-        nn = -np.einsum("evij,ejk,ewkl->eviwl", S, Hc, S)
-        nn -= np.einsum("vw,eil->eviwl", _GAMMA, _skew(h))
-        ke[:, 3:, :, 3:, :] += nn
-        ke *= A[:, None, None, None, None]
-        return energy, fe, ke
+        return self.assemble(U, x, lambda km: huber(km - slip, self.K, self.M0), tangent=tangent, psd=psd)
 
     def commit(self, U, x, slip) -> tuple[np.ndarray, float]:
         """Return mapping at a converged step (H4): the new slip ``(E, 2)`` [1/m] and the energy dissipated
@@ -199,8 +115,7 @@ def bending_friction(patches, area, Db, *, warp_angle, M0, ratio) -> BendingFric
     from rftstatic.material import voigt_rotation
 
     T = voigt_rotation(warp_angle)
-    Ti = np.linalg.inv(T)
-    Bm = np.diag(Ti.T @ np.asarray(Db, float) @ Ti)[:2]
+    Bm = axis_rigidities(Db, T)
     M0 = np.asarray(M0, float).reshape(2)
     if np.any(M0 < 0) or not ratio > 0:
         raise ValueError(f"bending friction needs M0 >= 0 and ratio > 0, got M0 = {M0}, ratio = {ratio!r}")

@@ -39,6 +39,10 @@ Feng et al.'s public data set (below; ``ctd_*``, the ClothDrapeTester repository
 ctd_density        kg/m^2              weight [N/m^2] = density * g (standard gravity 9.80665 m/s^2; the
                                        repository's own ``bending_validation/Main.m`` takes 9.8)
 ctd_B_warp/weft    1e-9 N m            B [N m] = value * 1e-9 (column "linear warp/weft[SI*1e9]")
+ctd_k2_warp/weft   1e-12 N m^2         nonlinear (softening) bending: k2 [N m^2] = value * 1e-12 (column "nonlinear
+                                       warp/weft[SI*1e12]"), the moment B kappa + k2 kappa |kappa| of
+                                       :mod:`rftstatic.element.nonlinear_bending` (slope floored at
+                                       ``bending_floor`` x B, default 0.2); both or neither; <= 0
 =================  ==================  ===================================================================
 
 What the data set's columns are, as far as its repository (commit 24a980c) establishes them (its readme
@@ -55,25 +59,28 @@ modulus`` (density [kg/m^2], gravity [m/s^2], L [m]): the dimensionless group rh
 (Peirce's bending length c = (B / rho g)^(1/3)). How the values were obtained (which tester; the paper's
 drape tester and its network, or another instrument) the repository does not say, and the paper was not
 read here: they are the published parameters, not necessarily a direct measurement. This module reads
-only k1 (warp, weft) and the density; the linear model's B is the data set's small-curvature rigidity.
-What it drops: k2 (at the curvature 1/c of the bending length, k2 kappa / k1 over the 618 rows is, warp
-and weft, -0.41 / -0.36 at the 5th percentile, -0.13 / -0.14 at the median, -0.05 / -0.04 at the 95th:
-the data set's own moment at that curvature is that fraction below k1 kappa; ``tools/select_ctd_fabrics.py``
-prints these) and the bias k1 (it is a value of the repository's interpolation, not of a plate
-theory: turning it into a twisting rigidity would need the plate's compliance rotation, which the
+k1 (warp, weft) and the density; the linear model's B is the data set's small-curvature rigidity. k2 enters
+only when asked for (``ctd_k2_*``, or ``nonlinear_bending = true`` next to a ``ctd-*`` preset): at the curvature
+1/c of the bending length, k2 kappa / k1 over the 618 rows is, warp and weft, -0.41 / -0.36 at the 5th
+percentile, -0.13 / -0.14 at the median, -0.05 / -0.04 at the 95th (the data set's own moment at that curvature
+is that fraction below k1 kappa; ``tools/select_ctd_fabrics.py`` prints these). Six rows (three distinct fabrics)
+have a positive k2 along warp or weft (+2693148.6, +50701.9 warp; +1755.9 weft; k2 kappa / k1 = +1.3 at 1/c for
+the first): a stiffening law the model refuses (:mod:`rftstatic.element.nonlinear_bending`: give 0 for such a
+direction). The largest softening |k2| is 1122487.5 (k2 kappa / k1 = -0.72 at 1/c); ``ctd_k2_*`` is bounded at
+-1e7 (a factor 9 beyond). What it drops: the bias k1 and k2 (values of the repository's interpolation, not of a plate
+theory: turning them into a twisting rigidity would need the plate's compliance rotation, which the
 repository's law does not follow).
 
-What the model drops (bending hysteresis 2HB is an option, ``kes_2HB_*`` above): the shear hysteresis (KES 2HG,
-2HG5), the nonlinear
-shear curve beyond the small angles where G is measured (0.5-5 deg), the tensile curve's nonlinearity
-(the secant at Fm replaces it: crimp interchange makes the initial modulus far lower, so a drape that
-stretches little is too stiff in tension; drape is insensitive to it while C >> B / h^2), the
-compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measured: Poisson coupling
-(C12 = B12 = 0) and the twisting rigidity, which defaults to ``B_twist = sqrt(B_warp B_weft) / 2`` (the
-orthotropic plate with zero Poisson ratio, M_xy = D (1 - nu)/2 * 2 k_xy; Kang & Yu's wool has 0.37 instead
-of 0.5 of the mean) unless the scene gives ``B_twist``.
-A fabric given by lab data and no preset gets every quantity it lacks (tensile, shear, twist, Poisson) by
-the stated rules of :mod:`rftstatic.fabrics.rules`, each listed in the run's summary (``material.filled``).
+What the model drops (bending hysteresis 2HB and nonlinear bending k2 are options, ``kes_2HB_*`` and ``ctd_k2_*``
+above): the shear hysteresis (KES 2HG, 2HG5), the nonlinear shear curve beyond the small angles where G is measured
+(0.5-5 deg), the tensile curve's nonlinearity (the secant at Fm replaces it: crimp interchange makes the initial
+modulus far lower, so a drape that stretches little is too stiff in tension; drape is insensitive to it while C >> B /
+h^2), the compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measured: Poisson coupling (C12 =
+B12 = 0) and the twisting rigidity, which defaults to ``B_twist = sqrt(B_warp B_weft) / 2`` (the orthotropic plate
+with zero Poisson ratio, M_xy = D (1 - nu)/2 * 2 k_xy; Kang & Yu's wool has 0.37 instead of 0.5 of the mean) unless
+the scene gives ``B_twist``. A fabric given by lab data and no preset gets every quantity it lacks (tensile, shear,
+twist, Poisson) by the stated rules of :mod:`rftstatic.fabrics.rules`, each listed in the run's summary
+(``material.filled``).
 
 Range checks (:data:`RANGES`): a value outside them is almost surely a slip of unit or decimal point.
 What the bounds rest on (searched for through public material on 2026-12-02; nothing entered from memory):
@@ -109,8 +116,8 @@ import math
 from rftstatic.errors import ParameterError
 from rftstatic.units import STANDARD_GRAVITY, unit_system
 
-__all__ = ["LAB_KEYS", "RANGES", "RANGE_EVIDENCE", "QUANTITY_KEYS", "check_ranges", "default_twist", "lab_to_si",
-           "range_source", "sources_of"]
+__all__ = ["K2_RANGE", "LAB_KEYS", "RANGES", "RANGE_EVIDENCE", "QUANTITY_KEYS", "check_ranges", "default_twist",
+           "lab_to_si", "range_source", "sources_of"]
 
 GF = STANDARD_GRAVITY * 1e-3
 """One gram-force [N]."""
@@ -140,6 +147,9 @@ LAB_KEYS = {
     "ctd_B_warp": ("1e-9 N m", 'Feng et al. (2022) data set, column "linear warp[SI*1e9]" (k1 along the warp)'),
     "ctd_B_weft": ("1e-9 N m", 'Feng et al. (2022) data set, column "linear weft[SI*1e9]"'),
     "ctd_density": ("kg/m^2", 'Feng et al. (2022) data set, column "density[kg.m-2]" (mass per area)'),
+    "ctd_k2_warp": ("1e-12 N m^2", 'Feng et al. (2022) data set, column "nonlinear warp[SI*1e12]" (k2 along the '
+                    "warp: softening bending, <= 0)"),
+    "ctd_k2_weft": ("1e-12 N m^2", 'Feng et al. (2022) data set, column "nonlinear weft[SI*1e12]"'),
 }
 """Lab keys of ``[material]``: (unit as printed by the instrument, meaning)."""
 
@@ -156,6 +166,10 @@ RANGES.update({"ctd_B_warp": tuple(b * 1e3 for b in RANGES["fast_B_warp"]),   # 
                "ctd_density": tuple(w * 1e-3 for w in RANGES["fast_W"])})      # g/m^2 -> kg/m^2
 """Plausible bounds (inclusive) of each lab key, in its lab unit (module docstring: B and W from a public
 618-fabric data set; the others unverified and loose)."""
+
+K2_RANGE = (-1e7, 0.0)
+"""Bounds (inclusive) of ``ctd_k2_*`` [1e-12 N m^2]: softening only (module docstring: the data set's largest
+|k2| is 1.12e6; its six positive values are refused)."""
 
 RANGE_EVIDENCE = {
     "source": "Feng, Huang, Xu & Wang (2022), ACM TOG 41(6), doi:10.1145/3550454.3555464; "
@@ -174,6 +188,8 @@ QUANTITY_KEYS = {
     "thickness": ("kes_T", "fast_T"),
     "M0_warp": ("kes_2HB_warp",),
     "M0_weft": ("kes_2HB_weft",),
+    "bending_k2_warp": ("ctd_k2_warp",),
+    "bending_k2_weft": ("ctd_k2_weft",),
 }
 """Model quantity -> the lab keys that give it (one source per quantity)."""
 
@@ -205,6 +221,8 @@ def check_ranges(values: dict) -> None:
     """ParameterError(key, ...) for a lab value that is not a number inside :data:`RANGES`; a zero or negative
     value is named as such. The message gives the range and where it comes from (:func:`range_source`)."""
     for key, v in values.items():
+        if key in ("ctd_k2_warp", "ctd_k2_weft"):
+            _check_k2(key, v)
         if key not in RANGES:
             continue
         lo, hi = RANGES[key]
@@ -217,6 +235,21 @@ def check_ranges(values: dict) -> None:
         if not lo <= v <= hi:
             raise ParameterError(key, f"{v!r} {unit} is outside the plausible range [{lo:g}, {hi:g}] {unit} of "
                                  f"a {meaning} ({range_source(key)}); check the unit and the decimal point")
+
+
+def _check_k2(key: str, v) -> None:
+    """ParameterError unless the data set's k2 ``v`` [1e-12 N m^2] is a finite number in :data:`K2_RANGE`."""
+    lo, hi = K2_RANGE
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ParameterError(key, f"{v!r} is not a finite number: give the {LAB_KEYS[key][1]} in 1e-12 N m^2")
+    if v > hi:
+        raise ParameterError(key, f"{v!r} 1e-12 N m^2 is > 0: a stiffening k2 is refused (six rows of the data set "
+                             "have one, up to k2 kappa / k1 = +1.3 at the bending length's curvature, which the "
+                             "stable time step, estimated from B, does not see); give 0 for this direction (the "
+                             "linear law)")
+    if v < lo:
+        raise ParameterError(key, f"{v!r} 1e-12 N m^2 is outside [{lo:g}, 0] (the data set's largest |k2| is "
+                             "1.12e6 among 618 fabrics); check the unit (1e-12 N m^2) and the decimal point")
 
 
 def _tensile(values: dict, d: str) -> tuple[float, dict] | None:
@@ -257,7 +290,8 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
     -------
     si : dict
         ``{quantity: value}`` for the quantities given: ``B_warp, B_weft`` [N m], ``C_shear, C_warp,
-        C_weft`` [N/m], ``weight`` [N/m^2], ``thickness`` [m], ``M0_warp, M0_weft`` [N m/m = N].
+        C_weft`` [N/m], ``weight`` [N/m^2], ``thickness`` [m], ``M0_warp, M0_weft`` [N m/m = N],
+        ``bending_k2_warp, bending_k2_weft`` [N m^2].
     record : dict
         ``{quantity: {"from": key, "value": lab value, "unit": lab unit, "rule": ...}}``.
 
@@ -300,6 +334,9 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
         if key in lab:
             put("thickness", key, lab[key] * 1e-3, "mm")
     for d in ("warp", "weft"):
+        if f"ctd_k2_{d}" in lab:
+            put(f"bending_k2_{d}", f"ctd_k2_{d}", lab[f"ctd_k2_{d}"] * 1e-12, "1e-12 N m^2: the data set's k2 "
+                "(moment per width per curvature^2)")
         if f"kes_2HB_{d}" in lab:
             put(f"M0_{d}", f"kes_2HB_{d}", 0.5 * lab[f"kes_2HB_{d}"] * GF,
                 "friction moment per width M0 = 2HB / 2; gf cm/cm = gf = 9.80665e-3 N")

@@ -15,7 +15,9 @@ fabric names): ``ctd-<row>-<kind>``, ``row`` the 0-based data row (header exclud
 ``subspace/train.txt`` indexes it; file line row + 2). What the columns are and which the model takes:
 :mod:`rftstatic.fabrics.lab` (``ctd_*`` keys): the density and the linear (small-curvature) bending
 rigidities k1 along warp and weft are *published* and used (``values``); the bias k1 and the nonlinear k2
-are published but not used by the linear model (``not_used``, verbatim with the file's column names).
+are published but not used by the linear model (``not_used``, verbatim with the file's column names). The warp
+and weft k2 enter on request only (``[material] nonlinear_bending = true`` next to the preset: the softening of
+:mod:`rftstatic.element.nonlinear_bending`, :func:`nonlinear_values`), so a preset's results do not change.
 The five rows are chosen by a rule, not by hand (``tools/select_ctd_fabrics.py``): with the data set's
 percentile ranks of the weight and of the mean bending length sqrt(c_warp c_weft), the row nearest (in
 the larger of the two rank differences; first row on a tie) to (10, 10) light-soft, (10, 90) light-stiff,
@@ -44,7 +46,8 @@ import numpy as np
 from rftstatic.material import PRESETS as _MATERIAL_PRESETS
 from rftstatic.material import voigt_rotation
 
-__all__ = ["CTD_COLUMNS", "CTD_SOURCE", "CTD_TARGETS", "FABRICS", "Fabric", "bending_lengths"]
+__all__ = ["CTD_COLUMNS", "CTD_K2", "CTD_SOURCE", "CTD_TARGETS", "FABRICS", "Fabric", "bending_lengths",
+           "nonlinear_values"]
 
 
 @dataclass(frozen=True)
@@ -103,6 +106,9 @@ CTD_COLUMNS = ("density[kg.m-2]", "linear warp[SI*1e9]", "linear weft[SI*1e9]", 
 _CTD_USED = {"density[kg.m-2]": "ctd_density", "linear warp[SI*1e9]": "ctd_B_warp",
              "linear weft[SI*1e9]": "ctd_B_weft"}
 
+CTD_K2 = {"nonlinear warp[SI*1e12]": "ctd_k2_warp", "nonlinear weft[SI*1e12]": "ctd_k2_weft"}
+"""The data set's k2 columns and the lab keys that take them (opt-in: :func:`nonlinear_values`)."""
+
 _MEMBRANE_RULE = ("membrane rigidities C_warp, C_weft, C_shear of the library's wool-kang-yu (not in the data set; "
                   "the cantilever does not feel them, the Cusick DC does: docs/howto/fabric-data.md), "
                   "C12 = B12 = 0, B_twist = sqrt(B_warp B_weft) / 2 (not measured)")
@@ -140,6 +146,12 @@ for _fab in (
 ):
     FABRICS[_fab.name] = _fab
 del _fab
+
+
+def nonlinear_values(fab: Fabric) -> dict:
+    """The lab keys of a preset's published k2 (``{"ctd_k2_warp": v, "ctd_k2_weft": v}`` [1e-12 N m^2], as
+    printed in the data set), or ``{}`` for a preset whose source gives none."""
+    return {key: fab.not_used[col] for col, key in CTD_K2.items() if col in fab.not_used}
 
 
 def bending_lengths(material) -> dict:

@@ -11,7 +11,9 @@ E_b holds the hinges of the mesh's creases (``mesh.folds``, attribute ``hinges``
 :class:`rftstatic.element.hinge.FoldHinges`), ``E_s`` is the self-contact energy
 (:class:`rftstatic.contact.self_contact.law.SelfContact`, optional); with bending
 hysteresis (``material.hysteresis``, attribute ``friction``: :class:`rftstatic.element.hysteresis.BendingFriction`)
-E_b also holds the friction's incremental potential at the committed slip (``State.bending_slip``, keyword ``slip``),
+E_b also holds the friction's incremental potential at the committed slip (``State.bending_slip``, keyword ``slip``);
+with nonlinear bending (``material.nonlinear_bending``, attribute ``bending_softening``:
+:class:`rftstatic.element.nonlinear_bending.BendingSoftening`) E_b also holds its softening correction,
 
 its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
 A Model is read-only once built (:class:`~rftstatic.model.frozen.Frozen`): what a solve advances or
@@ -32,6 +34,7 @@ from rftstatic.element.curvature import curvature_norm
 from rftstatic.element.hinge import fold_hinges
 from rftstatic.element.hysteresis import bending_friction
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
+from rftstatic.element.nonlinear_bending import nonlinear_bending
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
 from rftstatic.material import Material
 from rftstatic.mesh.trimesh import TriMesh
@@ -164,6 +167,10 @@ class Model(Frozen):
         self.bending_friction = (None if h is None or h.M0_warp == h.M0_weft == 0.0 else bending_friction(
             self.patches, mesh.area, material.Db, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
             M0=(h.M0_warp, h.M0_weft), ratio=h.ratio))
+        nb = material.nonlinear_bending
+        self.bending_softening = (None if nb is None or nb.k2_warp == nb.k2_weft == 0.0 else nonlinear_bending(
+            self.patches, mesh.area, material.Db, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
+            k2=(nb.k2_warp, nb.k2_weft), floor=nb.floor))
         warnings = []
         if element == "RFT6" and self.with_membrane:
             lock = locking_number(mesh, material)
@@ -235,6 +242,8 @@ class Model(Frozen):
         Eb = 0.5 * float(np.einsum("ni,ni->", Ub, self.Kb @ Ub))
         if self.bending_friction is not None:
             Eb += self._friction(U, slip)[0]
+        if self.bending_softening is not None:
+            Eb += self._softening(U)[0]
         if self.hinges is not None:
             Eb += self.hinges.energy(self.positions(U))
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
@@ -259,6 +268,12 @@ class Model(Frozen):
         return self.bending_friction.evaluate(self.bending_displacement(U), self.positions(U), slip, tangent=tangent,
                                               psd=psd)
 
+    def _softening(self, U, tangent=False, psd=False):
+        """The softening correction's energy [J], element forces (E, 6, 3) [N] and tangents (E, 6, 3, 6, 3) [N/m]
+        (:mod:`rftstatic.element.nonlinear_bending`)."""
+        return self.bending_softening.evaluate(self.bending_displacement(U), self.positions(U), tangent=tangent,
+                                               psd=psd)
+
     def commit_slip(self, U, slip) -> tuple[np.ndarray, float]:
         """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] from the committed ``slip (E, 2)``
         [1/m]: the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
@@ -279,6 +294,8 @@ class Model(Frozen):
         f = self.Kb @ self.bending_displacement(U)
         if self.bending_friction is not None:
             f += scatter_forces(self.patches.nodes, self._friction(U, slip)[1], self.mesh.n_nodes)
+        if self.bending_softening is not None:
+            f += scatter_forces(self.patches.nodes, self._softening(U)[1], self.mesh.n_nodes)
         if self.hinges is not None:
             f += self.hinges.force(self.positions(U))
         if self.with_membrane:
@@ -316,6 +333,10 @@ class Model(Frozen):
         x = self.positions(U)
         if self.bending_friction is not None:
             _, fe, ke = self._friction(U, slip, tangent=True, psd=psd)
+            f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
+            data += scatter_matrices(self._patch_map, ke, plan.nnz)
+        if self.bending_softening is not None:
+            _, fe, ke = self._softening(U, tangent=True, psd=psd)
             f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
             data += scatter_matrices(self._patch_map, ke, plan.nnz)
         if self.hinges is not None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from rftstatic import material as mat
-from rftstatic.fabrics.lab import LAB_KEYS, RANGES, range_source
+from rftstatic.fabrics.lab import K2_RANGE, LAB_KEYS, RANGES, range_source
 from rftstatic.fabrics.library import bending_lengths
 from rftstatic.fabrics.rules import FILL_RULES, unit_label
 from rftstatic.scenes.material import build_material, material_summary
@@ -24,7 +24,8 @@ __all__ = ["explain_fabrics"]
 def _rules_text() -> list[str]:
     lines = ["Lab keys of [material] (each in its instrument's unit; a value outside its range is refused):"]
     for key, (unit, meaning) in LAB_KEYS.items():
-        bounds = f"[{RANGES[key][0]:g}, {RANGES[key][1]:g}]" if key in RANGES else "-"
+        lo, hi = RANGES.get(key, K2_RANGE if key.startswith("ctd_k2") else (None, None))
+        bounds = f"[{lo:g}, {hi:g}]" if lo is not None else "-"
         lines.append(f"  {key:16s} {unit:12s} {bounds:16s} {meaning}")
     sources = dict.fromkeys(range_source(k) for k in RANGES)
     lines += ["  range sources: " + "; ".join(sources), "",
@@ -33,7 +34,12 @@ def _rules_text() -> list[str]:
     for q, rule in FILL_RULES.items():
         lines += [f"  {q:8s} {rule.rule}", f"  {'':8s} source: {rule.source}"]
     lines += ["A preset never lends values to lab data: lab keys next to preset are refused. What each rule does to the "
-              "Cusick drape coefficient: validation/fabric_rules.md."]
+              "Cusick drape coefficient: validation/fabric_rules.md.", "",
+              "Nonlinear (softening) bending, M = B kappa + k2 kappa |kappa| with the slope floored at bending_floor x "
+              "B (rftstatic.element.nonlinear_bending): ctd_k2_warp and ctd_k2_weft (above), or bending_k2_warp and "
+              "bending_k2_weft [force length^2, scene units], both directions or neither, <= 0 (stiffening refused; "
+              "0: linear); bending_floor in (0, 1), default 0.2; nonlinear_bending = true next to a ctd-* preset takes "
+              "its data row's k2 (opt-in)."]
     return lines
 
 
@@ -65,6 +71,13 @@ def _scene_text(scene) -> list[str]:
     lines.append("  bending length c = (B/W)^(1/3): " + ", ".join(
         f"{d} {u.from_si(c[d]['c'], 'length'):.4g} {unit_label(u, 'length')}" for d in ("warp", "weft")
         if c[d]["c"] is not None))
+    nb = s.get("nonlinear_bending")
+    if nb is not None:
+        lines.append(f"  nonlinear bending: k2 warp {nb['k2_warp']:.5g}, weft {nb['k2_weft']:.5g} "
+                     f"[force length^2, {u.name}], floor {nb['floor']:g} x B; k2 kappa / B at "
+                     "kappa = 1/c: " + ", ".join(f"{d} {nb[f'ratio_at_bending_length_{d}']:.3g}"
+                                                for d in ("warp", "weft")
+                                                if nb[f"ratio_at_bending_length_{d}"] is not None))
     return lines
 
 

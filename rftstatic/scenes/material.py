@@ -15,23 +15,36 @@ the lab fabric alone: ``--set "material={kes_B_warp=0.05, kes_B_weft=0.04, kes_W
 replaces the whole table). A *model* key next to a preset (``--set material.C_warp=900``, what ``fit``
 varies) changes that one value of the preset: the fabric is labelled "(modified)" and the summary lists
 the changed keys (``material.changed``).
+
+Nonlinear (softening) bending (:mod:`rftstatic.element.nonlinear_bending`: Feng et al.'s M = B kappa + k2 kappa
+|kappa|, slope floored at ``bending_floor`` x B) is an option: ``bending_k2_warp``, ``bending_k2_weft`` [force
+length^2 in the scene's units: moment per width per curvature^2; gf cm^2 in cm-gf-s], or the data set's
+``ctd_k2_warp``, ``ctd_k2_weft`` [1e-12 N m^2], both directions or neither (0: that direction stays linear), <= 0
+(a stiffening k2 is refused); ``bending_floor`` [-] in (0, 1), default 0.2; a ``ctd-*`` preset carries the k2 of
+its data row with ``nonlinear_bending = true`` (opt-in: a preset's results do not change otherwise).
 """
 
 from __future__ import annotations
+
+import math
+from dataclasses import replace
 
 import numpy as np
 
 from rftstatic import material as mat
 from rftstatic.errors import ParameterError
 from rftstatic.fabrics.lab import LAB_KEYS, QUANTITY_KEYS, lab_to_si, sources_of
-from rftstatic.fabrics.library import FABRICS, bending_lengths
+from rftstatic.fabrics.library import FABRICS, bending_lengths, nonlinear_values
 from rftstatic.fabrics.rules import NEEDS_KEYS, fill, unit_label
 from rftstatic.scenes.ranges import SHEET_RANGE_M
 from rftstatic.units import UnitSystem, unit_system
 
 __all__ = ["build_material", "material_summary", "FABRIC_KEYS"]
 
-FABRIC_KEYS = set(mat._FABRIC_KINDS) | {"thickness", "hysteresis_ratio"} | set(LAB_KEYS)
+NONLINEAR_KEYS = ("bending_k2_warp", "bending_k2_weft", "bending_floor", "nonlinear_bending")
+"""Keys of nonlinear bending besides the lab keys ``ctd_k2_*`` (module docstring)."""
+
+FABRIC_KEYS = set(mat._FABRIC_KINDS) | {"thickness", "hysteresis_ratio"} | set(NONLINEAR_KEYS) | set(LAB_KEYS)
 """Keys of a fabric ``[material]`` table besides ``preset``, ``kind`` and ``warp_angle``."""
 
 _REQUIRED = ("C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "weight")
@@ -59,6 +72,15 @@ def _to_si(values: dict, units: UnitSystem) -> tuple[dict, dict]:
             si[key] = units.to_si(float(values[key]), kind)
     if "thickness" in values:
         si["thickness"] = units.to_si(float(values["thickness"]), "length")
+    for key in ("bending_k2_warp", "bending_k2_weft"):
+        if key in values:
+            v = values[key]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v > 0:
+                raise ParameterError(key, f"{v!r} must be a finite number <= 0 (Feng et al.'s k2: moment per width "
+                                     "per curvature^2 in the scene's units, force length^2; softening only: a "
+                                     "stiffening k2 > 0 is refused, rftstatic.element.nonlinear_bending; 0 keeps "
+                                     "the direction linear)")
+            si[key] = units.to_si(float(v), "moment_length")
     return si, record
 
 
@@ -122,6 +144,10 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
     m.pop("kind", None)
     lab_given = sorted(k for k in m if k in LAB_KEYS)
     si, record, filled = _preset(name, lab_given) if name is not None else ({}, {}, {})
+    if _opted_in(m):
+        k2_si, k2_record = _preset_k2(name)
+        si.update(k2_si)
+        record.update(k2_record)
     own_si, own_record = _to_si(m, scene.units)
     for q in own_si:  # a scene key replaces the preset's value of its quantity
         record.pop(q, None)
@@ -162,7 +188,7 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
         raise
     if "thickness" in si:
         material.info["thickness"] = si["thickness"]
-    material = _with_hysteresis(material, m, si)
+    material = _with_nonlinear(_with_hysteresis(material, m, si), m, si)
     for q, rec in record.items():
         rec["si"] = si[q]
     if record:
@@ -174,7 +200,8 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
     return material
 
 
-_SUMMARY_KINDS = {**mat._FABRIC_KINDS, "thickness": "length", "M0_warp": "force", "M0_weft": "force"}
+_SUMMARY_KINDS = {**mat._FABRIC_KINDS, "thickness": "length", "M0_warp": "force", "M0_weft": "force",
+                  "bending_k2_warp": "moment_length", "bending_k2_weft": "moment_length"}
 """Unit kind of every quantity a lab record may convert (for the summary in scene units)."""
 
 
@@ -196,9 +223,55 @@ def _with_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Material:
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 1.0 <= ratio <= 1e4:
         raise ParameterError("hysteresis_ratio", f"{ratio!r} must be a number in [1, 1e4] (the friction element's "
                              "stick stiffness over B; default 10)")
-    from dataclasses import replace
-
     return replace(material, hysteresis=mat.BendingHysteresis(si["M0_warp"], si["M0_weft"], float(ratio)))
+
+
+def _opted_in(m: dict) -> bool:
+    """``nonlinear_bending`` of the table (default false); ParameterError unless a boolean."""
+    v = m.get("nonlinear_bending", False)
+    if not isinstance(v, bool):
+        raise ParameterError("nonlinear_bending", f"{v!r} must be true or false (true: a ctd-* preset's published "
+                             "k2, the softening of rftstatic.element.nonlinear_bending)")
+    return v
+
+
+def _preset_k2(name) -> tuple[dict, dict]:
+    """SI values and lab record of the k2 a preset's source gives (``nonlinear_bending = true``)."""
+    if name is None:
+        raise ParameterError("nonlinear_bending", "true applies next to a library preset whose source gives k2 (the "
+                             "ctd-* presets: python -m rftstatic fabrics); a lab fabric gives ctd_k2_warp and "
+                             "ctd_k2_weft [1e-12 N m^2], a fabric of model rigidities bending_k2_warp and "
+                             "bending_k2_weft [scene units]")
+    values = nonlinear_values(FABRICS[name])
+    if not values:
+        raise ParameterError("nonlinear_bending", f'true, but preset "{name}" has no published k2 (only the ctd-* '
+                             "presets do); give bending_k2_warp and bending_k2_weft [force length^2, scene units] "
+                             "to make it nonlinear, or remove nonlinear_bending")
+    return lab_to_si(values)
+
+
+def _with_nonlinear(material: mat.Material, m: dict, si: dict) -> mat.Material:
+    """``material`` with the nonlinear bending of ``bending_k2_*`` / ``ctd_k2_*`` (both directions or neither; SI
+    in ``si``) and ``bending_floor`` (:class:`rftstatic.material.NonlinearBending`)."""
+    given = [d for d in ("warp", "weft") if f"bending_k2_{d}" in si]
+    if not given:
+        if "bending_floor" in m:
+            raise ParameterError("bending_floor", f"{m['bending_floor']!r} is given without nonlinear bending: give "
+                                 "bending_k2_warp and bending_k2_weft (or ctd_k2_warp and ctd_k2_weft), or remove "
+                                 "bending_floor")
+        return material
+    if len(given) == 1:
+        d, other = given[0], "weft" if given[0] == "warp" else "warp"
+        key = next(k for k in (f"bending_k2_{d}", f"ctd_k2_{d}") if k in m)
+        missing = f"{key.rsplit('_', 1)[0]}_{other}"
+        raise ParameterError(missing, f"missing: {key} = {m[key]!r} is given without {missing}; nonlinear bending "
+                             "needs both directions (0 for a direction that stays linear)")
+    floor = m.get("bending_floor", mat.NONLINEAR_FLOOR)
+    if isinstance(floor, bool) or not isinstance(floor, (int, float)) or not 0.0 < floor < 1.0:
+        raise ParameterError("bending_floor", f"{floor!r} must be a number in (0, 1): the least bending slope as a "
+                             f"fraction of B (default {mat.NONLINEAR_FLOOR}; rftstatic.element.nonlinear_bending)")
+    return replace(material, nonlinear_bending=mat.NonlinearBending(si["bending_k2_warp"], si["bending_k2_weft"],
+                                                                     float(floor)))
 
 
 def build_material(scene) -> mat.Material:
@@ -274,9 +347,24 @@ def material_summary(scene, material: mat.Material) -> dict:
         out["bending_hysteresis"] = {"M0_warp": u.from_si(h.M0_warp, "force"), "M0_weft": u.from_si(h.M0_weft, "force"),
                                      "unit": "force per width x length / length (gf in cm-gf-s: gf cm/cm)",
                                      "stick_ratio": h.ratio, "model": "rftstatic.element.hysteresis"}
+    if material.nonlinear_bending is not None:
+        out["nonlinear_bending"] = _nonlinear_summary(u, material.nonlinear_bending, lengths)
     for key in ("preset", "changed"):
         if key in material.info:
             out[key] = material.info[key]
+    return out
+
+
+def _nonlinear_summary(u: UnitSystem, nb: mat.NonlinearBending, lengths: dict) -> dict:
+    """Nonlinear bending in scene units: k2, the floor, the floor curvature kappa_f (N2) and k2 kappa / B at the
+    bending length's curvature kappa = 1/c (the data set's -0.41 ... -0.05, median -0.13)."""
+    out = {"unit": "force length^2 (moment per width per curvature^2; gf cm^2 in cm-gf-s)", "floor": nb.floor,
+           "model": "rftstatic.element.nonlinear_bending"}
+    for d in ("warp", "weft"):
+        k2, B, c = getattr(nb, f"k2_{d}"), lengths[d]["B"], lengths[d]["c"]
+        out[f"k2_{d}"] = u.from_si(k2, "moment_length")
+        out[f"floor_curvature_{d}"] = None if k2 == 0 else u.length * (1 - nb.floor) * B / (2 * abs(k2))
+        out[f"ratio_at_bending_length_{d}"] = None if c is None else k2 / (B * c)
     return out
 
 

@@ -141,6 +141,10 @@ SCHEMA = {
         "nu": (NUM, "Poisson ratio"),
         "thickness": (NUM, "shell thickness, or a fabric's (self-contact default) [length]"),
         "hysteresis_ratio": (NUM, "bending hysteresis: stick stiffness / B (default 10; with kes_2HB_*)"),
+        **{f"bending_k2_{d}": (NUM, f"nonlinear bending: Feng et al.'s k2, {d} [force length^2], <= 0 "
+                                   "(rftstatic.element.nonlinear_bending)") for d in ("warp", "weft")},
+        "bending_floor": (NUM, "nonlinear bending: least slope / B, in (0, 1) (default 0.2)"),
+        "nonlinear_bending": (bool, "true: a ctd-* preset's published k2 (opt-in nonlinear bending)"),
         **{k: (NUM, f"{meaning} [{unit}], lab units whatever the scene's (rftstatic.fabrics.lab)")
            for k, (unit, meaning) in LAB_KEYS.items()},
     }, "fabric or shell rigidities; fabric lab data (KES-F kes_*, FAST fast_*)"),

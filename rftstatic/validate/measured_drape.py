@@ -278,8 +278,8 @@ def _literature() -> str:
 
 SCOPE = ("Measured with the current Cusick route (cases/cusick-*.toml: dynamic relaxation at full load, then Newton; "
          "specimen = seeded start); the route is being reworked in another branch, so these numbers belong to this "
-         "commit's route. Not built, so not measured: nonlinear bending (the moment's fall-off with curvature, e.g. "
-         "the k2 of Feng et al.'s data set) and shear hysteresis (KES 2HG, 2HG5).")
+         "commit's route. Nonlinear bending (Feng et al.'s k2, rftstatic.element.nonlinear_bending) is measured in "
+         "section g of the hand-written section; not built, so not measured: shear hysteresis (KES 2HG, 2HG5).")
 
 
 NODES_HEADING = "Why the node count does not follow the fabric"
