@@ -38,23 +38,29 @@ STARTS = {"relax": ["solver.start=relax"], "load steps": ["solver.start=load-ste
 """Starts of ``--starts``: the scene's two routes, and the load steps from n-fold lifts of one element size."""
 
 
-def _run(fabric, variant, seed, out: Path) -> dict | None:
+def run_case(sets: list[str], out: Path, label: str) -> dict | None:
+    """``python -m rftstatic case cusick-30 --no-figures --out OUT --set ...`` in its own process, unless ``out``
+    already holds a finished run; its summary.json with the whole process's ``wall_s``, or None (and the last
+    error line, after ``label``, on stderr) when it exits with an error."""
     if not (out / "summary.json").is_file():
-        keys = [f"kes_B_warp={fabric['B']}", f"kes_B_weft={fabric['B']}", f"kes_W={fabric['W']}", f"kes_T={fabric['T']}"]
-        if "2HB" in variant:
-            keys += [f"kes_2HB_warp={fabric['2HB']}", f"kes_2HB_weft={fabric['2HB']}"]
-        sets = ["material={" + ", ".join(keys) + "}", f"solver.seed={seed}", *{**VARIANTS, **STARTS}[variant]]
         t = time.perf_counter()
         p = subprocess.run([sys.executable, "-m", "rftstatic", "case", "cusick-30", "--no-figures", "--out", str(out)]
                            + [a for k in sets for a in ("--set", k)], capture_output=True, text=True)
         if p.returncode:
-            print(f"{fabric['id']} {variant} seed {seed}: exit {p.returncode}: {p.stderr.strip().splitlines()[-1:]}",
-                  file=sys.stderr)
+            print(f"{label}: exit {p.returncode}: {p.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
             return None
         (out / "wall.json").write_text(json.dumps({"wall_s": time.perf_counter() - t}))
     s = json.loads((out / "summary.json").read_text())
     s["wall_s"] = json.loads((out / "wall.json").read_text())["wall_s"]
     return s
+
+
+def _run(fabric, variant, seed, out: Path) -> dict | None:
+    keys = [f"kes_B_warp={fabric['B']}", f"kes_B_weft={fabric['B']}", f"kes_W={fabric['W']}", f"kes_T={fabric['T']}"]
+    if "2HB" in variant:
+        keys += [f"kes_2HB_warp={fabric['2HB']}", f"kes_2HB_weft={fabric['2HB']}"]
+    sets = ["material={" + ", ".join(keys) + "}", f"solver.seed={seed}", *{**VARIANTS, **STARTS}[variant]]
+    return run_case(sets, out, f"{fabric['id']} {variant} seed {seed}")
 
 
 def main(argv=None):

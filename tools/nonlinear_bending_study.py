@@ -16,11 +16,9 @@ not solved again). Prints a Markdown table.
 from __future__ import annotations
 
 import argparse
-import json
-import subprocess
-import sys
-import time
 from pathlib import Path
+
+from matsudaira_study import run_case  # tools/: the same cached one-process run of cusick-30
 
 WOOL = {"id": "wool", "name": "(preset wool-kang-yu)", "B_warp": 0.083, "B_weft": 0.063, "W": 0.019, "DC": None,
         "nodes": None}
@@ -53,19 +51,8 @@ def _material(f: dict, r: float, floor: float | None = None) -> list[str]:
 
 
 def _run(f: dict, r: float, route: str, out: Path, floor: float | None = None) -> dict | None:
-    if not (out / "summary.json").is_file():
-        sets = _material(f, r, floor) + ["solver.seed=1"] + ROUTES[route]
-        t = time.perf_counter()
-        p = subprocess.run([sys.executable, "-m", "rftstatic", "case", "cusick-30", "--no-figures", "--out", str(out)]
-                           + [a for k in sets for a in ("--set", k)], capture_output=True, text=True)
-        if p.returncode:
-            print(f"{f['id']} r={r} {route}: exit {p.returncode}: {p.stderr.strip().splitlines()[-1:]}",
-                  file=sys.stderr)
-            return None
-        (out / "wall.json").write_text(json.dumps({"wall_s": time.perf_counter() - t}))
-    s = json.loads((out / "summary.json").read_text())
-    s["wall_s"] = json.loads((out / "wall.json").read_text())["wall_s"]
-    return s
+    sets = _material(f, r, floor) + ["solver.seed=1"] + ROUTES[route]
+    return run_case(sets, out, f"{f['id']} r={r} {route}")
 
 
 def main(argv=None):

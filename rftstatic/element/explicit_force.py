@@ -60,10 +60,6 @@ class ForceKernel:
         if backend == "auto":
             backend = "numba" if numba_available() else "numpy"
         self.backend = backend
-        # nonlinear bending (rftstatic.element.nonlinear_bending; numpy, added in __call__) and its scatter
-        self.bending_softening = getattr(model, "bending_softening", None)
-        self._soft_dofs = (None if self.bending_softening is None
-                           else (3 * self.bending_softening.nodes[..., None] + np.arange(3)).ravel())
         self.model = model
         self.Kb = model.Kb.tocsr()
         self.Dm = np.ascontiguousarray(model.material.Dm, dtype=float)
@@ -86,9 +82,12 @@ class ForceKernel:
                                                                                           self._bend_offset))
         self.threads = 1
         self.hinges = getattr(model, "hinges", None)
+        # the patch terms of the material-axes curvature (numpy, added in __call__): bending friction
+        # (rftstatic.element.hysteresis) and softening (rftstatic.element.nonlinear_bending), one scatter for both
         self.bending_friction = getattr(model, "bending_friction", None)
-        if self.bending_friction is not None:  # the bending friction's scatter
-            self._patch_dofs = (3 * self.bending_friction.nodes[..., None] + np.arange(3)).ravel()
+        self.bending_softening = getattr(model, "bending_softening", None)
+        if self.bending_friction is not None or self.bending_softening is not None:
+            self._patch_dofs = (3 * model.patches.nodes[..., None] + np.arange(3)).ravel()
         if backend == "numpy":
             self._G_last = element_last(self.G)
             self._dofs = (3 * self.nodes.T[:, None, :] + np.arange(3)[:, None]).ravel()  # scatter of fe (A, 3, E)
@@ -149,17 +148,17 @@ class ForceKernel:
         if self._bend_offset is not None:
             f += self._bend_offset
             W += float(np.einsum("ni,ni->", U, self._bend_offset)) + self._bend_energy if energy else 0.0
-        if self.bending_friction is not None:
-            held = self.bending_friction.initial_slip() if slip is None else slip
-            Ub = U if self._bend_offset is None else self.X3 + U
-            Wf, fe, _ = self.bending_friction.evaluate(Ub, self.X3 + U, held)
-            f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
-            W += Wf if energy else 0.0
-        if self.bending_softening is not None:
-            Ub = U if self._bend_offset is None else self.X3 + U
-            Wn, fe, _ = self.bending_softening.evaluate(Ub, self.X3 + U)
-            f += np.bincount(self._soft_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
-            W += Wn if energy else 0.0
+        if self.bending_friction is not None or self.bending_softening is not None:
+            Ub, x = (U if self._bend_offset is None else self.X3 + U), self.X3 + U
+            terms = []
+            if self.bending_friction is not None:
+                held = self.bending_friction.initial_slip() if slip is None else slip
+                terms.append(self.bending_friction.evaluate(Ub, x, held))
+            if self.bending_softening is not None:
+                terms.append(self.bending_softening.evaluate(Ub, x))
+            for Wt, fe, _ in terms:
+                f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
+                W += Wt if energy else 0.0
         if self.hinges is not None:
             Wh, fh = self.hinges.energy_force(self.X3 + U)
             f += fh

@@ -38,6 +38,26 @@ def _mixed_slip(mod, U, rng):
     return km + (fr.M0 / fr.K) * rng.uniform(-2.0, 2.0, size=km.shape)
 
 
+def derivative_errors(mod, U, lam, rng, h=1e-7, columns=24, **kw):
+    """Largest central-difference errors of ``mod``'s residual against its potential and of its tangent against
+    its internal force, over ``columns`` displacement components drawn by ``rng`` (``kw``: e.g. the slip); and
+    the residual, the tangent's force and the tangent (dense) at ``U``."""
+    r = mod.residual(U, lam, **kw)
+    f, K = mod.tangent(U, lam=lam, **kw)
+    K = K.toarray()
+    err_f = err_k = 0.0
+    for c in rng.choice(U.size, columns, replace=False):
+        Up, Um = U.ravel().copy(), U.ravel().copy()
+        Up[c] += h
+        Um[c] -= h
+        Up, Um = Up.reshape(-1, 3), Um.reshape(-1, 3)
+        fd = (mod.potential(Up, lam, **kw) - mod.potential(Um, lam, **kw)) / (2 * h)
+        err_f = max(err_f, abs(fd - r.ravel()[c]))
+        dk = (mod.internal_force(Up, **kw) - mod.internal_force(Um, **kw)).ravel() / (2 * h)
+        err_k = max(err_k, np.abs(dk - K[:, c]).max())
+    return err_f, err_k, r, f, K
+
+
 @pytest.mark.parametrize("element", ["RFT3", "RFT6"])
 def test_friction_force_and_tangent_are_derivatives_of_the_incremental_potential(element):
     m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
@@ -48,20 +68,7 @@ def test_friction_force_and_tangent_are_derivatives_of_the_incremental_potential
     km = mod.bending_friction.curvature(U, mod.positions(U))[:, :2]
     stick = np.abs(km - slip) <= mod.bending_friction.M0 / mod.bending_friction.K
     assert 0.2 < stick.mean() < 0.8  # both branches of (H2) are exercised
-    h = 1e-7
-    r = mod.residual(U, 0.6, slip=slip)
-    f, K = mod.tangent(U, lam=0.6, slip=slip)
-    K = K.toarray()
-    err_f = err_k = 0.0
-    for c in rng.choice(U.size, 24, replace=False):
-        Up, Um = U.ravel().copy(), U.ravel().copy()
-        Up[c] += h
-        Um[c] -= h
-        Up, Um = Up.reshape(-1, 3), Um.reshape(-1, 3)
-        fd = (mod.potential(Up, 0.6, slip=slip) - mod.potential(Um, 0.6, slip=slip)) / (2 * h)
-        err_f = max(err_f, abs(fd - r.ravel()[c]))
-        dk = (mod.internal_force(Up, slip=slip) - mod.internal_force(Um, slip=slip)).ravel() / (2 * h)
-        err_k = max(err_k, np.abs(dk - K[:, c]).max())
+    err_f, err_k, r, f, K = derivative_errors(mod, U, 0.6, rng, slip=slip)
     assert err_f < 1e-6 * np.abs(r).max()
     assert err_k < 1e-6 * np.abs(K).max()
     np.testing.assert_allclose(f - 0.6 * mod.load, r, atol=1e-12 * np.abs(r).max())

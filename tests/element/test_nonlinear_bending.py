@@ -11,6 +11,7 @@ from rftstatic import material
 from rftstatic.element.nonlinear_bending import floor_curvature, softening
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
+from tests.element.test_hysteresis import derivative_errors
 
 K2 = (-0.006, -0.003)  # [N m^2]: kappa_f = 0.8 B / (2 |k2|) = 2.0 and 2.67 /m for B = 0.03, 0.02 N m
 
@@ -60,26 +61,14 @@ def test_force_and_tangent_are_derivatives_of_the_energy_on_both_branches(elemen
     term = mod.bending_softening
     floor = term.on_floor(U, mod.positions(U))
     assert 0.2 < floor.mean() < 0.8  # the k2 branch and the floor branch of (N3) both exercised
-    h = 1e-7
-    r = mod.residual(U, 0.6)
-    f, K = mod.tangent(U, lam=0.6)
-    K = K.toarray()
-    err_f = err_k = 0.0
-    for c in rng.choice(U.size, 24, replace=False):
-        Up, Um = U.ravel().copy(), U.ravel().copy()
-        Up[c] += h
-        Um[c] -= h
-        Up, Um = Up.reshape(-1, 3), Um.reshape(-1, 3)
-        fd = (mod.potential(Up, 0.6) - mod.potential(Um, 0.6)) / (2 * h)
-        err_f = max(err_f, abs(fd - r.ravel()[c]))
-        dk = (mod.internal_force(Up) - mod.internal_force(Um)).ravel() / (2 * h)
-        err_k = max(err_k, np.abs(dk - K[:, c]).max())
+    err_f, err_k, r, f, K = derivative_errors(mod, U, 0.6, rng)
     assert err_f < 1e-6 * np.abs(r).max()
     assert err_k < 1e-6 * np.abs(K).max()
     np.testing.assert_allclose(f - 0.6 * mod.load, r, atol=1e-12 * np.abs(r).max())
     # the term itself (not only the sum with K_b) by finite differences of its own energy
     x = mod.positions(U)
     _, fe, _ = term.evaluate(U, x)
+    h = 1e-7
     for e, a, i in ((3, 4, 2), (11, 0, 0), (17, 5, 1)):
         n = term.nodes[e, a]
         Up, Um = U.copy(), U.copy()
