@@ -150,24 +150,24 @@ def _skew(v, S):
 
 
 @nb.njit(**_JIT)
-def tangents(geom, Ub, x, slip, laws, psd, fe, ke):
+def tangents(geom, Ub, x, slip, laws, psd, fe, ke, emap, data):
     """Fill ``fe (E, 6, 3)`` [N] with the element forces (A2) and ``ke (E, 6, 3, 6, 3)`` [N/m] with the element
     tangents (A3) (``psd``: only ``A sum_k max(psi''_k, 0) g_k g_k^T``); return the energy [J] (A1); ``geom``,
-    ``laws`` as :func:`add_forces`."""
+    ``laws`` as :func:`add_forces`. With rows in ``emap (E, 6, 3, 6, 3)`` (int64; ``(0, 6, 3, 6, 3)`` else) the
+    tangents are added into the sparse matrix values ``data`` at those positions instead (``ke`` unused): the
+    scatter of :func:`rftstatic.model.assembly.scatter_matrices` without the element array."""
     nodes, L, area, T = geom
+    scatter = emap.shape[0] > 0
+    kl = np.empty((6, 3, 6, 3))
     d = np.empty((3, 3))
     n = np.empty(3)
     Ev = np.empty((3, 3))
     g = np.empty((2, 6, 3))
-    S = np.empty((3, 3, 3))
-    P = np.empty((3, 3))
-    Hc = np.empty((3, 3))
-    SH = np.empty((3, 3))
-    hx = np.empty((3, 3))
+    scratch = (np.empty((3, 3)), np.empty((3, 3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)))
     hv = np.empty(3)
-    gam = ((0.0, 1.0, -1.0), (-1.0, 0.0, 1.0), (1.0, -1.0, 0.0))  # gamma_vw of (A3)
     W = 0.0
     for e in range(nodes.shape[0]):
+        ke_e = kl if scatter else ke[e]
         A = area[e]
         r = _geometry(e, nodes, L, Ub, x, d, n, Ev)
         km0 = _axis_curvature(T, d, n, 0)
@@ -184,41 +184,55 @@ def tangents(geom, Ub, x, slip, laws, psd, fe, ke):
                 ga0, ga1 = A * dm0 * g[0, a, i], A * dm1 * g[1, a, i]
                 for b in range(6):
                     for j in range(3):
-                        ke[e, a, i, b, j] = ga0 * g[0, b, j] + ga1 * g[1, b, j]
-        if psd:
-            continue
-        w0 = T[0, 0] * m0 + T[1, 0] * m1
-        w1 = T[0, 1] * m0 + T[1, 1] * m1
-        w2 = T[0, 2] * m0 + T[1, 2] * m1
-        for i in range(3):
-            for j in range(3):
-                P[i, j] = (1.0 if i == j else 0.0) - n[i] * n[j]
-        for v in range(3):
-            _skew(Ev[v], S[v])
-        # l_a dn/dx_v and its transpose: dn/dx_v = -(P / r) [E_v]_x
-        for v in range(3):
-            for i in range(3):
-                for j in range(3):
-                    dn = -(P[i, 0] * S[v, 0, j] + P[i, 1] * S[v, 1, j] + P[i, 2] * S[v, 2, j]) / r
-                    for a in range(6):
-                        c = A * (w0 * L[e, 0, a] + w1 * L[e, 1, a] + w2 * L[e, 2, a]) * dn
-                        ke[e, a, i, 3 + v, j] += c
-                        ke[e, 3 + v, j, a, i] += c
-        # d2(D . n)/dx_v dx_w = -[E_v]_x H_c [E_w]_x - gamma_vw [h]_x, H_c = -(s P + t n^T + n t^T) / r^2
-        t0, t1, t2 = hv[0] * r, hv[1] * r, hv[2] * r
-        for i in range(3):
-            ti = (t0, t1, t2)[i]
-            for j in range(3):
-                tj = (t0, t1, t2)[j]
-                Hc[i, j] = -(nD * P[i, j] + ti * n[j] + n[i] * tj) / (r * r)
-        _skew(hv, hx)
-        for v in range(3):
-            for i in range(3):
-                for k in range(3):
-                    SH[i, k] = S[v, i, 0] * Hc[0, k] + S[v, i, 1] * Hc[1, k] + S[v, i, 2] * Hc[2, k]
-            for w in range(3):
+                        ke_e[a, i, b, j] = ga0 * g[0, b, j] + ga1 * g[1, b, j]
+        if not psd:
+            _turning(e, L, T, (n, r, Ev, hv, nD), m0, m1, A, scratch, ke_e)
+        if scatter:
+            for a in range(6):
                 for i in range(3):
-                    for m in range(3):
-                        s = SH[i, 0] * S[w, 0, m] + SH[i, 1] * S[w, 1, m] + SH[i, 2] * S[w, 2, m]
-                        ke[e, 3 + v, i, 3 + w, m] += A * (-s - gam[v][w] * hx[i, m])
+                    for b in range(6):
+                        for j in range(3):
+                            data[emap[e, a, i, b, j]] += kl[a, i, b, j]
     return W
+
+
+@nb.njit(inline="always", **_JIT)
+def _turning(e, L, T, geo, m0, m1, A, scratch, ke_e):
+    """Add to ``ke_e (6, 3, 6, 3)`` the terms of (A3) from the turning normal at the moments ``(m0, m1)``:
+    ``A (l_a dn/dx_b + (l_b dn/dx_a)^T + d2(D . n)/dx_a dx_b)``; ``geo = (n, r, Ev, hv, nD)`` with ``hv = P D / r``
+    and ``nD = n . D``; ``scratch = (P, S, Hc, SH, hx)``."""
+    n, r, Ev, hv, nD = geo
+    P, S, Hc, SH, hx = scratch
+    gam = ((0.0, 1.0, -1.0), (-1.0, 0.0, 1.0), (1.0, -1.0, 0.0))  # gamma_vw of (A3)
+    w0 = T[0, 0] * m0 + T[1, 0] * m1
+    w1 = T[0, 1] * m0 + T[1, 1] * m1
+    w2 = T[0, 2] * m0 + T[1, 2] * m1
+    for i in range(3):
+        for j in range(3):
+            P[i, j] = (1.0 if i == j else 0.0) - n[i] * n[j]
+    for v in range(3):
+        _skew(Ev[v], S[v])
+    # l_a dn/dx_v and its transpose: dn/dx_v = -(P / r) [E_v]_x
+    for v in range(3):
+        for i in range(3):
+            for j in range(3):
+                dn = -(P[i, 0] * S[v, 0, j] + P[i, 1] * S[v, 1, j] + P[i, 2] * S[v, 2, j]) / r
+                for a in range(6):
+                    c = A * (w0 * L[e, 0, a] + w1 * L[e, 1, a] + w2 * L[e, 2, a]) * dn
+                    ke_e[a, i, 3 + v, j] += c
+                    ke_e[3 + v, j, a, i] += c
+    # d2(D . n)/dx_v dx_w = -[E_v]_x H_c [E_w]_x - gamma_vw [h]_x, H_c = -(s P + t n^T + n t^T) / r^2, t = P D
+    t = (hv[0] * r, hv[1] * r, hv[2] * r)
+    for i in range(3):
+        for j in range(3):
+            Hc[i, j] = -(nD * P[i, j] + t[i] * n[j] + n[i] * t[j]) / (r * r)
+    _skew(hv, hx)
+    for v in range(3):
+        for i in range(3):
+            for k in range(3):
+                SH[i, k] = S[v, i, 0] * Hc[0, k] + S[v, i, 1] * Hc[1, k] + S[v, i, 2] * Hc[2, k]
+        for w in range(3):
+            for i in range(3):
+                for m in range(3):
+                    s = SH[i, 0] * S[w, 0, m] + SH[i, 1] * S[w, 1, m] + SH[i, 2] * S[w, 2, m]
+                    ke_e[3 + v, i, 3 + w, m] += A * (-s - gam[v][w] * hx[i, m])

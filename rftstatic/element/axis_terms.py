@@ -21,6 +21,9 @@ __all__ = ["AxisTerms", "axis_terms"]
 
 BACKENDS = ("numpy", "numba")
 
+_NO_MAP = np.zeros((0, 6, 3, 6, 3), dtype=np.int64)
+_NO_KE = np.zeros((1, 6, 3, 6, 3))
+
 
 class AxisTerms:
     """Bending friction and/or softening of one mesh's patches (module docstring).
@@ -85,8 +88,21 @@ class AxisTerms:
             return W, fe, ke
         E = len(self._geom[0])
         fe, ke = np.empty((E, 6, 3)), np.empty((E, 6, 3, 6, 3))
-        W = self._nb.tangents(self._geom, *self._args(Ub, x, slip), bool(psd), fe, ke)
+        W = self._nb.tangents(self._geom, *self._args(Ub, x, slip), bool(psd), fe, ke, _NO_MAP, np.empty(0))
         return float(W), fe, ke
+
+    def add_tangents(self, Ub, x, emap, data, slip=None, *, psd=False):
+        """Add the element tangents (A3) into sparse matrix values ``data`` (in place) at the positions ``emap
+        (E, 6, 3, 6, 3)`` (int64; :meth:`rftstatic.model.assembly.AssemblyPlan.element_map` of the patches); return
+        the element forces ``(E, 6, 3)`` [N]; other arguments as :meth:`evaluate`. The compiled back end adds each
+        element's block as it is made (no ``(E, 6, 3, 6, 3)`` array)."""
+        if self.backend == "numpy":
+            _, fe, ke = self.evaluate(Ub, x, slip, tangent=True, psd=psd)
+            data += np.bincount(emap.ravel(), ke.ravel(), minlength=len(data))
+            return fe
+        fe = np.empty((len(self._geom[0]), 6, 3))
+        self._nb.tangents(self._geom, *self._args(Ub, x, slip), bool(psd), fe, _NO_KE, emap, data)
+        return fe
 
     def _args(self, Ub, x, slip):
         return np.ascontiguousarray(Ub, dtype=float), np.ascontiguousarray(x, dtype=float), self._slip(slip), self._laws

@@ -320,9 +320,8 @@ class Model(Frozen):
         f = self.Kb @ self.bending_displacement(U)
         x = self.positions(U)
         if self.axis_terms is not None:  # bending friction and softening
-            _, fe, ke = self.axis_terms.evaluate(self.bending_displacement(U), x, slip, tangent=True, psd=psd)
+            fe = self.axis_terms.add_tangents(self.bending_displacement(U), x, self._patch_map, data, slip, psd=psd)
             f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
-            data += scatter_matrices(self._patch_map, ke, plan.nnz)
         if self.hinges is not None:
             fh, (rows, cols, blocks) = self.hinges.force_tangent_blocks(x, psd=psd)
             f += fh

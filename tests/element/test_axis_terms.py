@@ -72,6 +72,14 @@ def test_compiled_terms_equal_the_numpy_reference(terms):
         assert Wb == pytest.approx(Wa, rel=TOL)
         _close(fea, feb)
         _close(kea, keb)
+    for psd in (False, True):  # straight into the sparse values, as Model.tangent does
+        da, db = np.zeros(ref.plan.nnz), np.zeros(ref.plan.nnz)
+        fea = a.add_tangents(U, x, ref._patch_map, da, slip, psd=psd)
+        feb = b.add_tangents(U, x, comp._patch_map, db, slip, psd=psd)
+        _close(fea, feb)
+        _close(da, db)
+        _close(da, np.bincount(ref._patch_map.ravel(), a.evaluate(U, x, slip, tangent=True, psd=psd)[2].ravel(),
+                               minlength=ref.plan.nnz))
     if slip is not None:
         (sa, da), (sb, db) = a.commit(U, x, slip), b.commit(U, x, slip)
         _close(sa, sb)
