@@ -15,8 +15,16 @@ Arrays: ``nodes (E, 6)`` int64 (slots 3-5 the element's vertices), ``L (E, 3, 6)
 The sums run in a fixed order, so a result does not depend on anything but its inputs; they differ from numpy's
 einsum order by round-off (the tests' tolerance: 1e-12 of the largest entry).
 
+The functions are written plain and compiled at import (:func:`_compile`, ``cache=True``): numba keys a cached
+function on its own file only, and these loops link the laws' code from two other files, so each compiled copy is
+named after a hash of the laws' code (:data:`LAW_KEY`): a changed law compiles new loops instead of loading old ones.
+
 Imported only when numba is installed and a compiled back end is chosen (:mod:`rftstatic.element.axis_terms`).
 """
+
+import hashlib
+import marshal
+import types
 
 import numba as nb
 import numpy as np
@@ -25,11 +33,13 @@ from rftstatic.element.hysteresis import friction_law as _friction_py
 from rftstatic.element.nonlinear_bending import softening_law as _softening_py
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
-_friction = nb.njit(**_JIT)(_friction_py)
+_friction = nb.njit(**_JIT)(_friction_py)  # each cached on its own file
 _softening = nb.njit(**_JIT)(_softening_py)
 
+LAW_KEY = hashlib.sha1(b"".join(marshal.dumps(f.__code__) for f in (_friction_py, _softening_py))).hexdigest()[:12]
+"""Hash of the compiled laws' code, in the names of the loops' cache entries (module docstring)."""
 
-@nb.njit(inline="always", **_JIT)
+
 def _geometry(e, nodes, L, Ub, x, d, n, Ev):
     """``d[j] = sum_a L[e, j, a] Ub[nodes[e, a]]`` (3, 3), the unit normal ``n`` (3,) and the vertex edges
     ``Ev[v] = x_(v+1) - x_(v+2)`` (3, 3) of element ``e`` into the scratch arrays; returns ``r = |c|`` [m^2]."""
@@ -52,7 +62,6 @@ def _geometry(e, nodes, L, Ub, x, d, n, Ev):
     return r
 
 
-@nb.njit(inline="always", **_JIT)
 def _axis_curvature(T, d, n, k):
     """``kappa_m,k = sum_j T[k, j] (d_j . n)`` [1/m] (A1)."""
     s = 0.0
@@ -61,7 +70,6 @@ def _axis_curvature(T, d, n, k):
     return s
 
 
-@nb.njit(inline="always", **_JIT)
 def _laws(e, km, k, slip, laws, psd):
     """psi [N m/m], M = psi' [N m/m] and psi'' [N m] of direction ``k`` of element ``e``: the sum of the terms on
     (``psd``: each term's psi'' clipped at 0 before the sum, as each term's reference)."""
@@ -82,7 +90,6 @@ def _laws(e, km, k, slip, laws, psd):
     return psi, m, dm
 
 
-@nb.njit(inline="always", **_JIT)
 def _force(e, L, T, d, n, r, Ev, w0, w1, A, fe):
     """Element force ``fe (6, 3)`` [N] of the moments ``(w0, w1)`` (warp, weft) (A2): ``w = T^T M``,
     ``f_a = A (l_a n + [a = 3 + v] E_v x (P D) / r)``."""
@@ -107,7 +114,6 @@ def _force(e, L, T, d, n, r, Ev, w0, w1, A, fe):
     return nD, h0, h1, h2
 
 
-@nb.njit(**_JIT)
 def curvatures(nodes, L, T, Ub, x, km):
     """Fill ``km (E, 2)`` [1/m] with the warp and weft curvatures in material axes (A1) of every element."""
     d = np.empty((3, 3))
@@ -119,7 +125,6 @@ def curvatures(nodes, L, T, Ub, x, km):
         km[e, 1] = _axis_curvature(T, d, n, 1)
 
 
-@nb.njit(**_JIT)
 def add_forces(geom, Ub, x, slip, laws, f):
     """Add the terms' nodal forces (A2) into ``f (N, 3)`` [N]; return their energy [J] (A1). ``geom = (nodes, L,
     area, T)``, ``laws = (K, M0, y, k2, kf, friction, softening)`` (module docstring)."""
@@ -141,7 +146,6 @@ def add_forces(geom, Ub, x, slip, laws, f):
     return W
 
 
-@nb.njit(inline="always", **_JIT)
 def _skew(v, S):
     """``S = [v]_x`` (3, 3)."""
     S[0, 0], S[0, 1], S[0, 2] = 0.0, -v[2], v[1]
@@ -149,7 +153,6 @@ def _skew(v, S):
     S[2, 0], S[2, 1], S[2, 2] = -v[1], v[0], 0.0
 
 
-@nb.njit(**_JIT)
 def tangents(geom, Ub, x, slip, laws, psd, fe, ke, emap, data):
     """Fill ``fe (E, 6, 3)`` [N] with the element forces (A2) and ``ke (E, 6, 3, 6, 3)`` [N/m] with the element
     tangents (A3) (``psd``: only ``A sum_k max(psi''_k, 0) g_k g_k^T``); return the energy [J] (A1); ``geom``,
@@ -196,7 +199,6 @@ def tangents(geom, Ub, x, slip, laws, psd, fe, ke, emap, data):
     return W
 
 
-@nb.njit(inline="always", **_JIT)
 def _turning(e, L, T, geo, m0, m1, A, scratch, ke_e):
     """Add to ``ke_e (6, 3, 6, 3)`` the terms of (A3) from the turning normal at the moments ``(m0, m1)``:
     ``A (l_a dn/dx_b + (l_b dn/dx_a)^T + d2(D . n)/dx_a dx_b)``; ``geo = (n, r, Ev, hv, nD)`` with ``hv = P D / r``
@@ -236,3 +238,23 @@ def _turning(e, L, T, geo, m0, m1, A, scratch, ke_e):
                 for m in range(3):
                     s = SH[i, 0] * S[w, 0, m] + SH[i, 1] * S[w, 1, m] + SH[i, 2] * S[w, 2, m]
                     ke_e[3 + v, i, 3 + w, m] += A * (-s - gam[v][w] * hx[i, m])
+
+
+_INLINE = ("_geometry", "_axis_curvature", "_laws", "_force", "_skew", "_turning")
+_LOOPS = ("curvatures", "add_forces", "tangents")
+
+
+def _compile():
+    """Replace each function of :data:`_INLINE` (inlined into the loops) and :data:`_LOOPS` by its compiled copy,
+    named ``NAME_<LAW_KEY>`` for numba's cache; the copies' globals are this module's, so that they call each
+    other's compiled copies."""
+    scope = globals()
+    for name in _INLINE + _LOOPS:
+        f = scope[name]
+        copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
+        copy.__qualname__ = f"{name}_{LAW_KEY}"
+        copy.__doc__ = f.__doc__
+        scope[name] = nb.njit(copy, inline="always" if name in _INLINE else "never", **_JIT)
+
+
+_compile()

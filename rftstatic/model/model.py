@@ -30,9 +30,9 @@ from functools import cached_property
 import numpy as np
 
 from rftstatic.compiled import choose_kernels
+from rftstatic.element.axis_terms import axis_terms
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.element.hinge import fold_hinges
-from rftstatic.element.axis_terms import axis_terms
 from rftstatic.element.hysteresis import bending_friction
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.nonlinear_bending import nonlinear_bending

@@ -156,6 +156,15 @@ def test_the_friction_law_is_h3_on_both_branches():
     assert stick.any() and not stick.all()
 
 
+def test_compiled_loops_are_named_after_the_laws_code():
+    """numba keys a cache entry on its function's own file: the loops carry a hash of the laws (other files)."""
+    from rftstatic.element import _axis_numba as nb_terms
+
+    for f in (nb_terms.add_forces, nb_terms.tangents, nb_terms.curvatures):
+        assert f.py_func.__qualname__.endswith("_" + nb_terms.LAW_KEY)
+    assert len(nb_terms.LAW_KEY) == 12
+
+
 def test_backends_are_checked():
     _, mod = _models("both")
     with pytest.raises(ValueError, match="backend"):
