@@ -27,6 +27,10 @@ for the fixed vector D, ``d2(D . n)/dx_v dx_w = -[E_v]_x H_c [E_w]_x - gamma_vw 
 ``gamma_vw = -gamma_wv``. The element tests (tests/element/test_hysteresis.py, test_nonlinear_bending.py) check
 (A2) and (A3) by finite differences for both laws.
 
+:meth:`AxisCurvature.assemble` is the numpy reference; :mod:`rftstatic.element.axis_terms` evaluates the terms of
+a model together, with the compiled loops of :mod:`rftstatic.element._axis_numba` on a compiled run (the same
+(A1)-(A3), tested against this module to round-off).
+
 ``psd``: the tangent keeps only ``A sum_k max(psi''_k, 0) g_k g_k^T`` (the terms of the turning normal dropped, and
 a law's negative curvature too: a softening term's ``psi'' < 0`` lowers the constant K_b of Eq. 13 and need not
 leave a positive semi-definite sum, e.g. with a Poisson coupling B12).

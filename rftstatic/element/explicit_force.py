@@ -30,6 +30,7 @@ import time
 import numpy as np
 
 from rftstatic.compiled import ThreadTuner, fixed_threads, force_threads, numba_available
+from rftstatic.element.axis_terms import axis_terms
 from rftstatic.element.kernels import element_slots, lane_blocks
 from rftstatic.element.kernels_numpy import element_last, forces_numpy
 
@@ -82,12 +83,11 @@ class ForceKernel:
                                                                                           self._bend_offset))
         self.threads = 1
         self.hinges = getattr(model, "hinges", None)
-        # the patch terms of the material-axes curvature (numpy, added in __call__): bending friction
-        # (rftstatic.element.hysteresis) and softening (rftstatic.element.nonlinear_bending), one scatter for both
-        self.bending_friction = getattr(model, "bending_friction", None)
-        self.bending_softening = getattr(model, "bending_softening", None)
-        if self.bending_friction is not None or self.bending_softening is not None:
-            self._patch_dofs = (3 * model.patches.nodes[..., None] + np.arange(3)).ravel()
+        # the patch terms of the material-axes curvature, added in __call__: bending friction
+        # (rftstatic.element.hysteresis) and softening (rftstatic.element.nonlinear_bending) on one patch pass,
+        # compiled on the numba back end (rftstatic.element.axis_terms)
+        self.axis_terms = axis_terms(getattr(model, "bending_friction", None), getattr(model, "bending_softening", None),
+                                     backend=backend)
         if backend == "numpy":
             self._G_last = element_last(self.G)
             self._dofs = (3 * self.nodes.T[:, None, :] + np.arange(3)[:, None]).ravel()  # scatter of fe (A, 3, E)
@@ -118,7 +118,7 @@ class ForceKernel:
         the potential of the model's potential loads (``model.load_terms``) at load factor 1;
         ``candidates`` is the solve's contact candidate list (a cache; None: every node), ``pairs`` its
         self-contact pair cache (``State.self_pairs``; None: a fresh broad phase), ``slip`` the committed
-        slip of the bending friction (``State.bending_slip``, :mod:`rftstatic.element.hysteresis`; numpy).
+        slip of the bending friction (``State.bending_slip``, :mod:`rftstatic.element.hysteresis`).
         """
         U = np.ascontiguousarray(U, dtype=float)
         if self.backend == "numba":
@@ -148,17 +148,9 @@ class ForceKernel:
         if self._bend_offset is not None:
             f += self._bend_offset
             W += float(np.einsum("ni,ni->", U, self._bend_offset)) + self._bend_energy if energy else 0.0
-        if self.bending_friction is not None or self.bending_softening is not None:
-            Ub, x = (U if self._bend_offset is None else self.X3 + U), self.X3 + U
-            terms = []
-            if self.bending_friction is not None:
-                held = self.bending_friction.initial_slip() if slip is None else slip
-                terms.append(self.bending_friction.evaluate(Ub, x, held))
-            if self.bending_softening is not None:
-                terms.append(self.bending_softening.evaluate(Ub, x))
-            for Wt, fe, _ in terms:
-                f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
-                W += Wt if energy else 0.0
+        if self.axis_terms is not None:
+            Wt = self.axis_terms.add_forces(U if self._bend_offset is None else self.X3 + U, self.X3 + U, f, slip)
+            W += Wt if energy else 0.0
         if self.hinges is not None:
             Wh, fh = self.hinges.energy_force(self.X3 + U)
             f += fh

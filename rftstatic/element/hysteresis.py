@@ -53,18 +53,33 @@ import numpy as np
 
 from rftstatic.element.axis_curvature import AxisCurvature, axis_rigidities
 
-__all__ = ["BendingFriction", "huber"]
+__all__ = ["BendingFriction", "friction_law", "friction_yield", "huber"]
+
+
+def friction_yield(K, M0):
+    """The stick range ``y = M0 / K`` [1/m] of (H3) per direction, for stiffness ``K (2,)`` [N m] and yield moment
+    ``M0 (2,)`` [N m/m] (``M0`` where K = 0)."""
+    return M0 / np.where(K > 0, K, 1.0)
+
+
+def friction_law(e, K, M0, y):
+    """Incremental friction potential psi (H3) [N m/m], its derivative the moment M_f (H2) [N m/m] and its
+    second derivative [N m] at trial stick curvatures ``e`` [1/m], for stiffness ``K`` [N m], yield moment ``M0``
+    [N m/m] and stick range ``y`` (:func:`friction_yield`) [1/m]. Written with ufuncs only, so that one source
+    serves numpy arrays (``e (E, 2)``, the rest ``(2,)``) and the compiled kernels of
+    :mod:`rftstatic.element._axis_numba` (scalars): with ``e_c = clip(e, -y, y)``,
+    ``psi = K e_c^2 / 2 + M0 (|e| - |e_c|)``, which is (H3) on both branches (K y = M0)."""
+    m = np.minimum(np.maximum(K * e, -M0), M0)
+    ec = np.minimum(np.maximum(e, -y), y)
+    psi = 0.5 * K * ec * ec + M0 * (np.abs(e) - np.abs(ec))
+    return psi, m, K * (np.abs(e) <= y)
 
 
 def huber(e, K, M0):
     """Incremental friction potential psi (H3) [N m/m], its derivative the moment M_f (H2) [N m/m] and its
     second derivative [N m] for trial stick curvatures ``e (E, 2)`` [1/m], stiffness ``K (2,)`` [N m] and
-    yield moment ``M0 (2,)`` [N m/m] (a zero M0 gives a zero term)."""
-    y = M0 / np.where(K > 0, K, 1.0)
-    stick = np.abs(e) <= y
-    m = np.clip(K * e, -M0, M0)
-    psi = np.where(stick, 0.5 * K * e * e, M0 * np.abs(e) - 0.5 * M0 * y)
-    return psi, m, np.where(stick, K, 0.0) * np.ones_like(e)
+    yield moment ``M0 (2,)`` [N m/m] (a zero M0 gives a zero term): :func:`friction_law`."""
+    return friction_law(e, K, M0, friction_yield(K, M0))
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,11 +110,19 @@ class BendingFriction(AxisCurvature):
     def commit(self, U, x, slip) -> tuple[np.ndarray, float]:
         """Return mapping at a converged step (H4): the new slip ``(E, 2)`` [1/m] and the energy dissipated
         in the step [J]."""
-        km = self.curvature(U, x)[:, :2]
+        return self.return_map(self.curvature(U, x)[:, :2], slip)
+
+    def return_map(self, km, slip) -> tuple[np.ndarray, float]:
+        """(H4) from the material-axes curvatures ``km (E, 2)`` [1/m] (warp, weft) of a converged step and the
+        committed ``slip (E, 2)`` [1/m]: the new slip and the energy dissipated in the step [J]."""
         e = km - slip
-        y = self.M0 / np.where(self.K > 0, self.K, 1.0)
-        ds = e - np.clip(e, -y, y)
+        ds = e - np.clip(e, -self.y, self.y)
         return slip + ds, float(np.einsum("e,ek,k->", self.area, np.abs(ds), self.M0))
+
+    @property
+    def y(self) -> np.ndarray:
+        """The stick range ``M0 / K (2,)`` [1/m] (:func:`friction_yield`)."""
+        return friction_yield(self.K, self.M0)
 
     def moment(self, U, x, slip) -> np.ndarray:
         """Friction moment ``M_f (E, 2)`` per unit width [N m/m] (H2), warp and weft."""

@@ -54,7 +54,7 @@ import numpy as np
 from rftstatic.element.axis_curvature import AxisCurvature, axis_rigidities
 from rftstatic.material import NONLINEAR_FLOOR, voigt_rotation
 
-__all__ = ["FLOOR", "BendingSoftening", "nonlinear_bending", "softening"]
+__all__ = ["FLOOR", "BendingSoftening", "nonlinear_bending", "softening", "softening_law"]
 
 FLOOR = NONLINEAR_FLOOR
 """Default floor phi of the bending slope, a fraction of B [-] (module docstring: the moment stays within
@@ -69,17 +69,24 @@ def floor_curvature(B, k2, floor):
         return np.where(k2 < 0, (1.0 - floor) * B / (2.0 * np.abs(k2)), np.inf)
 
 
+def softening_law(kappa, k2, kf):
+    """The correction's potential psi (N4) [N m/m], moment psi' (N3 less B kappa) [N m/m] and psi'' (N5) [N m] at
+    curvatures ``kappa`` [1/m] for ``k2`` [N m^2] (<= 0) and the floor curvature ``kf`` [1/m] (:func:`floor_curvature`,
+    inf without k2). Written with ufuncs only, so that one source serves numpy arrays (``kappa (E, 2)``, the rest
+    ``(2,)``) and the compiled kernels of :mod:`rftstatic.element._axis_numba` (scalars): with ``a = |kappa|`` and
+    ``c = min(a, kf)`` (a on the k2 branch, kf on the floor), ``psi = k2 (c^3 / 3 + c a (a - c))``,
+    ``psi' = sign(kappa) k2 c (2 a - c)``, ``psi'' = 2 k2 c``."""
+    a = np.abs(kappa)
+    c = np.minimum(a, kf)
+    psi = k2 * (c * c * c / 3.0 + c * a * (a - c))
+    return psi, np.sign(kappa) * k2 * (c * (2.0 * a - c)), 2.0 * k2 * c
+
+
 def softening(kappa, B, k2, floor=FLOOR):
     """The correction's potential psi (N4) [N m/m], moment psi' (N3 less B kappa) [N m/m] and psi'' (N5) [N m]
-    at curvatures ``kappa (E, 2)`` [1/m] for ``B (2,)`` [N m], ``k2 (2,)`` [N m^2] (<= 0) and ``floor`` [-]."""
-    kf = floor_curvature(B, k2, floor)
-    a = np.abs(kappa)
-    on = a > kf  # the floor branch
-    kfs = np.where(np.isfinite(kf), kf, 0.0) * np.ones_like(a)
-    k2 = np.asarray(k2, float) * np.ones_like(a)
-    psi = np.where(on, k2 * (kfs * a * a - kfs * kfs * a + kfs ** 3 / 3.0), k2 * a ** 3 / 3.0)
-    m = np.sign(kappa) * np.where(on, k2 * (2.0 * kfs * a - kfs * kfs), k2 * a * a)
-    return psi, m, 2.0 * k2 * np.where(on, kfs, a)
+    at curvatures ``kappa (E, 2)`` [1/m] for ``B (2,)`` [N m], ``k2 (2,)`` [N m^2] (<= 0) and ``floor`` [-]:
+    :func:`softening_law`."""
+    return softening_law(kappa, np.asarray(k2, float), floor_curvature(B, k2, floor))
 
 
 @dataclass(frozen=True, eq=False)

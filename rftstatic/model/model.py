@@ -30,6 +30,7 @@ from functools import cached_property
 import numpy as np
 
 from rftstatic.compiled import choose_kernels
+from rftstatic.element.axis_terms import axis_terms
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.element.hinge import fold_hinges
 from rftstatic.element.hysteresis import bending_friction
@@ -171,6 +172,9 @@ class Model(Frozen):
         self.bending_softening = (None if nb is None or nb.k2_warp == nb.k2_weft == 0.0 else nonlinear_bending(
             self.patches, mesh.area, material.Db, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
             k2=(nb.k2_warp, nb.k2_weft), floor=nb.floor))
+        # both terms on one patch pass, compiled with the run's kernels (rftstatic.element.axis_terms)
+        self.axis_terms = axis_terms(self.bending_friction, self.bending_softening,
+                                     backend="numba" if self.kernels == "compiled" else "numpy")
         warnings = []
         if element == "RFT6" and self.with_membrane:
             lock = locking_number(mesh, material)
@@ -240,10 +244,8 @@ class Model(Frozen):
         at the committed ``slip (E, 2)`` [1/m] (None: the virgin state), when the material has one."""
         Ub = self.bending_displacement(U)
         Eb = 0.5 * float(np.einsum("ni,ni->", Ub, self.Kb @ Ub))
-        if self.bending_friction is not None:
-            Eb += self._friction(U, slip)[0]
-        if self.bending_softening is not None:
-            Eb += self._softening(U)[0]
+        if self.axis_terms is not None:
+            Eb += self.axis_terms.energy(Ub, self.positions(U), slip)
         if self.hinges is not None:
             Eb += self.hinges.energy(self.positions(U))
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
@@ -262,23 +264,11 @@ class Model(Frozen):
         """Total potential energy Pi(U) [J]."""
         return self.energies(U, lam, candidates=candidates, pairs=pairs, branches=branches, slip=slip)["total"]
 
-    def _friction(self, U, slip, tangent=False, psd=False):
-        """The bending friction's energy [J], element forces (E, 6, 3) [N] and tangents (E, 6, 3, 6, 3) [N/m]."""
-        slip = self.bending_friction.initial_slip() if slip is None else slip
-        return self.bending_friction.evaluate(self.bending_displacement(U), self.positions(U), slip, tangent=tangent,
-                                              psd=psd)
-
-    def _softening(self, U, tangent=False, psd=False):
-        """The softening correction's energy [J], element forces (E, 6, 3) [N] and tangents (E, 6, 3, 6, 3) [N/m]
-        (:mod:`rftstatic.element.nonlinear_bending`)."""
-        return self.bending_softening.evaluate(self.bending_displacement(U), self.positions(U), tangent=tangent,
-                                               psd=psd)
-
     def commit_slip(self, U, slip) -> tuple[np.ndarray, float]:
         """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] from the committed ``slip (E, 2)``
         [1/m]: the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
         <rftstatic.element.hysteresis.BendingFriction.commit>`, H4)."""
-        return self.bending_friction.commit(self.bending_displacement(U), self.positions(U), slip)
+        return self.axis_terms.commit(self.bending_displacement(U), self.positions(U), slip)
 
     def load_branches(self, U, previous=None) -> tuple:
         """The branch of each potential load at the converged ``U (N, 3)`` [m], continuous from ``previous``
@@ -292,10 +282,8 @@ class Model(Frozen):
         """Internal (bending + membrane + contact + self-contact) force ``(N, 3)`` [N], the gradient of
         the stored energy (with the bending friction at the committed ``slip``, :meth:`energies`)."""
         f = self.Kb @ self.bending_displacement(U)
-        if self.bending_friction is not None:
-            f += scatter_forces(self.patches.nodes, self._friction(U, slip)[1], self.mesh.n_nodes)
-        if self.bending_softening is not None:
-            f += scatter_forces(self.patches.nodes, self._softening(U)[1], self.mesh.n_nodes)
+        if self.axis_terms is not None:
+            self.axis_terms.add_forces(self.bending_displacement(U), self.positions(U), f, slip)
         if self.hinges is not None:
             f += self.hinges.force(self.positions(U))
         if self.with_membrane:
@@ -331,14 +319,9 @@ class Model(Frozen):
         data = self._bending_data.copy()
         f = self.Kb @ self.bending_displacement(U)
         x = self.positions(U)
-        if self.bending_friction is not None:
-            _, fe, ke = self._friction(U, slip, tangent=True, psd=psd)
+        if self.axis_terms is not None:  # bending friction and softening
+            fe = self.axis_terms.add_tangents(self.bending_displacement(U), x, self._patch_map, data, slip, psd=psd)
             f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
-            data += scatter_matrices(self._patch_map, ke, plan.nnz)
-        if self.bending_softening is not None:
-            _, fe, ke = self._softening(U, tangent=True, psd=psd)
-            f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
-            data += scatter_matrices(self._patch_map, ke, plan.nnz)
         if self.hinges is not None:
             fh, (rows, cols, blocks) = self.hinges.force_tangent_blocks(x, psd=psd)
             f += fh
