@@ -86,6 +86,10 @@ class ForceKernel:
         # (rftstatic.element.hysteresis) and softening (rftstatic.element.nonlinear_bending), one scatter for both
         self.bending_friction = getattr(model, "bending_friction", None)
         self.bending_softening = getattr(model, "bending_softening", None)
+        # the shear friction (rftstatic.element.shear_friction, numpy) on the membrane's elements
+        self.shear_friction = getattr(model, "shear_friction", None)
+        if self.shear_friction is not None:
+            self._membrane_dofs = (3 * self.nodes[..., None] + np.arange(3)).ravel()
         if self.bending_friction is not None or self.bending_softening is not None:
             self._patch_dofs = (3 * model.patches.nodes[..., None] + np.arange(3)).ravel()
         if backend == "numpy":
@@ -118,7 +122,8 @@ class ForceKernel:
         the potential of the model's potential loads (``model.load_terms``) at load factor 1;
         ``candidates`` is the solve's contact candidate list (a cache; None: every node), ``pairs`` its
         self-contact pair cache (``State.self_pairs``; None: a fresh broad phase), ``slip`` the committed
-        slip of the bending friction (``State.bending_slip``, :mod:`rftstatic.element.hysteresis`; numpy).
+        slips of the frictions (``State.bending_slip``: :mod:`rftstatic.element.hysteresis` and
+        :mod:`rftstatic.element.shear_friction`, :meth:`Model.split_slip`; numpy).
         """
         U = np.ascontiguousarray(U, dtype=float)
         if self.backend == "numba":
@@ -152,13 +157,16 @@ class ForceKernel:
             Ub, x = (U if self._bend_offset is None else self.X3 + U), self.X3 + U
             terms = []
             if self.bending_friction is not None:
-                held = self.bending_friction.initial_slip() if slip is None else slip
-                terms.append(self.bending_friction.evaluate(Ub, x, held))
+                terms.append(self.bending_friction.evaluate(Ub, x, self.model.split_slip(slip)[0]))
             if self.bending_softening is not None:
                 terms.append(self.bending_softening.evaluate(Ub, x))
             for Wt, fe, _ in terms:
                 f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
                 W += Wt if energy else 0.0
+        if self.shear_friction is not None:
+            Ws, fe, _ = self.shear_friction.evaluate(U, self.model.split_slip(slip)[1])
+            f += np.bincount(self._membrane_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
+            W += Ws if energy else 0.0
         if self.hinges is not None:
             Wh, fh = self.hinges.energy_force(self.X3 + U)
             f += fh

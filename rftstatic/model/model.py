@@ -13,7 +13,12 @@ E_b holds the hinges of the mesh's creases (``mesh.folds``, attribute ``hinges``
 hysteresis (``material.hysteresis``, attribute ``friction``: :class:`rftstatic.element.hysteresis.BendingFriction`)
 E_b also holds the friction's incremental potential at the committed slip (``State.bending_slip``, keyword ``slip``);
 with nonlinear bending (``material.nonlinear_bending``, attribute ``bending_softening``:
-:class:`rftstatic.element.nonlinear_bending.BendingSoftening`) E_b also holds its softening correction,
+:class:`rftstatic.element.nonlinear_bending.BendingSoftening`) E_b also holds its softening correction;
+with shear hysteresis (``material.shear_hysteresis``, attribute ``shear_friction``:
+:class:`rftstatic.element.shear_friction.ShearFriction`) E_m also holds the shear friction's incremental potential
+at its committed slip. Both frictions' slips travel as one array (keyword ``slip``, ``State.bending_slip``,
+:meth:`Model.initial_slip`): columns 0-1 the bending friction's (warp, weft) when there is one, the last the
+shear friction's when there is one,
 
 its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
 A Model is read-only once built (:class:`~rftstatic.model.frozen.Frozen`): what a solve advances or
@@ -36,6 +41,7 @@ from rftstatic.element.hysteresis import bending_friction
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.nonlinear_bending import nonlinear_bending
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
+from rftstatic.element.shear_friction import shear_friction
 from rftstatic.material import Material
 from rftstatic.mesh.trimesh import TriMesh
 from rftstatic.model.assembly import AssemblyPlan, scatter_forces, scatter_matrices
@@ -171,6 +177,10 @@ class Model(Frozen):
         self.bending_softening = (None if nb is None or nb.k2_warp == nb.k2_weft == 0.0 else nonlinear_bending(
             self.patches, mesh.area, material.Db, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
             k2=(nb.k2_warp, nb.k2_weft), floor=nb.floor))
+        sh = material.shear_hysteresis
+        self.shear_friction = (None if sh is None or sh.tau0 == 0.0 or not self.with_membrane else shear_friction(
+            self.membrane, material.Dm, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
+            tau0=sh.tau0, ratio=sh.ratio))
         warnings = []
         if element == "RFT6" and self.with_membrane:
             lock = locking_number(mesh, material)
@@ -247,6 +257,8 @@ class Model(Frozen):
         if self.hinges is not None:
             Eb += self.hinges.energy(self.positions(U))
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
+        if self.shear_friction is not None:
+            Em += self._shear(U, slip)[0]
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
         Es = (self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).energy
               if self.self_contact is not None else 0.0)
@@ -262,9 +274,33 @@ class Model(Frozen):
         """Total potential energy Pi(U) [J]."""
         return self.energies(U, lam, candidates=candidates, pairs=pairs, branches=branches, slip=slip)["total"]
 
+    @property
+    def has_friction(self) -> bool:
+        """Whether the model has a friction term with a slip history (bending or shear hysteresis): its drape
+        depends on the route."""
+        return self.bending_friction is not None or self.shear_friction is not None
+
+    def initial_slip(self) -> np.ndarray | None:
+        """The virgin slips of the friction terms, ``(E, k)``: the bending friction's two columns [1/m] (when there
+        is one), then the shear friction's one [-] (when there is one); None without either."""
+        parts = [t.initial_slip() for t in (self.bending_friction, self.shear_friction) if t is not None]
+        return np.concatenate(parts, axis=1) if parts else None
+
+    def split_slip(self, slip) -> tuple:
+        """``(bending (E, 2) or None, shear (E, 1) or None)``: the two frictions' columns of the slip array of
+        :meth:`initial_slip` (None: the virgin state)."""
+        slip = self.initial_slip() if slip is None else slip
+        nb = 2 if self.bending_friction is not None else 0
+        return (slip[:, :nb] if nb else None), (slip[:, nb:] if self.shear_friction is not None else None)
+
+    def _shear(self, U, slip, tangent=False, psd=False):
+        """The shear friction's energy [J], element forces (E, A, 3) [N] and tangents (E, A, 3, A, 3) [N/m]
+        (:mod:`rftstatic.element.shear_friction`)."""
+        return self.shear_friction.evaluate(U, self.split_slip(slip)[1], tangent=tangent, psd=psd)
+
     def _friction(self, U, slip, tangent=False, psd=False):
         """The bending friction's energy [J], element forces (E, 6, 3) [N] and tangents (E, 6, 3, 6, 3) [N/m]."""
-        slip = self.bending_friction.initial_slip() if slip is None else slip
+        slip = self.split_slip(slip)[0]
         return self.bending_friction.evaluate(self.bending_displacement(U), self.positions(U), slip, tangent=tangent,
                                               psd=psd)
 
@@ -275,10 +311,21 @@ class Model(Frozen):
                                                psd=psd)
 
     def commit_slip(self, U, slip) -> tuple[np.ndarray, float]:
-        """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] from the committed ``slip (E, 2)``
-        [1/m]: the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
-        <rftstatic.element.hysteresis.BendingFriction.commit>`, H4)."""
-        return self.bending_friction.commit(self.bending_displacement(U), self.positions(U), slip)
+        """Return mapping of the frictions at a converged ``U (N, 3)`` [m] from the committed ``slip (E, k)``
+        (:meth:`initial_slip`): the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
+        <rftstatic.element.hysteresis.BendingFriction.commit>`, H4; :meth:`ShearFriction.commit
+        <rftstatic.element.shear_friction.ShearFriction.commit>`, S6)."""
+        bend, shear = self.split_slip(slip)
+        parts, dissipated = [], 0.0
+        if bend is not None:
+            new, d = self.bending_friction.commit(self.bending_displacement(U), self.positions(U), bend)
+            parts.append(new)
+            dissipated += d
+        if shear is not None:
+            new, d = self.shear_friction.commit(U, shear)
+            parts.append(new)
+            dissipated += d
+        return np.concatenate(parts, axis=1), dissipated
 
     def load_branches(self, U, previous=None) -> tuple:
         """The branch of each potential load at the converged ``U (N, 3)`` [m], continuous from ``previous``
@@ -300,6 +347,8 @@ class Model(Frozen):
             f += self.hinges.force(self.positions(U))
         if self.with_membrane:
             fe = self.membrane.element_forces(U, self.material.Dm, backend=self.membrane_backend)
+            if self.shear_friction is not None:
+                fe = fe + self._shear(U, slip)[1]
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             f += self.contact.force(self.positions(U), candidates=candidates)
@@ -346,6 +395,10 @@ class Model(Frozen):
         if self.with_membrane:
             fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress,
                                              backend=self.membrane_backend)
+            if self.shear_friction is not None:
+                _, fs, ks = self._shear(U, slip, tangent=True, psd=psd)
+                fe = fe + fs
+                data += scatter_matrices(self._membrane_map, ks, plan.nnz)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             cs = self.contact.evaluate(x, candidates=candidates)
