@@ -161,3 +161,14 @@ def test_kes_shear_loop_has_width_2hg_and_slips_commit_with_the_bending_friction
         U[:, 0] = np.tan(g) * X[:, 1]
         st.commit_slip(mod, U)
     assert st.dissipated - d0 == pytest.approx(expect_per_cycle, rel=2e-2)
+
+
+def test_the_stable_step_bound_counts_the_stick_stiffness():
+    """The guaranteed bound of omega_max (rftstatic.solvers.timestep.element_bound) sees the sticking friction: a
+    stick stiffness far above the membrane's (ratio 1e4 x G) raises it, the default barely."""
+    from rftstatic.solvers.timestep import element_bound
+
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    elastic = model.Model(m, replace(_material(), shear_hysteresis=None), element="RFT6")
+    stiff = model.Model(m, _material(ratio=1e4), element="RFT6")
+    assert element_bound(stiff) > 2.0 * element_bound(elastic)
