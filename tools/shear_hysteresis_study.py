@@ -5,7 +5,8 @@ The four fabrics of Matsudaira et al. (2015) as a third party transcribed them
 B per fabric, so B_warp = B_weft; no G and no 2HG) are given to ``cusick-30`` by their KES values alone (every other
 quantity, the shear rigidity G among them, filled by the stated rules: ``python -m rftstatic fabrics --explain``),
 seed 1, on the scene's own route (relaxation, then Newton), without and with an assumed 2HG (:data:`HG2`: the
-transcription has none). Then one fabric (:data:`COMBINED`) with its transcribed 2HB alone and with 2HB and 2HG
+transcription has none), and on the load steps (``solver.start = "load-steps"``) without and with the smaller 2HG.
+Then one fabric (:data:`COMBINED`) with its transcribed 2HB alone and with 2HB and 2HG
 together, and with the stick ratio of the shear friction raised (a modelling choice). Each run is one process
 (:func:`tools.matsudaira_study.run_case`, kept in ``--out``: a finished run is read, not solved again). Prints a
 Markdown table.
@@ -34,6 +35,10 @@ COMBINED = "B"
 RULE_G = 578.1
 """The filled shear rigidity's ratio r_G [cm^-2] (rftstatic.fabrics.rules: C_shear = r_G sqrt(B_warp B_weft) [gf/cm per
 rad]), to print G [gf/(cm deg)] next to each fabric; the run's summary gives the value used."""
+
+
+LOAD_STEPS = ["solver.start=load-steps"]
+"""Route keys of the load-steps rows."""
 
 
 def _keys(f, hg=None, hb=False, ratio=None):
@@ -75,17 +80,20 @@ def main(argv=None):
                 "nodes": int(r["nodes_pub"])} for r in secondary_table()]
     runs = []
     for f in fabrics:
-        runs.append((f, "no hysteresis", _keys(f), "none"))
-        runs += [(f, f"2HG {hg:g}", _keys(f, hg), f"hg{hg:g}") for hg in HG2]
+        runs.append((f, "no hysteresis", _keys(f), "none", []))
+        runs += [(f, f"2HG {hg:g}", _keys(f, hg), f"hg{hg:g}", []) for hg in HG2]
     f = next(f for f in fabrics if f["id"] == COMBINED)
-    runs += [(f, f"2HB {f['2HB']:g}", _keys(f, hb=True), "hb"),
-             (f, f"2HB {f['2HB']:g} + 2HG {HG2[0]:g}", _keys(f, HG2[0], hb=True), f"hb-hg{HG2[0]:g}"),
-             (f, f"2HG {HG2[0]:g}, stick ratio 100", _keys(f, HG2[0], ratio=100.0), f"hg{HG2[0]:g}-r100")]
+    runs += [(f, f"2HB {f['2HB']:g}", _keys(f, hb=True), "hb", []),
+             (f, f"2HB {f['2HB']:g} + 2HG {HG2[0]:g}", _keys(f, HG2[0], hb=True), f"hb-hg{HG2[0]:g}", []),
+             (f, f"2HG {HG2[0]:g}, stick ratio 100", _keys(f, HG2[0], ratio=100.0), f"hg{HG2[0]:g}-r100", [])]
+    for f in fabrics:
+        runs += [(f, "load steps, no hysteresis", _keys(f), "ls-none", LOAD_STEPS),
+                 (f, f"load steps, 2HG {HG2[0]:g}", _keys(f, HG2[0]), f"ls-hg{HG2[0]:g}", LOAD_STEPS)]
     lines = ["| fabric | measured DC [%], nodes | G filled [gf/(cm deg)] | variant | DC [%] | nodes | energy [gf cm] | "
              "dissipated [gf cm] | shear slipping share | max shear [deg] | stable | crossing pairs | wall [s] |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for f, label, keys, tag in runs:
-        s = run_case(["material={" + ", ".join(keys) + "}", "solver.seed=1"], root / f"{f['id']}-{tag}",
+    for f, label, keys, tag, route in runs:
+        s = run_case(["material={" + ", ".join(keys) + "}", "solver.seed=1", *route], root / f"{f['id']}-{tag}",
                      f"{f['id']} {label}")
         if s is None:
             continue

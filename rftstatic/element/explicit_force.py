@@ -88,8 +88,6 @@ class ForceKernel:
         self.bending_softening = getattr(model, "bending_softening", None)
         # the shear friction (rftstatic.element.shear_friction, numpy) on the membrane's elements
         self.shear_friction = getattr(model, "shear_friction", None)
-        if self.shear_friction is not None:
-            self._membrane_dofs = (3 * self.nodes[..., None] + np.arange(3)).ravel()
         if self.bending_friction is not None or self.bending_softening is not None:
             self._patch_dofs = (3 * model.patches.nodes[..., None] + np.arange(3)).ravel()
         if backend == "numpy":
@@ -164,8 +162,8 @@ class ForceKernel:
                 f += np.bincount(self._patch_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
                 W += Wt if energy else 0.0
         if self.shear_friction is not None:
-            Ws, fe, _ = self.shear_friction.evaluate(U, self.model.split_slip(slip)[1])
-            f += np.bincount(self._membrane_dofs, fe.ravel(), minlength=f.size).reshape(f.shape)
+            Ws, fs = self.shear_friction.nodal_force(U, self.model.split_slip(slip)[1])
+            f += fs
             W += Ws if energy else 0.0
         if self.hinges is not None:
             Wh, fh = self.hinges.energy_force(self.X3 + U)

@@ -50,12 +50,14 @@ angle (real fabrics have 2HG5 > 2HG: the friction grows with the shear; not mode
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+import scipy.sparse as sp
 
 from rftstatic.element.hysteresis import huber
-from rftstatic.element.kernels import positive_part
-from rftstatic.element.kernels_numpy import strain_operator, strains_numpy
+from rftstatic.element.kernels import averaged_strain, positive_part
+from rftstatic.element.kernels_numpy import strain_operator
 
 __all__ = ["ShearFriction", "shear_friction"]
 
@@ -72,6 +74,7 @@ class ShearFriction:
     t : (3,) the warp/weft shear row of the Voigt strain rotation (gamma = t . eps, S2)
     tau0 : yield shear force per width [N/m] (= 2HG / 2, S1)
     K : stick stiffness per width [N/m] (ratio x G_12)
+    n_nodes : N, the mesh's node count
     offset : (A, 3, E) reference offsets of a sewn mesh (the membrane's ``offset_last``), or None
     """
 
@@ -81,6 +84,7 @@ class ShearFriction:
     t: np.ndarray
     tau0: float
     K: float
+    n_nodes: int
     offset: np.ndarray | None = None
 
     @property
@@ -94,9 +98,43 @@ class ShearFriction:
     def _law(self, e):
         return huber(e, np.array([self.K]), np.array([self.tau0]))
 
+    @cached_property
+    def _gradient(self):
+        """The displacement gradients as one sparse product: ``Gs (Q 2 E, N)`` [1/m] with ``H[q, J, i, e] = (Gs
+        U[:, i])[(q, J, e)] + H0[q, J, i, e]``, ``H0 (Q, 2, 3, E)`` the reference offsets' part of a sewn mesh (zero
+        without), the same sum as :func:`rftstatic.element.kernels_numpy.strains_numpy` (Eq. 24-25)."""
+        Q, A, _, E = self.G_last.shape
+        rows = (np.arange(Q)[:, None, None, None] * 2 + np.arange(2)[None, None, :, None]) * E + np.arange(E)
+        cols = np.asarray(self.nodes).T[None, :, None, :]
+        shape = (Q, A, 2, E)
+        ij = (np.broadcast_to(rows, shape).ravel(), np.broadcast_to(cols, shape).ravel())
+        Gs = sp.csr_matrix((self.G_last.ravel(), ij), shape=(Q * 2 * E, self.n_nodes))
+        H0 = 0.0 if self.offset is None else np.einsum("qaJe,aie->qJie", self.G_last, self.offset)
+        return Gs, H0
+
     def _strain(self, U):
         """``eps (E, 3)`` [-] and ``H (Q, 2, 3, E)`` [-] at ``U (N, 3)`` [m]."""
-        return strains_numpy(self.G_last, self.nodes, np.ascontiguousarray(U, dtype=float), self.offset)
+        Gs, H0 = self._gradient
+        Q, _, _, E = self.G_last.shape
+        H = (Gs @ np.asarray(U, float)).reshape(Q, 2, E, 3).transpose(0, 1, 3, 2) + H0
+        return np.stack(averaged_strain(H, ...), axis=-1), H
+
+    def nodal_force(self, U, slip) -> tuple[float, np.ndarray]:
+        """Friction energy [J] and nodal forces ``(N, 3)`` [N] at ``U (N, 3)`` [m] with the committed ``slip (E, 1)``:
+        :meth:`evaluate`'s forces (S4) summed into the nodes, as ``f_a = A/Q sum_q g_qa . (S_f F_q)`` through the
+        sparse gradient (no element array; the explicit force's path, :mod:`rftstatic.element.explicit_force`)."""
+        eps, H = self._strain(U)
+        psi, tau, _ = self._law((eps @ self.t)[:, None] - slip)
+        Q = H.shape[0]
+        w = self.area * tau[:, 0] / Q
+        sxx, syy, sxy = w * self.t[0], w * self.t[1], w * self.t[2]
+        F = H.copy()  # F[q, J, i, e]
+        F[:, 0, 0] += 1.0
+        F[:, 1, 1] += 1.0
+        P = np.stack([sxx * F[:, 0] + sxy * F[:, 1], sxy * F[:, 0] + syy * F[:, 1]], axis=1)  # (Q, 2, 3, E)
+        Gs, _ = self._gradient
+        f = Gs.T @ P.transpose(0, 1, 3, 2).reshape(-1, 3)
+        return float(self.area @ psi[:, 0]), f
 
     def shear_angle(self, U) -> np.ndarray:
         """``gamma (E, 1)`` [-], the warp-weft engineering Green shear strain of every element (S2)."""
@@ -143,11 +181,11 @@ class ShearFriction:
         return self._law(self.shear_angle(U) - slip)[1]
 
 
-def shear_friction(membrane, Dm, *, warp_angle, tau0, ratio) -> ShearFriction:
+def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio) -> ShearFriction:
     """The :class:`ShearFriction` of a membrane operator ``membrane``
-    (:class:`rftstatic.element.membrane.MembraneOperator`) for a fabric of membrane matrix ``Dm (3, 3)`` in global
-    axes [N/m] whose warp lies at ``warp_angle`` [rad] from X: yield force per width ``tau0`` [N/m] (2HG / 2) and
-    stick stiffness ``ratio * G_12`` (G_12 the material-axes shear rigidity)."""
+    (:class:`rftstatic.element.membrane.MembraneOperator`) of a mesh of ``n_nodes`` nodes for a fabric of membrane
+    matrix ``Dm (3, 3)`` in global axes [N/m] whose warp lies at ``warp_angle`` [rad] from X: yield force per width
+    ``tau0`` [N/m] (2HG / 2) and stick stiffness ``ratio * G_12`` (G_12 the material-axes shear rigidity)."""
     from rftstatic.material import voigt_rotation
 
     T = voigt_rotation(warp_angle)
@@ -157,4 +195,4 @@ def shear_friction(membrane, Dm, *, warp_angle, tau0, ratio) -> ShearFriction:
         raise ValueError(f"shear friction needs tau0 >= 0, ratio > 0 and a shear rigidity G_12 > 0, got tau0 = "
                          f"{tau0!r}, ratio = {ratio!r}, G_12 = {G12!r} N/m")
     return ShearFriction(np.asarray(membrane.nodes), membrane.G_last, np.asarray(membrane.area, float),
-                         T[2].copy(), float(tau0), float(ratio) * G12, membrane.offset_last)
+                         T[2].copy(), float(tau0), float(ratio) * G12, int(n_nodes), membrane.offset_last)

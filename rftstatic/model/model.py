@@ -179,7 +179,7 @@ class Model(Frozen):
             k2=(nb.k2_warp, nb.k2_weft), floor=nb.floor))
         sh = material.shear_hysteresis
         self.shear_friction = (None if sh is None or sh.tau0 == 0.0 or not self.with_membrane else shear_friction(
-            self.membrane, material.Dm, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
+            self.membrane, material.Dm, n_nodes=mesh.n_nodes, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
             tau0=sh.tau0, ratio=sh.ratio))
         warnings = []
         if element == "RFT6" and self.with_membrane:

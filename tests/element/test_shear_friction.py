@@ -172,3 +172,21 @@ def test_the_stable_step_bound_counts_the_stick_stiffness():
     elastic = model.Model(m, replace(_material(), shear_hysteresis=None), element="RFT6")
     stiff = model.Model(m, _material(ratio=1e4), element="RFT6")
     assert element_bound(stiff) > 2.0 * element_bound(elastic)
+
+
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+def test_nodal_force_is_the_element_forces_summed(element):
+    """The explicit path's sparse-gradient force (ShearFriction.nodal_force) against the element forces (S4)."""
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    mod = model.Model(m, _material(), element=element)
+    fr = mod.shear_friction
+    rng = np.random.default_rng(9)
+    U = _sheared(mod, rng)
+    slip = _mixed_slip(mod, U, rng)
+    e, fe, _ = fr.evaluate(U, slip)
+    W, f = fr.nodal_force(U, slip)
+    ref = np.zeros_like(U)
+    np.add.at(ref, fr.nodes, fe)
+    np.testing.assert_allclose(f, ref, atol=1e-12 * np.abs(ref).max())
+    assert W == pytest.approx(e, rel=1e-12)
+    np.testing.assert_allclose(fr.shear_angle(U)[:, 0], mod.membrane_strain(U) @ fr.t, atol=1e-15)  # the membrane's eps
