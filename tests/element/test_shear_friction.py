@@ -190,3 +190,15 @@ def test_nodal_force_is_the_element_forces_summed(element):
     np.testing.assert_allclose(f, ref, atol=1e-12 * np.abs(ref).max())
     assert W == pytest.approx(e, rel=1e-12)
     np.testing.assert_allclose(fr.shear_angle(U)[:, 0], mod.membrane_strain(U) @ fr.t, atol=1e-15)  # the membrane's eps
+
+
+
+def test_newton_takes_the_displacement_iteration_with_shear_hysteresis():
+    """MIP Newton cycles across the friction's kink (rftstatic.solvers.newton.mixed_scheme): a model with shear
+    hysteresis runs the displacement iteration whatever ``solver.iteration`` says; one without keeps the mixed."""
+    from rftstatic.solvers.newton import mixed_scheme
+
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    assert not mixed_scheme(model.Model(m, _material()), "mixed")
+    assert mixed_scheme(model.Model(m, replace(_material(), shear_hysteresis=None)), "mixed")
+    assert not mixed_scheme(model.Model(m, replace(_material(), shear_hysteresis=None)), "displacement")
