@@ -65,6 +65,31 @@ class BendingHysteresis:
         return {"M0_warp_N": self.M0_warp, "M0_weft_N": self.M0_weft, "stick_ratio": self.ratio}
 
 
+@dataclass(frozen=True)
+class ShearHysteresis:
+    """Shear hysteresis of a fabric: a friction shear force per unit width in parallel with its shear rigidity
+    (:mod:`rftstatic.element.shear_friction`, the KES-FB1 shear loop).
+
+    Attributes
+    ----------
+    tau0 : yield (friction) shear force per unit width [N/m]: half the KES loop width at 0.5 deg, ``2HG / 2``
+    ratio : stick stiffness over the shear rigidity G_12 of D^m (material axes) [-]; after a reversal the friction
+        element sticks over a shear-angle change ``2 tau0 / (ratio G_12)`` before it slips
+    """
+
+    tau0: float
+    ratio: float = 10.0
+
+    def __post_init__(self):
+        if isinstance(self.tau0, bool) or not (np.isfinite(self.tau0) and self.tau0 >= 0):
+            raise ValueError(f"shear hysteresis tau0 must be a finite number >= 0 [N/m], got {self.tau0!r}")
+        if not (np.isfinite(self.ratio) and self.ratio > 0):
+            raise ValueError(f"shear hysteresis ratio must be a finite number > 0, got {self.ratio!r}")
+
+    def as_dict(self) -> dict:
+        return {"tau0_N_per_m": self.tau0, "stick_ratio": self.ratio}
+
+
 NONLINEAR_FLOOR = 0.2
 """Default floor of the bending slope under nonlinear bending, a fraction of B [-] (why 0.2:
 :mod:`rftstatic.element.nonlinear_bending`)."""
@@ -111,6 +136,7 @@ class Material:
     name : label for summaries
     hysteresis : bending hysteresis (:class:`BendingHysteresis`), or None (elastic bending)
     nonlinear_bending : softening bending (:class:`NonlinearBending`), or None (linear bending)
+    shear_hysteresis : shear hysteresis (:class:`ShearHysteresis`), or None (elastic shear)
     """
 
     Dm: np.ndarray
@@ -120,6 +146,7 @@ class Material:
     info: dict = field(default_factory=dict)
     hysteresis: BendingHysteresis | None = None
     nonlinear_bending: NonlinearBending | None = None
+    shear_hysteresis: ShearHysteresis | None = None
 
     def __post_init__(self):
         for key in ("Dm", "Db"):
@@ -168,6 +195,7 @@ class Material:
             "weight_N_per_m2": self.weight,
             **({"bending_hysteresis": self.hysteresis.as_dict()} if self.hysteresis is not None else {}),
             **({"nonlinear_bending": self.nonlinear_bending.as_dict()} if self.nonlinear_bending is not None else {}),
+            **({"shear_hysteresis": self.shear_hysteresis.as_dict()} if self.shear_hysteresis is not None else {}),
             **self.info,
         }
 

@@ -61,10 +61,10 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     opts = static_options(scene, progress=progress)
     seeds = seed_count(scene)
     other = compare_start(scene)
-    if other is not None and model.bending_friction is not None:
-        raise scene.error("solver.compare", f"{other!r}: a drape with bending hysteresis depends on its route (the "
-                          "friction's history), so two routes' energies do not tell which drape a specimen keeps; "
-                          "remove solver.compare or the kes_2HB keys")
+    if other is not None and model.has_friction:
+        raise scene.error("solver.compare", f"{other!r}: a drape with bending or shear hysteresis depends on its route "
+                          "(the friction's history), so two routes' energies do not tell which drape a specimen keeps; "
+                          "remove solver.compare or the kes_2HB / kes_2HG keys")
     path = out / CHECKPOINT
     remove_stale(path)
     resumed = None
@@ -99,6 +99,8 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
         summary["starts"] = starts
     if model.bending_friction is not None and state is not None:  # bending hysteresis: what the route dissipated
         summary["bending_hysteresis"] = hysteresis_summary(scene, model, state, result.U)
+    if model.shear_friction is not None and state is not None:
+        summary["shear_hysteresis"] = shear_hysteresis_summary(scene, model, state, result.U)
     if model.bending_softening is not None:  # nonlinear bending: how far the drape went along its law
         summary["nonlinear_bending"] = softening_summary(scene, model, result.U)
     if seeds > 1 and error is None and isinstance(summary.get("drape"), dict):
@@ -127,13 +129,25 @@ def _measures(scene, model, extras):
 
 
 def hysteresis_summary(scene, model, state, U) -> dict:
-    """The bending friction at the end of a solve (scene units): energy dissipated along the route, and the
+    """The bending friction at the end of a solve (scene units): energy dissipated along the route (with shear
+    hysteresis too: by both frictions), and the
     share of element-directions (warp, weft) whose friction moment is at its yield M0 (slipping) [-]."""
     fr = model.bending_friction
-    moment = fr.moment(U, model.positions(U), state.bending_slip)
+    moment = fr.moment(U, model.positions(U), model.split_slip(state.bending_slip)[0])
     at_yield = np.abs(moment) >= fr.M0 * (1 - 1e-9)
     return {"dissipated": scene.units.from_si(state.dissipated, "energy"),
             "yielded_share_warp": float(at_yield[:, 0].mean()), "yielded_share_weft": float(at_yield[:, 1].mean())}
+
+
+def shear_hysteresis_summary(scene, model, state, U) -> dict:
+    """The shear friction at the end of a solve (:mod:`rftstatic.element.shear_friction`, scene units): energy
+    dissipated along the route by both frictions (one total), the share of elements whose friction shear force is at
+    its yield tau0 (slipping) and the largest shear angle [deg]."""
+    fr = model.shear_friction
+    tau = fr.force(U, model.split_slip(state.bending_slip)[1])
+    return {"dissipated_both_frictions": scene.units.from_si(state.dissipated, "energy"),
+            "yielded_share": float((np.abs(tau) >= fr.tau0 * (1 - 1e-9)).mean()),
+            "max_shear_angle_deg": float(np.degrees(np.abs(fr.shear_angle(U)).max()))}
 
 
 def softening_summary(scene, model, U) -> dict:

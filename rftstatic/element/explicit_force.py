@@ -88,6 +88,8 @@ class ForceKernel:
         # compiled on the numba back end (rftstatic.element.axis_terms)
         self.axis_terms = axis_terms(getattr(model, "bending_friction", None), getattr(model, "bending_softening", None),
                                      backend=backend)
+        # the shear friction (rftstatic.element.shear_friction, numpy) on the membrane's elements
+        self.shear_friction = getattr(model, "shear_friction", None)
         if backend == "numpy":
             self._G_last = element_last(self.G)
             self._dofs = (3 * self.nodes.T[:, None, :] + np.arange(3)[:, None]).ravel()  # scatter of fe (A, 3, E)
@@ -118,7 +120,8 @@ class ForceKernel:
         the potential of the model's potential loads (``model.load_terms``) at load factor 1;
         ``candidates`` is the solve's contact candidate list (a cache; None: every node), ``pairs`` its
         self-contact pair cache (``State.self_pairs``; None: a fresh broad phase), ``slip`` the committed
-        slip of the bending friction (``State.bending_slip``, :mod:`rftstatic.element.hysteresis`).
+        slips of the frictions (``State.bending_slip``: :mod:`rftstatic.element.hysteresis` and
+        :mod:`rftstatic.element.shear_friction`, :meth:`Model.split_slip`).
         """
         U = np.ascontiguousarray(U, dtype=float)
         if self.backend == "numba":
@@ -149,8 +152,13 @@ class ForceKernel:
             f += self._bend_offset
             W += float(np.einsum("ni,ni->", U, self._bend_offset)) + self._bend_energy if energy else 0.0
         if self.axis_terms is not None:
-            Wt = self.axis_terms.add_forces(U if self._bend_offset is None else self.X3 + U, self.X3 + U, f, slip)
+            Wt = self.axis_terms.add_forces(U if self._bend_offset is None else self.X3 + U, self.X3 + U, f,
+                                              self.model.split_slip(slip)[0])
             W += Wt if energy else 0.0
+        if self.shear_friction is not None:
+            Ws, fs = self.shear_friction.nodal_force(U, self.model.split_slip(slip)[1])
+            f += fs
+            W += Ws if energy else 0.0
         if self.hinges is not None:
             Wh, fh = self.hinges.energy_force(self.X3 + U)
             f += fh

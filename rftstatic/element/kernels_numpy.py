@@ -63,6 +63,23 @@ def forces_numpy(G_last, nodes, area, Dm, U, D=None):
     return fe, strain_energy(area, *S)
 
 
+def strain_operator(G_last, H):
+    """``Bbar (E, 3, A, 3)`` [1/m]: the derivative of the averaged Green strain (e_xx, e_yy, 2 e_xy) of Eq. 14 with
+    respect to the nodal displacements ``u_a,i``, the mean over the Q strain points of
+    ``dE_q = sym(F_q^T dF_q)`` with ``F_q = I + H_q``, for gradients ``G_last (Q, A, 2, E)`` [1/m] and ``H (Q, 2, 3,
+    E)`` [-] (:func:`strains_numpy`); element axis first."""
+    Q, A, _, E = G_last.shape
+    F = H.copy()  # F[q, J, i] = dx_i / dX_J = delta_iJ + H[q, J, i]
+    F[:, 0, 0] += 1.0
+    F[:, 1, 1] += 1.0
+    gx, gy = G_last[:, :, 0], G_last[:, :, 1]  # (Q, A, E)
+    B = np.empty((E, 3, A, 3))  # Bbar[k, a, i] (the mean over the strain points), element axis first
+    B[:, 0] = np.einsum("qie,qae->eai", F[:, 0], gx) / Q
+    B[:, 1] = np.einsum("qie,qae->eai", F[:, 1], gy) / Q
+    B[:, 2] = (np.einsum("qie,qae->eai", F[:, 0], gy) + np.einsum("qie,qae->eai", F[:, 1], gx)) / Q
+    return B
+
+
 def tangents_numpy(G_last, nodes, area, Dm, U, psd, S=None, D=None):
     """Element forces ``(E, A, 3)`` [N] and tangents ``(E, A, 3, A, 3)`` [N/m] (:func:`membrane_tangents`;
     ``S (E, 3)`` or None as there). The forces come from the kernel :func:`element_force` (through an
@@ -81,15 +98,8 @@ def tangents_numpy(G_last, nodes, area, Dm, U, psd, S=None, D=None):
         sxx, syy, sxy = S[:, 0], S[:, 1], S[:, 2]
     if psd:
         sxx, syy, sxy = positive_part(sxx, syy, sxy)
-    F = H.copy()  # F[q, J, i] = dx_i / dX_J = delta_iJ + H[q, J, i]
-    F[:, 0, 0] += 1.0
-    F[:, 1, 1] += 1.0
     gx, gy = G_last[:, :, 0], G_last[:, :, 1]  # (Q, A, E)
-    B = np.empty((E, 3, A, 3))  # Bbar[k, a, i] (the mean over the strain points), element axis first
-    B[:, 0] = np.einsum("qie,qae->eai", F[:, 0], gx) / Q
-    B[:, 1] = np.einsum("qie,qae->eai", F[:, 1], gy) / Q
-    B[:, 2] = (np.einsum("qie,qae->eai", F[:, 0], gy) + np.einsum("qie,qae->eai", F[:, 1], gx)) / Q
-    Bm = B.reshape(E, 3, 3 * A)
+    Bm = strain_operator(G_last, H).reshape(E, 3, 3 * A)
     DB = np.matmul(np.asarray(Dm, float)[None] * area[:, None, None], Bm)  # A D^m Bbar (E, 3, 3A)
     ke = np.matmul(Bm.transpose(0, 2, 1), DB).reshape(E, A, 3, A, 3)
     w = area / Q  # geometric part: (A/Q) sum_q g_qa . S g_qb, times the identity in space

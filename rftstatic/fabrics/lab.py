@@ -21,6 +21,13 @@ kes_T              mm                  thickness (self-contact default): T / 10 
 kes_2HB_warp/weft  gf cm/cm            bending hysteresis: the friction moment per width M0 = 2HB / 2 [gf cm/cm = gf]
                                        of :mod:`rftstatic.element.hysteresis` (the KES-FB2 loop's width is 2HB);
                                        the stick stiffness is ``hysteresis_ratio`` (default 10) times B
+kes_2HG            gf/cm               shear hysteresis: the friction shear force per width tau0 = 2HG / 2
+                                       [gf/cm] of :mod:`rftstatic.element.shear_friction` (the KES-FB1 loop's
+                                       width at +-0.5 deg); stick stiffness ``shear_hysteresis_ratio``
+                                       (default 10) times the shear rigidity G (given, or filled by its rule)
+kes_2HG5           gf/cm               the loop's width at +-5 deg: range-checked and recorded in the summary
+                                       only (the model's Coulomb friction has the one width 2HG at every angle
+                                       past its stick range); needs kes_2HG
 =================  ==================  ===================================================================
 
 FAST (SiroFAST: De Boos & Tester 1994, CSIRO report WT92.02), key ``fast_*``:
@@ -71,8 +78,9 @@ direction). The largest softening |k2| is 1122487.5 (k2 kappa / k1 = -0.72 at 1/
 theory: turning them into a twisting rigidity would need the plate's compliance rotation, which the
 repository's law does not follow).
 
-What the model drops (bending hysteresis 2HB and nonlinear bending k2 are options, ``kes_2HB_*`` and ``ctd_k2_*``
-above): the shear hysteresis (KES 2HG, 2HG5), the nonlinear shear curve beyond the small angles where G is measured
+What the model drops (bending hysteresis 2HB, nonlinear bending k2 and shear hysteresis 2HG are options,
+``kes_2HB_*``, ``ctd_k2_*`` and ``kes_2HG`` above): the growth of the shear hysteresis with the angle (2HG5 > 2HG is
+recorded, not modelled), the nonlinear shear curve beyond the small angles where G is measured
 (0.5-5 deg), the tensile curve's nonlinearity (the secant at Fm replaces it: crimp interchange makes the initial
 modulus far lower, so a drape that stretches little is too stiff in tension; drape is insensitive to it while C >> B /
 h^2), the compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measured: Poisson coupling (C12 =
@@ -96,7 +104,8 @@ What the bounds rest on (searched for through public material on 2026-12-02; not
   a factor 4.5-7.5 beyond that span (tests/fabrics/test_lab.py checks the extremes are inside);
 - the paper's wool (B 0.083/0.063 gf cm, G 0.73 gf/(cm deg), W 19 mg/cm^2) is inside every bound;
 - UNVERIFIED (no table found through the tools; Kawabata's charts, the SiroFAST manual and its control
-  chart could not be read): the bounds of G, EMT, LT, WT, Fm, thickness, FAST E100 and G. They are kept
+  chart could not be read): the bounds of G, 2HG, 2HG5 (searched again on 2026-12-05: the public KES parameter
+  lists give their definitions, 2HG at 0.5 deg and 2HG5 at 5 deg in gf/cm, but no readable table of values), EMT, LT, WT, Fm, thickness, FAST E100 and G. They are kept
   loose (two to three decades) and only catch gross slips; a fabric outside them is refused by name, so
   widen a bound here (with its source) rather than bend a measured value.
 
@@ -137,6 +146,8 @@ LAB_KEYS = {
     "kes_T": ("mm", "KES-FB3 thickness at 0.5 gf/cm^2"),
     "kes_2HB_warp": ("gf cm/cm", "KES-FB2 bending hysteresis (loop width at +-1 /cm), warp"),
     "kes_2HB_weft": ("gf cm/cm", "KES-FB2 bending hysteresis, weft"),
+    "kes_2HG": ("gf/cm", "KES-FB1 shear hysteresis (loop width at +-0.5 deg)"),
+    "kes_2HG5": ("gf/cm", "KES-FB1 shear hysteresis at +-5 deg (recorded only)"),
     "fast_B_warp": ("uN m", "FAST-2 bending rigidity, warp"),
     "fast_B_weft": ("uN m", "FAST-2 bending rigidity, weft"),
     "fast_E100_warp": ("%", "FAST-3 extensibility at 100 gf/cm, warp"),
@@ -158,6 +169,7 @@ RANGES = {
     "kes_EMT_warp": (0.2, 60.0), "kes_EMT_weft": (0.2, 60.0), "kes_LT_warp": (0.2, 1.5), "kes_LT_weft": (0.2, 1.5),
     "kes_WT_warp": (0.5, 100.0), "kes_WT_weft": (0.5, 100.0), "kes_Fm": (5.0, 1000.0),
     "kes_W": (0.3, 500.0), "kes_T": (0.05, 10.0), "kes_2HB_warp": (0.0005, 20.0), "kes_2HB_weft": (0.0005, 20.0),
+    "kes_2HG": (0.01, 50.0), "kes_2HG5": (0.01, 100.0),
     "fast_B_warp": (0.05, 2000.0), "fast_B_weft": (0.05, 2000.0), "fast_E100_warp": (0.1, 60.0),
     "fast_E100_weft": (0.1, 60.0), "fast_G": (2.0, 2000.0), "fast_W": (3.0, 5000.0), "fast_T": (0.05, 10.0),
 }
@@ -190,6 +202,8 @@ QUANTITY_KEYS = {
     "M0_weft": ("kes_2HB_weft",),
     "bending_k2_warp": ("ctd_k2_warp",),
     "bending_k2_weft": ("ctd_k2_weft",),
+    "shear_tau0": ("kes_2HG",),
+    "shear_width_5deg": ("kes_2HG5",),
 }
 """Model quantity -> the lab keys that give it (one source per quantity)."""
 
@@ -291,7 +305,8 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
     si : dict
         ``{quantity: value}`` for the quantities given: ``B_warp, B_weft`` [N m], ``C_shear, C_warp,
         C_weft`` [N/m], ``weight`` [N/m^2], ``thickness`` [m], ``M0_warp, M0_weft`` [N m/m = N],
-        ``bending_k2_warp, bending_k2_weft`` [N m^2].
+        ``bending_k2_warp, bending_k2_weft`` [N m^2], ``shear_tau0`` (2HG / 2) and ``shear_width_5deg`` (2HG5, recorded
+        only) [N/m].
     record : dict
         ``{quantity: {"from": key, "value": lab value, "unit": lab unit, "rule": ...}}``.
 
@@ -340,4 +355,10 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
         if f"kes_2HB_{d}" in lab:
             put(f"M0_{d}", f"kes_2HB_{d}", 0.5 * lab[f"kes_2HB_{d}"] * GF,
                 "friction moment per width M0 = 2HB / 2; gf cm/cm = gf = 9.80665e-3 N")
+    if "kes_2HG" in lab:
+        put("shear_tau0", "kes_2HG", 0.5 * lab["kes_2HG"] * GF / 1e-2,
+            "friction shear force per width tau0 = 2HG / 2; gf/cm = 0.980665 N/m")
+    if "kes_2HG5" in lab:
+        put("shear_width_5deg", "kes_2HG5", lab["kes_2HG5"] * GF / 1e-2, "recorded only (not a model parameter: the "
+            "friction element's loop has the width 2HG at every angle past its stick range); gf/cm = 0.980665 N/m")
     return si, record

@@ -13,7 +13,12 @@ E_b holds the hinges of the mesh's creases (``mesh.folds``, attribute ``hinges``
 hysteresis (``material.hysteresis``, attribute ``friction``: :class:`rftstatic.element.hysteresis.BendingFriction`)
 E_b also holds the friction's incremental potential at the committed slip (``State.bending_slip``, keyword ``slip``);
 with nonlinear bending (``material.nonlinear_bending``, attribute ``bending_softening``:
-:class:`rftstatic.element.nonlinear_bending.BendingSoftening`) E_b also holds its softening correction,
+:class:`rftstatic.element.nonlinear_bending.BendingSoftening`) E_b also holds its softening correction;
+with shear hysteresis (``material.shear_hysteresis``, attribute ``shear_friction``:
+:class:`rftstatic.element.shear_friction.ShearFriction`) E_m also holds the shear friction's incremental potential
+at its committed slip. Both frictions' slips travel as one array (keyword ``slip``, ``State.bending_slip``,
+:meth:`Model.initial_slip`): columns 0-1 the bending friction's (warp, weft) when there is one, the last the
+shear friction's when there is one,
 
 its gradient (the out-of-balance force) and its Hessian (the tangent) on the assembly plan.
 A Model is read-only once built (:class:`~rftstatic.model.frozen.Frozen`): what a solve advances or
@@ -37,6 +42,7 @@ from rftstatic.element.hysteresis import bending_friction
 from rftstatic.element.membrane import ELEMENTS, membrane_operator
 from rftstatic.element.nonlinear_bending import nonlinear_bending
 from rftstatic.element.patch import bending_stiffness, build_patches, curvature
+from rftstatic.element.shear_friction import shear_friction
 from rftstatic.material import Material
 from rftstatic.mesh.trimesh import TriMesh
 from rftstatic.model.assembly import AssemblyPlan, scatter_forces, scatter_matrices
@@ -175,6 +181,10 @@ class Model(Frozen):
         # both terms on one patch pass, compiled with the run's kernels (rftstatic.element.axis_terms)
         self.axis_terms = axis_terms(self.bending_friction, self.bending_softening,
                                      backend="numba" if self.kernels == "compiled" else "numpy")
+        sh = material.shear_hysteresis
+        self.shear_friction = (None if sh is None or sh.tau0 == 0.0 or not self.with_membrane else shear_friction(
+            self.membrane, material.Dm, n_nodes=mesh.n_nodes, warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)),
+            tau0=sh.tau0, ratio=sh.ratio))
         warnings = []
         if element == "RFT6" and self.with_membrane:
             lock = locking_number(mesh, material)
@@ -245,10 +255,12 @@ class Model(Frozen):
         Ub = self.bending_displacement(U)
         Eb = 0.5 * float(np.einsum("ni,ni->", Ub, self.Kb @ Ub))
         if self.axis_terms is not None:
-            Eb += self.axis_terms.energy(Ub, self.positions(U), slip)
+            Eb += self.axis_terms.energy(Ub, self.positions(U), self.split_slip(slip)[0])
         if self.hinges is not None:
             Eb += self.hinges.energy(self.positions(U))
         Em = self.membrane.energy(U, self.material.Dm, backend=self.membrane_backend) if self.with_membrane else 0.0
+        if self.shear_friction is not None:
+            Em += self._shear(U, slip)[0]
         Ec = self.contact.energy(self.positions(U), candidates=candidates) if self.contact is not None else 0.0
         Es = (self.self_contact.evaluate(self.positions(U), tangent=False, cache=pairs).energy
               if self.self_contact is not None else 0.0)
@@ -264,11 +276,46 @@ class Model(Frozen):
         """Total potential energy Pi(U) [J]."""
         return self.energies(U, lam, candidates=candidates, pairs=pairs, branches=branches, slip=slip)["total"]
 
+    @property
+    def has_friction(self) -> bool:
+        """Whether the model has a friction term with a slip history (bending or shear hysteresis): its drape
+        depends on the route."""
+        return self.bending_friction is not None or self.shear_friction is not None
+
+    def initial_slip(self) -> np.ndarray | None:
+        """The virgin slips of the friction terms, ``(E, k)``: the bending friction's two columns [1/m] (when there
+        is one), then the shear friction's one [-] (when there is one); None without either."""
+        parts = [t.initial_slip() for t in (self.bending_friction, self.shear_friction) if t is not None]
+        return np.concatenate(parts, axis=1) if parts else None
+
+    def split_slip(self, slip) -> tuple:
+        """``(bending (E, 2) or None, shear (E, 1) or None)``: the two frictions' columns of the slip array of
+        :meth:`initial_slip` (None: the virgin state)."""
+        slip = self.initial_slip() if slip is None else slip
+        nb = 2 if self.bending_friction is not None else 0
+        return (slip[:, :nb] if nb else None), (slip[:, nb:] if self.shear_friction is not None else None)
+
+    def _shear(self, U, slip, tangent=False, psd=False):
+        """The shear friction's energy [J], element forces (E, A, 3) [N] and tangents (E, A, 3, A, 3) [N/m]
+        (:mod:`rftstatic.element.shear_friction`)."""
+        return self.shear_friction.evaluate(U, self.split_slip(slip)[1], tangent=tangent, psd=psd)
+
     def commit_slip(self, U, slip) -> tuple[np.ndarray, float]:
-        """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] from the committed ``slip (E, 2)``
-        [1/m]: the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
-        <rftstatic.element.hysteresis.BendingFriction.commit>`, H4)."""
-        return self.axis_terms.commit(self.bending_displacement(U), self.positions(U), slip)
+        """Return mapping of the frictions at a converged ``U (N, 3)`` [m] from the committed ``slip (E, k)``
+        (:meth:`initial_slip`): the new slip and the energy dissipated in the step [J] (:meth:`BendingFriction.commit
+        <rftstatic.element.hysteresis.BendingFriction.commit>`, H4; :meth:`ShearFriction.commit
+        <rftstatic.element.shear_friction.ShearFriction.commit>`, S6)."""
+        bend, shear = self.split_slip(slip)
+        parts, dissipated = [], 0.0
+        if bend is not None:
+            new, d = self.axis_terms.commit(self.bending_displacement(U), self.positions(U), bend)
+            parts.append(new)
+            dissipated += d
+        if shear is not None:
+            new, d = self.shear_friction.commit(U, shear)
+            parts.append(new)
+            dissipated += d
+        return np.concatenate(parts, axis=1), dissipated
 
     def load_branches(self, U, previous=None) -> tuple:
         """The branch of each potential load at the converged ``U (N, 3)`` [m], continuous from ``previous``
@@ -283,11 +330,13 @@ class Model(Frozen):
         the stored energy (with the bending friction at the committed ``slip``, :meth:`energies`)."""
         f = self.Kb @ self.bending_displacement(U)
         if self.axis_terms is not None:
-            self.axis_terms.add_forces(self.bending_displacement(U), self.positions(U), f, slip)
+            self.axis_terms.add_forces(self.bending_displacement(U), self.positions(U), f, self.split_slip(slip)[0])
         if self.hinges is not None:
             f += self.hinges.force(self.positions(U))
         if self.with_membrane:
             fe = self.membrane.element_forces(U, self.material.Dm, backend=self.membrane_backend)
+            if self.shear_friction is not None:
+                fe = fe + self._shear(U, slip)[1]
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             f += self.contact.force(self.positions(U), candidates=candidates)
@@ -320,7 +369,8 @@ class Model(Frozen):
         f = self.Kb @ self.bending_displacement(U)
         x = self.positions(U)
         if self.axis_terms is not None:  # bending friction and softening
-            fe = self.axis_terms.add_tangents(self.bending_displacement(U), x, self._patch_map, data, slip, psd=psd)
+            fe = self.axis_terms.add_tangents(self.bending_displacement(U), x, self._patch_map, data,
+                                                  self.split_slip(slip)[0], psd=psd)
             f += scatter_forces(self.patches.nodes, fe, self.mesh.n_nodes)
         if self.hinges is not None:
             fh, (rows, cols, blocks) = self.hinges.force_tangent_blocks(x, psd=psd)
@@ -329,6 +379,10 @@ class Model(Frozen):
         if self.with_membrane:
             fe = self.membrane.tangents_into(U, self.material.Dm, self._membrane_map, data, psd=psd, stress=stress,
                                              backend=self.membrane_backend)
+            if self.shear_friction is not None:
+                _, fs, ks = self._shear(U, slip, tangent=True, psd=psd)
+                fe = fe + fs
+                data += scatter_matrices(self._membrane_map, ks, plan.nnz)
             f += scatter_forces(self.membrane.nodes, fe, self.mesh.n_nodes)
         if self.contact is not None:
             cs = self.contact.evaluate(x, candidates=candidates)

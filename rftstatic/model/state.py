@@ -49,10 +49,13 @@ class State:
         directions in a row it has given: ``{"mode": "psd" | "shift", "rung": index into SHIFT_LADDER, "run": int}``; the next
         direction starts from it (:func:`~rftstatic.solvers.iteration.direction`); None after an exact or
         modified step
-    bending_slip : the committed slip curvature of the bending friction (E, 2) [1/m], warp and weft in material
-        axes (:mod:`rftstatic.element.hysteresis`, internal variable of the return mapping (H4)), set at every
-        converged step (:meth:`commit_slip`); None for a model without bending hysteresis
-    dissipated : energy dissipated by the bending friction since the flat start [J] (sum of (H4) over the
+    bending_slip : the committed slips of the model's friction terms (E, k) (:meth:`rftstatic.model.model.Model.
+        initial_slip`; the name is from when bending had the only one): the bending friction's slip curvature
+        (E, 2) [1/m], warp and weft in material axes (:mod:`rftstatic.element.hysteresis`, internal variable of
+        the return mapping (H4)), then the shear friction's slip angle (E, 1) [-]
+        (:mod:`rftstatic.element.shear_friction`, S6), each present when the material has that hysteresis; set at
+        every converged step (:meth:`commit_slip`); None for a model without hysteresis
+    dissipated : energy dissipated by the frictions since the flat start [J] (sum of (H4) and (S6) over the
         committed steps)
     route : the position of every route under way, keyed by route (:mod:`rftstatic.solvers.drive`): what a
         checkpoint of this State lets the route go on from (e.g. the load steps' next increment, the
@@ -90,15 +93,15 @@ class State:
         candidates = model.contact.new_candidates() if model.contact is not None else None
         sc = getattr(model, "self_contact", None)
         pairs = sc.new_pairs() if sc is not None else None
-        friction = getattr(model, "bending_friction", None)
-        slip = friction.initial_slip() if friction is not None else None
+        initial_slip = getattr(model, "initial_slip", None)
+        slip = initial_slip() if initial_slip is not None else None
         return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates, self_pairs=pairs,
                    bending_slip=slip)
 
     def commit_slip(self, model, U=None) -> float:
-        """Return mapping of the bending friction at a converged ``U (N, 3)`` [m] (default ``self.U``): the new
+        """Return mapping of the frictions at a converged ``U (N, 3)`` [m] (default ``self.U``): the new
         :attr:`bending_slip` and :attr:`dissipated` (:meth:`rftstatic.model.model.Model.commit_slip`); returns the
-        energy dissipated in the step [J] (0 without bending hysteresis)."""
+        energy dissipated in the step [J] (0 without hysteresis)."""
         if self.bending_slip is None:
             return 0.0
         self.bending_slip, d = model.commit_slip(self.U if U is None else U, self.bending_slip)

@@ -326,10 +326,10 @@ def build_model(scene: Scene, mesh=None, *, contact: str | None = None, quiet: b
         raise scene.error("material.weight", f"{material.weight!r} N/m^2 is negative; give the fabric's areal weight "
                           "(>= 0; upward loads are loads.pressure < 0)")
     check_weight(scene, material.weight)
-    if material.hysteresis is not None and scene.analysis == "static" and \
-            static_options(scene, progress=False).increments.continuation == "arc-length":
-        raise scene.error("solver.continuation", '"arc-length" does not commit the bending friction\'s slip '
-                          '(material kes_2HB_*): use continuation = "load" or start = "relax"')
+    if (material.hysteresis is not None or material.shear_hysteresis is not None) and scene.analysis == "static" \
+            and static_options(scene, progress=False).increments.continuation == "arc-length":
+        raise scene.error("solver.continuation", '"arc-length" does not commit the friction\'s slip (material '
+                          'kes_2HB_*, kes_2HG): use continuation = "load" or start = "relax"')
     if scene.analysis != "static" and not material.mass_per_area > 0:
         raise scene.error("material.weight", "an explicit (dynamic or relax) run needs a positive areal weight "
                           "(the mass); got 0")

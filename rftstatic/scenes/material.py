@@ -22,6 +22,10 @@ length^2 in the scene's units: moment per width per curvature^2; gf cm^2 in cm-g
 ``ctd_k2_warp``, ``ctd_k2_weft`` [1e-12 N m^2], both directions or neither (0: that direction stays linear), <= 0
 (a stiffening k2 is refused); ``bending_floor`` [-] in (0, 1), default 0.2; a ``ctd-*`` preset carries the k2 of
 its data row with ``nonlinear_bending = true`` (opt-in: a preset's results do not change otherwise).
+
+Bending hysteresis (``kes_2HB_warp``, ``kes_2HB_weft``, both or neither; ``hysteresis_ratio``) and shear hysteresis
+(``kes_2HG`` [gf/cm], :mod:`rftstatic.element.shear_friction`; ``shear_hysteresis_ratio`` [-] in [1, 1e4], default 10:
+the stick stiffness over the fabric's G; ``kes_2HG5`` recorded only, with ``kes_2HG``) are options of a lab fabric.
 """
 
 from __future__ import annotations
@@ -44,7 +48,8 @@ __all__ = ["build_material", "material_summary", "FABRIC_KEYS"]
 NONLINEAR_KEYS = ("bending_k2_warp", "bending_k2_weft", "bending_floor", "nonlinear_bending")
 """Keys of nonlinear bending besides the lab keys ``ctd_k2_*`` (module docstring)."""
 
-FABRIC_KEYS = set(mat._FABRIC_KINDS) | {"thickness", "hysteresis_ratio"} | set(NONLINEAR_KEYS) | set(LAB_KEYS)
+FABRIC_KEYS = (set(mat._FABRIC_KINDS) | {"thickness", "hysteresis_ratio", "shear_hysteresis_ratio"} | set(NONLINEAR_KEYS)
+               | set(LAB_KEYS))
 """Keys of a fabric ``[material]`` table besides ``preset``, ``kind`` and ``warp_angle``."""
 
 _REQUIRED = ("C_warp", "C_weft", "C_shear", "B_warp", "B_weft", "weight")
@@ -188,7 +193,7 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
         raise
     if "thickness" in si:
         material.info["thickness"] = si["thickness"]
-    material = _with_nonlinear(_with_hysteresis(material, m, si), m, si)
+    material = _with_shear_hysteresis(_with_nonlinear(_with_hysteresis(material, m, si), m, si), m, si)
     for q, rec in record.items():
         rec["si"] = si[q]
     if record:
@@ -201,7 +206,8 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
 
 
 _SUMMARY_KINDS = {**mat._FABRIC_KINDS, "thickness": "length", "M0_warp": "force", "M0_weft": "force",
-                  "bending_k2_warp": "moment_length", "bending_k2_weft": "moment_length"}
+                  "bending_k2_warp": "moment_length", "bending_k2_weft": "moment_length", "shear_tau0": "line_force",
+                  "shear_width_5deg": "line_force"}
 """Unit kind of every quantity a lab record may convert (for the summary in scene units)."""
 
 
@@ -224,6 +230,23 @@ def _with_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Material:
         raise ParameterError("hysteresis_ratio", f"{ratio!r} must be a number in [1, 1e4] (the friction element's "
                              "stick stiffness over B; default 10)")
     return replace(material, hysteresis=mat.BendingHysteresis(si["M0_warp"], si["M0_weft"], float(ratio)))
+
+
+def _with_shear_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Material:
+    """``material`` with the shear hysteresis of ``kes_2HG`` (tau0 = 2HG / 2 in ``si``) and ``shear_hysteresis_ratio``
+    (:class:`rftstatic.material.ShearHysteresis`); ``kes_2HG5`` or the ratio without ``kes_2HG`` are refused."""
+    if "shear_tau0" not in si:
+        for key in ("kes_2HG5", "shear_hysteresis_ratio"):
+            if key in m:
+                raise ParameterError("kes_2HG", f"missing: {key} = {m[key]!r} is given without kes_2HG [gf/cm], the "
+                                     "shear loop's width at +-0.5 deg that sets the friction (give it, or remove "
+                                     f"{key})")
+        return material
+    ratio = m.get("shear_hysteresis_ratio", 10.0)
+    if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 1.0 <= ratio <= 1e4:
+        raise ParameterError("shear_hysteresis_ratio", f"{ratio!r} must be a number in [1, 1e4] (the shear friction's "
+                             "stick stiffness over the fabric's shear rigidity G; default 10)")
+    return replace(material, shear_hysteresis=mat.ShearHysteresis(si["shear_tau0"], float(ratio)))
 
 
 def _opted_in(m: dict) -> bool:
@@ -349,6 +372,10 @@ def material_summary(scene, material: mat.Material) -> dict:
                                      "stick_ratio": h.ratio, "model": "rftstatic.element.hysteresis"}
     if material.nonlinear_bending is not None:
         out["nonlinear_bending"] = _nonlinear_summary(u, material.nonlinear_bending, lengths)
+    sh = material.shear_hysteresis
+    if sh is not None:
+        out["shear_hysteresis"] = {"tau0": u.from_si(sh.tau0, "line_force"), "unit": unit_label(u, "line_force"),
+                                   "stick_ratio": sh.ratio, "model": "rftstatic.element.shear_friction"}
     for key in ("preset", "changed"):
         if key in material.info:
             out[key] = material.info[key]

@@ -141,6 +141,8 @@ SCHEMA = {
         "nu": (NUM, "Poisson ratio"),
         "thickness": (NUM, "shell thickness, or a fabric's (self-contact default) [length]"),
         "hysteresis_ratio": (NUM, "bending hysteresis: stick stiffness / B (default 10; with kes_2HB_*)"),
+        "shear_hysteresis_ratio": (NUM, "shear hysteresis: stick stiffness / G (default 10; with kes_2HG; "
+                                        "rftstatic.element.shear_friction)"),
         **{f"bending_k2_{d}": (NUM, f"nonlinear bending: Feng et al.'s k2, {d} [force length^2], <= 0 "
                                    "(rftstatic.element.nonlinear_bending)") for d in ("warp", "weft")},
         "bending_floor": (NUM, "nonlinear bending: least slope / B, in (0, 1) (default 0.2)"),

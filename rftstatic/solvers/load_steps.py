@@ -25,7 +25,7 @@ from rftstatic.errors import ConvergenceError
 from rftstatic.progress import Progress
 from rftstatic.solvers.linear import LinearSolveError, NotPositiveDefinite
 from rftstatic.model.state import State
-from rftstatic.solvers.newton import StaticResult, close_record, newton, start_state
+from rftstatic.solvers.newton import StaticResult, close_record, mixed_scheme, newton, start_state
 from rftstatic.solvers import friction_lag
 from rftstatic.solvers.drive import Pause, finish
 from rftstatic.solvers.options import StaticOptions
@@ -120,7 +120,7 @@ def _load_steps(model, state, opts, U0, callback, iteration_fallback, relaxed):
     target = inc.increment_displacement if inc.increment_displacement is not None else TARGET_SHARE * diagonal
     result = StaticResult(U=U, lam=0.0, converged=False, linear_solver=solver.name, seed=seed)
     lam = 0.0
-    mixed = opts.newton.iteration == "mixed" and model.with_membrane
+    mixed = mixed_scheme(model, opts.newton.iteration)
     friction_lag.link(model, state, U)
     if resume is None:
         dlam = _first_increment(model, U, opts, state, target)

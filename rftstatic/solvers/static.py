@@ -96,8 +96,9 @@ def static_route(model, state, opts: StaticOptions, *, U0=None, callback=None):
     else:
         try:
             if opts.increments.continuation == "arc-length":
-                if model.bending_friction is not None:  # the path's points are not committed steps
-                    raise ParameterError("solver.continuation", '"arc-length" cannot carry bending hysteresis')
+                if model.has_friction:  # the path's points are not committed steps
+                    raise ParameterError("solver.continuation", '"arc-length" cannot carry bending or shear '
+                                         'hysteresis')
                 result = solve_arc_length(model, U0=U0, options=opts, callback=callback, state=state)
             else:
                 result = yield from load_steps(model, state, opts, U0=U0, callback=callback)

@@ -48,7 +48,9 @@ def test_comparing_with_the_scenes_own_start_is_a_single_solve(tmp_path, caplog)
 @pytest.mark.parametrize("sets, text", [
     (["solver.compare=sideways"], "solver.compare"),
     (["material={kes_B_warp=0.083, kes_B_weft=0.063, kes_W=25.0, kes_T=0.5, kes_2HB_warp=0.05, kes_2HB_weft=0.04}",
-      "solver.compare=load-steps"], "bending hysteresis depends on its route"),
+      "solver.compare=load-steps"], "bending or shear hysteresis depends on its route"),
+    (["material={kes_B_warp=0.083, kes_B_weft=0.063, kes_W=25.0, kes_T=0.5, kes_2HG=1.0}",
+      "solver.compare=load-steps"], "bending or shear hysteresis depends on its route"),
 ])
 def test_bad_compare_exits_2_naming_the_key(tmp_path, capsys, sets, text):
     args = ["case", "cusick-30", "--no-figures", "--out", str(tmp_path / "o")]

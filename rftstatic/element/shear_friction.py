@@ -1,0 +1,198 @@
+"""Shear hysteresis: a friction shear force per width in the membrane (the KES-FB1 shear loop, 2HG).
+
+KES-FB1 shears a strip to and fro (to +-8 deg, under a tension of 10 gf/cm); the shear force per width against the
+shear angle traces a loop of slope G (the shear rigidity) whose width is ``2HG`` at 0.5 deg and ``2HG5`` at 5 deg
+[gf/cm]. As for bending (Grosberg's model of :mod:`rftstatic.element.hysteresis`), the loop is read as inter-yarn
+friction at the crossings: a friction shear force per width ``tau_0`` resists any change of the angle between warp
+and weft, in parallel with the elastic ``G gamma``. After a reversal the friction element first sticks (stiffness
+``K``) and then slips at ``|tau_f| = tau_0``, so on the slipping branches
+
+    tau = G gamma +/- tau_0,     loop width 2 tau_0 = 2HG,    tau_0 = 2HG / 2                    (S1)
+
+Model (per element e of the membrane, RFT3 or RFT6):
+
+- shear angle ``gamma = t . eps`` with ``eps = (e_xx, e_yy, 2 e_xy)`` the element's averaged Green strain of Eq. 14
+  (RFT6: Eq. 24-26) in global axes and ``t`` the third row of the Voigt strain rotation T of
+  :func:`rftstatic.material.voigt_rotation` (x along the warp), i.e. the engineering Green shear strain ``2 E_12`` in
+  warp/weft axes. ``2 E_12 = sin(phi) sqrt((1 + 2 E_11)(1 + 2 E_22))`` with phi the change of the warp-weft angle,
+  so gamma is the shear angle to first order (at 8 deg and no stretch 0.3 % below it); it is invariant under rigid
+  motion (so is the Green strain): a sheet turned as a whole does not shear                            (S2)
+- the friction element's angle splits into a stick part and a slip ``s`` (the internal variable, ``(E, 1)`` [-],
+  kept in the State next to the bending friction's); with the slip of the last converged step ``s_n`` held, the
+  return-mapped friction force per width is
+
+      tau_f = clip(K (gamma - s_n), -tau_0, tau_0)                                                (S3)
+
+  the derivative of the Huber potential ``psi(e)`` of :func:`rftstatic.element.hysteresis.huber` (H3, with ``M_0``
+  -> ``tau_0``) of the trial stick angle ``e = gamma - s_n``, ``y = tau_0 / K``. The stick stiffness is
+  ``K = ratio G_12`` with ``G_12`` the shear rigidity of D^m in material axes [N/m];
+- element force, the membrane force of the stress ``S_f = tau_f t`` (conjugate to eps), with ``b_a = t . Bbar_a``
+  (Bbar the strain operator of :func:`rftstatic.element.kernels_numpy.strain_operator`):
+
+      f_a = A tau_f b_a                                                                             (S4)
+      K_ab = A (psi'' b_a b_b^T + 1/Q sum_q (g_qa . S_f g_qb) I)                                    (S5)
+
+  with ``psi'' = K`` (stick) or 0 (slip), ``g_qa`` the strain-point gradients of the membrane and ``S_f`` as the 2 x
+  2 tensor ``[[S_xx, S_xy], [S_xy, S_yy]]``. ``psd``: ``S_f`` replaced by its positive part (as the membrane's
+  own geometric stiffness, :func:`rftstatic.element.kernels.positive_part`);
+- at a converged step the slip is committed (backward Euler of the flow rule, as H4):
+
+      s_n+1 = s_n + (e - clip(e, -y, y)),     dissipated  D = sum_e A_e tau_0 |s_n+1 - s_n|              (S6)
+
+The elastic shear stays in D^m (Eq. 15); this module adds only the friction term. A static solve minimises
+``Pi + sum_e A_e psi`` within a step, the same incremental potential as the bending friction, so the routes treat
+both alike (the slips are committed together: :meth:`rftstatic.model.model.Model.commit_slip`). KES 2HG5 (the width
+at 5 deg) is not a parameter here: past the stick range this Coulomb element's loop has the one width 2HG at every
+angle (real fabrics have 2HG5 > 2HG: the friction grows with the shear; not modelled). The element tests
+(tests/element/test_shear_friction.py) check (S4) and (S5) by finite differences on both branches.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+
+from rftstatic.element.hysteresis import huber
+from rftstatic.element.kernels import averaged_strain, positive_part
+from rftstatic.element.kernels_numpy import strain_operator
+
+__all__ = ["ShearFriction", "shear_friction"]
+
+
+@dataclass(frozen=True, eq=False)
+class ShearFriction:
+    """The friction shear term of every membrane element (module docstring), built once per mesh.
+
+    Attributes
+    ----------
+    nodes : (E, A) the membrane's local-to-global node map (A = 3 for RFT3, 6 for RFT6)
+    G_last : (Q, A, 2, E) strain-point gradients of the membrane [1/m], element axis last
+    area : (E,) element areas [m^2]
+    t : (3,) the warp/weft shear row of the Voigt strain rotation (gamma = t . eps, S2)
+    tau0 : yield shear force per width [N/m] (= 2HG / 2, S1)
+    K : stick stiffness per width [N/m] (ratio x G_12)
+    n_nodes : N, the mesh's node count
+    offset : (A, 3, E) reference offsets of a sewn mesh (the membrane's ``offset_last``), or None
+    """
+
+    nodes: np.ndarray
+    G_last: np.ndarray
+    area: np.ndarray
+    t: np.ndarray
+    tau0: float
+    K: float
+    n_nodes: int
+    offset: np.ndarray | None = None
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.nodes)
+
+    def initial_slip(self) -> np.ndarray:
+        """The virgin state: no slip, ``(E, 1)`` [-]."""
+        return np.zeros((self.n_elements, 1))
+
+    def _law(self, e):
+        return huber(e, np.array([self.K]), np.array([self.tau0]))
+
+    @cached_property
+    def _gradient(self):
+        """The displacement gradients as one sparse product: ``Gs (Q 2 E, N)`` [1/m] with ``H[q, J, i, e] = (Gs
+        U[:, i])[(q, J, e)] + H0[q, J, i, e]``, ``H0 (Q, 2, 3, E)`` the reference offsets' part of a sewn mesh (zero
+        without), the same sum as :func:`rftstatic.element.kernels_numpy.strains_numpy` (Eq. 24-25)."""
+        Q, A, _, E = self.G_last.shape
+        rows = (np.arange(Q)[:, None, None, None] * 2 + np.arange(2)[None, None, :, None]) * E + np.arange(E)
+        cols = np.asarray(self.nodes).T[None, :, None, :]
+        shape = (Q, A, 2, E)
+        ij = (np.broadcast_to(rows, shape).ravel(), np.broadcast_to(cols, shape).ravel())
+        Gs = sp.csr_matrix((self.G_last.ravel(), ij), shape=(Q * 2 * E, self.n_nodes))
+        H0 = 0.0 if self.offset is None else np.einsum("qaJe,aie->qJie", self.G_last, self.offset)
+        return Gs, H0
+
+    def _strain(self, U):
+        """``eps (E, 3)`` [-] and ``H (Q, 2, 3, E)`` [-] at ``U (N, 3)`` [m]."""
+        Gs, H0 = self._gradient
+        Q, _, _, E = self.G_last.shape
+        H = (Gs @ np.asarray(U, float)).reshape(Q, 2, E, 3).transpose(0, 1, 3, 2) + H0
+        return np.stack(averaged_strain(H, ...), axis=-1), H
+
+    def nodal_force(self, U, slip) -> tuple[float, np.ndarray]:
+        """Friction energy [J] and nodal forces ``(N, 3)`` [N] at ``U (N, 3)`` [m] with the committed ``slip (E, 1)``:
+        :meth:`evaluate`'s forces (S4) summed into the nodes, as ``f_a = A/Q sum_q g_qa . (S_f F_q)`` through the
+        sparse gradient (no element array; the explicit force's path, :mod:`rftstatic.element.explicit_force`)."""
+        eps, H = self._strain(U)
+        psi, tau, _ = self._law((eps @ self.t)[:, None] - slip)
+        Q = H.shape[0]
+        w = self.area * tau[:, 0] / Q
+        sxx, syy, sxy = w * self.t[0], w * self.t[1], w * self.t[2]
+        F = H.copy()  # F[q, J, i, e]
+        F[:, 0, 0] += 1.0
+        F[:, 1, 1] += 1.0
+        P = np.stack([sxx * F[:, 0] + sxy * F[:, 1], sxy * F[:, 0] + syy * F[:, 1]], axis=1)  # (Q, 2, 3, E)
+        Gs, _ = self._gradient
+        f = Gs.T @ P.transpose(0, 1, 3, 2).reshape(-1, 3)
+        return float(self.area @ psi[:, 0]), f
+
+    def shear_angle(self, U) -> np.ndarray:
+        """``gamma (E, 1)`` [-], the warp-weft engineering Green shear strain of every element (S2)."""
+        return (self._strain(U)[0] @ self.t)[:, None]
+
+    def evaluate(self, U, slip, *, tangent=False, psd=False):
+        """Friction energy [J] (the sum of A psi), element forces ``(E, A, 3)`` [N] (S4) and, with ``tangent``,
+        element tangents ``(E, A, 3, A, 3)`` [N/m] (S5), at ``U (N, 3)`` [m] with the committed ``slip (E, 1)`` [-].
+        ``psd``: the geometric part with the positive part of the friction stress."""
+        eps, H = self._strain(U)
+        G_last = self.G_last
+        psi, tau, dtau = self._law((eps @ self.t)[:, None] - slip)
+        B = strain_operator(G_last, H)  # (E, 3, A, 3)
+        b = np.einsum("k,ekai->eai", self.t, B)
+        A = self.area
+        fe = (A * tau[:, 0])[:, None, None] * b
+        energy = float(A @ psi[:, 0])
+        if not tangent:
+            return energy, fe, None
+        ke = (A * dtau[:, 0])[:, None, None, None, None] * b[:, :, :, None, None] * b[:, None, None, :, :]
+        S = tau[:, 0][:, None] * self.t[None, :]  # (E, 3): S_xx, S_yy, S_xy of S_f
+        sxx, syy, sxy = S[:, 0], S[:, 1], S[:, 2]
+        if psd:
+            sxx, syy, sxy = positive_part(sxx, syy, sxy)
+        Q = G_last.shape[0]
+        gx, gy = G_last[:, :, 0], G_last[:, :, 1]  # (Q, A, E)
+        w = A / Q
+        geo = (np.einsum("qae,qbe->eab", gx, w * (sxx * gx + sxy * gy))
+               + np.einsum("qae,qbe->eab", gy, w * (sxy * gx + syy * gy)))
+        for i in range(3):
+            ke[:, :, i, :, i] += geo
+        return energy, fe, ke
+
+    def commit(self, U, slip) -> tuple[np.ndarray, float]:
+        """Return mapping at a converged step (S6): the new slip ``(E, 1)`` [-] and the energy dissipated in the
+        step [J]."""
+        e = self.shear_angle(U) - slip
+        y = self.tau0 / self.K
+        ds = e - np.clip(e, -y, y)
+        return slip + ds, float(self.tau0 * (self.area @ np.abs(ds[:, 0])))
+
+    def force(self, U, slip) -> np.ndarray:
+        """Friction shear force per width ``tau_f (E, 1)`` [N/m] (S3)."""
+        return self._law(self.shear_angle(U) - slip)[1]
+
+
+def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio) -> ShearFriction:
+    """The :class:`ShearFriction` of a membrane operator ``membrane``
+    (:class:`rftstatic.element.membrane.MembraneOperator`) of a mesh of ``n_nodes`` nodes for a fabric of membrane
+    matrix ``Dm (3, 3)`` in global axes [N/m] whose warp lies at ``warp_angle`` [rad] from X: yield force per width
+    ``tau0`` [N/m] (2HG / 2) and stick stiffness ``ratio * G_12`` (G_12 the material-axes shear rigidity)."""
+    from rftstatic.material import voigt_rotation
+
+    T = voigt_rotation(warp_angle)
+    Ti = np.linalg.inv(T)
+    G12 = float((Ti.T @ np.asarray(Dm, float) @ Ti)[2, 2])
+    if not (np.isfinite(tau0) and tau0 >= 0) or not ratio > 0 or not G12 > 0:
+        raise ValueError(f"shear friction needs tau0 >= 0, ratio > 0 and a shear rigidity G_12 > 0, got tau0 = "
+                         f"{tau0!r}, ratio = {ratio!r}, G_12 = {G12!r} N/m")
+    return ShearFriction(np.asarray(membrane.nodes), membrane.G_last, np.asarray(membrane.area, float),
+                         T[2].copy(), float(tau0), float(ratio) * G12, int(n_nodes), membrane.offset_last)

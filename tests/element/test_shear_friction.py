@@ -1,0 +1,204 @@
+"""Shear hysteresis (rftstatic.element.shear_friction): derivatives on both branches, rigid-motion invariance, the
+explicit force, the KES shear loop's width and the slips committed with the bending friction's."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from rftstatic import material
+from rftstatic.element.explicit_force import ForceKernel
+from rftstatic.mesh import trimesh as mesh
+from rftstatic.model import model
+from rftstatic.model.state import State
+from tests.element.test_hysteresis import derivative_errors
+
+TAU0 = 0.05  # N/m (2HG = 0.1 N/m ~ 0.1 gf/cm on this toy fabric)
+
+
+def _material(angle=0.3, ratio=10.0, bending=False):
+    base = material.fabric(C_warp=3.0, C_weft=2.0, C_shear=0.7, B_warp=0.03, B_weft=0.02, B_twist=0.01,
+                           weight=0.1, warp_angle=angle)
+    h = material.BendingHysteresis(0.004, 0.003, 10.0) if bending else None
+    return replace(base, shear_hysteresis=material.ShearHysteresis(TAU0, ratio), hysteresis=h)
+
+
+def _sheared(mod, rng):
+    X = mod.X3
+    U = 0.03 * rng.normal(size=X.shape)
+    U[:, 0] += 0.1 * X[:, 1]  # a shear of the sheet
+    U[:, 2] += 0.3 * X[:, 0] ** 2 - 0.2 * X[:, 0] * X[:, 1]
+    return U
+
+
+def _mixed_slip(mod, U, rng):
+    """A committed slip (both frictions' columns) that leaves about half the elements sticking at ``U``."""
+    fr = mod.shear_friction
+    s = fr.shear_angle(U) + (fr.tau0 / fr.K) * rng.uniform(-2.0, 2.0, size=(fr.n_elements, 1))
+    if mod.bending_friction is None:
+        return s
+    bf = mod.bending_friction
+    km = bf.curvature(U, mod.positions(U))[:, :2]
+    return np.concatenate([km + (bf.M0 / bf.K) * rng.uniform(-2.0, 2.0, size=km.shape), s], axis=1)
+
+
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+@pytest.mark.parametrize("bending", [False, True])
+def test_force_and_tangent_are_derivatives_on_both_branches(element, bending):
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    mod = model.Model(m, _material(bending=bending), element=element, load=model.gravity_load(m, 0.1))
+    rng = np.random.default_rng(4)
+    U = _sheared(mod, rng)
+    slip = _mixed_slip(mod, U, rng)
+    fr = mod.shear_friction
+    stick = np.abs(fr.shear_angle(U) - mod.split_slip(slip)[1]) <= fr.tau0 / fr.K
+    assert 0.2 < stick.mean() < 0.8  # both branches of (S3) are exercised
+    err_f, err_k, r, f, K = derivative_errors(mod, U, 0.6, rng, slip=slip)
+    assert err_f < 1e-6 * np.abs(r).max()
+    assert err_k < 1e-6 * np.abs(K).max()
+    # the friction term alone, whose forces are small next to the membrane's
+    e, fe, ke = fr.evaluate(U, mod.split_slip(slip)[1], tangent=True)
+    h = 1e-7
+    for c in rng.choice(U.size, 12, replace=False):
+        Up, Um = U.ravel().copy(), U.ravel().copy()
+        Up[c] += h
+        Um[c] -= h
+        Up, Um = Up.reshape(-1, 3), Um.reshape(-1, 3)
+        sp, sm = mod.split_slip(slip)[1], mod.split_slip(slip)[1]
+        fd = (fr.evaluate(Up, sp)[0] - fr.evaluate(Um, sm)[0]) / (2 * h)
+        g = np.zeros(U.size)
+        np.add.at(g, (3 * fr.nodes[..., None] + np.arange(3)).ravel(), fe.ravel())
+        assert abs(fd - g[c]) < 1e-6 * np.abs(g).max()
+        gp, gm = np.zeros(U.size), np.zeros(U.size)
+        np.add.at(gp, (3 * fr.nodes[..., None] + np.arange(3)).ravel(), fr.evaluate(Up, sp)[1].ravel())
+        np.add.at(gm, (3 * fr.nodes[..., None] + np.arange(3)).ravel(), fr.evaluate(Um, sm)[1].ravel())
+        Kd = np.zeros((U.size, U.size))
+        dofs = 3 * fr.nodes[..., None] + np.arange(3)
+        for k in range(len(ke)):
+            d = dofs[k].ravel()
+            Kd[np.ix_(d, d)] += ke[k].reshape(d.size, d.size)
+        assert np.abs((gp - gm) / (2 * h) - Kd[:, c]).max() < 1e-6 * np.abs(Kd).max()
+
+
+def test_psd_tangent_is_positive_semi_definite():
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    mod = model.Model(m, _material(), element="RFT6")
+    rng = np.random.default_rng(6)
+    U = _sheared(mod, rng)
+    _, _, ke = mod.shear_friction.evaluate(U, _mixed_slip(mod, U, rng), tangent=True, psd=True)
+    k = ke.reshape(len(ke), 18, 18)
+    assert np.linalg.eigvalsh(0.5 * (k + k.transpose(0, 2, 1))).min() > -1e-12 * np.abs(k).max()
+
+
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+def test_a_rigid_motion_does_not_shear_and_turns_the_force(element):
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    mod = model.Model(m, _material(), element=element)
+    fr = mod.shear_friction
+    rng = np.random.default_rng(7)
+    R = Rotation.from_rotvec([0.7, -1.1, 0.4]).as_matrix()
+    flat_turned = mod.X3 @ R.T + np.array([0.3, -2.0, 5.0]) - mod.X3
+    np.testing.assert_allclose(fr.shear_angle(flat_turned), 0.0, atol=1e-14)
+    slip = fr.initial_slip() + 1e-3 * rng.uniform(-1, 1, size=(fr.n_elements, 1))  # a held slip: a force at rest
+    f0 = fr.evaluate(np.zeros_like(mod.X3), slip)[1]
+    np.testing.assert_allclose(fr.evaluate(flat_turned, slip)[1], f0 @ R.T, atol=1e-12 * np.abs(f0).max())
+    e_rest, f_rest, _ = fr.evaluate(flat_turned, fr.initial_slip())  # no slip: no force, no energy (round-off)
+    assert abs(e_rest) < 1e-12 * TAU0 * fr.area.sum() and np.abs(f_rest).max() < 1e-10 * np.abs(f0).max()
+    U = _sheared(mod, rng)
+    x2 = mod.positions(U) @ R.T
+    np.testing.assert_allclose(fr.shear_angle(x2 - mod.X3), fr.shear_angle(U), atol=1e-12)
+    f = mod.internal_force(U, slip=slip)
+    np.testing.assert_allclose(mod.internal_force(x2 - mod.X3, slip=slip), f @ R.T, atol=1e-10 * np.abs(f).max())
+
+
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_explicit_force_equals_the_model_force(element, backend):
+    pytest.importorskip("numba") if backend == "numba" else None
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    mod = model.Model(m, _material(bending=True), element=element)
+    rng = np.random.default_rng(8)
+    U = _sheared(mod, rng)
+    slip = _mixed_slip(mod, U, rng)
+    kern = ForceKernel(mod, backend=backend)
+    f, W = kern(U, energy=True, slip=slip)
+    ref = mod.internal_force(U, slip=slip)
+    np.testing.assert_allclose(f, ref, atol=1e-10 * np.abs(ref).max())
+    e = mod.energies(U, slip=slip)
+    assert W == pytest.approx(e["bending"] + e["membrane"], rel=1e-10)
+
+
+def test_kes_shear_loop_has_width_2hg_and_slips_commit_with_the_bending_frictions():
+    """A 2 cm x 2 cm warp-aligned square sheared to +-0.5 deg and back by prescribed displacements (simple shear,
+    the KES-FB1 test's small cycle): the friction shear force per width at +-0.5 deg differs by 2 tau0 between the
+    loading and unloading branches, and the dissipated energy is the loop's area."""
+    m = mesh.rectangle(0.02, 0.02, 5, 5, origin=(0.0, 0.0))
+    mat = _material(angle=0.0, ratio=100.0, bending=True)
+    mod = model.Model(m, mat, element="RFT6")
+    fr = mod.shear_friction
+    st = State.initial(mod)
+    assert st.bending_slip.shape == (m.n_elements, 3)
+    X = mod.X3
+    loop = np.radians(np.concatenate([np.linspace(0, 0.5, 11), np.linspace(0.5, -0.5, 41), np.linspace(-0.5, 0.5, 41)]))
+    forces = []
+    for g in loop:
+        U = np.zeros_like(X)
+        U[:, 0] = np.tan(g) * X[:, 1]
+        forces.append(float(fr.force(U, mod.split_slip(st.bending_slip)[1]).mean()))
+        st.commit_slip(mod, U)
+    forces = np.array(forces)
+    down = forces[11 + 40]  # at -0.5 deg coming down
+    up = forces[-1]  # at +0.5 deg going up
+    assert up == pytest.approx(fr.tau0, rel=1e-9) and down == pytest.approx(-fr.tau0, rel=1e-9)
+    assert st.dissipated > 0
+    # a full cycle -0.5 -> +0.5 -> -0.5 deg dissipates A 2 tau0 (2 * 1 deg - 2 * stick range) per element
+    y = fr.tau0 / fr.K
+    expect_per_cycle = 2 * fr.tau0 * (np.radians(1.0) - 2 * y) * fr.area.sum()
+    d0 = st.dissipated
+    for g in np.radians(np.concatenate([np.linspace(0.5, -0.5, 41), np.linspace(-0.5, 0.5, 41)])):
+        U = np.zeros_like(X)
+        U[:, 0] = np.tan(g) * X[:, 1]
+        st.commit_slip(mod, U)
+    assert st.dissipated - d0 == pytest.approx(expect_per_cycle, rel=2e-2)
+
+
+def test_the_stable_step_bound_counts_the_stick_stiffness():
+    """The guaranteed bound of omega_max (rftstatic.solvers.timestep.element_bound) sees the sticking friction: a
+    stick stiffness far above the membrane's (ratio 1e4 x G) raises it, the default barely."""
+    from rftstatic.solvers.timestep import element_bound
+
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    elastic = model.Model(m, replace(_material(), shear_hysteresis=None), element="RFT6")
+    stiff = model.Model(m, _material(ratio=1e4), element="RFT6")
+    assert element_bound(stiff) > 2.0 * element_bound(elastic)
+
+
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+def test_nodal_force_is_the_element_forces_summed(element):
+    """The explicit path's sparse-gradient force (ShearFriction.nodal_force) against the element forces (S4)."""
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    mod = model.Model(m, _material(), element=element)
+    fr = mod.shear_friction
+    rng = np.random.default_rng(9)
+    U = _sheared(mod, rng)
+    slip = _mixed_slip(mod, U, rng)
+    e, fe, _ = fr.evaluate(U, slip)
+    W, f = fr.nodal_force(U, slip)
+    ref = np.zeros_like(U)
+    np.add.at(ref, fr.nodes, fe)
+    np.testing.assert_allclose(f, ref, atol=1e-12 * np.abs(ref).max())
+    assert W == pytest.approx(e, rel=1e-12)
+    np.testing.assert_allclose(fr.shear_angle(U)[:, 0], mod.membrane_strain(U) @ fr.t, atol=1e-15)  # the membrane's eps
+
+
+
+def test_newton_takes_the_displacement_iteration_with_shear_hysteresis():
+    """MIP Newton cycles across the friction's kink (rftstatic.solvers.newton.mixed_scheme): a model with shear
+    hysteresis runs the displacement iteration whatever ``solver.iteration`` says; one without keeps the mixed."""
+    from rftstatic.solvers.newton import mixed_scheme
+
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    assert not mixed_scheme(model.Model(m, _material()), "mixed")
+    assert mixed_scheme(model.Model(m, replace(_material(), shear_hysteresis=None)), "mixed")
+    assert not mixed_scheme(model.Model(m, replace(_material(), shear_hysteresis=None)), "displacement")
