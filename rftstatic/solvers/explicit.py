@@ -28,8 +28,9 @@ Friction: Coulomb impulses after each velocity update, on the penalty contact
 
 Energy bookkeeping (history): kinetic energy at step n from the mean of the two half-step
 velocities, potential = stored (bending + membrane + penalty) energy - P.D_n, dissipated = the work
-of the damping force ``sum alpha dt v_(n-1/2) M v_(n+1/2)`` plus, with bending hysteresis, the friction's
-(:mod:`rftstatic.element.hysteresis`, H4: its slip is committed after every step, each step a converged one).
+of the damping force ``sum alpha dt v_(n-1/2) M v_(n+1/2)`` plus, with bending or shear hysteresis, the frictions'
+(:mod:`rftstatic.element.hysteresis`, H4, and :mod:`rftstatic.element.shear_friction`, S6: their slip is committed
+after every step, each step a converged one; both under the key ``"bending_friction"`` of the run's accumulators).
 ``total`` = kinetic + potential + dissipated is conserved up to the scheme's O(dt^2) error without
 obstacles. Supports may move at a prescribed velocity (``model.supports.velocity``: a dragged edge); their work
 ``sum (F - P) . v dt`` on the driven dofs enters ``dissipated`` with a minus sign, and the mean of that reaction

@@ -90,3 +90,26 @@ def test_a_short_cusick_run_records_the_shear_friction(capsys, tmp_path):
     assert sh["dissipated_both_frictions"] > 0 and 0 <= sh["yielded_share"] <= 1
     assert 0 < sh["max_shear_angle_deg"] < 90
     assert np.isfinite(s["drape"]["drape_coefficient_percent"])
+
+
+def test_checkpoint_keeps_both_frictions_slips(tmp_path):
+    """With bending and shear hysteresis the State's slip array holds three columns (warp, weft bending; shear) and a
+    checkpoint gives them back."""
+    from rftstatic.mesh import trimesh as mesh
+    from rftstatic.model import model
+    from rftstatic.model.state import State
+    from rftstatic.solvers.checkpoint import read_checkpoint, restore_state, state_arrays
+
+    mat = build_material(_scene({**LAB, "kes_2HB_warp": 0.05, "kes_2HB_weft": 0.04, "kes_2HG": 1.0}))
+    mod = model.Model(mesh.rectangle(0.02, 0.01, 5, 3), mat)
+    state = State.initial(mod)
+    assert state.bending_slip.shape == (mod.mesh.n_elements, 3)
+    state.bending_slip = np.random.default_rng(2).normal(size=state.bending_slip.shape)
+    state.dissipated = 2.5e-6
+    path = tmp_path / "c.npz"
+    np.savez(path, **state_arrays(state, {"what": "test"}))
+    back = restore_state(mod, read_checkpoint(path)[1])
+    np.testing.assert_array_equal(back.bending_slip, state.bending_slip)
+    bend, shear = mod.split_slip(back.bending_slip)
+    np.testing.assert_array_equal(shear[:, 0], state.bending_slip[:, 2])
+    assert bend.shape[1] == 2 and back.dissipated == 2.5e-6
