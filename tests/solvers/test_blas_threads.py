@@ -17,7 +17,9 @@ print(json.dumps([[i["internal_api"], i["num_threads"]] for i in threadpool_info
 
 
 def blas_threads(first: str, env_threads: str | None = None) -> list:
-    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    # OpenBLAS also reads GOTO_NUM_THREADS and OMP_NUM_THREADS (other tests or the machine may set them)
+    names = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
+    env = {k: v for k, v in os.environ.items() if k not in names}
     if env_threads is not None:
         env["OPENBLAS_NUM_THREADS"] = env_threads
     out = subprocess.run([sys.executable, "-c", PROBE.format(first=first)], env=env, capture_output=True, text=True,
