@@ -133,7 +133,7 @@ def hysteresis_summary(scene, model, state, U) -> dict:
     hysteresis too: by both frictions), and the
     share of element-directions (warp, weft) whose friction moment is at its yield M0 (slipping) [-]."""
     fr = model.bending_friction
-    moment = fr.moment(U, model.positions(U), model.split_slip(state.bending_slip)[0])
+    moment = fr.moment(U, model.positions(U), model.split_slip(state.slip)[0])
     at_yield = np.abs(moment) >= fr.M0 * (1 - 1e-9)
     return {"dissipated": scene.units.from_si(state.dissipated, "energy"),
             "yielded_share_warp": float(at_yield[:, 0].mean()), "yielded_share_weft": float(at_yield[:, 1].mean())}
@@ -144,7 +144,7 @@ def shear_hysteresis_summary(scene, model, state, U) -> dict:
     dissipated along the route by both frictions (one total), the share of elements whose friction shear force is at
     its yield tau0 (slipping) and the largest shear angle [deg]."""
     fr = model.shear_friction
-    tau = fr.force(U, model.split_slip(state.bending_slip)[1])
+    tau = fr.force(U, model.split_slip(state.slip)[1])
     return {"dissipated_both_frictions": scene.units.from_si(state.dissipated, "energy"),
             "yielded_share": float((np.abs(tau) >= fr.tau0 * (1 - 1e-9)).mean()),
             "max_shear_angle_deg": float(np.degrees(np.abs(fr.shear_angle(U)).max()))}

@@ -120,7 +120,7 @@ class ForceKernel:
         the potential of the model's potential loads (``model.load_terms``) at load factor 1;
         ``candidates`` is the solve's contact candidate list (a cache; None: every node), ``pairs`` its
         self-contact pair cache (``State.self_pairs``; None: a fresh broad phase), ``slip`` the committed
-        slips of the frictions (``State.bending_slip``: :mod:`rftstatic.element.hysteresis` and
+        slips of the frictions (``State.slip``: :mod:`rftstatic.element.hysteresis` and
         :mod:`rftstatic.element.shear_friction`, :meth:`Model.split_slip`).
         """
         U = np.ascontiguousarray(U, dtype=float)

@@ -11,12 +11,12 @@ E_b holds the hinges of the mesh's creases (``mesh.folds``, attribute ``hinges``
 :class:`rftstatic.element.hinge.FoldHinges`), ``E_s`` is the self-contact energy
 (:class:`rftstatic.contact.self_contact.law.SelfContact`, optional); with bending
 hysteresis (``material.hysteresis``, attribute ``friction``: :class:`rftstatic.element.hysteresis.BendingFriction`)
-E_b also holds the friction's incremental potential at the committed slip (``State.bending_slip``, keyword ``slip``);
+E_b also holds the friction's incremental potential at the committed slip (``State.slip``, keyword ``slip``);
 with nonlinear bending (``material.nonlinear_bending``, attribute ``bending_softening``:
 :class:`rftstatic.element.nonlinear_bending.BendingSoftening`) E_b also holds its softening correction;
 with shear hysteresis (``material.shear_hysteresis``, attribute ``shear_friction``:
 :class:`rftstatic.element.shear_friction.ShearFriction`) E_m also holds the shear friction's incremental potential
-at its committed slip. Both frictions' slips travel as one array (keyword ``slip``, ``State.bending_slip``,
+at its committed slip. Both frictions' slips travel as one array (keyword ``slip``, ``State.slip``,
 :meth:`Model.initial_slip`): columns 0-1 the bending friction's (warp, weft) when there is one, the last the
 shear friction's when there is one,
 

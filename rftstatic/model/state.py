@@ -49,8 +49,8 @@ class State:
         directions in a row it has given: ``{"mode": "psd" | "shift", "rung": index into SHIFT_LADDER, "run": int}``; the next
         direction starts from it (:func:`~rftstatic.solvers.iteration.direction`); None after an exact or
         modified step
-    bending_slip : the committed slips of the model's friction terms (E, k) (:meth:`rftstatic.model.model.Model.
-        initial_slip`; the name is from when bending had the only one): the bending friction's slip curvature
+    slip : the committed slips of the model's friction terms (E, k) (:meth:`rftstatic.model.model.Model.
+        initial_slip`): the bending friction's slip curvature
         (E, 2) [1/m], warp and weft in material axes (:mod:`rftstatic.element.hysteresis`, internal variable of
         the return mapping (H4)), then the shear friction's slip angle (E, 1) [-]
         (:mod:`rftstatic.element.shear_friction`, S6), each present when the material has that hysteresis; set at
@@ -78,7 +78,7 @@ class State:
     modified_shift: float = 0.0
     fallback: dict | None = None
     route: dict = field(default_factory=dict)
-    bending_slip: np.ndarray | None = None
+    slip: np.ndarray | None = None
     dissipated: float = 0.0
 
     @classmethod
@@ -96,15 +96,15 @@ class State:
         initial_slip = getattr(model, "initial_slip", None)
         slip = initial_slip() if initial_slip is not None else None
         return cls(U=U, V=V, t=float(t), step=int(step), lam=float(lam), candidates=candidates, self_pairs=pairs,
-                   bending_slip=slip)
+                   slip=slip)
 
     def commit_slip(self, model, U=None) -> float:
         """Return mapping of the frictions at a converged ``U (N, 3)`` [m] (default ``self.U``): the new
-        :attr:`bending_slip` and :attr:`dissipated` (:meth:`rftstatic.model.model.Model.commit_slip`); returns the
+        :attr:`slip` and :attr:`dissipated` (:meth:`rftstatic.model.model.Model.commit_slip`); returns the
         energy dissipated in the step [J] (0 without hysteresis)."""
-        if self.bending_slip is None:
+        if self.slip is None:
             return 0.0
-        self.bending_slip, d = model.commit_slip(self.U if U is None else U, self.bending_slip)
+        self.slip, d = model.commit_slip(self.U if U is None else U, self.slip)
         self.dissipated += d
         return d
 

@@ -75,7 +75,7 @@ def switch_branch(model, U, lam, K, fac, opts, state, inertia, max_step, *, seed
         branch = {"sign": sign, "converged": bool(nt.converged), "iterations": int(nt.iterations)}
         if nt.converged:
             _, K2 = model.tangent(nt.U, lam=lam, candidates=state.candidates, pairs=state.self_pairs,
-                                  slip=state.bending_slip)
+                                  slip=state.slip)
             try:
                 fac2 = inertia.factor(K2)
             except LinearSolveError as exc:
@@ -83,7 +83,7 @@ def switch_branch(model, U, lam, K, fac, opts, state, inertia, max_step, *, seed
                 record["branches"].append(branch)
                 continue
             energy = model.potential(nt.U, lam, candidates=state.candidates, pairs=state.self_pairs,
-                                     slip=state.bending_slip)
+                                     slip=state.slip)
             branch.update(negative=fac2.negative, energy=float(energy))
             found.append({"U": nt.U, "negative": fac2.negative, "energy": energy, "factor": fac2, "K": K2,
                           "sign": sign})

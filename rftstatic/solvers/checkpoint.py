@@ -83,11 +83,12 @@ def save_atomic(path, arrays: dict) -> None:
         raise
 
 
-CHECKPOINT_FORMAT = 2
-"""Version of the one checkpoint layout (key ``checkpoint_format``): a State and a header."""
+CHECKPOINT_FORMAT = 3
+"""Version of the one checkpoint layout (key ``checkpoint_format``): a State and a header (3: the frictions' slips
+as ``slip``, for both the bending and the shear friction)."""
 
 SAVED = ("U", "V", "t", "step", "lam", "load_branches", "contact_history", "modes", "factorisations", "lm_scale",
-         "modified_shift", "fallback", "route", "bending_slip", "dissipated")
+         "modified_shift", "fallback", "route", "slip", "dissipated")
 """The :class:`~rftstatic.model.state.State` fields a checkpoint keeps (with ``self_contact_scale``,
 ``obstacle_offsets`` and ``obstacle_poses``); the contact candidate list, the self-contact pair cache and the linear solver are caches,
 made again."""

@@ -107,7 +107,7 @@ class LineSearch:
         if dn.fresh:
             self._trust_region(x.energy, Pi, alpha, slope, cap, dn.curvature)
         r = model.residual(U, x.lam, candidates=state.candidates, pairs=state.self_pairs,
-                           slip=state.bending_slip).ravel()[free]
+                           slip=state.slip).ravel()[free]
         work = abs(float(alpha * step.ravel()[free] @ r))
         if self.work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
@@ -167,9 +167,9 @@ def displacement_iterations(model, U, lam, opts, state, max_step, refine: bool =
     max_iterations = 2 * opts.max_iterations if lam >= 1.0 else opts.max_iterations
     U = U.copy()
     parts = model.energies(U, lam, candidates=state.candidates, pairs=state.self_pairs,
-                           slip=state.bending_slip, branches=state.load_branches)
+                           slip=state.slip, branches=state.load_branches)
     r = model.residual(U, lam, candidates=state.candidates, pairs=state.self_pairs,
-                       slip=state.bending_slip).ravel()[model.free.ravel()]
+                       slip=state.slip).ravel()[model.free.ravel()]
     x = Iterate(U, lam, r, float(np.linalg.norm(r)), energy=parts["total"], energy_scale=energy_scale(parts))
     if not np.isfinite(x.rnorm):
         return Iteration(False, U, 0, x.rnorm, "non-finite residual")
@@ -194,13 +194,13 @@ def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_tr
     shorter Armijo point is refined to the lowest energy near it (:func:`lowest_near`)."""
     def parts_at(alpha):
         return model.energies(U + alpha * step, lam, candidates=state.candidates, pairs=state.self_pairs,
-                              slip=state.bending_slip, branches=state.load_branches)
+                              slip=state.slip, branches=state.load_branches)
 
     if not opts.line_search:
         return 1.0, parts_at(1.0)
     if scale is None:
         scale = energy_scale(model.energies(U, lam, candidates=state.candidates, pairs=state.self_pairs,
-                                            slip=state.bending_slip, branches=state.load_branches))
+                                            slip=state.slip, branches=state.load_branches))
     if abs(slope) <= 1e-10 * scale:
         # the predicted decrease is below what the energy can resolve: near the solution the Newton
         # step is reliable, and the force residual (not the energy) decides convergence

@@ -263,7 +263,7 @@ class _Loop:
         self.probe_hist, self.frames = [], []
         self._pose(state, state.t, work=False)
         if start_consistent:
-            f = self.kernel(state.U, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
+            f = self.kernel(state.U, candidates=state.candidates, pairs=state.self_pairs, slip=state.slip)
             a0 = (self.P - f) / self.mass[:, None] - self.alpha * state.V
             state.V = state.V - 0.5 * dt * a0 * self.free
 
@@ -304,9 +304,9 @@ class _Loop:
             self._pose(state, t)
             if checked:
                 f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs,
-                                   slip=state.bending_slip)
+                                   slip=state.slip)
             else:
-                f = self.kernel(U, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
+                f = self.kernel(U, candidates=state.candidates, pairs=state.self_pairs, slip=state.slip)
             self._frames_due(t, U)
             if self.drive is not None:  # the driven supports' reaction f - P: its work and impulse (module docstring)
                 _drive_work(acc, f, P, self.drive, dt, step, n_steps)
@@ -355,7 +355,7 @@ class _Loop:
                     np.copyto(U, Ufix, where=~free)
             step += 1
             state.U, state.V, state.t, state.step = U, V, step * dt, step
-            if state.bending_slip is not None:
+            if state.slip is not None:
                 acc["bending_friction"] = acc.get("bending_friction", 0.0) + state.commit_slip(self.model, U)
             if stopped:
                 break
@@ -372,7 +372,7 @@ class _Loop:
         """The history sample (and any frame due) at the end state."""
         t, U, V, dt = state.t, state.U, state.V, self.dt
         self._pose(state, t, work=False)
-        f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
+        f, W = self.kernel(U, energy=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.slip)
         self._frames_due(t, U)
         g = (self.P - f) * self.minv * dt
         Vend = V * (1.0 - self.alpha * dt) + g

@@ -147,7 +147,7 @@ def direction(model, U, lam, r, opts, state, damping=0.0, stress=None):
     def tangent(psd, shift):
         if psd not in matrices:
             matrices[psd] = model.tangent(U, psd=psd, lam=lam, candidates=state.candidates, stress=stress,
-                                          pairs=state.self_pairs, slip=state.bending_slip)[1]
+                                          pairs=state.self_pairs, slip=state.slip)[1]
         K = matrices[psd]
         if shift:
             K = K.copy()
@@ -238,7 +238,7 @@ def roundoff_floor(model, U) -> float:
 def diagonal_scale(model, U, state) -> float:
     """Mean diagonal of the tangent [N/m], computed once per solve (the scale of the LM damping)."""
     if state.lm_scale is None:
-        _, K0 = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
+        _, K0 = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.slip)
         state.lm_scale = float(np.abs(K0.diagonal()).mean())
     return state.lm_scale
 

@@ -131,7 +131,7 @@ def krylov_direction(model, U, lam, r, state, mu, rtol):
     iterations are counted in its modes); ``mu``: the Levenberg-Marquardt damping relative to the mean
     tangent diagonal; ``rtol``: the forcing term (:func:`forcing`)."""
     try:
-        K = model.tangent(U, lam=lam, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)[1]
+        K = model.tangent(U, lam=lam, candidates=state.candidates, pairs=state.self_pairs, slip=state.slip)[1]
         shift = mu * diagonal_scale(model, U, state) if mu else 0.0
         step = truncated_cg(K, r, state.solver.resolve, shift=shift, rtol=rtol)
     except LinearSolveError:

@@ -313,7 +313,7 @@ def _first_increment(model, U, opts, state, target) -> float:
     if not np.any(P) or model.load_terms:
         return opts.increments.initial_increment
     try:
-        _, K = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.bending_slip)
+        _, K = model.tangent(U, psd=True, candidates=state.candidates, pairs=state.self_pairs, slip=state.slip)
         du = np.zeros(3 * model.mesh.n_nodes)
         state.factorisations += 1
         du[free] = state.solver.solve(K, P)

@@ -45,7 +45,7 @@ def mixed_iterations(model, U, lam, opts, state, max_step, stress, reach=None) -
     U = U.copy()
     S = model.membrane_stress(U) if stress is None else np.array(stress, float)
     r = model.residual(U, lam, candidates=state.candidates, pairs=state.self_pairs,
-                       slip=state.bending_slip).ravel()[model.free.ravel()]
+                       slip=state.slip).ravel()[model.free.ravel()]
     x = Iterate(U, lam, r, float(np.linalg.norm(r)), stress=S)
     if not np.isfinite(x.rnorm):
         return Iteration(False, U, 0, x.rnorm, "non-finite residual", scheme="mixed")
@@ -110,7 +110,7 @@ class CappedStep:
         S = model.mixed_stress(x.U, step)
         U = x.U + step
         r = model.residual(U, x.lam, candidates=state.candidates, pairs=state.self_pairs,
-                           slip=state.bending_slip).ravel()[self.free]
+                           slip=state.slip).ravel()[self.free]
         new = Iterate(U, x.lam, r, float(np.linalg.norm(r)), work=abs(float(step.ravel()[self.free] @ r)), stress=S)
         if not np.isfinite(new.rnorm):
             raise StepFailure("non-finite residual", new)

@@ -149,7 +149,7 @@ def close_record(model, result: StaticResult, state: State, t0: float, error: Co
         counts(result)
     result.wall_time = time.perf_counter() - t0
     result.energies = model.energies(result.U, result.lam, candidates=state.candidates, pairs=state.self_pairs,
-                                     slip=state.bending_slip,
+                                     slip=state.slip,
                                      branches=state.load_branches)
     state.U, state.lam = result.U, result.lam
     if error is not None:

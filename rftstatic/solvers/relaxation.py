@@ -203,7 +203,7 @@ def _held_rest(model, state, at_rest: AtRest, P, mass_scale):
     at_rest.peak_kinetic, at_rest.peak_residual = peaks["kinetic"], peaks["residual"]
 
     def test(st, sample):
-        r = -model.residual(st.U, 1.0, candidates=st.candidates, pairs=st.self_pairs, slip=st.bending_slip)
+        r = -model.residual(st.U, 1.0, candidates=st.candidates, pairs=st.self_pairs, slip=st.slip)
         x = model.positions(st.U)
         holds = [] if law is None else [obstacle_holds(law, model.contact, x)]
         if self_law is not None:
@@ -225,7 +225,7 @@ def newton_descent(model, state: State, route, result) -> bool:
     potential than the relaxed state ``route.U`` (on a flat landscape, e.g. leaving a saddle, Newton's line-searched
     descent is kept instead of thrown away); return whether it did. Not with bending hysteresis (its energy depends on
     the path: the relaxation's own history is kept)."""
-    if result is None or result.lam < 1.0 or state.bending_slip is not None or not np.all(np.isfinite(result.U)):
+    if result is None or result.lam < 1.0 or state.slip is not None or not np.all(np.isfinite(result.U)):
         return False
     new, old = (model.potential(U, 1.0, candidates=state.candidates) for U in (result.U, route.U))
     if not new < old:

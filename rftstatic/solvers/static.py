@@ -170,7 +170,7 @@ def _check_stability(model, result, state):
     if tested is not None and np.array_equal(tested, result.U):
         return replace(result, stable=True)
     stable = (_positive_definite(model, result.U, state.solver, lam=result.lam, pairs=state.self_pairs,
-                                  slip=state.bending_slip, candidates=state.candidates)
+                                  slip=state.slip, candidates=state.candidates)
               if state.solver.detects_indefinite else None)
     return replace(result, stable=stable)
 
@@ -288,7 +288,7 @@ def _relax_route(model, opts, callback, state, first):
         final = (route.at_rest and route.tol_force < 1.0) or route.t_used >= plan.max_time * (1 - 1e-9)
         friction_lag.anchor(model, state, route.U)  # Coulomb friction: stick anchors at the relaxed state
         if not final and route.tol_force < 1.0 and not _positive_definite(
-                model, route.U, state.solver, slip=state.bending_slip, candidates=state.candidates):
+                model, route.U, state.solver, slip=state.slip, candidates=state.candidates):
             route.phase = "relax"
             continue  # still outside the basin of a stable minimum: relax on
         handover = {"time_s": route.t_used, "steps": info["steps"], "at_rest": route.at_rest,
@@ -303,13 +303,13 @@ def _relax_route(model, opts, callback, state, first):
             handover["basin"] = route.tol_force < 1.0
             options = (polish if final else short.replace(max_continuations=FIRST_HANDOVER_CONTINUATIONS)
                        if first_try else basin if long_try else short)
-            history = state.bending_slip, state.dissipated  # committed by a converged Newton
+            history = state.slip, state.dissipated  # committed by a converged Newton
             res = solve_load_steps(model, U0=route.U, options=options, callback=callback, state=state,
                                    iteration_fallback=final or long_try or first_try, relaxed=True)
             if first_try:  # kept only if a stable minimum (which the final stability check then knows)
                 if not _positive_definite(model, res.U, state.solver, pairs=state.self_pairs,
-                                          slip=state.bending_slip, candidates=state.candidates):
-                    state.bending_slip, state.dissipated = history  # the relaxation goes on from before that Newton
+                                          slip=state.slip, candidates=state.candidates):
+                    state.slip, state.dissipated = history  # the relaxation goes on from before that Newton
                     raise ConvergenceError(f"converged in {res.iterations} iterations to an equilibrium that is not "
                                            "a stable minimum", res)
                 state.route[TESTED] = res.U
@@ -318,7 +318,7 @@ def _relax_route(model, opts, callback, state, first):
             if final:
                 result = exc.result
                 if result is not None:  # write the relaxed shape at full load, labelled not converged
-                    r = model.residual(route.U, 1.0, slip=state.bending_slip).ravel()[model.free.ravel()]
+                    r = model.residual(route.U, 1.0, slip=state.slip).ravel()[model.free.ravel()]
                     result = replace(result, U=route.U, lam=1.0, residual=float(np.linalg.norm(r)))
                 raise fail(f"{exc} (after dynamic relaxation to t = {route.t_used:.3g} s, {info['steps']} steps; "
                            "the result is the relaxed shape at full load, not an equilibrium)", result) from None
@@ -348,7 +348,7 @@ def _segment_state(model, state, route) -> State:
     seg = as_state(model, state.route.get(SEGMENT))
     if seg is None:
         seg = State.initial(model, route.U, route.V)
-        seg.bending_slip, seg.dissipated = state.bending_slip, state.dissipated  # the friction's history goes on
+        seg.slip, seg.dissipated = state.slip, state.dissipated  # the friction's history goes on
     state.route[SEGMENT] = seg
     return seg
 
@@ -398,7 +398,7 @@ def _relax_segment(model, opts, plan, route, fail, state, t0):
         except StepLimitError as exc:  # the stable step at this state collapsed (a stretched start)
             raise fail(f"dynamic relaxation cannot go on from t = {route.t_used:.3g} s: {exc}") from None
     del state.route[SEGMENT]
-    state.bending_slip, state.dissipated = seg.bending_slip, seg.dissipated
+    state.slip, state.dissipated = seg.slip, seg.dissipated
     route.U, route.V, route.peak, route.at_rest = rel.U, rel.V, rel.peak_kinetic, rel.converged
     route.t_used += rel.t
     route.info.update(time_s=route.t_used, steps=route.info["steps"] + rel.steps, at_rest=rel.converged,
@@ -436,7 +436,7 @@ def _guided_relaxation(model, opts: StaticOptions, plan, route, fail, state):
     except StepLimitError as exc:
         raise fail(f"the guided dynamic relaxation cannot run: {exc}") from None
     del state.route[SEGMENT]
-    state.bending_slip, state.dissipated = seg.bending_slip, seg.dissipated
+    state.slip, state.dissipated = seg.slip, seg.dissipated
     route.U, route.V, route.peak, route.t_used = rel.U, rel.V, rel.peak_kinetic, rel.t
     route.seed = guide.seed
     route.info.update(time_s=rel.t, steps=rel.steps, guide={"folds": guide.guide_folds, "weight": guide.guide_weight,

@@ -135,7 +135,7 @@ def _kes_loop(step_per_cm=0.01):
         state.U = _cylinder(mod.X3, kappa) - mod.X3
         x = mod.positions(state.U)
         K.append(mod.bending_friction.curvature(state.U, x)[:, 0])
-        MF.append(mod.bending_friction.moment(state.U, x, state.bending_slip)[:, 0])
+        MF.append(mod.bending_friction.moment(state.U, x, state.slip)[:, 0])
         D.append(state.commit_slip(mod))
     return path, np.array(K), np.array(MF), np.array(D), mod, starts
 
@@ -203,8 +203,8 @@ def test_slip_is_committed_by_the_route_and_the_drape_depends_on_it():
         state = start_state(mod)
         res = solve_load_steps(mod, options=StaticOptions(), state=state)
         out[name] = (res.U[tip, 2], state)
-    assert out["elastic"][1].bending_slip is None
-    slip = out["hysteresis"][1].bending_slip
+    assert out["elastic"][1].slip is None
+    slip = out["hysteresis"][1].slip
     assert np.abs(slip).max() > 0 and out["hysteresis"][1].dissipated > 0
     # friction resists the bending on loading: the strip droops less than the elastic one
     assert out["hysteresis"][0] > out["elastic"][0]

@@ -138,14 +138,14 @@ def test_kes_shear_loop_has_width_2hg_and_slips_commit_with_the_bending_friction
     mod = model.Model(m, mat, element="RFT6")
     fr = mod.shear_friction
     st = State.initial(mod)
-    assert st.bending_slip.shape == (m.n_elements, 3)
+    assert st.slip.shape == (m.n_elements, 3)
     X = mod.X3
     loop = np.radians(np.concatenate([np.linspace(0, 0.5, 11), np.linspace(0.5, -0.5, 41), np.linspace(-0.5, 0.5, 41)]))
     forces = []
     for g in loop:
         U = np.zeros_like(X)
         U[:, 0] = np.tan(g) * X[:, 1]
-        forces.append(float(fr.force(U, mod.split_slip(st.bending_slip)[1]).mean()))
+        forces.append(float(fr.force(U, mod.split_slip(st.slip)[1]).mean()))
         st.commit_slip(mod, U)
     forces = np.array(forces)
     down = forces[11 + 40]  # at -0.5 deg coming down
@@ -248,6 +248,6 @@ def test_load_steps_commit_the_shear_slip_and_the_friction_resists():
         out[shear] = (res, state, mod)
     far = np.argmax(out[True][2].X3[:, :2].sum(axis=1))
     res, state, mod = out[True]
-    assert np.abs(state.bending_slip).max() > 0 and state.dissipated > 0
+    assert np.abs(state.slip).max() > 0 and state.dissipated > 0
     assert {s["scheme"] for s in res.load_steps} == {"displacement"}
     assert res.U[far, 2] > out[False][0].U[far, 2]  # measured -2.458 cm against -2.504 cm

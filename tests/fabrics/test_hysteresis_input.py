@@ -48,13 +48,13 @@ def test_checkpoint_keeps_the_slip_and_the_dissipation(tmp_path):
     mat = build_material(_scene({**LAB, "kes_2HB_warp": 0.05, "kes_2HB_weft": 0.04}))
     mod = model.Model(mesh.rectangle(0.02, 0.01, 5, 3), mat)
     state = State.initial(mod)
-    state.bending_slip = np.random.default_rng(1).normal(size=state.bending_slip.shape)
+    state.slip = np.random.default_rng(1).normal(size=state.slip.shape)
     state.dissipated = 1.25e-6
     path = tmp_path / "c.npz"
     np.savez(path, **state_arrays(state, {"what": "test"}))
     _, saved = read_checkpoint(path)
     back = restore_state(mod, saved)
-    np.testing.assert_array_equal(back.bending_slip, state.bending_slip)
+    np.testing.assert_array_equal(back.slip, state.slip)
     assert back.dissipated == 1.25e-6
 
 

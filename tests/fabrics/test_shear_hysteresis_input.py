@@ -103,13 +103,13 @@ def test_checkpoint_keeps_both_frictions_slips(tmp_path):
     mat = build_material(_scene({**LAB, "kes_2HB_warp": 0.05, "kes_2HB_weft": 0.04, "kes_2HG": 1.0}))
     mod = model.Model(mesh.rectangle(0.02, 0.01, 5, 3), mat)
     state = State.initial(mod)
-    assert state.bending_slip.shape == (mod.mesh.n_elements, 3)
-    state.bending_slip = np.random.default_rng(2).normal(size=state.bending_slip.shape)
+    assert state.slip.shape == (mod.mesh.n_elements, 3)
+    state.slip = np.random.default_rng(2).normal(size=state.slip.shape)
     state.dissipated = 2.5e-6
     path = tmp_path / "c.npz"
     np.savez(path, **state_arrays(state, {"what": "test"}))
     back = restore_state(mod, read_checkpoint(path)[1])
-    np.testing.assert_array_equal(back.bending_slip, state.bending_slip)
-    bend, shear = mod.split_slip(back.bending_slip)
-    np.testing.assert_array_equal(shear[:, 0], state.bending_slip[:, 2])
+    np.testing.assert_array_equal(back.slip, state.slip)
+    bend, shear = mod.split_slip(back.slip)
+    np.testing.assert_array_equal(shear[:, 0], state.slip[:, 2])
     assert bend.shape[1] == 2 and back.dissipated == 2.5e-6

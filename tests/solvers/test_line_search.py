@@ -31,7 +31,7 @@ class LineModel:
         return float(min(r.real for r in roots if abs(r.imag) < 1e-12 and r.real > 0))
 
 
-STATE = SimpleNamespace(candidates=None, self_pairs=None, bending_slip=None, load_branches=None)
+STATE = SimpleNamespace(candidates=None, self_pairs=None, slip=None, load_branches=None)
 OPTS = SimpleNamespace(line_search=True)
 
 
