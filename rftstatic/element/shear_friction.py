@@ -76,6 +76,8 @@ class ShearFriction:
     K : stick stiffness per width [N/m] (ratio x G_12)
     n_nodes : N, the mesh's node count
     offset : (A, 3, E) reference offsets of a sewn mesh (the membrane's ``offset_last``), or None
+    compiled : :meth:`nodal_force` by the compiled loop of :mod:`rftstatic.element._shear_numba` (a run on the
+        compiled kernels, :func:`rftstatic.compiled.choose_kernels`), else by numpy (the reference)
     """
 
     nodes: np.ndarray
@@ -86,6 +88,7 @@ class ShearFriction:
     K: float
     n_nodes: int
     offset: np.ndarray | None = None
+    compiled: bool = False
 
     @property
     def n_elements(self) -> int:
@@ -121,8 +124,30 @@ class ShearFriction:
 
     def nodal_force(self, U, slip) -> tuple[float, np.ndarray]:
         """Friction energy [J] and nodal forces ``(N, 3)`` [N] at ``U (N, 3)`` [m] with the committed ``slip (E, 1)``:
-        :meth:`evaluate`'s forces (S4) summed into the nodes, as ``f_a = A/Q sum_q g_qa . (S_f F_q)`` through the
-        sparse gradient (no element array; the explicit force's path, :mod:`rftstatic.element.explicit_force`)."""
+        :meth:`evaluate`'s forces (S4) summed into the nodes, as ``f_a = A/Q sum_q g_qa . (S_f F_q)`` (no element
+        array; the explicit force's path, :mod:`rftstatic.element.explicit_force`): by the compiled loop
+        (``compiled``) or through the sparse gradient (:meth:`nodal_force_numpy`)."""
+        if not self.compiled:
+            return self.nodal_force_numpy(U, slip)
+        from rftstatic.element._shear_numba import shear_force
+
+        nodes, G, offset = self._element_first
+        f = np.zeros((self.n_nodes, 3))
+        W = shear_force(nodes, G, self.area, self.t, offset, np.ascontiguousarray(U, dtype=float),
+                        np.ascontiguousarray(slip[:, 0], dtype=float), self.K, self.tau0, self.tau0 / self.K, f)
+        return float(W), f
+
+    @cached_property
+    def _element_first(self):
+        """The compiled loop's arrays, element axis first: nodes (E, A) int64, gradients (E, Q, A, 2) [1/m],
+        offsets (E, A, 3) [m] (``(0, A, 3)`` without)."""
+        A = self.nodes.shape[1]
+        offset = np.zeros((0, A, 3)) if self.offset is None else np.ascontiguousarray(self.offset.transpose(2, 0, 1))
+        return (np.ascontiguousarray(self.nodes, dtype=np.int64),
+                np.ascontiguousarray(self.G_last.transpose(3, 0, 1, 2)), offset)
+
+    def nodal_force_numpy(self, U, slip) -> tuple[float, np.ndarray]:
+        """:meth:`nodal_force` through the sparse gradient (numpy; the reference of the compiled loop)."""
         eps, H = self._strain(U)
         psi, tau, _ = self._law((eps @ self.t)[:, None] - slip)
         Q = H.shape[0]
@@ -137,8 +162,16 @@ class ShearFriction:
         return float(self.area @ psi[:, 0]), f
 
     def shear_angle(self, U) -> np.ndarray:
-        """``gamma (E, 1)`` [-], the warp-weft engineering Green shear strain of every element (S2)."""
-        return (self._strain(U)[0] @ self.t)[:, None]
+        """``gamma (E, 1)`` [-], the warp-weft engineering Green shear strain of every element (S2); by the compiled
+        loop when ``compiled``."""
+        if not self.compiled:
+            return (self._strain(U)[0] @ self.t)[:, None]
+        from rftstatic.element._shear_numba import shear_angles
+
+        nodes, G, offset = self._element_first
+        gamma = np.empty(self.n_elements)
+        shear_angles(nodes, G, self.t, offset, np.ascontiguousarray(U, dtype=float), gamma)
+        return gamma[:, None]
 
     def evaluate(self, U, slip, *, tangent=False, psd=False):
         """Friction energy [J] (the sum of A psi), element forces ``(E, A, 3)`` [N] (S4) and, with ``tangent``,
@@ -181,11 +214,12 @@ class ShearFriction:
         return self._law(self.shear_angle(U) - slip)[1]
 
 
-def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio) -> ShearFriction:
+def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio, compiled=False) -> ShearFriction:
     """The :class:`ShearFriction` of a membrane operator ``membrane``
     (:class:`rftstatic.element.membrane.MembraneOperator`) of a mesh of ``n_nodes`` nodes for a fabric of membrane
     matrix ``Dm (3, 3)`` in global axes [N/m] whose warp lies at ``warp_angle`` [rad] from X: yield force per width
-    ``tau0`` [N/m] (2HG / 2) and stick stiffness ``ratio * G_12`` (G_12 the material-axes shear rigidity)."""
+    ``tau0`` [N/m] (2HG / 2) and stick stiffness ``ratio * G_12`` (G_12 the material-axes shear rigidity);
+    ``compiled``: its explicit force by the compiled loop (:attr:`ShearFriction.compiled`)."""
     from rftstatic.material import voigt_rotation
 
     T = voigt_rotation(warp_angle)
@@ -195,4 +229,5 @@ def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio) -> ShearFr
         raise ValueError(f"shear friction needs tau0 >= 0, ratio > 0 and a shear rigidity G_12 > 0, got tau0 = "
                          f"{tau0!r}, ratio = {ratio!r}, G_12 = {G12!r} N/m")
     return ShearFriction(np.asarray(membrane.nodes), membrane.G_last, np.asarray(membrane.area, float),
-                         T[2].copy(), float(tau0), float(ratio) * G12, int(n_nodes), membrane.offset_last)
+                         T[2].copy(), float(tau0), float(ratio) * G12, int(n_nodes), membrane.offset_last,
+                         bool(compiled))

@@ -251,3 +251,28 @@ def test_load_steps_commit_the_shear_slip_and_the_friction_resists():
     assert np.abs(state.slip).max() > 0 and state.dissipated > 0
     assert {s["scheme"] for s in res.load_steps} == {"displacement"}
     assert res.U[far, 2] > out[False][0].U[far, 2]  # measured -2.458 cm against -2.504 cm
+
+
+@pytest.mark.parametrize("element", ["RFT3", "RFT6"])
+@pytest.mark.parametrize("sewn", [False, True])
+def test_compiled_nodal_force_equals_numpy(element, sewn):
+    """The compiled loop (rftstatic.element._shear_numba) against the sparse-gradient reference, on both branches
+    of (S3), with and without a sewn mesh's reference offsets."""
+    pytest.importorskip("numba")
+    m = mesh.rectangle(2.0, 1.0, 7, 5, origin=(-1.0, -0.5))
+    mod = model.Model(m, _material(), element=element, kernels="compiled")
+    fr = mod.shear_friction
+    assert fr.compiled
+    rng = np.random.default_rng(11)
+    if sewn:
+        fr = replace(fr, offset=1e-2 * rng.normal(size=(fr.nodes.shape[1], 3, fr.n_elements)))
+    U = _sheared(mod, rng)
+    slip = _mixed_slip(mod, U, rng)
+    W, f = fr.nodal_force(U, slip)
+    W0, f0 = fr.nodal_force_numpy(U, slip)
+    assert np.abs(f0).max() > 0 and W0 > 0
+    np.testing.assert_allclose(f, f0, atol=1e-12 * np.abs(f0).max())
+    assert W == pytest.approx(W0, rel=1e-12)
+    assert not model.Model(m, _material(), element=element, kernels="numpy").shear_friction.compiled
+    gamma = fr.shear_angle(U)
+    np.testing.assert_allclose(gamma, replace(fr, compiled=False).shear_angle(U), atol=1e-12 * np.abs(gamma).max())
