@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from rftstatic.errors import CheckpointError, ConvergenceError
-from rftstatic.remesh.transfer import transfer_fields
+from rftstatic.remesh.transfer import element_values, transfer_fields
 from rftstatic.scenes.build import build_mesh, build_model
 from rftstatic.scenes.levels import level_scenes
 from rftstatic.scenes.options import run_options
@@ -52,7 +52,7 @@ from rftstatic.solvers.static_checkpoint import static_fingerprint
 
 log = logging.getLogger(__name__)
 
-__all__ = ["TRANSFER", "membrane_match", "solve_levels", "transfer_start"]
+__all__ = ["TRANSFER", "carry_slip", "membrane_match", "solve_levels", "transfer_start"]
 
 TRANSFER = "mesh"
 """How an equilibrium goes to the next mesh (:func:`rftstatic.remesh.transfer.transfer_fields`): linear
@@ -118,7 +118,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             log.info("mesh sequencing: level %d of %d (%d nodes) taken from %s", k, len(scenes), carry.mesh.n_nodes,
                      _level_path(folder, k))
             records.append({**saved["record"], "resumed": True})
-            prev = (carry, saved["U"])
+            prev = (carry, saved["U"], saved["slip"])
             continue
         if prev is None:  # the route finds the branch with the scene's own fabric
             m = carry if scale == 1.0 else build_model(sc, mesh, quiet=True)[0]
@@ -131,6 +131,8 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
         log.info("mesh sequencing: level %d of %d, %s nodes, by %s", k, len(scenes), m.mesh.n_nodes, what)
         try:
             state = start_state(m, level_opts.newton.linear_solver)
+            if prev is not None and prev[2] is not None and state.slip is not None:
+                state.slip = carry_slip(prev[0], prev[2], m)
             route = static_route(m, state, level_opts, U0=U0, callback=callback if last else None)
             res = drive(route, saver.on(state) if last and saver is not None else None)
         except ConvergenceError as exc:
@@ -152,13 +154,22 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
         if m is not carry:  # the coarsest level, matched: its equilibrium again with the matched membrane
             U, carry = _rematched(m, carry, res, opts, records[-1], totals)
         if folder is not None and not last:
-            _save_level(folder, k, carry, U, records[-1])
+            _save_level(folder, k, carry, U, records[-1], state.slip)
         if prev is None:
             first_path, first_relax = res.path, res.relax
-        prev = (carry, U)
+        prev = (carry, U, state.slip)
     res = _sequence_outcome(res, records, totals)
     return replace(res, path=res.path or first_path, relax=res.relax or first_relax,
                    wall_time=time.perf_counter() - t_all)
+
+
+def carry_slip(coarse_model, slip, fine_model) -> np.ndarray:
+    """The frictions' committed slips ``(E_coarse, k)`` of a coarser level's equilibrium on the elements of
+    ``fine_model`` (:func:`rftstatic.remesh.transfer.element_values`: the slip of the coarse element holding each
+    fine element's centroid): the next level's Newton starts from the history of the drape it carries, not from a
+    virgin fabric (the bending slip is a curvature [1/m] in material axes, the shear slip an angle [-]: both do not
+    depend on the element size). The two models have the same fabric, so the same columns."""
+    return element_values(coarse_model.mesh, slip, fine_model.mesh)
 
 
 def membrane_match(mesh, finest) -> float:
@@ -242,10 +253,11 @@ def _level_path(folder, k) -> Path:
     return Path(folder) / f"level-{k}.npz"
 
 
-def _save_level(folder, k, model, U, record) -> None:
-    """Level ``k``'s equilibrium ``U`` (N, 3) [m] of ``model`` and its record, in the one checkpoint format (a State
-    whose ``route["level"]`` is the record), keyed to the model's fingerprint."""
-    state = State(U=np.array(U, dtype=float), V=np.zeros_like(U), route={"level": record})
+def _save_level(folder, k, model, U, record, slip=None) -> None:
+    """Level ``k``'s equilibrium ``U`` (N, 3) [m] of ``model``, its frictions' committed ``slip`` (E, k) (None:
+    none) and its record, in the one checkpoint format (a State whose ``route["level"]`` is the record), keyed to
+    the model's fingerprint."""
+    state = State(U=np.array(U, dtype=float), V=np.zeros_like(U), route={"level": record}, slip=slip)
     save_atomic(_level_path(folder, k), state_arrays(state, {"kind": "level", "level": k,
                                                              "model": static_fingerprint(model)}))
 
@@ -264,4 +276,4 @@ def _load_level(folder, k, model):
             saved["U"].shape != (model.mesh.n_nodes, 3):
         log.warning("%s was saved for another model: level %d is solved again", path, k)
         return None
-    return {"U": saved["U"], "record": saved["route"]["level"]}
+    return {"U": saved["U"], "record": saved["route"]["level"], "slip": saved.get("slip")}

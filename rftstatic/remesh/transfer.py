@@ -50,7 +50,8 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
-__all__ = ["locate", "interpolate", "patch_weights", "GridField", "fit_grid", "transfer_fields", "METHODS"]
+__all__ = ["locate", "interpolate", "patch_weights", "GridField", "fit_grid", "transfer_fields", "element_values",
+           "METHODS"]
 
 METHODS = ("mesh", "patch", "grid")
 
@@ -331,3 +332,19 @@ def transfer_fields(old_mesh, new_points, fields, *, method="mesh", outside="ext
         result.append(out[:, c:c + n].reshape((len(pts),) + f.shape[1:]))
         c += n
     return result
+
+
+def element_values(old_mesh, values, new_mesh) -> np.ndarray:
+    """Per-element values ``(E_old, ...)`` of ``old_mesh`` on the elements of ``new_mesh``: ``(E_new, ...)``.
+
+    Each new element takes the value of the old element that holds its centroid (reference coordinates; a centroid
+    outside the old mesh takes the nearest old element's, :func:`locate` with ``outside="clamp"``): piecewise
+    constant, as the internal variables it carries are (the frictions' committed slips,
+    :meth:`rftstatic.model.model.Model.initial_slip`), so the values stay within the old ones' range."""
+    values = np.asarray(values, dtype=float)
+    if values.shape[0] != old_mesh.n_elements:
+        raise ValueError(f"values must have one row per element of the old mesh ({old_mesh.n_elements}), got "
+                         f"{values.shape}")
+    centroids = new_mesh.X[new_mesh.tri].mean(axis=1)
+    elem, _, _ = locate(old_mesh, centroids, outside="clamp")
+    return values[elem].copy()

@@ -274,3 +274,55 @@ def test_a_generated_mesh_without_nodes_has_the_builders_default_nodes():
     assert built == level_nodes(sc) == MESH_NODES["rectangle"][0] * MESH_NODES["rectangle"][1]
     assert auto_levels(sc) == 1 and run_options(sc).levels == 1
     assert level_mesh(sc, 1)["nodes"] == [6, 6]
+
+
+def test_element_values_go_to_the_old_element_holding_each_new_centroid():
+    """rftstatic.remesh.transfer.element_values, checked by barycentric coordinates computed here."""
+    from rftstatic.remesh.transfer import element_values
+
+    coarse = build_model(load_scene("strip", ["mesh.nodes=[11,3]"]))[0].mesh
+    fine = build_model(load_scene("strip", ["mesh.nodes=[21,5]"]))[0].mesh
+    values = np.stack([np.arange(coarse.n_elements, dtype=float), -np.arange(coarse.n_elements) ** 2.0], axis=1)
+    out = element_values(coarse, values, fine)
+    assert out.shape == (fine.n_elements, 2)
+    owner = out[:, 0].astype(int)
+    np.testing.assert_array_equal(out[:, 1], -owner ** 2.0)
+    c = fine.X[fine.tri].mean(axis=1)
+    P = coarse.X[coarse.tri[owner]]  # (E_fine, 3, 2)
+    T = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=2)
+    b12 = np.linalg.solve(T, (c - P[:, 0])[..., None])[..., 0]
+    bary = np.column_stack([1.0 - b12.sum(axis=1), b12])
+    assert bary.min() >= -1e-12  # each fine centroid lies in the coarse element whose value it took
+    with pytest.raises(ValueError, match="one row per element"):
+        element_values(coarse, values[:-1], fine)
+
+
+HYSTERESIS = ["material={kes_B_warp=0.083, kes_B_weft=0.063, kes_W=19.0, kes_T=0.5, kes_2HB_warp=0.05, "
+              "kes_2HB_weft=0.04}"]
+
+
+def test_the_frictions_slips_go_to_the_next_level_and_a_resume_takes_them_up(tmp_path, monkeypatch):
+    """A drape with bending hysteresis solved level by level: the fine level's Newton starts from the coarse
+    equilibrium's committed slips (carried by levels.carry_slip, not a virgin fabric), the saved level keeps them, and
+    a resumed sequence, which reads them from the level file, ends where the uninterrupted one did."""
+    scene = load_scene("pedestal-square-20", DRAPE + HYSTERESIS)
+    opts = static_options(scene, progress=False)
+    carried = []
+    real = levels_mod.carry_slip
+
+    def spy(coarse, slip, fine):
+        out = real(coarse, slip, fine)
+        carried.append((slip.copy(), out))
+        return out
+
+    monkeypatch.setattr(levels_mod, "carry_slip", spy)
+    first = solve_levels(scene, build_model(scene)[0], opts, folder=tmp_path)
+    assert first.converged and len(carried) == 1
+    coarse_slip, fine_slip = carried[0]
+    assert np.abs(coarse_slip).max() > 0  # the coarse drape slipped somewhere
+    assert fine_slip.shape == (build_model(scene)[0].mesh.n_elements, 2)
+    assert np.abs(fine_slip).max() == np.abs(coarse_slip).max()  # piecewise constant: the values carried as they are
+    again = solve_levels(scene, build_model(scene)[0], opts, folder=tmp_path, resume=True)
+    assert again.levels[0]["resumed"] and len(carried) == 2
+    np.testing.assert_array_equal(carried[1][0], coarse_slip)
+    assert np.allclose(again.U, first.U, rtol=0, atol=1e-9)
