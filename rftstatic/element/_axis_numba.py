@@ -17,7 +17,7 @@ einsum order by round-off (the tests' tolerance: 1e-12 of the largest entry).
 
 Scratch arrays are on the stack (:func:`rftstatic.element._kernels_numba._stack`: LLVM then knows they alias no
 argument; cusick-30's force of the softening 0.45 -> 0.37 ms a call). The functions are written plain and compiled
-at import (:func:`_compile`, ``cache=True``): numba keys a cached
+at import (:func:`rftstatic.element._kernels_numba.compile_in_place`, ``cache=True``): numba keys a cached
 function on its own file only, and these loops link the laws' code from two other files, so each compiled copy is
 named after a hash of the laws' code (:data:`LAW_KEY`): a changed law compiles new loops instead of loading old ones.
 
@@ -26,12 +26,11 @@ Imported only when numba is installed and a compiled back end is chosen (:mod:`r
 
 import hashlib
 import marshal
-import types
 
 import numba as nb
 import numpy as np
 
-from rftstatic.element._kernels_numba import _stack
+from rftstatic.element._kernels_numba import _stack, compile_in_place
 from rftstatic.element.hysteresis import friction_law as _friction_py
 from rftstatic.element.nonlinear_bending import softening_law as _softening_py
 
@@ -246,18 +245,4 @@ def _turning(e, L, T, geo, m0, m1, A, scratch, ke_e):
 _INLINE = ("_geometry", "_axis_curvature", "_laws", "_force", "_skew", "_turning")
 _LOOPS = ("curvatures", "add_forces", "tangents")
 
-
-def _compile():
-    """Replace each function of :data:`_INLINE` (inlined into the loops) and :data:`_LOOPS` by its compiled copy,
-    named ``NAME_<LAW_KEY>`` for numba's cache; the copies' globals are this module's, so that they call each
-    other's compiled copies."""
-    scope = globals()
-    for name in _INLINE + _LOOPS:
-        f = scope[name]
-        copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
-        copy.__qualname__ = f"{name}_{LAW_KEY}"
-        copy.__doc__ = f.__doc__
-        scope[name] = nb.njit(copy, inline="always" if name in _INLINE else "never", **_JIT)
-
-
-_compile()
+compile_in_place(globals(), _INLINE, _LOOPS, LAW_KEY, **_JIT)

@@ -75,6 +75,19 @@ def _compile(names, scope, suffix="", **options):
         scope[name] = nb.njit(copy, cache=True, nogil=True, error_model="numpy", **options)
 
 
+def compile_in_place(scope, inline, loops, key, **options):
+    """Replace each function named in ``inline`` (inlined into the loops) and ``loops`` in ``scope`` (a module's
+    globals) by its compiled copy named ``NAME_<key>`` for numba's cache (``cache=True``): a module whose loops
+    link code of other files names them after a hash of that code (``key``), since numba keys a cached function on
+    its own file only. The copies' globals are ``scope``, so that they call each other's compiled copies."""
+    for name in tuple(inline) + tuple(loops):
+        f = scope[name]
+        copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
+        copy.__qualname__ = f"{name}_{key}"
+        copy.__doc__ = f.__doc__
+        scope[name] = nb.njit(copy, inline="always" if name in inline else "never", **options)
+
+
 _base = dict(vars(kernels))
 _base.update(prange=nb.prange, _scratch=_stack, lanes=nb.njit(_lanes, cache=True, nogil=True, inline="always"))
 _twins = {}

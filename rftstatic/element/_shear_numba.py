@@ -28,7 +28,7 @@ import types
 import numba as nb
 
 from rftstatic.element import kernels
-from rftstatic.element._kernels_numba import _stack
+from rftstatic.element._kernels_numba import _stack, compile_in_place
 from rftstatic.element.hysteresis import friction_law as _friction_py
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
@@ -107,19 +107,7 @@ def shear_angles(nodes, G, t, offset, U, gamma):
 _INLINE = ("_gradients", "_shear_angle")
 _LOOPS = ("shear_force", "shear_angles")
 
+compile_in_place(globals(), _INLINE, _LOOPS, CODE_KEY, **_JIT)
 
-def _compile():
-    """Replace each function of :data:`_INLINE` (inlined into the loops) and :data:`_LOOPS` by its compiled copy
-    named ``NAME_<CODE_KEY>`` (module docstring); the copies' globals are this module's."""
-    scope = globals()
-    for name in _INLINE + _LOOPS:
-        f = scope[name]
-        copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
-        copy.__qualname__ = f"{name}_{CODE_KEY}"
-        copy.__doc__ = f.__doc__
-        scope[name] = nb.njit(copy, inline="always" if name in _INLINE else "never", **_JIT)
-
-
-_compile()
 
 __all__ = ["CODE_KEY", "shear_angles", "shear_force"]

@@ -151,12 +151,13 @@ class ForceKernel:
         if self._bend_offset is not None:
             f += self._bend_offset
             W += float(np.einsum("ni,ni->", U, self._bend_offset)) + self._bend_energy if energy else 0.0
+        if self.axis_terms is not None or self.shear_friction is not None:
+            bend, shear = self.model.split_slip(slip)
         if self.axis_terms is not None:
-            Wt = self.axis_terms.add_forces(U if self._bend_offset is None else self.X3 + U, self.X3 + U, f,
-                                              self.model.split_slip(slip)[0])
+            Wt = self.axis_terms.add_forces(U if self._bend_offset is None else self.X3 + U, self.X3 + U, f, bend)
             W += Wt if energy else 0.0
         if self.shear_friction is not None:
-            Ws, fs = self.shear_friction.nodal_force(U, self.model.split_slip(slip)[1])
+            Ws, fs = self.shear_friction.nodal_force(U, shear)
             f += fs
             W += Ws if energy else 0.0
         if self.hinges is not None:
