@@ -39,7 +39,8 @@ from pathlib import Path
 import numpy as np
 
 from rftstatic.errors import CheckpointError, ConvergenceError
-from rftstatic.remesh.transfer import element_values, transfer_fields
+from rftstatic.remesh.adapt import carry_slip
+from rftstatic.remesh.transfer import transfer_fields
 from rftstatic.scenes.build import build_mesh, build_model
 from rftstatic.scenes.levels import level_scenes
 from rftstatic.scenes.options import run_options
@@ -161,15 +162,6 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     res = _sequence_outcome(res, records, totals)
     return replace(res, path=res.path or first_path, relax=res.relax or first_relax,
                    wall_time=time.perf_counter() - t_all)
-
-
-def carry_slip(coarse_model, slip, fine_model) -> np.ndarray:
-    """The frictions' committed slips ``(E_coarse, k)`` of a coarser level's equilibrium on the elements of
-    ``fine_model`` (:func:`rftstatic.remesh.transfer.element_values`: the slip of the coarse element holding each
-    fine element's centroid): the next level's Newton starts from the history of the drape it carries, not from a
-    virgin fabric (the bending slip is a curvature [1/m] in material axes, the shear slip an angle [-]: both do not
-    depend on the element size). The two models have the same fabric, so the same columns."""
-    return element_values(coarse_model.mesh, slip, fine_model.mesh)
 
 
 def membrane_match(mesh, finest) -> float:

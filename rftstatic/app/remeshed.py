@@ -18,7 +18,9 @@ Outputs in the run folder, every number in the scene's units:
   time, the ``[remesh]`` settings, one record per mesh (cycle, time and step, reason, node and
   triangle counts, mesher quality, largest |kappa| h and |kappa| h^2, node-count change, wall time),
   the drape measures of the final state (:func:`rftstatic.io.summary.drape_summary`), its self-intersection
-  check (:func:`rftstatic.io.summary.self_intersection_summary`) and the probes;
+  check (:func:`rftstatic.io.summary.self_intersection_summary`), the probes and, with bending or shear hysteresis,
+  what the frictions dissipated over all the meshes (their slips carried at every remesh,
+  :func:`rftstatic.remesh.adapt.carry_slip`) and the share slipping on the last;
 * ``mesh_<k>_{top,iso}.png``: the deformed sheet with its mesh edges at each successive mesh
   (relax: the transferred state just after remesh k; static: the equilibrium on mesh k is only
   known for the last mesh, so the earlier ones are drawn flat in the top view), ``remesh.gif``
@@ -102,7 +104,8 @@ class _Tracker:
         self._rebind = len(self.meshes) == len(meshes)  # the next call is on the last snapshot's mesh
         self.advance.restore(fields, same_mesh=self._rebind)
 
-    def __call__(self, model, U, V, n):
+    def __call__(self, model, U, V, n, **history):
+        """The stepper's chunk (``history``: the frictions' ``slip``, passed on; its returns, passed back)."""
         if self._rebind:
             self.meshes[-1]["model"], self._rebind = model, False
         if not self.meshes or self.meshes[-1]["model"] is not model:
@@ -111,11 +114,12 @@ class _Tracker:
             self.last = (model, U, V)
             raise _TimeUp
         # the last chunk ends at t_end itself (its last step shortened), not a chunk beyond it
-        U, V, dt = self.advance(model, U, V, n, max_time=self.t_end - self.t)
+        out = self.advance(model, U, V, n, max_time=self.t_end - self.t, **history)
+        U, V, dt = out[:3]
         self.t += float(dt)
         self.steps += getattr(self.advance, "last_steps", n)
         self.last = (model, U, V)
-        return U, V, dt
+        return out
 
 
 def run(scene, out: Path, *, progress=True, figures=True, resume=False,
@@ -205,7 +209,7 @@ def _static(scene, opts, state, saver) -> dict:
     meshes[-1]["U"] = res.result.U
     return {"route": "remesh_static", "model": res.model, "extras": res.extras, "U": res.result.U,
             "records": res.records, "converged": bool(res.converged and res.result.converged),
-            "self_contact_scale": res.result.self_contact_scale,
+            "self_contact_scale": res.result.self_contact_scale, "slip": res.slip, "dissipated": res.dissipated,
             "meshes": meshes, "t": None, "steps": None, "skipped": 0}
 
 
@@ -247,6 +251,7 @@ def _relax(scene, opts, state, saver) -> dict:
         route = remesh_relax_route(make, opts, state, motion, advance=track, residual=residual)
         res = drive(route, None if saver is None else on_pause)
         model, U, records, converged, skipped = res.model, res.U, res.records, res.converged, res.skipped
+        history = (res.slip, res.dissipated)
         t, steps = res.t, res.steps
         stopped_by = "rest" if converged else "max_steps" if steps >= max_steps else "max_remesh"
     except FloatingPointError:  # the explicit motion blew up: a goal not reached, not a bug
@@ -258,6 +263,7 @@ def _relax(scene, opts, state, saver) -> dict:
     except _TimeUp:
         # the driver keeps its records to itself; rebuild them from the meshes the stepper saw
         model, U, _ = track.last
+        history = (state.slip, state.dissipated)  # the route's last pause, just before this chunk
         records = []
         for k, m in enumerate(track.meshes):
             mm = m["mesh"]
@@ -276,6 +282,7 @@ def _relax(scene, opts, state, saver) -> dict:
     extras = extras0  # probes and obstacles are defined in reference coordinates: the same on every mesh
     return {"route": "remesh_relax", "model": model, "extras": extras, "U": U, "records": records,
             "converged": bool(converged), "meshes": meshes, "t": t, "steps": steps, "skipped": skipped,
+            "slip": history[0], "dissipated": history[1],
             "dynamics": d, "alphas": list(stepper.alphas), "stopped_by": stopped_by, "max_steps": max_steps}
 
 
@@ -355,10 +362,27 @@ def summarize(scene, opts, solved) -> dict:
         summary["newton_iterations"] = int(solved["records"][-1].solve.get("iterations", 0))
     if solved["extras"].get("obstacles"):
         summary["drape"] = drape_summary(scene, model, solved["extras"], U)
+    _friction_summaries(scene, model, solved, summary)
     if (crossings := obstacle_crossing_summary(scene, model, solved["extras"], U)) is not None:
         summary["obstacle_crossings"] = crossings
     summary["probes"] = probe_summary(scene, model, solved["extras"].get("probes", {}), U)
     return summary
+
+
+def _friction_summaries(scene, model, solved, summary: dict) -> None:
+    """With bending or shear hysteresis, the frictions at the end of the run (the static route's summaries,
+    :func:`rftstatic.app.static.hysteresis_summary`): energy dissipated along the run, over all its meshes [scene
+    units], and the share of the final mesh's elements slipping."""
+    if solved.get("slip") is None:
+        return
+    from rftstatic.app.static import hysteresis_summary, shear_hysteresis_summary
+
+    U = solved["U"]
+    state = State(U=U, V=np.zeros_like(U), slip=solved["slip"], dissipated=float(solved["dissipated"]))
+    if model.bending_friction is not None:
+        summary["bending_hysteresis"] = hysteresis_summary(scene, model, state, U)
+    if model.shear_friction is not None:
+        summary["shear_hysteresis"] = shear_hysteresis_summary(scene, model, state, U)
 
 
 def _write(scene, solved, out: Path, summary: dict, *, figures=True) -> None:

@@ -11,7 +11,9 @@ f. h_target to the square background grid with a gradation limit
 g. a new advancing-front mesh of the flat reference sheet (:func:`rftstatic.mesh.mesher.generate`);
    the sheet's outline is recovered from the old mesh (:func:`reference_domain`): straight sides
    as polygons, circles exactly, so repeated remeshing does not shrink a disc;
-h. U (and V) at the new nodes, then zero on the new mesh's supports;
+h. U (and V) at the new nodes, then zero on the new mesh's supports; the frictions' committed slips (bending and
+   shear hysteresis, per element) on the new elements by the old element holding each new centroid
+   (:func:`carry_slip`);
 and the model is rebuilt on the new mesh by the caller's factory (for a scene,
 :func:`rftstatic.scenes.build.build_model` with ``mesh=``: supports, loads, probes and obstacles are
 defined in reference coordinates, the bending stiffness and the lumped mass follow the mesh).
@@ -43,14 +45,14 @@ import numpy as np
 from rftstatic.element.curvature import curvature_norm
 from rftstatic.mesh import GRADATION
 from rftstatic.remesh.sizefield import check_size_bounds, size_field
-from rftstatic.remesh.transfer import transfer_fields
+from rftstatic.remesh.transfer import element_values, transfer_fields
 
 DAMPING = ("fixed", "critical")
 """Damping of the remeshed relaxation: the scene's alpha, or critical for the sheet's slowest swing."""
 
 log = logging.getLogger(__name__)
 
-__all__ = ["reference_domain", "adapt_mesh", "transfer_state", "RemeshRecord", "refinable_maxima",
+__all__ = ["reference_domain", "adapt_mesh", "transfer_state", "carry_slip", "RemeshRecord", "refinable_maxima",
            "DAMPING"]
 
 
@@ -135,6 +137,19 @@ def transfer_state(old_model, new_model, U, V=None, *, method="mesh"):
     U_new = out[0] * free
     V_new = None if V is None else out[1] * free
     return U_new, V_new
+
+
+def carry_slip(old_model, slip, new_model):
+    """The frictions' committed slips ``(E_old, k)`` of ``old_model``'s state on the elements of ``new_model``:
+    ``(E_new, k)`` (:func:`rftstatic.remesh.transfer.element_values`: each new element takes the slip of the old
+    element holding its centroid), or None when ``slip`` is (no friction). Mesh sequencing
+    (:mod:`rftstatic.app.levels`) and both adaptive remeshing drivers carry the slips with it, so the next mesh
+    starts from the history of the drape it takes over, not from a virgin fabric: the bending slip is a curvature
+    [1/m] in material axes and the shear slip an angle [-] (:meth:`rftstatic.model.model.Model.initial_slip`), per
+    element, neither depending on the element size. The two models have the same fabric, so the same columns."""
+    if slip is None:
+        return None
+    return element_values(old_model.mesh, slip, new_model.mesh)
 
 
 @dataclass

@@ -1,6 +1,11 @@
 """Dynamic relaxation with global adaptive remeshing (§5.2 a-i, §6): the damped, mass-scaled explicit
 motion in chunks, remeshed on a schedule or when the curvature asks, until the sheet is at rest on a
 mesh that would not change.
+
+With bending or shear hysteresis (``model.has_friction``) the frictions' committed slips ride along: every chunk of
+steps goes on from the slips the last one committed, every remesh carries them to the new elements
+(:func:`~rftstatic.remesh.adapt.carry_slip`: the slip of the old element holding each new centroid), and the energy
+they dissipate adds up over the run.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from rftstatic.remesh.adapt import (
     _curvature_figures,
     _factory,
     adapt_mesh,
+    carry_slip,
     reference_domain,
     refinable_maxima,
     transfer_state,
@@ -172,10 +178,15 @@ class ExplicitStepper:
         self.alphas = [float(a) for a in state["alphas"]]
         self._resumed_dt = state["dt"] if same_mesh else None
 
-    def __call__(self, model, U, V, n_steps, *, max_time=None):
+    def __call__(self, model, U, V, n_steps, *, max_time=None, slip=None):
         """Advance ``n_steps`` steps, or fewer (the last one shortened) that end at ``max_time`` [s] when
-        ``n_steps`` would go beyond it; ``last_steps`` is the number taken."""
-        from rftstatic.solvers.explicit import run_explicit
+        ``n_steps`` would go beyond it; ``last_steps`` is the number taken. Returns ``(U, V, t)``; given the
+        frictions' committed ``slip (E, k)`` (:meth:`rftstatic.model.model.Model.initial_slip`), the steps go on from
+        it and it returns ``(U, V, t, slip, dissipated)``, the slips committed by the last step and the energy the
+        frictions dissipated over the chunk [J] (without, each chunk starts from the virgin fabric)."""
+        from rftstatic.model.state import State
+        from rftstatic.solvers.drive import finish
+        from rftstatic.solvers.explicit import explicit_steps
         from rftstatic.solvers.explicit_options import ExplicitOptions
         from rftstatic.solvers.timestep import stable_time_step
 
@@ -197,9 +208,14 @@ class ExplicitStepper:
         options = ExplicitOptions(t_end=span, dt=step, alpha=a, mass_scale=self.mass_scale, start="given",
                                   sample_every=max(1, n_steps), progress=False, energy_check=self.energy_check,
                                   backend=self.backend)
-        run = run_explicit(model, options, obstacles=self.near, U0=U, V0=V)
+        state = State.initial(model, U, V)
+        if slip is not None:
+            state.slip = np.array(slip, dtype=float)
+        run = finish(explicit_steps(model, state, options, obstacles=self.near))
         self.last_steps = run.steps
-        return run.U, run.V, run.t
+        if slip is None:
+            return run.U, run.V, run.t
+        return run.U, run.V, run.t, state.slip, state.dissipated
 
 
 def explicit_advance(**options) -> ExplicitStepper:
@@ -211,7 +227,8 @@ def explicit_advance(**options) -> ExplicitStepper:
 class RemeshRelaxResult:
     """Outcome of :func:`remesh_relax`: final U, V (N, 3) [m, m/s], model and extras, the time [s]
     and steps advanced, one :class:`RemeshRecord` per mesh, whether the sheet came to rest on a
-    mesh that no longer changes, and how many triggered remeshes were skipped (mesh settled)."""
+    mesh that no longer changes, how many triggered remeshes were skipped (mesh settled), the frictions'
+    committed slips (E, k) on the final mesh (None without hysteresis) and the energy they dissipated [J]."""
 
     U: np.ndarray
     V: np.ndarray
@@ -222,6 +239,18 @@ class RemeshRelaxResult:
     records: list
     converged: bool
     skipped: int = 0
+    slip: np.ndarray | None = None
+    dissipated: float = 0.0
+
+
+def _chunk(advance, model, U, V, n, slip):
+    """``(U, V, t_advanced, slip, dissipated)``: ``n`` steps by ``advance`` from U, V (N, 3) [m, m/s]; for a model with
+    hysteresis (``slip`` (E, k) its frictions' committed slips, not None) ``advance(model, U, V, n, slip=slip)``, which
+    returns the slips committed at the chunk's end and the energy the frictions dissipated in it [J]
+    (:class:`ExplicitStepper`), else ``advance(model, U, V, n)`` (slip None, nothing dissipated)."""
+    if slip is None:
+        return (*advance(model, U, V, n), None, 0.0)
+    return advance(model, U, V, n, slip=slip)
 
 
 def _initial_state(model, U0, V0) -> RelaxState:
@@ -265,12 +294,14 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
         and ``damping`` (of the default stepper: ``"fixed"`` or ``"critical"``, :func:`critical_damping`)
     motion : :class:`~rftstatic.remesh.options.RemeshRelaxOptions` (damping, mass scaling, chunk, limits, rest
         test, skipping of settled meshes)
-    advance : ``advance(model, U, V, n_steps) -> (U, V, t_advanced)``; default
-        :func:`explicit_advance` with ``motion.alpha``, ``motion.mass_scale`` and the scene's obstacles
+    advance : ``advance(model, U, V, n_steps) -> (U, V, t_advanced)``, with hysteresis ``advance(..., slip=slip)
+        -> (U, V, t_advanced, slip, dissipated)`` (:func:`_chunk`); default :func:`explicit_advance` with
+        ``motion.alpha``, ``motion.mass_scale`` and the scene's obstacles
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
     state : the run's :class:`~rftstatic.model.state.State`; its position ``state.route[REMESH_RELAX]`` (a
         :class:`~rftstatic.remesh.checkpoint.RelaxState`) before every chunk (a pause, held back by the saver's
-        throttle; final after a remesh) and at the end (final). Given a State with a saved position, the run goes on
+        throttle; final after a remesh) and at the end (final), with U, V, t, step and the frictions' ``slip`` and
+        ``dissipated``. Given a State with a saved position, the run goes on
         from there (``start`` unused). With an ``advance`` that keeps state of its own (the damping history, the
         stable step of the mesh), the caller restores that too.
     start : ``(U0, V0)``, (N, 3) start on the initial mesh [m, m/s] (default zero)
@@ -308,12 +339,14 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
     peak, records, meshes, done, converged = r.peak, list(r.records), list(r.meshes), r.done, r.converged
     if len(meshes) > 1:  # a restart on a later mesh (the initial model serves mesh 0)
         model, extras = make(meshes[-1])
+    slip, dissipated = (model.initial_slip(), 0.0) if restart is None else (state.slip, state.dissipated)  # frictions'
     phase = None  # what the next snapshot is: None (the state just loaded or started), "chunk", "remesh"
 
     def pause(phase):
         state.route[REMESH_RELAX] = RelaxState(meshes, U, V, t, steps, since, n_remesh, skipped, peak, records,
                                                done=done, converged=converged, phase=phase)
         state.U, state.V, state.t, state.step = U, V, t, steps
+        state.slip, state.dissipated = slip, dissipated
         return Pause(f"t = {t:.4g} s, step {steps}, mesh {len(meshes) - 1} ({meshes[-1].n_nodes} nodes)",
                      final=phase != "chunk")
 
@@ -322,7 +355,8 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
             yield pause(phase)  # every path through the loop ends here: the state the next chunk starts from
         phase = "chunk"
         n = int(min(m.chunk, max_steps - steps))
-        U, V, dt_adv = advance(model, U, V, n)
+        U, V, dt_adv, slip, spent = _chunk(advance, model, U, V, n, slip)
+        dissipated += float(spent)
         if not (np.isfinite(U).all() and np.isfinite(V).all()):
             raise FloatingPointError(f"remesh_relax: non-finite state after step {steps + n} (t = {t:.4g} s) on a "
                                      f"mesh of {model.mesh.n_nodes} nodes; reduce the time step (safety) or raise alpha")
@@ -362,6 +396,7 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
             continue
         new_model, new_extras = make(new_mesh)
         U, V = transfer_state(model, new_model, U, V, method=o.transfer)
+        slip = carry_slip(model, slip, new_model)
         model, extras = new_model, new_extras
         n_remesh += 1
         since, peak = 0, 0.0
@@ -386,4 +421,4 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
         log.warning("remesh_relax: not at rest on a settled mesh after %d steps (t = %.4g s, %d remeshes)",
                     steps, t, n_remesh)
     return RemeshRelaxResult(U=U, V=V, model=model, extras=extras, t=t, steps=steps, records=records,
-                             converged=converged, skipped=skipped)
+                             converged=converged, skipped=skipped, slip=slip, dissipated=float(dissipated))

@@ -1,6 +1,11 @@
 """Static solution with global adaptive remeshing (a step beyond the paper, which remeshes only during
 dynamic relaxation): solve -> size a new mesh from the converged curvature (Eq. 28-29) -> transfer U ->
 solve again at full load from the transferred state, until the node count settles.
+
+With bending or shear hysteresis (``model.has_friction``) the frictions' committed slips go with U to every new mesh
+(:func:`~rftstatic.remesh.adapt.carry_slip`: each new element takes the slip of the old element holding its centroid),
+and the next solve goes on from them; the energy they dissipate adds up over the cycles. A cycle whose solve from the
+transferred state fails solves again from the flat sheet, a new path: from the virgin fabric, its dissipation alone.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ from rftstatic.remesh.adapt import (
     _curvature_figures,
     _factory,
     adapt_mesh,
+    carry_slip,
     reference_domain,
     refinable_maxima,
     transfer_state,
@@ -41,6 +47,9 @@ class RemeshStaticResult:
     records : one :class:`RemeshRecord` per mesh solved
     converged : the mesh stopped changing (and, if given, |kappa| h <= kappa_h_max) within ``max_cycles``
     meshes : the :class:`~rftstatic.mesh.trimesh.TriMesh` of every record
+    slip : the frictions' committed slips (E, k) on the final mesh (:meth:`rftstatic.model.model.Model.initial_slip`;
+        None without hysteresis)
+    dissipated : energy the frictions dissipated along the route that led to the final state [J] (module docstring)
     """
 
     result: object
@@ -49,6 +58,8 @@ class RemeshStaticResult:
     records: list
     converged: bool
     meshes: list = field(default_factory=list)
+    slip: np.ndarray | None = None
+    dissipated: float = 0.0
 
 
 def _continuation(options):
@@ -86,7 +97,8 @@ def remesh_static_route(problem, options: RemeshOptions, state: State, *, solver
         defaults, without a progress bar); later solves start from the transferred state at
         full load (one load step) and fall back to the full load ramp from flat if that fails
     domain : mesher Domain of the sheet (default: :func:`reference_domain` of the initial mesh)
-    state : the run's :class:`~rftstatic.model.state.State` (U is the last equilibrium at each pause)
+    state : the run's :class:`~rftstatic.model.state.State` (U is the last equilibrium at each pause, ``slip`` and
+        ``dissipated`` the frictions' there: what a resumed run goes on from)
 
     Returns
     -------
@@ -98,7 +110,7 @@ def remesh_static_route(problem, options: RemeshOptions, state: State, *, solver
         when a solve fails even from flat (its ``.result`` is the last equilibrium)
     """
     from rftstatic.errors import ConvergenceError
-    from rftstatic.solvers.static import StaticOptions, solve_static
+    from rftstatic.solvers.static import StaticOptions
 
     o = options
     const, h_lower, h_upper = o.const, o.h_lower, o.h_upper
@@ -111,13 +123,14 @@ def remesh_static_route(problem, options: RemeshOptions, state: State, *, solver
         domain = reference_domain(model.mesh)
     restart = state.route.get(REMESH_STATIC)
     if restart is None:
-        result = solve_static(model, options=solver)
+        result, history = _solve(model, solver)
         records = [RemeshRecord(0, model.mesh.n_nodes, model.mesh.n_elements, dict(model.mesh.info.get("quality", {})),
                                 solve=_static_figures(result, restarted=False))]
         meshes, first = [model.mesh], 1
-        yield _cycle_pause(state, StaticCycleState(0, meshes, result, records))
+        yield _cycle_pause(state, StaticCycleState(0, meshes, result, records), history)
     else:
         result, records, meshes, first = restart.result, list(restart.records), list(restart.meshes), restart.cycle + 1
+        history = (state.slip, state.dissipated)  # the frictions' on the last mesh, saved with the position
         if restart.cycle > 0:  # the initial model serves cycle 0
             model, extras = make(meshes[-1])
     converged = False
@@ -141,17 +154,18 @@ def remesh_static_route(problem, options: RemeshOptions, state: State, *, solver
         U0, _ = transfer_state(model, new_model, result.U, method=o.transfer)
         restarted = False
         try:
-            result = solve_static(new_model, U0=U0, options=_continuation(solver))
+            result, history = _solve(new_model, _continuation(solver), U0=U0,
+                                     history=(carry_slip(model, history[0], new_model), history[1]))
         except ConvergenceError as exc:
             log.info("remesh_static cycle %d: no equilibrium from the transferred state (%s); solving from flat",
                      cycle, exc)
             restarted = True
-            result = solve_static(new_model, options=solver)
+            result, history = _solve(new_model, solver)  # a new path from flat: the virgin fabric
         model, extras = new_model, new_extras
         records.append(RemeshRecord(cycle, new_mesh.n_nodes, new_mesh.n_elements, new_mesh.info["quality"],
                                     reason="cycle", solve=_static_figures(result, restarted=restarted)))
         meshes.append(new_mesh)
-        yield _cycle_pause(state, StaticCycleState(cycle, meshes, result, records))
+        yield _cycle_pause(state, StaticCycleState(cycle, meshes, result, records), history)
     state.route.pop(REMESH_STATIC, None)
     rec = records[-1]
     if not converged:
@@ -161,13 +175,32 @@ def remesh_static_route(problem, options: RemeshOptions, state: State, *, solver
         log.warning("remesh_static: the mesh still changes after %d cycles (max |kappa| h %.3g)",
                     o.max_cycles, rec.max_kappa_h)
     return RemeshStaticResult(result=result, model=model, extras=extras, records=records, converged=converged,
-                              meshes=meshes)
+                              meshes=meshes, slip=history[0], dissipated=float(history[1]))
 
 
-def _cycle_pause(state, position: StaticCycleState) -> Pause:
-    """``position`` as the route's in ``state`` (U its equilibrium), and the final pause after its cycle."""
+def _solve(model, options, *, U0=None, history=(None, 0.0)):
+    """``(result, history)``: the static solve of ``model`` (:func:`~rftstatic.solvers.static.static_route` from a
+    fresh :func:`~rftstatic.solvers.newton.start_state`, ``U0`` (N, 3) [m] or None) going on from the frictions'
+    ``history``, ``(slip (E, k) or None: the virgin fabric, dissipated [J])``, and that history at its end."""
+    from rftstatic.solvers.newton import start_state
+    from rftstatic.solvers.static import static_route
+
+    state = start_state(model, options.newton.linear_solver)
+    slip, state.dissipated = history[0], float(history[1])
+    if slip is not None and state.slip is not None:
+        if np.shape(slip) != state.slip.shape:
+            raise ValueError(f"slip has shape {np.shape(slip)}, the model's frictions need {state.slip.shape}")
+        state.slip = np.array(slip, dtype=float)
+    result = finish(static_route(model, state, options, U0=U0))
+    return result, (state.slip, state.dissipated)
+
+
+def _cycle_pause(state, position: StaticCycleState, history) -> Pause:
+    """``position`` as the route's in ``state`` (U its equilibrium, ``history`` = (slip, dissipated) the frictions'
+    there), and the final pause after its cycle."""
     state.route[REMESH_STATIC] = position
     state.U = position.result.U
+    state.slip, state.dissipated = history
     return Pause(f"cycle {position.cycle}, {position.meshes[-1].n_nodes} nodes", final=True)
 
 

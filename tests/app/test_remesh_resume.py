@@ -96,7 +96,7 @@ def test_an_interrupted_static_remesh_run_resumes_after_its_last_cycle(tmp_path,
     scene, full = strip_full
     assert full.summary["remeshes"] == 1 and full.summary["checkpoint"]["writes"] == 2  # one per solved cycle
     out = tmp_path / "cut"
-    _interrupt_call(monkeypatch, static_solver, "solve_static", 2)  # Ctrl-C in the solve of cycle 1
+    _interrupt_call(monkeypatch, static_solver, "static_route", 2)  # Ctrl-C in the solve of cycle 1
     with pytest.raises(KeyboardInterrupt):
         _run(scene, out)
     monkeypatch.undo()
