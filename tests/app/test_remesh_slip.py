@@ -10,6 +10,7 @@ import pytest
 from rftstatic.app import remeshed
 from rftstatic.app.remeshed import solve_remesh_scene, summarize
 from rftstatic.remesh import relax_driver, static_driver
+from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import remesh_options
 from rftstatic.scenes.schema import load_scene
 
@@ -92,6 +93,22 @@ def test_a_remeshed_relaxation_carries_the_slips_to_every_new_mesh(monkeypatch, 
     key = "bending_hysteresis" if columns == 2 else "shear_hysteresis"
     spent = summary[key]["dissipated" if columns == 2 else "dissipated_both_frictions"]
     assert spent == pytest.approx(scene.units.from_si(solved["dissipated"], "energy"), rel=1e-12)
+
+
+@pytest.mark.parametrize("material,slip", [(BENDING, [5.0, -5.0]), (SHEAR, [0.01])], ids=["2HB", "2HG"])
+def test_the_stepper_steps_from_the_slips_it_is_given(material, slip):
+    """The remeshed relaxation's stepper goes on from the committed slips it is given (a friction that slipped pulls
+    the flat sheet at rest away from where a virgin fabric's steps take it); virgin slips give the steps without."""
+    model = build_model(load_scene("remesh-pedestal-square-20", RELAX + material))[0]
+    stepper = relax_driver.ExplicitStepper(alpha=1.0, mass_scale=100.0)
+    Z = np.zeros((model.mesh.n_nodes, 3))
+    U0, _, t0 = stepper(model, Z, Z, 5)
+    virgin = stepper(model, Z, Z, 5, slip=model.initial_slip())
+    np.testing.assert_array_equal(virgin[0], U0)
+    assert virgin[2] == t0 and virgin[4] >= 0.0
+    given = np.tile(slip, (model.mesh.n_elements, 1))
+    U1, _, _, slip1, _ = stepper(model, Z, Z, 5, slip=given)
+    assert slip1.shape == given.shape and np.abs(U1 - U0).max() > 1e-3 * np.abs(U0).max()
 
 
 def test_a_static_remesh_run_carries_the_slips_to_every_new_mesh(monkeypatch):
