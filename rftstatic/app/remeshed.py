@@ -242,8 +242,8 @@ def _relax(scene, opts, state, saver) -> dict:
     def make(mesh=None):  # hand the already built initial model to the driver
         return first.pop() if mesh is None and first else factory(mesh)
 
-    def residual(model, U):  # the pedestal carries the weight of the nodes on it
-        return contact_reaction_residual(model, obstacles, U)
+    def residual(model, U, slip=None):  # the pedestal carries the weight of the nodes on it
+        return contact_reaction_residual(model, obstacles, U, slip=slip)
 
     try:
         motion = RemeshRelaxOptions(mass_scale=d.mass_scale, max_steps=max_steps,
@@ -355,7 +355,8 @@ def summarize(scene, opts, solved) -> dict:
                        alpha=d.alpha * u.time, mass_scale=d.mass_scale, damping=settings["damping"],
                        alpha_final=(solved["alphas"][-1] if solved.get("alphas") else d.alpha) * u.time)
         P = np.where(model.free, model.load, 0.0)
-        r = np.where(model.free, contact_reaction_residual(model, solved["extras"].get("obstacles", ()), U), 0.0)
+        r = np.where(model.free, contact_reaction_residual(model, solved["extras"].get("obstacles", ()), U,
+                                                           slip=solved.get("slip")), 0.0)
         summary["residual_relative"] = float(np.linalg.norm(r) / max(np.linalg.norm(P), 1e-300))
         summary["rest_test"] = RestCriterion(d.rest_tolerance, d.force_tolerance).record()
     else:

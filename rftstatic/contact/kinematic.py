@@ -99,8 +99,9 @@ TOUCH_TOLERANCE = 1e-3
 """A node touches an obstacle when its signed distance is below this fraction of the smallest element size."""
 
 
-def contact_reaction_residual(model, obstacles, U, lam: float = 1.0) -> np.ndarray:
-    """``model.residual(U, lam)`` ``(N, 3)`` [N] with the kinematic contact's reaction taken off.
+def contact_reaction_residual(model, obstacles, U, lam: float = 1.0, *, slip=None) -> np.ndarray:
+    """``model.residual(U, lam, slip=slip)`` ``(N, 3)`` [N] with the kinematic contact's reaction taken off (``slip``:
+    the frictions' committed slips (E, k), :meth:`rftstatic.model.model.Model.initial_slip`; None: the virgin fabric).
 
     ``model.residual(U)`` = F(U) - P knows nothing of the kinematic obstacles: the weight carried by a
     pedestal stays in it and the sheet never counts as at rest. At a node touching an obstacle (phi below
@@ -110,7 +111,7 @@ def contact_reaction_residual(model, obstacles, U, lam: float = 1.0) -> np.ndarr
     (on a fully free node lam = max(r . n, 0); on a node whose x and y are held, e.g. the in-plane hold
     on top of a sphere, the support takes the in-plane part of lam n), and r -> r - lam n there.
     """
-    r = model.residual(U, lam)
+    r = model.residual(U, lam, slip=slip)
     obstacles = _as_list(obstacles) if obstacles else []
     if not obstacles:
         return r

@@ -305,8 +305,8 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
         from there (``start`` unused). With an ``advance`` that keeps state of its own (the damping history, the
         stable step of the mesh), the caller restores that too.
     start : ``(U0, V0)``, (N, 3) start on the initial mesh [m, m/s] (default zero)
-    residual : ``residual(model, U) -> (N, 3)`` [N], the out-of-balance force of the rest test (default
-        ``model.residual(U)``; with kinematic obstacles,
+    residual : ``residual(model, U) -> (N, 3)`` [N], the out-of-balance force of the rest test (with hysteresis
+        ``slip=`` the frictions' committed slips too; default ``model.residual``; with kinematic obstacles,
         :func:`rftstatic.contact.kinematic.contact_reaction_residual` takes their reaction off)
 
     Returns
@@ -320,8 +320,8 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
     max_steps, mass_scale = m.max_steps, m.mass_scale
     make = _factory(problem)
     if residual is None:
-        def residual(model, U):
-            return model.residual(U)
+        def residual(model, U, slip=None):
+            return model.residual(U, slip=slip)
     model, extras = make(None)
     _check_extent(model.mesh, const, h_lower, h_upper)
     if advance is None:
@@ -360,16 +360,15 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
         if not (np.isfinite(U).all() and np.isfinite(V).all()):
             raise FloatingPointError(f"remesh_relax: non-finite state after step {steps + n} (t = {t:.4g} s) on a "
                                      f"mesh of {model.mesh.n_nodes} nodes; reduce the time step (safety) or raise alpha")
-        t += float(dt_adv)
-        steps += n
-        since += n
+        t, steps, since = t + float(dt_adv), steps + n, since + n
         kappa, kh, kh2 = _curvature_figures(model, U)
         rkh, rkh2 = refinable_maxima(model.mesh, kappa, const=const, h_lower=h_lower)
         mass = lumped_mass(model, mass_scale)
         kinetic = 0.5 * float(np.einsum("n,ni,ni->", mass, V, V))
         peak = max(peak, kinetic)
         P = np.where(model.free, model.load, 0.0)
-        r = float(np.linalg.norm(np.where(model.free, residual(model, U), 0.0)))
+        at = {} if slip is None else {"slip": slip}  # the frictions' committed slips, with hysteresis
+        r = float(np.linalg.norm(np.where(model.free, residual(model, U, **at), 0.0)))
         # no residual peak is kept across chunks: an unloaded sheet is at rest at r = 0 only
         rest = m.rest.holds(kinetic, peak, r, float(np.linalg.norm(P)), r)
         reason = ("rest" if rest else "every" if every is not None and since >= every
