@@ -253,6 +253,15 @@ def _chunk(advance, model, U, V, n, slip):
     return advance(model, U, V, n, slip=slip)
 
 
+def _friction_history(model, state, restart) -> tuple:
+    """``(slip, dissipated)`` the route starts from on ``model``: the frictions' committed slips (E, k) (None: no
+    hysteresis) and the energy they dissipated so far [J]; those ``state`` saved with the position ``restart``, else
+    (a fresh run, or a checkpoint of a model with hysteresis written before its slips were kept) the virgin fabric."""
+    if restart is not None and state.slip is not None:
+        return state.slip, state.dissipated
+    return model.initial_slip(), 0.0 if restart is None else float(state.dissipated)
+
+
 def _initial_state(model, U0, V0) -> RelaxState:
     """The state a remeshed relaxation starts from: U0, V0 (N, 3) [m, m/s] (default zero) on ``model``'s mesh."""
     N = model.mesh.n_nodes
@@ -339,7 +348,7 @@ def remesh_relax_route(problem, options: RemeshOptions, state: State, motion: Re
     peak, records, meshes, done, converged = r.peak, list(r.records), list(r.meshes), r.done, r.converged
     if len(meshes) > 1:  # a restart on a later mesh (the initial model serves mesh 0)
         model, extras = make(meshes[-1])
-    slip, dissipated = (model.initial_slip(), 0.0) if restart is None else (state.slip, state.dissipated)  # frictions'
+    slip, dissipated = _friction_history(model, state, restart)
     phase = None  # what the next snapshot is: None (the state just loaded or started), "chunk", "remesh"
 
     def pause(phase):

@@ -181,3 +181,19 @@ def test_a_remeshed_relaxation_with_hysteresis_comes_to_rest():
     comes to rest on a settled mesh (measured at t = 21 s of 30; at the virgin fabric's residual it never did)."""
     s = solve_remesh_scene(load_scene("remesh-pedestal-square-20", RELAX[:-1] + ["dynamics.t_end=30.0"] + BENDING))
     assert s["converged"] and s["stopped_by"] == "rest" and s["t"] < 25.0
+
+
+def test_a_restart_without_saved_slips_starts_the_friction_virgin():
+    """A remeshed relaxation's checkpoint without slips (written before they were kept) goes on with the virgin
+    fabric's, carried from then on, not without friction history at all; a saved one is taken as it is."""
+    from rftstatic.model.state import State
+
+    model = build_model(load_scene("remesh-pedestal-square-20", RELAX + BENDING))[0]
+    old = State(U=np.zeros((model.mesh.n_nodes, 3)), V=np.zeros((model.mesh.n_nodes, 3)), dissipated=2e-6)
+    slip, spent = relax_driver._friction_history(model, old, restart=object())
+    np.testing.assert_array_equal(slip, model.initial_slip())
+    assert spent == 2e-6
+    old.slip = np.ones_like(slip)
+    assert relax_driver._friction_history(model, old, restart=object())[0] is old.slip
+    fresh = relax_driver._friction_history(model, old, restart=None)
+    assert not fresh[0].any() and fresh[1] == 0.0
