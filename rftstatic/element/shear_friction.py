@@ -201,7 +201,7 @@ class ShearFriction:
     def evaluate(self, U, slip, *, tangent=False, psd=False):
         """Friction energy [J] (the sum of A psi), element forces ``(E, A, 3)`` [N] (S4) and, with ``tangent``,
         element tangents ``(E, A, 3, A, 3)`` [N/m] (S5), at ``U (N, 3)`` [m] with the committed ``slip (E, 1)`` [-].
-        ``psd``: the geometric part with the positive part of the friction stress."""
+        ``psd``: the geometric part with the positive part of the friction stress, and psi'' >= 0 (S10)."""
         eps, H = self._strain(U)
         G_last = self.G_last
         psi, tau, dtau, _ = self._law((eps @ self.t)[:, None], slip)
