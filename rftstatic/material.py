@@ -75,19 +75,28 @@ class ShearHysteresis:
     tau0 : yield (friction) shear force per unit width [N/m]: half the KES loop width at 0.5 deg, ``2HG / 2``
     ratio : stick stiffness over the shear rigidity G_12 of D^m (material axes) [-]; after a reversal the friction
         element sticks over a shear-angle change ``2 tau0 / (ratio G_12)`` before it slips
+    tau5 : yield shear force per unit width at 5 deg and beyond [N/m], half the KES loop width at 5 deg, ``2HG5 / 2``
+        (>= tau0; the threshold grows between 0.5 and 5 deg: :mod:`rftstatic.element.shear_threshold`), or None: tau0
+        at every angle
     """
 
     tau0: float
     ratio: float = 10.0
+    tau5: float | None = None
 
     def __post_init__(self):
         if isinstance(self.tau0, bool) or not (np.isfinite(self.tau0) and self.tau0 >= 0):
             raise ValueError(f"shear hysteresis tau0 must be a finite number >= 0 [N/m], got {self.tau0!r}")
         if not (np.isfinite(self.ratio) and self.ratio > 0):
             raise ValueError(f"shear hysteresis ratio must be a finite number > 0, got {self.ratio!r}")
+        if self.tau5 is not None and (isinstance(self.tau5, bool) or not (np.isfinite(self.tau5)
+                                                                         and self.tau5 >= self.tau0)):
+            raise ValueError(f"shear hysteresis tau5 (2HG5 / 2) must be a finite number >= tau0 = {self.tau0!r} N/m, "
+                             f"got {self.tau5!r}")
 
     def as_dict(self) -> dict:
-        return {"tau0_N_per_m": self.tau0, "stick_ratio": self.ratio}
+        return {"tau0_N_per_m": self.tau0, "stick_ratio": self.ratio,
+                **({"tau5_N_per_m": self.tau5} if self.tau5 is not None else {})}
 
 
 NONLINEAR_FLOOR = 0.2

@@ -142,11 +142,13 @@ def hysteresis_summary(scene, model, state, U) -> dict:
 def shear_hysteresis_summary(scene, model, state, U) -> dict:
     """The shear friction at the end of a solve (:mod:`rftstatic.element.shear_friction`, scene units): energy
     dissipated along the route by both frictions (one total), the share of elements whose friction shear force is at
-    its yield tau0 (slipping) and the largest shear angle [deg]."""
+    its yield tau0 (slipping; the threshold tau_0(gamma) of its shear angle with 2HG5) and the largest shear angle
+    [deg]."""
     fr = model.shear_friction
     tau = fr.force(U, model.split_slip(state.slip)[1])
+    yield_ = fr.tau0 if fr.tau5 is None else fr.threshold(fr.shear_angle(U))
     return {"dissipated_both_frictions": scene.units.from_si(state.dissipated, "energy"),
-            "yielded_share": float((np.abs(tau) >= fr.tau0 * (1 - 1e-9)).mean()),
+            "yielded_share": float((np.abs(tau) >= yield_ * (1 - 1e-9)).mean()),
             "max_shear_angle_deg": float(np.degrees(np.abs(fr.shear_angle(U)).max()))}
 
 

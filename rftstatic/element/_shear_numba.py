@@ -6,7 +6,8 @@ tests compare it with): the displacement gradients at the Q strain points, the a
 RFT6: Eq. 24-26) and its warp-weft shear angle (S2), the friction force per width (S3) at the committed slip, and
 the element's nodal forces (S4) as ``f_a = A/Q sum_q g_qa . (S_f F_q)``, summed into the nodes in element order.
 Nothing of the law or the strain is written here: the friction law is
-:func:`rftstatic.element.hysteresis.friction_law` (H2-H3, ufuncs on scalars) and the strain
+:func:`rftstatic.element.shear_threshold.growing_friction_law` (S7-S10, calling
+:func:`rftstatic.element.hysteresis.friction_law`, H2-H3; ufuncs on scalars) and the strain
 :func:`rftstatic.element.kernels.averaged_strain`, each compiled as it stands. The loop is serial (its scatter
 adds into shared nodes); its sums run in a fixed order and differ from numpy's sparse products by round-off
 (the tests' tolerance: 1e-12 of the largest entry).
@@ -14,7 +15,8 @@ adds into shared nodes); its sums run in a fixed order and differ from numpy's s
 Arrays, element axis first (each element's data contiguous): ``nodes (E, A)`` int64, ``G (E, Q, A, 2)`` [1/m]
 the strain-point gradients (the membrane's ``G_last`` transposed), ``area (E,)`` [m^2], ``t (3,)``, ``offset
 (E, A, 3)`` [m] the reference offsets of a sewn mesh (``(0, A, 3)`` without), ``U (N, 3)`` [m], ``slip (E,)``
-[-], ``f (N, 3)`` [N] added into. As in :mod:`rftstatic.element._axis_numba` the loop is compiled at import as a
+[-], ``law (5,)`` the law's stick stiffness K [N/m], thresholds tau_a, tau_b [N/m] and angles gamma_a, gamma_b [-]
+(S7), ``f (N, 3)`` [N] added into. As in :mod:`rftstatic.element._axis_numba` the loop is compiled at import as a
 copy named after a hash of the code it links from other files (:data:`CODE_KEY`), so that numba's cache, keyed on
 this file only, never loads a loop built from older code.
 
@@ -27,20 +29,27 @@ import types
 
 import numba as nb
 
-from rftstatic.element import kernels
+from rftstatic.element import kernels, shear_threshold
 from rftstatic.element._kernels_numba import _stack, compile_in_place
 from rftstatic.element.hysteresis import friction_law as _friction_py
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
 _friction = nb.njit(inline="always", **_JIT)(_friction_py)
+_threshold = nb.njit(inline="always", **_JIT)(shear_threshold.threshold)
+# shear_threshold.growing_friction_law calling the compiled threshold and friction law
+_law = nb.njit(inline="always", **_JIT)(types.FunctionType(
+    shear_threshold.growing_friction_law.__code__,
+    {**vars(shear_threshold), "threshold": _threshold, "friction_law": _friction}, "growing_friction_law"))
 _green = nb.njit(inline="always", **_JIT)(kernels.green_strain)
 # kernels.averaged_strain calling the compiled green_strain
 _averaged = nb.njit(inline="always", **_JIT)(types.FunctionType(
     kernels.averaged_strain.__code__, {**vars(kernels), "green_strain": _green}, "averaged_strain"))
 
 CODE_KEY = hashlib.sha1(b"".join(marshal.dumps(f.__code__) for f in (
-    _friction_py, kernels.green_strain, kernels.averaged_strain))).hexdigest()[:12]
-"""Hash of the linked code (the friction law, the Green strain and its average), in the loop's cache name."""
+    _friction_py, shear_threshold.threshold, shear_threshold.growing_friction_law, kernels.green_strain,
+    kernels.averaged_strain))).hexdigest()[:12]
+"""Hash of the linked code (the friction law and its threshold, the Green strain and its average), in the loop's
+cache name."""
 
 
 def _gradients(e, nodes, G, offset, U, u, H):
@@ -65,17 +74,19 @@ def _shear_angle(t, H, Q):
     return t[0] * exx + t[1] * eyy + t[2] * gxy
 
 
-def shear_force(nodes, G, area, t, offset, U, slip, K, tau0, y, f):
+def shear_force(nodes, G, area, t, offset, U, slip, law, f):
     """Add the friction's nodal forces (S4) into ``f (N, 3)`` [N]; return its energy ``sum_e A_e psi_e`` [J]
     (module docstring)."""
     Q, A = G.shape[1], G.shape[2]
+    K, ta, tb, ga, gb = law[0], law[1], law[2], law[3], law[4]
     H = _stack((3, 2, 3, 1))
     u = _stack((6, 3))
     fe = _stack((6, 3))
     W = 0.0
     for e in range(nodes.shape[0]):
         _gradients(e, nodes, G, offset, U, u, H)
-        psi, tau, _ = _friction(_shear_angle(t, H, Q) - slip[e], K, tau0, y)
+        gamma = _shear_angle(t, H, Q)
+        psi, tau, _, _ = _law(gamma - slip[e], gamma, K, ta, tb, ga, gb)
         W += area[e] * psi
         w = area[e] * tau / Q
         sxx, syy, sxy = w * t[0], w * t[1], w * t[2]

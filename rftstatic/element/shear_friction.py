@@ -32,32 +32,36 @@ Model (per element e of the membrane, RFT3 or RFT6):
       f_a = A tau_f b_a                                                                             (S4)
       K_ab = A (psi'' b_a b_b^T + 1/Q sum_q (g_qa . S_f g_qb) I)                                    (S5)
 
-  with ``psi'' = K`` (stick) or 0 (slip), ``g_qa`` the strain-point gradients of the membrane and ``S_f`` as the 2 x
-  2 tensor ``[[S_xx, S_xy], [S_xy, S_yy]]``. ``psd``: ``S_f`` replaced by its positive part (as the membrane's
-  own geometric stiffness, :func:`rftstatic.element.kernels.positive_part`);
+  with ``psi'' = K`` (stick) or 0 (slip) (S10 with 2HG5), ``g_qa`` the strain-point gradients of the membrane and
+  ``S_f`` as the 2 x 2 tensor ``[[S_xx, S_xy], [S_xy, S_yy]]``. ``psd``: ``S_f`` replaced by its positive part (as
+  the membrane's own geometric stiffness, :func:`rftstatic.element.kernels.positive_part`) and psi'' by max(psi'', 0);
 - at a converged step the slip is committed (backward Euler of the flow rule, as H4):
 
       s_n+1 = s_n + (e - clip(e, -y, y)),     dissipated  D = sum_e A_e tau_0 |s_n+1 - s_n|              (S6)
 
 The elastic shear stays in D^m (Eq. 15); this module adds only the friction term. A static solve minimises
 ``Pi + sum_e A_e psi`` within a step, the same incremental potential as the bending friction, so the routes treat
-both alike (the slips are committed together: :meth:`rftstatic.model.model.Model.commit_slip`). KES 2HG5 (the width
-at 5 deg) is not a parameter here: past the stick range this Coulomb element's loop has the one width 2HG at every
-angle (real fabrics have 2HG5 > 2HG: the friction grows with the shear; not modelled). The element tests
-(tests/element/test_shear_friction.py) check (S4) and (S5) by finite differences on both branches.
+both alike (the slips are committed together: :meth:`rftstatic.model.model.Model.commit_slip`).
+
+KES 2HG5 (the loop's width at 5 deg; ``tau5 = 2HG5 / 2``): the threshold grows with the shear angle from tau_0 below
+0.5 deg to tau5 beyond 5 deg (S7 of :mod:`rftstatic.element.shear_threshold`), taken at the end-of-step angle inside
+the incremental potential (S8), which adds ``tau_0'(gamma) |ds|`` to the force (S9) and the terms of (S10) to psi'';
+(S3)-(S6) above are its case tau5 = tau0 (no 2HG5), computed by the same law to the bit. The element tests
+(tests/element/test_shear_friction.py, test_shear_threshold.py) check (S4) and (S5) by finite differences on both
+branches, with and without the growth.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
 
-from rftstatic.element.hysteresis import huber
 from rftstatic.element.kernels import averaged_strain, positive_part
 from rftstatic.element.kernels_numpy import strain_operator
+from rftstatic.element.shear_threshold import KES_ANGLES, growing_friction_law, max_slope, threshold
 
 __all__ = ["ShearFriction", "shear_friction"]
 
@@ -72,12 +76,15 @@ class ShearFriction:
     G_last : (Q, A, 2, E) strain-point gradients of the membrane [1/m], element axis last
     area : (E,) element areas [m^2]
     t : (3,) the warp/weft shear row of the Voigt strain rotation (gamma = t . eps, S2)
-    tau0 : yield shear force per width [N/m] (= 2HG / 2, S1)
+    tau0 : yield shear force per width [N/m] (= 2HG / 2, S1), below the first of ``angles``
     K : stick stiffness per width [N/m] (ratio x G_12)
     n_nodes : N, the mesh's node count
     offset : (A, 3, E) reference offsets of a sewn mesh (the membrane's ``offset_last``), or None
     compiled : :meth:`nodal_force` by the compiled loop of :mod:`rftstatic.element._shear_numba` (a run on the
         compiled kernels, :func:`rftstatic.compiled.choose_kernels`), else by numpy (the reference)
+    tau5 : yield shear force per width beyond the second of ``angles`` [N/m] (= 2HG5 / 2, S7), or None: ``tau0`` at
+        every angle
+    angles : ``(gamma_a, gamma_b)`` [-] between which the threshold grows (S7; the KES readings' angles)
     """
 
     nodes: np.ndarray
@@ -89,6 +96,8 @@ class ShearFriction:
     n_nodes: int
     offset: np.ndarray | None = None
     compiled: bool = False
+    tau5: float | None = None
+    angles: tuple[float, float] = KES_ANGLES
 
     @property
     def n_elements(self) -> int:
@@ -98,8 +107,23 @@ class ShearFriction:
         """The virgin state: no slip, ``(E, 1)`` [-]."""
         return np.zeros((self.n_elements, 1))
 
-    def _law(self, e):
-        return huber(e, np.array([self.K]), np.array([self.tau0]))
+    @property
+    def tau_b(self) -> float:
+        """The threshold beyond the second angle [N/m]: ``tau5``, or ``tau0`` without it."""
+        return self.tau0 if self.tau5 is None else self.tau5
+
+    def _law(self, gamma, slip):
+        """psi (S8), tau_f (S9), psi'' (S10) and tau_0(gamma) (S7), each ``(E, 1)``, at shear angles ``gamma (E, 1)``
+        with the committed ``slip (E, 1)`` (:func:`rftstatic.element.shear_threshold.growing_friction_law`)."""
+        return growing_friction_law(gamma - slip, gamma, self.K, self.tau0, self.tau_b, *self.angles)
+
+    def stiffest(self) -> ShearFriction:
+        """This friction with its stick stiffness raised to ``K + 2 max|tau_0'|``, which bounds psi'' (S10) on both
+        branches but for the ``tau_0'' d`` term (of the order of a step's slip): for the stable-step bound
+        (:func:`rftstatic.solvers.timestep.element_bound`, evaluated all sticking). Itself without 2HG5."""
+        if self.tau5 is None:
+            return self
+        return replace(self, K=self.K + 2.0 * max_slope(self.tau0, self.tau5, *self.angles))
 
     @cached_property
     def _gradient(self):
@@ -134,7 +158,8 @@ class ShearFriction:
         nodes, G, offset = self._element_first
         f = np.zeros((self.n_nodes, 3))
         W = shear_force(nodes, G, self.area, self.t, offset, np.ascontiguousarray(U, dtype=float),
-                        np.ascontiguousarray(slip[:, 0], dtype=float), self.K, self.tau0, self.tau0 / self.K, f)
+                        np.ascontiguousarray(slip[:, 0], dtype=float),
+                        np.array([self.K, self.tau0, self.tau_b, *self.angles]), f)
         return float(W), f
 
     @cached_property
@@ -149,7 +174,7 @@ class ShearFriction:
     def nodal_force_numpy(self, U, slip) -> tuple[float, np.ndarray]:
         """:meth:`nodal_force` through the sparse gradient (numpy; the reference of the compiled loop)."""
         eps, H = self._strain(U)
-        psi, tau, _ = self._law((eps @ self.t)[:, None] - slip)
+        psi, tau, _, _ = self._law((eps @ self.t)[:, None], slip)
         Q = H.shape[0]
         w = self.area * tau[:, 0] / Q
         sxx, syy, sxy = w * self.t[0], w * self.t[1], w * self.t[2]
@@ -176,10 +201,10 @@ class ShearFriction:
     def evaluate(self, U, slip, *, tangent=False, psd=False):
         """Friction energy [J] (the sum of A psi), element forces ``(E, A, 3)`` [N] (S4) and, with ``tangent``,
         element tangents ``(E, A, 3, A, 3)`` [N/m] (S5), at ``U (N, 3)`` [m] with the committed ``slip (E, 1)`` [-].
-        ``psd``: the geometric part with the positive part of the friction stress."""
+        ``psd``: the geometric part with the positive part of the friction stress, and psi'' >= 0 (S10)."""
         eps, H = self._strain(U)
         G_last = self.G_last
-        psi, tau, dtau = self._law((eps @ self.t)[:, None] - slip)
+        psi, tau, dtau, _ = self._law((eps @ self.t)[:, None], slip)
         B = strain_operator(G_last, H)  # (E, 3, A, 3)
         b = np.einsum("k,ekai->eai", self.t, B)
         A = self.area
@@ -187,6 +212,8 @@ class ShearFriction:
         energy = float(A @ psi[:, 0])
         if not tangent:
             return energy, fe, None
+        if psd:  # a falling threshold's negative slope (S10) dropped
+            dtau = np.maximum(dtau, 0.0)
         ke = (A * dtau[:, 0])[:, None, None, None, None] * b[:, :, :, None, None] * b[:, None, None, :, :]
         S = tau[:, 0][:, None] * self.t[None, :]  # (E, 3): S_xx, S_yy, S_xy of S_f
         sxx, syy, sxy = S[:, 0], S[:, 1], S[:, 2]
@@ -202,24 +229,33 @@ class ShearFriction:
         return energy, fe, ke
 
     def commit(self, U, slip) -> tuple[np.ndarray, float]:
-        """Return mapping at a converged step (S6): the new slip ``(E, 1)`` [-] and the energy dissipated in the
-        step [J]."""
-        e = self.shear_angle(U) - slip
-        y = self.tau0 / self.K
+        """Return mapping at a converged step (S6, with the threshold tau_0(gamma) of S7 at the step's angle): the new
+        slip ``(E, 1)`` [-] and the energy dissipated in the step [J]."""
+        gamma = self.shear_angle(U)
+        tau = self.threshold(gamma)
+        e = gamma - slip
+        y = tau / self.K
         ds = e - np.clip(e, -y, y)
-        return slip + ds, float(self.tau0 * (self.area @ np.abs(ds[:, 0])))
+        if self.tau5 is None:
+            return slip + ds, float(self.tau0 * (self.area @ np.abs(ds[:, 0])))
+        return slip + ds, float(self.area @ (tau[:, 0] * np.abs(ds[:, 0])))
+
+    def threshold(self, gamma) -> np.ndarray:
+        """The friction threshold ``tau_0(gamma)`` [N/m] (S7) at shear angles ``gamma`` [-] (any shape)."""
+        return threshold(gamma, self.tau0, self.tau_b, *self.angles)[0]
 
     def force(self, U, slip) -> np.ndarray:
-        """Friction shear force per width ``tau_f (E, 1)`` [N/m] (S3)."""
-        return self._law(self.shear_angle(U) - slip)[1]
+        """Friction shear force per width ``tau_f (E, 1)`` [N/m] (S3; S9 with 2HG5)."""
+        return self._law(self.shear_angle(U), slip)[1]
 
 
-def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio, compiled=False) -> ShearFriction:
+def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio, compiled=False, tau5=None) -> ShearFriction:
     """The :class:`ShearFriction` of a membrane operator ``membrane``
     (:class:`rftstatic.element.membrane.MembraneOperator`) of a mesh of ``n_nodes`` nodes for a fabric of membrane
     matrix ``Dm (3, 3)`` in global axes [N/m] whose warp lies at ``warp_angle`` [rad] from X: yield force per width
     ``tau0`` [N/m] (2HG / 2) and stick stiffness ``ratio * G_12`` (G_12 the material-axes shear rigidity);
-    ``compiled``: its explicit force by the compiled loop (:attr:`ShearFriction.compiled`)."""
+    ``compiled``: its explicit force by the compiled loop (:attr:`ShearFriction.compiled`); ``tau5`` [N/m] (2HG5 / 2,
+    >= tau0): the threshold beyond 5 deg (S7), or None."""
     from rftstatic.material import voigt_rotation
 
     T = voigt_rotation(warp_angle)
@@ -228,6 +264,9 @@ def shear_friction(membrane, Dm, *, n_nodes, warp_angle, tau0, ratio, compiled=F
     if not (np.isfinite(tau0) and tau0 >= 0) or not ratio > 0 or not G12 > 0:
         raise ValueError(f"shear friction needs tau0 >= 0, ratio > 0 and a shear rigidity G_12 > 0, got tau0 = "
                          f"{tau0!r}, ratio = {ratio!r}, G_12 = {G12!r} N/m")
+    if tau5 is not None and not (np.isfinite(tau5) and tau5 >= tau0):
+        raise ValueError(f"shear friction needs tau5 >= tau0 (a threshold that grows with the shear), got tau5 = "
+                         f"{tau5!r}, tau0 = {tau0!r} N/m")
     return ShearFriction(np.asarray(membrane.nodes), membrane.G_last, np.asarray(membrane.area, float),
                          T[2].copy(), float(tau0), float(ratio) * G12, int(n_nodes), membrane.offset_last,
-                         bool(compiled))
+                         bool(compiled), None if tau5 is None else float(tau5))

@@ -25,9 +25,9 @@ kes_2HG            gf/cm               shear hysteresis: the friction shear forc
                                        [gf/cm] of :mod:`rftstatic.element.shear_friction` (the KES-FB1 loop's
                                        width at +-0.5 deg); stick stiffness ``shear_hysteresis_ratio``
                                        (default 10) times the shear rigidity G (given, or filled by its rule)
-kes_2HG5           gf/cm               the loop's width at +-5 deg: range-checked and recorded in the summary
-                                       only (the model's Coulomb friction has the one width 2HG at every angle
-                                       past its stick range); needs kes_2HG
+kes_2HG5           gf/cm               the loop's width at +-5 deg: the friction's threshold tau5 = 2HG5 / 2
+                                       [gf/cm] beyond 5 deg; it grows smoothly from tau0 at 0.5 deg
+                                       (:mod:`rftstatic.element.shear_threshold`); needs kes_2HG, >= kes_2HG
 =================  ==================  ===================================================================
 
 FAST (SiroFAST: De Boos & Tester 1994, CSIRO report WT92.02), key ``fast_*``:
@@ -78,9 +78,9 @@ direction). The largest softening |k2| is 1122487.5 (k2 kappa / k1 = -0.72 at 1/
 theory: turning them into a twisting rigidity would need the plate's compliance rotation, which the
 repository's law does not follow).
 
-What the model drops (bending hysteresis 2HB, nonlinear bending k2 and shear hysteresis 2HG are options,
-``kes_2HB_*``, ``ctd_k2_*`` and ``kes_2HG`` above): the growth of the shear hysteresis with the angle (2HG5 > 2HG is
-recorded, not modelled), the nonlinear shear curve beyond the small angles where G is measured
+What the model drops (bending hysteresis 2HB, nonlinear bending k2 and shear hysteresis 2HG, 2HG5 are options,
+``kes_2HB_*``, ``ctd_k2_*``, ``kes_2HG`` and ``kes_2HG5`` above): the nonlinear shear curve beyond the small angles
+where G is measured
 (0.5-5 deg), the tensile curve's nonlinearity (the secant at Fm replaces it: crimp interchange makes the initial
 modulus far lower, so a drape that stretches little is too stiff in tension; drape is insensitive to it while C >> B /
 h^2), the compression and surface data (LC, WC, RC, MIU, MMD, SMD), and anything not measured: Poisson coupling (C12 =
@@ -147,7 +147,8 @@ LAB_KEYS = {
     "kes_2HB_warp": ("gf cm/cm", "KES-FB2 bending hysteresis (loop width at +-1 /cm), warp"),
     "kes_2HB_weft": ("gf cm/cm", "KES-FB2 bending hysteresis, weft"),
     "kes_2HG": ("gf/cm", "KES-FB1 shear hysteresis (loop width at +-0.5 deg)"),
-    "kes_2HG5": ("gf/cm", "KES-FB1 shear hysteresis at +-5 deg (recorded only)"),
+    "kes_2HG5": ("gf/cm", "KES-FB1 shear hysteresis (loop width at +-5 deg): the friction threshold grows from "
+                 "2HG / 2 at 0.5 deg to 2HG5 / 2 at 5 deg"),
     "fast_B_warp": ("uN m", "FAST-2 bending rigidity, warp"),
     "fast_B_weft": ("uN m", "FAST-2 bending rigidity, weft"),
     "fast_E100_warp": ("%", "FAST-3 extensibility at 100 gf/cm, warp"),
@@ -203,7 +204,7 @@ QUANTITY_KEYS = {
     "bending_k2_warp": ("ctd_k2_warp",),
     "bending_k2_weft": ("ctd_k2_weft",),
     "shear_tau0": ("kes_2HG",),
-    "shear_width_5deg": ("kes_2HG5",),
+    "shear_tau5": ("kes_2HG5",),
 }
 """Model quantity -> the lab keys that give it (one source per quantity)."""
 
@@ -305,8 +306,8 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
     si : dict
         ``{quantity: value}`` for the quantities given: ``B_warp, B_weft`` [N m], ``C_shear, C_warp,
         C_weft`` [N/m], ``weight`` [N/m^2], ``thickness`` [m], ``M0_warp, M0_weft`` [N m/m = N],
-        ``bending_k2_warp, bending_k2_weft`` [N m^2], ``shear_tau0`` (2HG / 2) and ``shear_width_5deg`` (2HG5, recorded
-        only) [N/m].
+        ``bending_k2_warp, bending_k2_weft`` [N m^2], ``shear_tau0`` (2HG / 2) and ``shear_tau5`` (2HG5 / 2)
+        [N/m].
     record : dict
         ``{quantity: {"from": key, "value": lab value, "unit": lab unit, "rule": ...}}``.
 
@@ -359,6 +360,7 @@ def lab_to_si(values: dict) -> tuple[dict, dict]:
         put("shear_tau0", "kes_2HG", 0.5 * lab["kes_2HG"] * GF / 1e-2,
             "friction shear force per width tau0 = 2HG / 2; gf/cm = 0.980665 N/m")
     if "kes_2HG5" in lab:
-        put("shear_width_5deg", "kes_2HG5", lab["kes_2HG5"] * GF / 1e-2, "recorded only (not a model parameter: the "
-            "friction element's loop has the width 2HG at every angle past its stick range); gf/cm = 0.980665 N/m")
+        put("shear_tau5", "kes_2HG5", 0.5 * lab["kes_2HG5"] * GF / 1e-2,
+            "friction shear force per width beyond 5 deg tau5 = 2HG5 / 2, grown to from tau0 between 0.5 and 5 deg "
+            "(rftstatic.element.shear_threshold); gf/cm = 0.980665 N/m")
     return si, record

@@ -184,7 +184,8 @@ class Model(Frozen):
         sh = material.shear_hysteresis
         self.shear_friction = (None if sh is None or sh.tau0 == 0.0 or not self.with_membrane else shear_friction(
             self.membrane, material.Dm, n_nodes=mesh.n_nodes,
-            warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)), tau0=sh.tau0, ratio=sh.ratio, compiled=self.kernels == "compiled"))
+            warp_angle=np.radians(material.info.get("warp_angle_deg", 0.0)), tau0=sh.tau0, ratio=sh.ratio,
+            compiled=self.kernels == "compiled", tau5=sh.tau5))
         warnings = []
         if element == "RFT6" and self.with_membrane:
             lock = locking_number(mesh, material)

@@ -25,7 +25,8 @@ its data row with ``nonlinear_bending = true`` (opt-in: a preset's results do no
 
 Bending hysteresis (``kes_2HB_warp``, ``kes_2HB_weft``, both or neither; ``hysteresis_ratio``) and shear hysteresis
 (``kes_2HG`` [gf/cm], :mod:`rftstatic.element.shear_friction`; ``shear_hysteresis_ratio`` [-] in [1, 1e4], default 10:
-the stick stiffness over the fabric's G; ``kes_2HG5`` recorded only, with ``kes_2HG``) are options of a lab fabric.
+the stick stiffness over the fabric's G; ``kes_2HG5`` [gf/cm], with ``kes_2HG`` and >= it: the friction grows to
+2HG5 / 2 at 5 deg, :mod:`rftstatic.element.shear_threshold`) are options of a lab fabric.
 """
 
 from __future__ import annotations
@@ -207,7 +208,7 @@ def _fabric(scene, m: dict, angle: float) -> mat.Material:
 
 _SUMMARY_KINDS = {**mat._FABRIC_KINDS, "thickness": "length", "M0_warp": "force", "M0_weft": "force",
                   "bending_k2_warp": "moment_length", "bending_k2_weft": "moment_length", "shear_tau0": "line_force",
-                  "shear_width_5deg": "line_force"}
+                  "shear_tau5": "line_force"}
 """Unit kind of every quantity a lab record may convert (for the summary in scene units)."""
 
 
@@ -234,7 +235,9 @@ def _with_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Material:
 
 def _with_shear_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Material:
     """``material`` with the shear hysteresis of ``kes_2HG`` (tau0 = 2HG / 2 in ``si``) and ``shear_hysteresis_ratio``
-    (:class:`rftstatic.material.ShearHysteresis`); ``kes_2HG5`` or the ratio without ``kes_2HG`` are refused."""
+    (:class:`rftstatic.material.ShearHysteresis`) and, with ``kes_2HG5``, the threshold tau5 = 2HG5 / 2 beyond 5 deg;
+    ``kes_2HG5`` or the ratio without ``kes_2HG`` are refused, and so is 2HG5 < 2HG (a threshold that falls as the
+    fabric shears: KES data have 2HG5 >= 2HG)."""
     if "shear_tau0" not in si:
         for key in ("kes_2HG5", "shear_hysteresis_ratio"):
             if key in m:
@@ -246,7 +249,13 @@ def _with_shear_hysteresis(material: mat.Material, m: dict, si: dict) -> mat.Mat
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 1.0 <= ratio <= 1e4:
         raise ParameterError("shear_hysteresis_ratio", f"{ratio!r} must be a number in [1, 1e4] (the shear friction's "
                              "stick stiffness over the fabric's shear rigidity G; default 10)")
-    return replace(material, shear_hysteresis=mat.ShearHysteresis(si["shear_tau0"], float(ratio)))
+    tau5 = si.get("shear_tau5")
+    if tau5 is not None and tau5 < si["shear_tau0"]:
+        raise ParameterError("kes_2HG5", f"{m['kes_2HG5']!r} gf/cm is below kes_2HG = {m['kes_2HG']!r} gf/cm: the "
+                             "shear loop's width at 5 deg is at least its width at 0.5 deg in KES data, and the "
+                             "model's friction threshold only grows with the shear (give 2HG5 >= 2HG, or remove "
+                             "kes_2HG5)")
+    return replace(material, shear_hysteresis=mat.ShearHysteresis(si["shear_tau0"], float(ratio), tau5))
 
 
 def _opted_in(m: dict) -> bool:
@@ -376,6 +385,11 @@ def material_summary(scene, material: mat.Material) -> dict:
     if sh is not None:
         out["shear_hysteresis"] = {"tau0": u.from_si(sh.tau0, "line_force"), "unit": unit_label(u, "line_force"),
                                    "stick_ratio": sh.ratio, "model": "rftstatic.element.shear_friction"}
+        if sh.tau5 is not None:
+            out["shear_hysteresis"].update(
+                tau5=u.from_si(sh.tau5, "line_force"),
+                growth="the friction threshold grows smoothly (C1) from tau0 at 0.5 deg to tau5 at 5 deg and beyond "
+                       "(KES loop widths 2HG and 2HG5; rftstatic.element.shear_threshold)")
     for key in ("preset", "changed"):
         if key in material.info:
             out[key] = material.info[key]

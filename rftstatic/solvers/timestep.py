@@ -95,7 +95,7 @@ def element_bound(model, U=None, *, mass_scale: float = 1.0) -> float:
         _, ke = model.membrane.element_tangents(U, model.material.Dm, psd=True, backend=model.membrane_backend)
         fr = getattr(model, "shear_friction", None)
         if fr is not None:  # shear hysteresis at its stiffest: every element sticking (rftstatic.element.shear_friction)
-            ke = ke + fr.evaluate(U, fr.shear_angle(U), tangent=True, psd=True)[2]
+            ke = ke + fr.stiffest().evaluate(U, fr.shear_angle(U), tangent=True, psd=True)[2]
         E, A = model.membrane.nodes.shape
         ke = ke.reshape(E, 3 * A, 3 * A)
         lam_m = np.linalg.eigvalsh(ke)[:, -1]

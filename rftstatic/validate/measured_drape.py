@@ -279,8 +279,8 @@ def _literature() -> str:
 SCOPE = ("Measured with the current Cusick route (cases/cusick-*.toml: dynamic relaxation at full load, then Newton; "
          "specimen = seeded start); the route is being reworked in another branch, so these numbers belong to this "
          "commit's route. Nonlinear bending (Feng et al.'s k2, rftstatic.element.nonlinear_bending) is measured in "
-         "section g of the hand-written section, shear hysteresis (KES 2HG, rftstatic.element.shear_friction; 2HG5 "
-         "recorded only) in section h.")
+         "section g of the hand-written section, shear hysteresis (KES 2HG and 2HG5, rftstatic.element.shear_friction "
+         "and rftstatic.element.shear_threshold) in section h.")
 
 
 NODES_HEADING = "Why the node count does not follow the fabric"

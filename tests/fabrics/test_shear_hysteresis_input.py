@@ -1,4 +1,4 @@
-"""Shear hysteresis as scene input: the KES 2HG key, its conversion, the refusals (exit 2 naming the key), the summary,
+"""Shear hysteresis as scene input: the KES 2HG and 2HG5 keys, their conversion, the refusals (exit 2 naming the key), the summary,
 the explain listing, and a short run that records what the friction did."""
 
 import json
@@ -30,8 +30,12 @@ def test_kes_2hg_gives_the_friction_shear_force_half_the_loop_width():
     assert summary["shear_hysteresis"]["tau0"] == pytest.approx(0.6, rel=1e-12)
     assert summary["shear_hysteresis"]["unit"] == "gf/cm"
     assert summary["lab"]["shear_tau0"]["from"] == "kes_2HG"
-    assert summary["lab"]["shear_width_5deg"]["converted"] == pytest.approx(2.5, rel=1e-12)  # recorded only
-    assert "recorded only" in summary["lab"]["shear_width_5deg"]["rule"]
+    assert summary["lab"]["shear_tau5"]["converted"] == pytest.approx(1.25, rel=1e-12)  # 2HG5 / 2
+    assert "recorded only" not in summary["lab"]["shear_tau5"]["rule"]
+    assert mat.shear_hysteresis.tau5 == pytest.approx(1.25 * gf_per_cm, rel=1e-12)
+    assert summary["shear_hysteresis"]["tau5"] == pytest.approx(1.25, rel=1e-12)
+    assert "0.5 deg" in summary["shear_hysteresis"]["growth"] and "5 deg" in summary["shear_hysteresis"]["growth"]
+    assert build_material(_scene({**LAB, "kes_2HG": 1.2})).shear_hysteresis.tau5 is None  # no 2HG5: tau0 throughout
     assert "C_shear" in summary["filled"]  # the stick stiffness rests on the G its rule fills
     assert build_material(_scene(dict(LAB))).shear_hysteresis is None
 
@@ -44,6 +48,7 @@ def test_kes_2hg_gives_the_friction_shear_force_half_the_loop_width():
     ({"kes_2HG5": 2.0}, "material.kes_2HG", "missing: kes_2HG5"),
     ({"shear_hysteresis_ratio": 5.0}, "material.kes_2HG", "missing: shear_hysteresis_ratio"),
     ({"kes_2HG": 1.0, "shear_hysteresis_ratio": 0.5}, "material.shear_hysteresis_ratio", "[1, 1e4]"),
+    ({"kes_2HG": 2.0, "kes_2HG5": 1.5}, "material.kes_2HG5", "1.5 gf/cm is below kes_2HG = 2.0 gf/cm"),
 ])
 def test_bad_shear_hysteresis_input_names_the_key(extra, key, fragment):
     with pytest.raises(SceneError, match=key.replace(".", r"\.")) as err:
@@ -60,12 +65,18 @@ def test_bad_2hg_on_the_command_line_is_exit_2_naming_the_key(capsys, tmp_path):
     code = main(["case", "cusick-30", "--set", "material.kes_2HG=1.0", "--out", str(tmp_path / "p"), "--no-figures"])
     err = capsys.readouterr().err.strip()
     assert code == 2 and "material.kes_2HG: " in err and 'next to preset = "wool-kang-yu"' in err, err
+    table = "material={kes_B_warp=0.083, kes_B_weft=0.063, kes_W=19.0, kes_T=0.5, kes_2HG=2.0, kes_2HG5=1.0}"
+    code = main(["case", "cusick-30", "--set", table, "--out", str(tmp_path / "q"), "--no-figures"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "material.kes_2HG5: 1.0 gf/cm is below kes_2HG = 2.0 gf/cm" in err and "\n" not in err, err
 
 
 def test_explain_lists_the_key(capsys):
     assert main(["fabrics", "--explain"]) == 0
     out = capsys.readouterr().out
     assert "kes_2HG" in out and "kes_2HG5" in out
+    line = next(row for row in out.splitlines() if "kes_2HG5" in row)
+    assert "recorded only" not in line and "grows" in line
 
 
 def test_compare_and_arc_length_are_refused_with_shear_hysteresis():
