@@ -5,9 +5,10 @@
   factorisation while the residual falls fast (modified Newton), or on large meshes the step by CG on the
   exact tangent preconditioned with the last factorisation (:mod:`~rftstatic.solvers.krylov`);
 - globalisation (:class:`LineSearch`): the step cap ``max_step`` and the self-contact bound, an Armijo
-  backtracking line search on the total potential energy Pi (from a given state, a shortened step refined to the
-  lowest energy near it, :func:`lowest_near`), and Levenberg-Marquardt damping of the next
-  direction as a trust region (More's update of the ratio of actual to predicted decrease);
+  backtracking line search on the total potential energy Pi (from a given state, along the step's rotation-lifted
+  curve, :mod:`~rftstatic.solvers.rotation_lift`, and a shortened step refined to the lowest energy near it,
+  :func:`lowest_near`), and Levenberg-Marquardt damping of the next direction as a trust region (More's update of
+  the ratio of actual to predicted decrease);
 - the convergence test :class:`~rftstatic.solvers.iteration.Criteria`.
 """
 
@@ -19,6 +20,7 @@ from rftstatic.solvers.iteration import Criteria, Iteration, capped_step, direct
 from rftstatic.solvers.krylov import forcing, krylov_direction, uses_krylov
 from rftstatic.solvers.linear import LinearSolveError
 from rftstatic.solvers.loop import Direction, Iterate, StepFailure, newton_loop
+from rftstatic.solvers.rotation_lift import RotationLift
 
 
 class Damping:
@@ -89,6 +91,24 @@ class LineSearch:
         self.free = model.free.ravel()
         self.energies = [start.energy]
         self.work0 = None
+        self.lift = RotationLift.of_model(model) if refine and opts.line_search else None
+
+    def _lifted(self, x: Iterate, step, slope):
+        """The line search along the rotation-lifted curve of ``step`` (:mod:`~rftstatic.solvers.rotation_lift`):
+        ``(alpha, parts, displacement (N, 3))``, or None when the curve's chord would bring two layers of the sheet
+        closer than the self-contact step bound allows (the straight step, bounded, is taken then)."""
+        model, state = self.model, self.state
+        X = model.positions(x.U)
+        curve = self.lift.path(X, step)
+        alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, state, x.energy_scale,
+                                   refine=True, path=curve)
+        if alpha is None:
+            return None
+        dU = curve(alpha)
+        sc = getattr(model, "self_contact", None)
+        if sc is not None and sc.max_step_fraction(X, dU, cache=state.self_pairs) < 1.0:
+            return None
+        return alpha, parts, dU
 
     def __call__(self, x: Iterate, dn: Direction):
         model, state, free, mu = self.model, self.state, self.free, self.damping.mu
@@ -96,11 +116,17 @@ class LineSearch:
         step, frac = self_contact_limited(model, x.U, step, state)
         cap *= frac
         slope = float(x.r @ step.ravel()[free])
-        alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, state, x.energy_scale,
-                                   refine=self.refine)
+        lifted = self._lifted(x, step, slope) if self.lift is not None else None
+        if lifted is not None:
+            alpha, parts, dU = lifted
+            state.modes["lifted"] = state.modes.get("lifted", 0) + 1
+        else:
+            alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, state, x.energy_scale,
+                                       refine=self.refine)
+            dU = None if alpha is None else alpha * step
         if alpha is None:
             raise StepFailure("line search found no decrease of the energy")
-        U = x.U + alpha * step
+        U = x.U + dU
         Pi = parts["total"]
         self.energies.append(Pi)
         record = {"alpha": alpha, "cap": cap, "mu": mu, "fresh": dn.fresh, "mode": dn.mode}
@@ -108,7 +134,7 @@ class LineSearch:
             self._trust_region(x.energy, Pi, alpha, slope, cap, dn.curvature)
         r = model.residual(U, x.lam, candidates=state.candidates, pairs=state.self_pairs,
                            slip=state.slip).ravel()[free]
-        work = abs(float(alpha * step.ravel()[free] @ r))
+        work = abs(float(dU.ravel()[free] @ r))
         if self.work0 is None:
             # energy scale: the first step's work or the work of the load so far, whichever is larger
             # (a good predictor makes the first step tiny; round-off must not stall the criterion);
@@ -186,14 +212,17 @@ def displacement_iterations(model, U, lam, opts, state, max_step, refine: bool =
                      else 0.0, history=out.history)
 
 
-def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_trials=12, refine=False):
+def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_trials=12, refine=False, path=None):
     """Armijo backtracking on Pi along ``step (N, 3)`` [m] from ``U`` with energy ``Pi0`` [J] and slope
     ``r . step`` [J]: ``(alpha, parts)``, ``parts`` the energies (:meth:`~rftstatic.model.model.Model.energies`)
     at ``U + alpha step``; ``(None, None)`` when no trial lowers the energy. ``scale`` [J]: :func:`energy_scale`
     of the energies at ``U`` (computed when None). A full step that passes is taken as it is; with ``refine``, a
-    shorter Armijo point is refined to the lowest energy near it (:func:`lowest_near`)."""
+    shorter Armijo point is refined to the lowest energy near it (:func:`lowest_near`). ``path``: a curve
+    ``alpha -> displacement (N, 3)`` [m] with the tangent ``step`` at 0 (:mod:`~rftstatic.solvers.rotation_lift`),
+    searched in place of the straight line."""
     def parts_at(alpha):
-        return model.energies(U + alpha * step, lam, candidates=state.candidates, pairs=state.self_pairs,
+        dU = alpha * step if path is None else path(alpha)
+        return model.energies(U + dU, lam, candidates=state.candidates, pairs=state.self_pairs,
                               slip=state.slip, branches=state.load_branches)
 
     if not opts.line_search:
@@ -222,12 +251,13 @@ def line_search(model, U, step, lam, Pi0, slope, opts, state, scale=None, max_tr
     return None, None
 
 
-SHORT_STEP = 0.5
+SHORT_STEP = 0.3
 """Share of a fresh Newton step [-] below which a step the line search shortened damps the next direction
-(:meth:`LineSearch._trust_region`). Every shortened step damped it before (x 4, at least 1e-6 of the mean tangent
-diagonal); with the refined line search (:func:`lowest_near`), from the relaxed states of issue 34
-(validation/bench_profile.md, h-speed5): pedestal-round-50 89 Newton iterations and 105 factorisations (101, 112
-when every shortened step damps), pedestal-square-80 140 and 143 (148, 147); the same equilibria."""
+(:meth:`LineSearch._trust_region`) on the walk from a relaxed state (``refine``; elsewhere every shortened step
+damps it, x 4, at least 1e-6 of the mean tangent diagonal). Measured from the relaxed states of issue 34 with the
+rotation-lifted line search (validation/bench_profile.md, 2026-12-05): pedestal-round-50 94 Newton iterations and
+119 factorisations at 0.3 (116, 155 at 0.5; 101, 128 at 0.45; 99, 142 at 0.25), pedestal-square-80 145 and 196
+(153, 191 at 0.5), sphere-30 79 and 98; the same equilibria."""
 
 LINE_REFINE_FACTOR = 2.0 ** 0.5
 """Ratio of two trial step lengths of :func:`lowest_near` [-]."""

@@ -115,7 +115,13 @@ diagonal of the tangent (Nocedal & Wright, Numerical Optimization, 2nd ed., Algo
 added multiple of the identity)."""
 
 MODIFIED_GROWTH = 8.0
-"""Factor between two shifts tried; the first is the last one that worked divided by it."""
+"""Factor between two shifts tried."""
+
+MODIFIED_DECREASE = 2.0
+"""The first shift tried is the last one that worked divided by this factor (Nocedal & Wright's Algorithm 3.3 halves
+it). Measured with the rotation-lifted walk (validation/bench_profile.md, 2026-12-05) against 8 (the growth): the
+factorisations of pedestal-round-50 152 -> 122, pedestal-square-80 188 -> 186, cusick-24 107 -> 97, cusick-30
+48 -> 47, sphere-30 and pedestal-square-40 unchanged; the same equilibria."""
 
 MODIFIED_TRIES = 4
 """Most factorisations of the modified exact tangent per iteration before the projected one is used."""
@@ -129,7 +135,7 @@ def direction(model, U, lam, r, opts, state, damping=0.0, stress=None):
     geometric stiffness (:func:`rftstatic.solvers.mixed.mixed_iterations`; None: the exact Hessian).
 
     ``tangent = "auto"`` tries, in turn, the exact tangent; the modified exact tangent ``K + tau I``
-    (:data:`MODIFIED_SHIFTS`, from the last shift that worked over :data:`MODIFIED_GROWTH`; while the
+    (:data:`MODIFIED_SHIFTS`, from the last shift that worked over :data:`MODIFIED_DECREASE`; while the
     last iteration needed one, the exact tangent is not tried first: its factorisation would fail
     again); the projected tangent (compressive membrane stress dropped); and that one shifted
     (:data:`SHIFT_LADDER`). Each tangent is assembled once per call, its shifts added to the diagonal.
@@ -157,12 +163,12 @@ def direction(model, U, lam, r, opts, state, damping=0.0, stress=None):
     base = damping * diagonal_scale(model, U, state) if damping else 0.0
     memo = state.fallback
     start_rung = 0
-    if memo is not None and memo["mode"] in sequence and memo["run"] < FALLBACK_RUN:
+    if memo is not None and memo["mode"] in sequence and memo["run"] < memo.get("limit", FALLBACK_RUN):
         sequence = sequence[sequence.index(memo["mode"]):]  # the rungs below failed at the last iterate
         start_rung = max(memo.get("rung", 0) - 1, 0)
     elif "modified" in sequence:
         least = MODIFIED_SHIFTS[0] * diagonal_scale(model, U, state)
-        if state.modified_shift / MODIFIED_GROWTH < least:
+        if state.modified_shift / MODIFIED_DECREASE < least:
             state.modified_shift = 0.0
         elif base == 0.0:
             sequence = sequence[1:]  # the exact tangent was indefinite at the last iterate
@@ -171,7 +177,7 @@ def direction(model, U, lam, r, opts, state, damping=0.0, stress=None):
         shifts = [base]
         if mode == "modified":
             scale = diagonal_scale(model, U, state)
-            first = max(state.modified_shift / MODIFIED_GROWTH, MODIFIED_SHIFTS[0] * scale, base)
+            first = max(state.modified_shift / MODIFIED_DECREASE, MODIFIED_SHIFTS[0] * scale, base)
             shifts = [t for t in (first * MODIFIED_GROWTH ** k for k in range(MODIFIED_TRIES))
                       if t <= MODIFIED_SHIFTS[1] * scale]
         rungs = range(len(shifts))
@@ -204,18 +210,31 @@ SHIFT_LADDER = (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)
 FALLBACK_RUN = 4
 """Most Newton directions in a row that start from the remembered fallback tangent (``State.fallback``)
 before the exact tangent is tried again. On sphere-30 (61 x 61) the mixed iteration from the relaxed state
-took 3.7 factorisations per iteration without the memory, 208 of 308 on indefinite tangents."""
+took 3.7 factorisations per iteration without the memory, 208 of 308 on indefinite tangents. Each time the
+retried ladder ends on the fallback again, the run doubles, up to :data:`FALLBACK_RUN_MAX`."""
+
+FALLBACK_RUN_MAX = 32
+"""Longest run of directions from the remembered fallback tangent [-]: on a long indefinite stretch every retry
+of the ladder costs the failed factorisations of the exact and the modified tangents (up to
+1 + :data:`MODIFIED_TRIES`)."""
 
 
 def _remember(state, mode, rung) -> None:
     """Keep in ``state.fallback`` where the ladder of :func:`direction` succeeded (None for the exact or the
-    modified tangent: the next direction tries the whole ladder)."""
+    modified tangent: the next direction tries the whole ladder); a retried ladder that ends there again doubles the
+    run (:data:`FALLBACK_RUN`)."""
     if mode not in ("psd", "shift"):
         state.fallback = None
         return
     memo = state.fallback
-    run = memo["run"] + 1 if memo is not None and memo["run"] < FALLBACK_RUN else 1
-    state.fallback = {"mode": mode, "rung": int(rung), "run": run}
+    limit = FALLBACK_RUN if memo is None else memo.get("limit", FALLBACK_RUN)
+    if memo is not None and memo["run"] < limit:
+        run = memo["run"] + 1
+    else:
+        run = 1
+        if memo is not None:  # the run had expired and the retried ladder failed down to here again
+            limit = min(2 * limit, FALLBACK_RUN_MAX)
+    state.fallback = {"mode": mode, "rung": int(rung), "run": run, "limit": limit}
 
 
 def roundoff_floor(model, U) -> float:
