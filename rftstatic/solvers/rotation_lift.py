@@ -65,6 +65,7 @@ class RotationLift:
         m = len(edges)
         rows = np.repeat(np.arange(m), 2)
         self.D = sp.csr_matrix((np.tile([-1.0, 1.0], m), (rows, edges.ravel())), shape=(m, n_nodes))  # e = D x
+        self._ends = abs(self.D).T.tocsr()  # (N, M): sums an edge quantity into both its nodes
         L = (self.D.T @ self.D).tocsc()
         degree = float(L.diagonal().mean()) if n_nodes else 1.0
         self.free = ~held
@@ -86,18 +87,14 @@ class RotationLift:
         E = self.edges
         e = x[E[:, 1]] - x[E[:, 0]]
         de = d[E[:, 1]] - d[E[:, 0]]
-        blocks = np.einsum("m,ij->mij", np.einsum("mi,mi->m", e, e), np.eye(3)) - np.einsum("mi,mj->mij", e, e)
-        rhs = np.cross(e, de)
-        A = np.zeros((self.n_nodes, 3, 3))
-        b = np.zeros((self.n_nodes, 3))
-        for k in (0, 1):
-            np.add.at(A, E[:, k], blocks)
-            np.add.at(b, E[:, k], rhs)
+        blocks = np.einsum("mi,mi->m", e, e)[:, None, None] * np.eye(3) - e[:, :, None] * e[:, None, :]
+        A = (self._ends @ blocks.reshape(-1, 9)).reshape(-1, 3, 3)
+        b = self._ends @ _cross(e, de)
         # a node whose edges are collinear (none on a sheet) has no rotation about their line: a tiny Tikhonov term
         A += (1e-12 * np.trace(A, axis1=1, axis2=2) + 1e-300)[:, None, None] * np.eye(3)
         w_node = np.linalg.solve(A, b[..., None])[..., 0]
         w = 0.5 * (w_node[E[:, 0]] + w_node[E[:, 1]])
-        return w, e, de - np.cross(w, e)
+        return w, e, de - _cross(w, e)
 
     def path(self, x: np.ndarray, d: np.ndarray):
         """The curve of ``d (N, 3)`` [m] from ``x (N, 3)`` [m]: a function ``alpha -> y(alpha) - x (N, 3)`` [m],
@@ -111,7 +108,7 @@ class RotationLift:
             angle = np.sqrt(np.einsum("mi,mi->m", theta, theta))
             k = theta / np.where(angle > 0, angle, 1.0)[:, None]
             c, sn = np.cos(angle)[:, None], np.sin(angle)[:, None]
-            turned = e * c + np.cross(k, e) * sn + k * (np.einsum("mi,mi->m", k, e)[:, None] * (1.0 - c))
+            turned = e * c + _cross(k, e) * sn + k * (np.einsum("mi,mi->m", k, e)[:, None] * (1.0 - c))
             change = turned - e + alpha * s  # (R3) less the edge now: (R4) solved for the motion y - x
             out = alpha * d  # the held nodes' motion, and the anchors' targets
             if self._lu is not None:
@@ -120,3 +117,12 @@ class RotationLift:
             return out
 
         return displacement
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise ``a x b`` of ``(M, 3)`` arrays (numpy's ``cross`` is slower on many short rows)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
