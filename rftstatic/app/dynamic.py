@@ -359,7 +359,7 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     h = run.history
     plot_history(out / "energy.png", h["time"] / u.time,
                  {"kinetic": h["kinetic"] / u.energy, "potential (stored - P.D)": h["potential"] / u.energy,
-                  "dissipated (damping)": h["dissipated"] / u.energy},
+                  "dissipated (damping, frictions)": h["dissipated"] / u.energy},
                  xlabel="time [s]", ylabel=f"energy [{u.name.split('-')[1] if '-' in u.name else 'J'}"
                  f"{' ' + lu if lu else ''}]", title=f"{scene.name}: energies (alpha = {o.alpha * u.time:g} /s)")
     summary["energy_plot"] = "energy.png"
