@@ -263,7 +263,7 @@ class _Loop:
         """A fresh run with step ``dt`` [s]: empty records; ``v_(-1/2) = V0 - a_0 dt / 2`` if consistent."""
         self.dt = dt
         self.acc = {"damping": 0.0, "bending_friction": 0.0, "contact": 0.0, "total0": None, "scale": 0.0,
-                    "peak_kinetic": 0.0, "frame_index": 0}
+                    "peak_kinetic": 0.0, "frame_index": 0, "contact_energy": True}  # the booking of contact_energy
         self.hist = {k: [] for k in HISTORY_KEYS}
         self.probe_hist, self.frames = [], []
         self._pose(state, state.t, work=False)
@@ -276,6 +276,12 @@ class _Loop:
         """Continue the records of a saved position ``r`` (:meth:`position`)."""
         self.dt = dt
         self.acc = r["acc"]
+        if not self.acc.get("contact_energy"):  # saved by the earlier booking (before contact_energy): its
+            # contact_loss and total are not this one's, so the energy check measures growth from here on
+            log.warning("the saved explicit run booked its contact energy the earlier way: its energy history "
+                        "before the resume is not comparable, the energy check starts again from here")
+            self.acc.pop("projection", None)
+            self.acc.update(total0=None, scale=0.0, contact_energy=True)
         self.hist = {k: list(r["history"][k]) for k in HISTORY_KEYS}
         self.probe_hist = list(r["probes"])
         self.frames = list(r["frames"])

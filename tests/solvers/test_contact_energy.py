@@ -114,3 +114,30 @@ def test_on_an_incline_a_sliding_sheet_loses_mu_k_n_s_and_a_sticking_one_nothing
     assert np.abs(h["total"] - h["total"][0]).max() < 1e-9 * gravity
     _, stuck = runs[0.9]
     assert abs(stuck["contact_loss"][-1]) < 1e-3 * gravity
+
+
+def test_a_run_saved_by_the_earlier_booking_resumes_with_the_energy_check_started_again(caplog):
+    """A saved position of the earlier booking (no ``contact_energy`` mark; ``projection`` and a contact_loss
+    that grew while nothing moved) goes on without an instability from the changed meaning of ``total``: the
+    energy check measures from the resume (warned). Without that, the 1 J booked before jumps ``total``."""
+    import logging
+
+    from rftstatic.model.state import State
+    from rftstatic.solvers.drive import finish
+    from rftstatic.solvers.explicit import EXPLICIT, explicit_steps
+
+    mesh = rectangle(0.04, 0.04, 9, 9, origin=(-0.02, -0.02), z0=0.002)
+    wool = preset("wool-kang-yu")
+    model = Model(mesh, wool, load=gravity_load(mesh, wool.weight))
+    opts = ExplicitOptions(t_end=0.05, alpha=5.0, progress=False)
+    state = State.initial(model)
+    for pause in explicit_steps(model, state, opts, obstacles=[Floor(0.0)]):
+        if pause.step >= 300:
+            break
+    acc = state.route[EXPLICIT]["acc"]
+    acc.pop("contact_energy", None)
+    acc["projection"], acc["contact"] = -1e-6, acc["contact"] + 1.0
+    with caplog.at_level(logging.WARNING, logger="rftstatic.solvers.explicit"):
+        r = finish(explicit_steps(model, state, opts, obstacles=[Floor(0.0)]))
+    assert "earlier way" in caplog.text and r.t == pytest.approx(0.05)
+    assert "projection" not in acc and acc["contact_energy"]
