@@ -81,7 +81,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False) -> RunRe
     """Build ``scene``'s model (obstacles acting kinematically) and run it (:func:`run_dynamic_scene`)."""
     model, extras = build_model(scene)
     summary, explicit = _run(scene, model, extras, out, progress=progress, figures=figures, resume=resume)
-    return RunResult(summary, model, explicit.U, extras, out)
+    return RunResult(summary, model, explicit.U, extras, out, slip=explicit.state.slip)
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
@@ -94,14 +94,14 @@ def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:
 
 
 def run_dynamic_scene(scene, model, extras, out, *, progress=True, figures=True, resume=False,
-                      callback=None, backend="auto", U0=None) -> dict:
+                      callback=None, backend="auto", U0=None, slip=None) -> dict:
     """:func:`_run`, returning only the summary."""
     return _run(scene, model, extras, out, progress=progress, figures=figures, resume=resume, callback=callback,
-                backend=backend, U0=U0)[0]
+                backend=backend, U0=U0, slip=slip)[0]
 
 
 def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False, callback=None, backend="auto",
-         U0=None):
+         U0=None, slip=None):
     """Run a ``dynamic`` or ``relax`` scene and write its outputs into ``out`` (module docstring).
 
     Parameters
@@ -113,6 +113,9 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
     callback : extra ``callback(state, sample)`` at every history sample; returning True stops the run
     backend : force back end of :func:`rftstatic.solvers.explicit.run_explicit`
     U0 : (N, 3) displacements [m] the run starts from at rest (None: the reference), e.g. a drape's equilibrium
+    slip : the frictions' committed slips (E, k) at ``U0`` (bending 2HB, shear 2HG; that drape's
+        :attr:`~rftstatic.app.result.RunResult.slip`): the run goes on from them (None: the virgin fabric, right
+        for a sheet put in the shape ``U0`` but not for one that reached it along a route)
 
     Returns
     -------
@@ -181,6 +184,11 @@ def _run(scene, model, extras, out, *, progress=True, figures=True, resume=False
                                   rest_tol=o.rest_tolerance, backend=backend, max_steps=limit,
                                   max_steps_name=_limit_name(o, model.mesh.n_nodes), progress=progress)
         state = State.initial(model, U0)
+        if slip is not None and state.slip is not None:  # the friction's history goes on (the at-rest test too)
+            if np.shape(slip) != state.slip.shape:
+                raise ValueError(f"slip must have the shape {state.slip.shape} of the model's frictions, got "
+                                 f"{np.shape(slip)}")
+            state.slip = np.array(slip, dtype=float)
         route = explicit_steps(model, state, options, obstacles=obstacles, frame_times=save_times,
                                probes=pnodes.ravel(), callback=watch, plan=plan, friction=friction)
         reason = plan.reason
@@ -359,7 +367,7 @@ def _figures(scene, model, out: Path, run, summary, o, save_times, idx) -> None:
     h = run.history
     plot_history(out / "energy.png", h["time"] / u.time,
                  {"kinetic": h["kinetic"] / u.energy, "potential (stored - P.D)": h["potential"] / u.energy,
-                  "dissipated (damping)": h["dissipated"] / u.energy},
+                  "dissipated (damping, frictions)": h["dissipated"] / u.energy},
                  xlabel="time [s]", ylabel=f"energy [{u.name.split('-')[1] if '-' in u.name else 'J'}"
                  f"{' ' + lu if lu else ''}]", title=f"{scene.name}: energies (alpha = {o.alpha * u.time:g} /s)")
     summary["energy_plot"] = "energy.png"

@@ -18,11 +18,12 @@ Stages. (1) The static drape of the ``garment`` analysis on the form at rest (:f
 unchanged: the closing, sewing and the Newton drape with its ``[[supports]]``, e.g. the circle skirt's x-hold),
 written to ``drape/`` in the run folder. (2) An explicit run (:mod:`rftstatic.app.dynamic`, its outputs: frames,
 ``series/*.vtu`` + ``series.pvd``, ``animation.gif``, ``energy.png``, ``checkpoint.npz``) from that equilibrium at
-rest, on the same sewn mesh and contact surface, the scene's ``[[supports]]`` released (friction now holds the
-skirt's turn), with Coulomb friction ``motion.friction`` on the form's surface, which moves by its keyframes: the
-form is a penalty obstacle evaluated in its pose (:mod:`rftstatic.contact.motion`, the pose is State, the Model
-frozen), and a node sticking to it is carried at the surface's velocity. The form's own surface at every saved state
-is written as ``series/body_<k>.vtu`` (``body.pvd``).
+rest (with bending or shear hysteresis, from its frictions' committed slips), on the same sewn mesh and contact
+surface, the scene's ``[[supports]]`` released (friction now holds the skirt's turn), with Coulomb friction
+``motion.friction`` on the form's surface, which moves by its keyframes: the form is a penalty obstacle evaluated
+in its pose (:mod:`rftstatic.contact.motion`, the pose is State, the Model frozen), and a node sticking to it is
+carried at the surface's velocity. The form's own surface at every saved state is written as
+``series/body_<k>.vtu`` (``body.pvd``).
 
 Measures (``summary.json``, ``garment_motion``, scene units): the form's crossing check (the garment taken into the
 form's body frame and checked against ``body.obj``, the form itself: ``body_crossing_pairs`` at every saved state,
@@ -138,7 +139,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False):
     stage = moving_scene(scene, out / DRAPE / "body-m.obj", given, opts, drape.summary["garment"]["contact_smoothing"])
     model, extras = build_model(stage, mesh=drape.model.mesh, contact="penalty", start_check=False)
     summary, explicit = dynamic._run(stage, model, extras, out, progress=progress, figures=figures, resume=resume,
-                                     U0=drape.U)
+                                     U0=drape.U, slip=drape.slip)
     form = garment.dress_form(scene)
     summary["analysis"] = "garment-motion"
     summary["garment"] = drape.summary.get("garment")
@@ -146,7 +147,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False):
     write_json(out / "summary.json", summary)
     log.info("garment-motion: settled %s, body crossings %s", summary["garment_motion"]["settled"],
              summary["garment_motion"]["max_body_crossing_pairs"])
-    return RunResult(summary, model, explicit.U, extras, out)
+    return RunResult(summary, model, explicit.U, extras, out, slip=explicit.state.slip)
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:

@@ -151,7 +151,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False,
     summary["checkpoint"] = {"file": CHECKPOINT if saver.writes or resumed else None, "writes": saver.writes,
                              "write_time_s": saver.write_time, "resumed_from": resumed}
     _write(scene, solved, out, summary, figures=figures)
-    return RunResult(to_jsonable(summary), solved["model"], solved["U"], solved["extras"], out)
+    return RunResult(to_jsonable(summary), solved["model"], solved["U"], solved["extras"], out, slip=solved.get("slip"))
 
 
 def resume_scene(scene, out_dir, *, progress=True, figures=True) -> dict:

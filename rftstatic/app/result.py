@@ -19,6 +19,9 @@ class RunResult:
     U : (N, 3) final displacements [m]
     extras : obstacles and probes [m] of the scene (:func:`rftstatic.scenes.build.build_model`)
     out : the output folder
+    slip : the frictions' committed slips (E, k) of the final state (bending 2HB, shear 2HG:
+        :meth:`rftstatic.model.model.Model.initial_slip`), what a run going on from ``U`` starts from; None without
+        hysteresis, or where the analysis does not keep them (mesh sequencing)
     """
 
     summary: dict
@@ -26,6 +29,7 @@ class RunResult:
     U: np.ndarray
     extras: dict = field(default_factory=dict)
     out: Path | None = None
+    slip: np.ndarray | None = None
 
     @property
     def converged(self) -> bool:

@@ -114,7 +114,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     if error is not None:
         raise error
     remove_levels(out)
-    return RunResult(to_jsonable(summary), model, result.U, extras, out)
+    return RunResult(to_jsonable(summary), model, result.U, extras, out, slip=None if state is None else state.slip)
 
 
 def _measures(scene, model, extras):

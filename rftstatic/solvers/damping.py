@@ -21,7 +21,8 @@ cusick-30 blew up in 15 steps), by ``|1 - omega^2 dt^2 / 2| < 1`` with the half 
 
 The mixing never raises ``|v|_M`` (a convex combination of two vectors of its length). The kinetic energy a law
 takes at step n (that of the mean of the two half-step velocities, without the law less with it) enters the run's
-``dissipated`` (as the damping term), keeping ``total`` balanced.
+``dissipated`` (as the damping term) at step n, the rest of the law's change of the scheme's energy at step n + 1
+(:func:`rftstatic.solvers.explicit._apply_law`), keeping ``total`` balanced at every sample.
 
 Kinetic damping (Cundall 1976; Barnes, Int. J. Space Struct. 14, 1999): undamped motion, the kinetic energy of the
 half-step velocities ``T_(n+1/2)`` watched at every step; when it falls (``T_(n+1/2) < T_(n-1/2)``), it has passed

@@ -46,7 +46,8 @@ the sheet's weight, at ``d / 2`` under ten times it, :mod:`.law`), so the floor 
 Hence no pair's distance ever falls below ``min_fraction`` of its value at the start of a step:
 distances stay positive and no pair passes through another (straight-line steps; a kinematic obstacle's
 projection after the step is not part of the path). The kinetic energy the filter removes is returned
-(the explicit loop adds it to ``contact_loss``).
+(the explicit loop books the filter's change of the scheme's energy in ``contact_loss`` itself,
+:mod:`rftstatic.solvers.contact_energy`, C1).
 
 Shapes: ``x, v (N, 3)`` [m], [m/s]; ``minv (N, 3)`` [1/kg]; pairs ``(P, 4)`` node rows.
 """
