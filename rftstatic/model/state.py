@@ -46,8 +46,7 @@ class State:
     modified_shift : the last diagonal shift [N/m] that made an indefinite exact tangent positive definite
         (:func:`~rftstatic.solvers.iteration.direction`, mode ``"modified"``): the next try starts below it
     fallback : the last tangent beyond the exact and modified ones that gave a Newton direction, and how many
-        directions in a row it has given: ``{"mode": "psd" | "shift", "rung": index into SHIFT_LADDER, "run": int,
-        "limit": int}`` (``limit``: the run's length before the ladder is retried); the next
+        directions in a row it has given: ``{"mode": "psd" | "shift", "rung": index into SHIFT_LADDER, "run": int}``; the next
         direction starts from it (:func:`~rftstatic.solvers.iteration.direction`); None after an exact or
         modified step
     slip : the committed slips of the model's friction terms (E, k) (:meth:`rftstatic.model.model.Model.

@@ -119,12 +119,17 @@ MODIFIED_GROWTH = 8.0
 
 MODIFIED_DECREASE = 2.0
 """The first shift tried is the last one that worked divided by this factor (Nocedal & Wright's Algorithm 3.3 halves
-it). Measured with the rotation-lifted walk (validation/bench_profile.md, 2026-12-05) against 8 (the growth): the
-factorisations of pedestal-round-50 152 -> 122, pedestal-square-80 188 -> 186, cusick-24 107 -> 97, cusick-30
+it). Measured with the rotation-lifted walk (validation/bench_profile.md, 2026-12-05; 4 modified tries) against 8
+(the growth): the factorisations of pedestal-round-50 152 -> 122, pedestal-square-80 188 -> 186, cusick-24 107 -> 97, cusick-30
 48 -> 47, sphere-30 and pedestal-square-40 unchanged; the same equilibria."""
 
-MODIFIED_TRIES = 4
-"""Most factorisations of the modified exact tangent per iteration before the projected one is used."""
+MODIFIED_TRIES = 7
+"""Most factorisations of the modified exact tangent per iteration before the projected one is used: from the
+smallest shift (1e-7 of the mean diagonal) seven reach 2.6e-2 of it. The projected tangent, which drops the whole
+compressive geometric stiffness, is far stiffer along the fold modes than a shifted exact one: on the valley walks
+of issue 34 its steps were about 10 times shorter. Measured over the seeds 1-5 of pedestal-round-50 and sphere-30
+(validation/bench_profile.md, 2026-12-05): 694 and 214 factorisations in all against 805 and 249 with 4 tries;
+the same equilibria."""
 
 
 def direction(model, U, lam, r, opts, state, damping=0.0, stress=None):
@@ -163,7 +168,7 @@ def direction(model, U, lam, r, opts, state, damping=0.0, stress=None):
     base = damping * diagonal_scale(model, U, state) if damping else 0.0
     memo = state.fallback
     start_rung = 0
-    if memo is not None and memo["mode"] in sequence and memo["run"] < memo.get("limit", FALLBACK_RUN):
+    if memo is not None and memo["mode"] in sequence and memo["run"] < FALLBACK_RUN:
         sequence = sequence[sequence.index(memo["mode"]):]  # the rungs below failed at the last iterate
         start_rung = max(memo.get("rung", 0) - 1, 0)
     elif "modified" in sequence:
@@ -210,31 +215,18 @@ SHIFT_LADDER = (1e-8, 1e-6, 1e-4, 1e-2, 1.0, 1e2)
 FALLBACK_RUN = 4
 """Most Newton directions in a row that start from the remembered fallback tangent (``State.fallback``)
 before the exact tangent is tried again. On sphere-30 (61 x 61) the mixed iteration from the relaxed state
-took 3.7 factorisations per iteration without the memory, 208 of 308 on indefinite tangents. Each time the
-retried ladder ends on the fallback again, the run doubles, up to :data:`FALLBACK_RUN_MAX`."""
-
-FALLBACK_RUN_MAX = 32
-"""Longest run of directions from the remembered fallback tangent [-]: on a long indefinite stretch every retry
-of the ladder costs the failed factorisations of the exact and the modified tangents (up to
-1 + :data:`MODIFIED_TRIES`)."""
+took 3.7 factorisations per iteration without the memory, 208 of 308 on indefinite tangents."""
 
 
 def _remember(state, mode, rung) -> None:
     """Keep in ``state.fallback`` where the ladder of :func:`direction` succeeded (None for the exact or the
-    modified tangent: the next direction tries the whole ladder); a retried ladder that ends there again doubles the
-    run (:data:`FALLBACK_RUN`)."""
+    modified tangent: the next direction tries the whole ladder)."""
     if mode not in ("psd", "shift"):
         state.fallback = None
         return
     memo = state.fallback
-    limit = FALLBACK_RUN if memo is None else memo.get("limit", FALLBACK_RUN)
-    if memo is not None and memo["run"] < limit:
-        run = memo["run"] + 1
-    else:
-        run = 1
-        if memo is not None:  # the run had expired and the retried ladder failed down to here again
-            limit = min(2 * limit, FALLBACK_RUN_MAX)
-    state.fallback = {"mode": mode, "rung": int(rung), "run": run, "limit": limit}
+    run = memo["run"] + 1 if memo is not None and memo["run"] < FALLBACK_RUN else 1
+    state.fallback = {"mode": mode, "rung": int(rung), "run": run}
 
 
 def roundoff_floor(model, U) -> float:
