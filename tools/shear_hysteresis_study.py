@@ -104,13 +104,19 @@ def main(argv=None):
              "dissipated [gf cm] | shear slipping share | max shear [deg] | stable | crossing pairs | wall [s] |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for f, label, keys, tag, route in runs:
-        s = run_case(["material={" + ", ".join(keys) + "}", "solver.seed=1", *route], root / f"{f['id']}-{tag}",
-                     f"{f['id']} {label}")
+        s = _solve(f, label, keys, tag, route, root)
         if s is None:
             continue
         lines.append(_row(f, label, s))
         print(lines[-1], flush=True)
     print("\n".join(lines))
+
+
+def _solve(f, label, keys, tag, route, root: Path):
+    """The summary of fabric ``f`` given by its material ``keys`` on ``route`` (extra overrides), seed 1, in
+    ``root/<id>-<tag>``; None when the run failed."""
+    return run_case(["material={" + ", ".join(keys) + "}", "solver.seed=1", *route], root / f"{f['id']}-{tag}",
+                    f"{f['id']} {label}")
 
 
 def _hg5(f, root: Path):
@@ -125,8 +131,7 @@ def _hg5(f, root: Path):
              "max shear [deg] | Newton iterations | explicit / load steps | run [s] |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for route_label, label, keys, tag, route in runs:
-        s = run_case(["material={" + ", ".join(keys) + "}", "solver.seed=1", *route], root / f"{f['id']}-{tag}",
-                     f"{f['id']} {label}")
+        s = _solve(f, label, keys, tag, route, root)
         if s is None:
             continue
         d, sh = s["drape"], s["shear_hysteresis"]

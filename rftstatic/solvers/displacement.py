@@ -99,7 +99,13 @@ class LineSearch:
         closer than the self-contact step bound allows (the straight step, bounded, is taken then)."""
         model, state = self.model, self.state
         X = model.positions(x.U)
-        curve = self.lift.path(X, step)
+        path, trials = self.lift.path(X, step), {}
+
+        def curve(a):  # each trial's motion once: the chosen one is taken, not lifted again
+            if a not in trials:
+                trials[a] = path(a)
+            return trials[a]
+
         alpha, parts = line_search(model, x.U, step, x.lam, x.energy, slope, self.opts, state, x.energy_scale,
                                    refine=True, path=curve)
         if alpha is None:

@@ -13,6 +13,7 @@ from rftstatic.remesh import relax_driver, static_driver
 from rftstatic.scenes.build import build_model
 from rftstatic.scenes.options import remesh_options
 from rftstatic.scenes.schema import load_scene
+from tests.app.test_remesh_resume import _interrupt_call
 
 # the lab fabric of tests/app/test_levels.py with bending hysteresis, or with shear hysteresis
 LAB = "kes_B_warp=0.083, kes_B_weft=0.063, kes_W=19.0, kes_T=0.5"
@@ -138,19 +139,6 @@ def test_a_static_remesh_run_carries_the_slips_to_every_new_mesh(monkeypatch):
     np.testing.assert_array_equal(solved["slip"], solves[-1][2][0])
 
 
-def _cut(monkeypatch, owner, name, k):
-    """``owner.name`` raises KeyboardInterrupt at its k-th call (a Ctrl-C there)."""
-    original, calls = getattr(owner, name), []
-
-    def cut(*a, **kw):
-        calls.append(1)
-        if len(calls) == k:
-            raise KeyboardInterrupt
-        return original(*a, **kw)
-
-    monkeypatch.setattr(owner, name, cut)
-
-
 @pytest.mark.parametrize("name,overrides,owner,call", [
     ("remesh-pedestal-square-20", RELAX, relax_driver.ExplicitStepper, 4),  # after the 2nd remesh
     ("strip", STRIP, static_driver, 2),  # in the solve of cycle 1
@@ -165,7 +153,7 @@ def test_a_resumed_run_takes_the_slips_up_from_its_checkpoint(tmp_path, monkeypa
         return remeshed.run(scene, Path(out), progress=False, figures=False, checkpoint_seconds=1e9, **kw).summary
 
     full = run(tmp_path / "full")
-    _cut(monkeypatch, owner, "__call__" if owner is relax_driver.ExplicitStepper else "_solve", call)
+    _interrupt_call(monkeypatch, owner, "__call__" if owner is relax_driver.ExplicitStepper else "_solve", call)
     with pytest.raises(KeyboardInterrupt):
         run(tmp_path / "cut")
     monkeypatch.undo()

@@ -14,7 +14,8 @@ from rftstatic.element.shear_threshold import KES_ANGLES, growing_friction_law, 
 from rftstatic.mesh import trimesh as mesh
 from rftstatic.model import model
 from rftstatic.model.state import State
-from tests.element.test_shear_friction import TAU0, _corner_hung, _material, _mixed_slip, _sheared
+from tests.element.test_shear_friction import (TAU0, _corner_hung, _material, _mixed_slip, _sheared,
+                                               friction_derivative_errors)
 
 TAU5 = 2.5 * TAU0  # N/m: 2HG5 = 2.5 x 2HG
 GA, GB = KES_ANGLES
@@ -88,28 +89,12 @@ def test_element_force_and_tangent_are_derivatives_with_the_growing_threshold(el
     sliding = np.abs(e) > fr.threshold(gamma) / fr.K
     ramp = (np.abs(gamma) > GA) & (np.abs(gamma) < GB)
     assert 0.2 < sliding.mean() < 0.8 and (sliding & ramp).sum() >= 5  # the growth acts on slipping elements
-    _, fe, ke = fr.evaluate(U, slip, tangent=True)
-    dofs = 3 * fr.nodes[..., None] + np.arange(3)
-    g = np.zeros(U.size)
-    np.add.at(g, dofs.ravel(), fe.ravel())
-    Kd = np.zeros((U.size, U.size))
-    for k in range(len(ke)):
-        d = dofs[k].ravel()
-        Kd[np.ix_(d, d)] += ke[k].reshape(d.size, d.size)
-    h = 1e-7
-    for c in rng.choice(U.size, 16, replace=False):
-        Up, Um = U.ravel().copy(), U.ravel().copy()
-        Up[c] += h
-        Um[c] -= h
-        Up, Um = Up.reshape(-1, 3), Um.reshape(-1, 3)
-        assert abs((fr.evaluate(Up, slip)[0] - fr.evaluate(Um, slip)[0]) / (2 * h) - g[c]) < 1e-6 * np.abs(g).max()
-        gp, gm = np.zeros(U.size), np.zeros(U.size)
-        np.add.at(gp, dofs.ravel(), fr.evaluate(Up, slip)[1].ravel())
-        np.add.at(gm, dofs.ravel(), fr.evaluate(Um, slip)[1].ravel())
-        assert np.abs((gp - gm) / (2 * h) - Kd[:, c]).max() < 1e-6 * np.abs(Kd).max()
+    err_f, err_k = friction_derivative_errors(fr, U, slip, rng, 16)
+    assert err_f < 1e-6 and err_k < 1e-6
     assert (fr._law(gamma, slip)[2] < 0).any()  # unloading slips in the ramp: psi'' < 0 (S10)
     # the psd tangent: positive semi-definite although psi'' < 0 on the unloading slips
-    k = fr.evaluate(U, slip, tangent=True, psd=True)[2].reshape(len(ke), dofs.shape[1] * 3, -1)
+    kp, n = fr.evaluate(U, slip, tangent=True, psd=True)[2], 3 * fr.nodes.shape[1]
+    k = kp.reshape(len(kp), n, n)
     assert np.linalg.eigvalsh(0.5 * (k + k.transpose(0, 2, 1))).min() > -1e-12 * np.abs(k).max()
 
 
