@@ -28,8 +28,8 @@ from rftstatic.solvers.linear import LinearSolveError
 KRYLOV_FROM = 60_000
 """Free unknowns from which ``step_solver = "auto"`` takes the preconditioned CG step (the 201 x 201 sheet
 has 121,200; at 101 x 101, 30,600, a factorisation costs 0.4 s and the direct step is as fast or faster:
-docs/howto/solver-routes.md). The same size at which the factorisation turns to nested dissection
-(:data:`rftstatic.solvers.linear.CholmodSolver.NESTED_DISSECTION_FROM`)."""
+docs/howto/solver-routes.md; the factorisation there is ordered by nested dissection,
+:data:`rftstatic.solvers.linear.CholmodSolver.NESTED_DISSECTION_FROM`)."""
 
 REFRESH_ITERATIONS = 12
 """CG iterations above which the next step factorises the tangent anew (a factorisation at 201 x 201

@@ -177,15 +177,19 @@ class CholmodSolver:
     SIMPLICIAL_BELOW = 500
     """Unknowns below which the factorisation is simplicial; supernodal from there on."""
 
-    NESTED_DISSECTION_FROM = 60_000
+    NESTED_DISSECTION_FROM = 10_000
     """Unknowns from which the supernodal factorisation is ordered by CHOLMOD's nested dissection
-    (``nesdis``: METIS separators, CAMD on the parts). Measured (the 80 cm drape carried from
-    101 x 101 to 201 x 201 nodes, exact tangent + 1e-3 x its mean diagonal; best of 3 per ordering, three
-    processes on the 2 cores, so compare within a row): 121,200 unknowns: AMD 47.4e6 entries of L, 4.0 and
-    4.5 s per factorisation, analysis 0.6 s; METIS 41.6e6, 3.2 s, 1.6 s; nested dissection 41.1e6, 2.6 and
-    2.9 s, 1.5-2.9 s; 30,600 unknowns (101 x 101): AMD 8.4e6, 0.47 s; nested dissection 7.9e6, 0.41-0.65 s
-    (a tie). The analysis is redone when self-contact changes the pattern (8 times in the first 16
-    Newton iterations at 201 x 201, 29 factorisations), so the costlier analysis is paid back there too."""
+    (``nesdis``: METIS separators, CAMD on the parts); below, CHOLMOD's default (AMD here). Measured
+    (2026-12-05, near idle; one tangent of each scene's Newton walk shifted by 1e-2 x its mean diagonal so
+    that every factorisation runs to its end, median of 8 interleaved ``cholesky_inplace`` calls in
+    :class:`SerialOpenMP`, AMD / METIS / nested dissection [ms]): pedestal-round-50 (16,548 unknowns) 97.7 /
+    78.9 / 78.3; pedestal-square-80 (19,680) 82.1 / 79.6 / 75.9; sphere-30 (11,160) 40.2 / 37.6 / 37.0;
+    cusick-30 (5,760) 10.5 / 10.4 / 10.5 (a tie); the 80 cm drape carried to 201 x 201 nodes (121,200
+    unknowns): AMD 4.0-4.5 s, METIS 3.2 s, nested dissection 2.6-2.9 s. The back-substitution gains
+    alike (pedestal-round-50 7.0 against 6.0 ms). The analysis costs 50 instead of 20 ms at 16,548
+    unknowns; it is done once per pattern (again when self-contact changes it). Below 10,000 unknowns
+    the strips and sheets measured fill less with AMD (the strip 101 x 21: 0.76e6 against 0.97e6 entries
+    of L with METIS)."""
 
     def __init__(self):
         self._factor = None
@@ -232,8 +236,8 @@ class CholmodSolver:
         81 x 81: 4.60e6 against 4.70e6), so the supernodal mode takes CHOLMOD's default ordering,
         which is AMD here (same L) and tries METIS only where AMD fills badly, keeping the better;
         the analysis is done once per pattern (6,300 unknowns: 12 ms, METIS 26 ms). From
-        :data:`NESTED_DISSECTION_FROM` unknowns (the 201 x 201 sheet) nested dissection fills and costs
-        less (measured there). The ordering
+        :data:`NESTED_DISSECTION_FROM` unknowns nested dissection fills and costs less (measured there).
+        The ordering
         changes the round-off of the steps, which matters where the tangent is nearly singular: the
         33 x 33 sheet's load steps from the flat start now get through (193 Newton iterations, 6.8 s)
         where with METIS they failed at load factor 1e-5 and fell back to dynamic relaxation (359
