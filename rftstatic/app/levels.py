@@ -75,7 +75,7 @@ def transfer_start(coarse_model, U, fine_model) -> np.ndarray:
     return U0
 
 
-def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None, saver=None):
+def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None, saver=None, state=None):
     """Solve ``model`` (the model of ``scene``) by mesh sequencing over the scene's ``solver.levels`` meshes
     (:func:`~rftstatic.scenes.options.run_options`).
 
@@ -88,6 +88,9 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     resume : take up the levels saved in ``folder`` (those of the same model only)
     callback : ``callback(lam, U)`` after every converged increment of the finest level
     saver : a :class:`~rftstatic.solvers.checkpoint.CheckpointSaver` given the finest level's pauses (None: none)
+    state : the finest level's :class:`~rftstatic.model.state.State`, fresh from
+        :func:`~rftstatic.solvers.newton.start_state` on ``model``; after the solve it holds what the finest level
+        ended with (the frictions' committed slips, the dissipation, the contact caches). None: made here
 
     Returns the finest level's :class:`~rftstatic.solvers.newton.StaticResult`, its ``route``
     ``"<coarsest route>+levels"``, ``levels`` one record per mesh, the counters summed over them, and
@@ -105,6 +108,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
     prev = None
     first_path, first_relax = {}, {}  # the coarsest route's own record (its path or relaxation), if solved here
     matched = run.level_membrane == "matched"
+    given = state
     t_all = time.perf_counter()
     for k, sc in enumerate(scenes, start=1):
         last = k == len(scenes)
@@ -119,7 +123,7 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             log.info("mesh sequencing: level %d of %d (%d nodes) taken from %s", k, len(scenes), carry.mesh.n_nodes,
                      _level_path(folder, k))
             records.append({**saved["record"], "resumed": True})
-            prev = (carry, saved["U"], saved["slip"])
+            prev = (carry, saved["U"], saved["slip"], saved["dissipated"])
             continue
         if prev is None:  # the route finds the branch with the scene's own fabric
             m = carry if scale == 1.0 else build_model(sc, mesh, quiet=True)[0]
@@ -131,9 +135,10 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
             what = f"Newton at full load from level {k - 1}" + (f", membrane x {scale:.4g}" if scale != 1.0 else "")
         log.info("mesh sequencing: level %d of %d, %s nodes, by %s", k, len(scenes), m.mesh.n_nodes, what)
         try:
-            state = start_state(m, level_opts.newton.linear_solver)
+            state = start_state(m, level_opts.newton.linear_solver) if not last or given is None else given
             if prev is not None and prev[2] is not None and state.slip is not None:
                 state.slip = carry_slip(prev[0], prev[2], m)
+                state.dissipated = prev[3]  # the route's dissipation goes on from the coarser levels'
             route = static_route(m, state, level_opts, U0=U0, callback=callback if last else None)
             res = drive(route, saver.on(state) if last and saver is not None else None)
         except ConvergenceError as exc:
@@ -155,10 +160,10 @@ def solve_levels(scene, model, opts, *, folder=None, resume=False, callback=None
         if m is not carry:  # the coarsest level, matched: its equilibrium again with the matched membrane
             U, carry = _rematched(m, carry, res, opts, records[-1], totals)
         if folder is not None and not last:
-            _save_level(folder, k, carry, U, records[-1], state.slip)
+            _save_level(folder, k, carry, U, records[-1], state.slip, state.dissipated)
         if prev is None:
             first_path, first_relax = res.path, res.relax
-        prev = (carry, U, state.slip)
+        prev = (carry, U, state.slip, state.dissipated)
     res = _sequence_outcome(res, records, totals)
     return replace(res, path=res.path or first_path, relax=res.relax or first_relax,
                    wall_time=time.perf_counter() - t_all)
@@ -245,11 +250,12 @@ def _level_path(folder, k) -> Path:
     return Path(folder) / f"level-{k}.npz"
 
 
-def _save_level(folder, k, model, U, record, slip=None) -> None:
+def _save_level(folder, k, model, U, record, slip=None, dissipated=0.0) -> None:
     """Level ``k``'s equilibrium ``U`` (N, 3) [m] of ``model``, its frictions' committed ``slip`` (E, k) (None:
-    none) and its record, in the one checkpoint format (a State whose ``route["level"]`` is the record), keyed to
-    the model's fingerprint."""
-    state = State(U=np.array(U, dtype=float), V=np.zeros_like(U), route={"level": record}, slip=slip)
+    none), the energy they dissipated since the flat start [J] and its record, in the one checkpoint format (a
+    State whose ``route["level"]`` is the record), keyed to the model's fingerprint."""
+    state = State(U=np.array(U, dtype=float), V=np.zeros_like(U), route={"level": record}, slip=slip,
+                  dissipated=float(dissipated))
     save_atomic(_level_path(folder, k), state_arrays(state, {"kind": "level", "level": k,
                                                              "model": static_fingerprint(model)}))
 
@@ -268,4 +274,5 @@ def _load_level(folder, k, model):
             saved["U"].shape != (model.mesh.n_nodes, 3):
         log.warning("%s was saved for another model: level %d is solved again", path, k)
         return None
-    return {"U": saved["U"], "record": saved["route"]["level"], "slip": saved.get("slip")}
+    return {"U": saved["U"], "record": saved["route"]["level"], "slip": saved.get("slip"),
+            "dissipated": float(saved.get("dissipated", 0.0))}

@@ -69,7 +69,7 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     remove_stale(path)
     resumed = None
     single = run_options(scene).levels == 1  # mesh sequencing resumes from its own saved levels (level-K.npz)
-    state = None  # the single mesh's solve State (mesh sequencing makes one per level)
+    state = None  # the solve's State (with mesh sequencing the finest level's)
     if resume and single and path.exists():
         state = load_static_state(path, model, opts, scene=scene.name)
         resumed = where(state)
@@ -80,11 +80,11 @@ def run(scene, out: Path, *, progress=True, figures=True, resume=False, callback
     error = None
     try:
         with saver.stopping():
-            if not single:
+            state = state or start_state(model, opts.newton.linear_solver)
+            if not single:  # mesh sequencing: ``state`` becomes the finest level's
                 result = solve_levels(scene, model, opts, folder=out, resume=resume, callback=callback,
-                                      saver=saver)
+                                      saver=saver, state=state)
             else:
-                state = state or start_state(model, opts.newton.linear_solver)
                 result = drive(static_route(model, state, opts, callback=callback), saver.on(state))
     except ConvergenceError as exc:
         error, result = exc, exc.result

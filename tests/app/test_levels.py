@@ -326,3 +326,24 @@ def test_the_frictions_slips_go_to_the_next_level_and_a_resume_takes_them_up(tmp
     assert again.levels[0]["resumed"] and len(carried) == 2
     np.testing.assert_array_equal(carried[1][0], coarse_slip)
     assert np.allclose(again.U, first.U, rtol=0, atol=1e-9)
+
+
+def test_a_sequenced_run_returns_the_finest_levels_slips_and_the_whole_routes_dissipation(tmp_path, monkeypatch):
+    """``app.run`` with mesh sequencing returns what a run going on from its drape starts from (the finest level's
+    committed slips, ``RunResult.slip``), and its hysteresis summary counts the energy the frictions dissipated along
+    the whole route: the coarse level's relaxation and the fine level's Newton."""
+    scene = load_scene("pedestal-square-20", DRAPE + HYSTERESIS)
+    saved = []
+    real = levels_mod._save_level
+
+    def spy(folder, k, model, U, record, slip=None, dissipated=0.0):
+        saved.append(dissipated)
+        return real(folder, k, model, U, record, slip, dissipated)
+
+    monkeypatch.setattr(levels_mod, "_save_level", spy)
+    res = app.run(scene, tmp_path, progress=False, figures=False)
+    fine = res.model.mesh.n_elements
+    assert res.slip is not None and res.slip.shape == (fine, 2) and np.abs(res.slip).max() > 0
+    assert len(saved) == 1 and saved[0] > 0  # the coarse level dissipated on its way down
+    dissipated = res.summary["bending_hysteresis"]["dissipated"]
+    assert dissipated >= scene.units.from_si(saved[0], "energy") * (1 - 1e-12)
