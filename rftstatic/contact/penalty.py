@@ -49,8 +49,8 @@ import numpy as np
 from rftstatic.contact.candidates import CandidateList
 from rftstatic.contact.common import as_list as _as_list, as_points as _as_points, positive as _positive
 from rftstatic.contact.friction import friction_terms
-from rftstatic.contact.penalty_compiled import compiled_force, point_form
 from rftstatic.contact.obstacles import Obstacle
+from rftstatic.contact.penalty_compiled import compiled_force, point_form
 from rftstatic.model.frozen import Frozen
 
 FEATURE_GAP = 0.05
