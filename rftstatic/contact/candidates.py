@@ -120,5 +120,12 @@ class CandidateList:
         """``(N,)`` every point's distance [m] at the last refresh (None before one)."""
         return self._gap
 
+    @property
+    def reference(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """``(positions (N, 3) [m] (``(M, N, 3)`` in the body frames with :attr:`poses`), indices (C,), distances
+        (N,) [m])`` at the last refresh, what :meth:`lookup` tests and returns (the compiled twin of its test and of
+        the penalty's filter, :mod:`rftstatic.contact.penalty_compiled`, reads them); None before a refresh."""
+        return None if self._x is None else (self._x, self._indices, self._gap)
+
     def __len__(self) -> int:
         return 0 if self._indices is None else len(self._indices)

@@ -47,11 +47,10 @@ from typing import Sequence
 import numpy as np
 
 from rftstatic.contact.candidates import CandidateList
-from rftstatic.contact.common import as_list as _as_list
-from rftstatic.contact.common import as_points as _as_points
-from rftstatic.contact.common import positive as _positive
+from rftstatic.contact.common import as_list as _as_list, as_points as _as_points, positive as _positive
 from rftstatic.contact.friction import friction_terms
 from rftstatic.contact.obstacles import Obstacle
+from rftstatic.contact.penalty_compiled import compiled_force, point_form
 from rftstatic.model.frozen import Frozen
 
 FEATURE_GAP = 0.05
@@ -162,6 +161,7 @@ class PenaltyContact(Frozen):
         # list margin [m]: a few onset widths, and half a node spacing so explicit runs refresh seldom
         spacing = float(np.sqrt(np.mean(area))) if area.size and np.mean(area) > 0 else 0.0
         self.margin = max(4.0 * self.smoothing, 0.5 * spacing)
+        self.point_form = point_form(self.obstacles)  # compiled distances (rftstatic.contact.penalty_compiled) or None
         self.features = None
         if sheet is not None and any(ob.sharp_features() is not None for ob in self.obstacles):
             from rftstatic.contact.features import FeatureContact
@@ -228,8 +228,7 @@ class PenaltyContact(Frozen):
         return out
 
     def _offsets(self, candidates):
-        """The obstacles' poses (:class:`~rftstatic.contact.motion.Poses`) the solve's ``candidates`` carry, or
-        None."""
+        """The obstacles' poses (:class:`~rftstatic.contact.motion.Poses`) the solve's ``candidates`` carry, or None."""
         poses = getattr(candidates, "poses", None)
         if poses is None:
             return None
@@ -306,8 +305,8 @@ class PenaltyContact(Frozen):
         return ContactState(energy, force, blocks, gap, active, pairs)
 
     def _near(self, x, candidates):
-        """Indices of the candidate nodes and an ``(N,)`` gap array: exact values are filled in by
-        the caller for the candidates; the others hold a lower bound (> margin / 2) [m]."""
+        """Indices of the candidate nodes and an ``(N,)`` gap array: exact values are filled in by the caller for the
+        candidates; the others hold a lower bound (> margin / 2) [m]."""
         n = x.shape[0]
         if not self.obstacles:
             return np.arange(0), np.full(n, np.inf)
@@ -356,19 +355,22 @@ class PenaltyContact(Frozen):
 
         ``k A_n min(phi, 0) n`` summed over the obstacles; it points into the obstacle, so it is the
         contact term of the residual (the obstacle pushes the sheet with its negative). The explicit
-        loop calls this once per step: only the candidates' distances and the slope of the energy
-        density are computed (no energy, gaps or tangent blocks), where the distance may be below ``eps``.
+        loop calls this once per step: only the candidates' distances and the slope of the energy density are
+        computed (no energy, gaps or tangent blocks), where the distance may be below ``eps``; for rigid analytic
+        obstacles at rest in three compiled passes, bit-identical (:mod:`rftstatic.contact.penalty_compiled`).
         """
         x = _as_points(x, self.n_nodes)
-        cand, bound = self._near(x, candidates)
-        gap0 = getattr(candidates, "gaps", None)  # distances at the refresh; bound = gap0 - the motion since
-        if gap0 is not None and cand.size:  # 2 x motion: room for |grad phi| up to 2 (a smooth surface's: near 1)
-            cand = cand[gap0[cand] - 2.0 * (gap0[cand] - bound[cand]) < self.smoothing]
-        force = np.zeros((x.shape[0], 3))
-        if cand.size:
-            phi, normal = self._distances_of(x[cand], self._offsets(candidates))
-            d1 = self._slope(phi)
-            force[cand] = np.einsum("n,mn,mni->ni", self.stiffness * self.node_area[cand], d1, normal)
+        force = compiled_force(self, x, candidates)  # None: not covered, the numpy path (the reference)
+        if force is None:
+            cand, bound = self._near(x, candidates)
+            gap0 = getattr(candidates, "gaps", None)  # distances at the refresh; bound = gap0 - the motion since
+            if gap0 is not None and cand.size:  # 2 x motion: room for |grad phi| up to 2 (a smooth surface's: ~1)
+                cand = cand[gap0[cand] - 2.0 * (gap0[cand] - bound[cand]) < self.smoothing]
+            force = np.zeros((x.shape[0], 3))
+            if cand.size:
+                phi, normal = self._distances_of(x[cand], self._offsets(candidates))
+                d1 = self._slope(phi)
+                force[cand] = np.einsum("n,mn,mni->ni", self.stiffness * self.node_area[cand], d1, normal)
         if self.features is not None:
             force += self.features.evaluate(x, tangent=False, cache=candidates).force
         lag = getattr(candidates, "friction", None)
@@ -377,10 +379,8 @@ class PenaltyContact(Frozen):
         return force
 
     def tangent_blocks(self, x: np.ndarray, *, candidates: CandidateList | None = None) -> np.ndarray:
-        """Node-diagonal blocks ``(N, 3, 3)`` [N/m] of ``d force / dx`` at ``x (N, 3)`` [m].
-
-        ``k A_n (n n^T + phi H)`` for each obstacle the node penetrates; symmetric.
-        """
+        """Node-diagonal blocks ``(N, 3, 3)`` [N/m] of ``d force / dx`` at ``x (N, 3)`` [m]: ``k A_n (n n^T + phi H)``
+        for each obstacle the node penetrates; symmetric."""
         return self.evaluate(x, candidates=candidates).tangent_blocks
 
     def gaps(self, x: np.ndarray) -> np.ndarray:

@@ -1,7 +1,9 @@
 """Compiled (numba) twin of :mod:`.pedestal_kernels`, made from its own code as
 :mod:`rftstatic.contact.self_contact._kernels_numba` does (a copy of each function whose globals resolve to the
-compiled twins; :func:`~.pedestal_kernels.vertical_one` and :func:`~.pedestal_kernels.rounded_box_one` inlined
-into the loops). Imported only when numba is installed and a call is large enough
+compiled twins; :func:`~.pedestal_kernels.vertical_one`, :func:`~.pedestal_kernels.rounded_box_one`, the per-point
+:func:`~.pedestal_kernels.square_one`, :func:`~.pedestal_kernels.round_one` and
+:func:`~.pedestal_kernels.distance_one` inlined into the loops: all from the one source file numba's cache is keyed
+on). Imported only when numba is installed and a call is large enough
 (:func:`rftstatic.contact.obstacles.pedestal_kernels.compiled_for`)."""
 
 import types
@@ -21,7 +23,10 @@ def _compile(f, name, **options):
 
 _compile(pedestal_kernels.vertical_one, "vertical_one", inline="always")
 _compile(pedestal_kernels.rounded_box_one, "rounded_box_one", inline="always")
-_compile(pedestal_kernels.square_all, "square_all")
-_compile(pedestal_kernels.round_all, "round_all")
+for _name in ("square_one", "round_one", "distance_one"):
+    _compile(getattr(pedestal_kernels, _name), _name, inline="always")
+for _name in ("square_all", "round_all", "distances_at"):
+    _compile(getattr(pedestal_kernels, _name), _name)
 square_all = _scope["square_all"]
 round_all = _scope["round_all"]
+distances_at = _scope["distances_at"]

@@ -242,6 +242,14 @@ class Obstacle(abc.ABC):
     def params(self) -> dict[str, Any]:
         """Defining parameters in metres, keyed as in a scene table (without ``type``)."""
 
+    def point_kernel(self) -> tuple[int, tuple[float, ...]] | None:
+        """The obstacle as a compiled per-point distance: ``(kind, params)`` of
+        :func:`rftstatic.contact.obstacles.pedestal_kernels.distance_one` (lengths [m]), which computes exactly what
+        :meth:`signed_distance` does; None: no such kernel (the penalty contact's explicit force then calls
+        :meth:`signed_distance`). Read only from the class that defines it (``vars(type(obstacle))``): a subclass
+        that changes the distance does not inherit its parent's kernel."""
+        return None
+
     psd_tangent: ClassVar[bool] = False
     """The curvature of ``phi`` is unbounded (sharp edges and corners, a triangle surface): the penalty
     contact projects each node's tangent block onto the positive semi-definite matrices

@@ -6,6 +6,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from rftstatic.contact.obstacles import pedestal_kernels
 from rftstatic.contact.obstacles.base import Obstacle, SceneKey, _as_points, _finite
 from rftstatic.contact.obstacles.registry import register
 
@@ -36,6 +37,9 @@ class Floor(Obstacle):
     def normal_gradient(self, x):
         x = _as_points(x)
         return np.zeros((x.shape[0], 3, 3))
+
+    def point_kernel(self):
+        return pedestal_kernels.FLOOR, (self.height,)
 
     def bounding_box(self):
         return np.array([-np.inf, -np.inf, -np.inf]), np.array([np.inf, np.inf, self.height])

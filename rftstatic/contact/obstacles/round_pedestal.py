@@ -85,12 +85,15 @@ class RoundPedestal(Obstacle):
         phi, g, G = _rounded_box(q, r, hessian)
         return phi, g, G, J, e, rho, on_axis
 
+    def point_kernel(self):
+        cx, cy = self.centre_xy
+        return pedestal_kernels.ROUND, (float(cx), float(cy), self.radius, self.top_z, float(self.height),
+                                        self.edge_radius)
+
     def _compiled(self, x, hessian):
         from rftstatic.contact.obstacles._pedestal_numba import round_all
 
-        cx, cy = self.centre_xy
-        params = (float(cx), float(cy), self.radius, self.top_z, float(self.height), self.edge_radius)
-        return pedestal_kernels.run(round_all, x, params, hessian)
+        return pedestal_kernels.run(round_all, x, self.point_kernel()[1], hessian)
 
     def signed_distance(self, x):
         x = _as_points(x)

@@ -7,6 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from rftstatic.contact.obstacles import pedestal_kernels
 from rftstatic.contact.obstacles.base import NUMBERS, Obstacle, SceneKey, _as_points, _finite, _positive
 from rftstatic.contact.obstacles.registry import register
 
@@ -54,6 +55,9 @@ class Sphere(Obstacle):
         dist, normal, at_centre = self._offset(x)
         H = np.eye(3) - np.einsum("ni,nj->nij", normal, normal)
         return H * np.where(at_centre, 0.0, 1.0 / np.where(at_centre, 1.0, dist))[:, None, None]
+
+    def point_kernel(self):
+        return pedestal_kernels.SPHERE, (*(float(c) for c in self.centre), self.radius)
 
     def bounding_box(self):
         return self.centre - self.radius, self.centre + self.radius

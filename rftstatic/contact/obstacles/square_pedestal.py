@@ -88,12 +88,15 @@ class SquarePedestal(Obstacle):
         q = np.column_stack([np.abs(p) - (self.half_width - r), qz])
         return q, sign
 
+    def point_kernel(self):
+        (cx, cy), (hx, hy) = self.centre_xy, self.half_width
+        params = (float(cx), float(cy), float(hx), float(hy), self.top_z, float(self.height), self.edge_radius)
+        return pedestal_kernels.SQUARE, params
+
     def _compiled(self, x, hessian):
         from rftstatic.contact.obstacles._pedestal_numba import square_all
 
-        (cx, cy), (hx, hy) = self.centre_xy, self.half_width
-        params = (float(cx), float(cy), float(hx), float(hy), self.top_z, float(self.height), self.edge_radius)
-        return pedestal_kernels.run(square_all, x, params, hessian)
+        return pedestal_kernels.run(square_all, x, self.point_kernel()[1], hessian)
 
     def signed_distance(self, x):
         x = _as_points(x)
