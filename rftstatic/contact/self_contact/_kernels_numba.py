@@ -24,7 +24,7 @@ _INLINE = {geometry: ("_unit_clamp", "segment_param", "_end_point_param", "pt_cl
            kernels: (), grid: ("_grow",)}
 _LOOPS = {geometry: ("distances_all", "derivatives_all", "ccd_all", "distances_by_index"),
           kernels: ("jacobi_eigen", "psd_project_one", "psd_project_all", "midrange_motion"),
-          grid: ("boxes", "cell_list", "join")}
+          grid: ("boxes", "frame", "cell_ranges", "cell_list", "join")}
 
 
 def _compile(f, name, scope, **options):
@@ -56,5 +56,7 @@ ccd_all = _scopes[geometry]["ccd_all"]
 midrange_motion = _scopes[kernels]["midrange_motion"]
 distances_by_index = _scopes[geometry]["distances_by_index"]
 boxes = _scopes[grid]["boxes"]
+frame = _scopes[grid]["frame"]
+cell_ranges = _scopes[grid]["cell_ranges"]
 cell_list = _scopes[grid]["cell_list"]
 join = _scopes[grid]["join"]

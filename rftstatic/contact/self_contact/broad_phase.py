@@ -196,10 +196,6 @@ def _cell_size(lo_t, hi_t):
     return float(np.mean(np.max(hi_t - lo_t, axis=1)))
 
 
-def _cell_range(lo, hi, origin, cell):
-    return np.floor((lo - origin) / cell).astype(np.int64), np.floor((hi - origin) / cell).astype(np.int64)
-
-
 DENSE_CELLS = 8
 """The compiled cell list keeps an array over every grid cell (a counting sort) when the grid has at
 most this many cells per box entry (or 65,536 in all), else it sorts the occupied cells."""
@@ -207,7 +203,7 @@ most this many cells per box entry (or 65,536 in all), else it sorts the occupie
 
 def _find_pairs_compiled(prims, x0, radius, x1):
     """:func:`find_pairs` by the compiled cell list (:mod:`.grid`)."""
-    from rftstatic.contact.self_contact._kernels_numba import boxes, cell_list, join
+    from rftstatic.contact.self_contact._kernels_numba import boxes, cell_list, cell_ranges, frame, join
 
     tri, edges = np.ascontiguousarray(prims.tri), np.ascontiguousarray(prims.edges)
     nodes = np.arange(prims.n_nodes, dtype=np.int64)[:, None]
@@ -218,17 +214,17 @@ def _find_pairs_compiled(prims, x0, radius, x1):
         lo, hi = np.empty((len(prim), 3)), np.empty((len(prim), 3))
         boxes(x0, x1, prim, inflate, lo, hi)
         box[name] = lo, hi
-    lo_t, hi_t = box["t"]
-    cell = _cell_size(lo_t, hi_t)
-    origin = lo_t.min(axis=0) - cell
-    dims = np.floor((hi_t.max(axis=0) - origin) / cell).astype(np.int64) + 2
-    c = {k: _cell_range(*v, origin, cell) for k, v in box.items()}
+    origin, dims = np.empty(3), np.empty(3, dtype=np.int64)
+    cell = frame(*box["t"], origin, dims)
+    c, entries = {}, {}
+    for k, (lo, hi) in box.items():
+        c[k] = np.empty((len(lo), 3), dtype=np.int64), np.empty((len(lo), 3), dtype=np.int64)
+        entries[k] = cell_ranges(lo, hi, origin, cell, *c[k])
     out = []
     for a, b, na, nb_, same in (("n", "t", nodes, tri, False), ("e", "e", edges, edges, True)):
-        entries = int(np.prod(c[b][1] - c[b][0] + 1, axis=1).sum())
-        dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries, 1 << 16)
+        dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries[b], 1 << 16)
         cl = cell_list(c[b][0], c[b][1], dims, dense)
-        args = (c[a][0], c[a][1], *box[a], na, c[b][0], *box[b], nb_, *cl, dims, dense, same)
+        args = (c[a][0], c[a][1], *box[a], na, *box[b], nb_, *cl, dims, dense, same)
         out.append(_join_on_threads(join, args, len(na)))
     return Pairs(out[0], out[1])
 
