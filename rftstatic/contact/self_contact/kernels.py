@@ -180,3 +180,46 @@ def midrange_motion(a, b, s, c, out):
         out[k] = r
         big = max(big, r)
     return big
+
+
+def step_motions(x, xb, dx, m, spread):
+    """The three translation-free motions (Eq. 1 of :mod:`.near_pairs`) of an explicit step's filter in two passes:
+    ``m (N,)`` since the build ``xb`` at ``x`` (``w = x - xb``), ``spread (N,)`` of the step ``dx`` itself
+    (``w = dx``), and the largest at the step's end (``w = x + dx - xb``, not stored); ``x, xb, dx (N, 3)`` [m].
+    Returns ``(max m, max end motion, max spread)`` [m]. The same arithmetic as three calls of
+    :func:`midrange_motion` (``a + s b - c`` with ``s = 0`` is ``a - c``), so the same values."""
+    n = x.shape[0]
+    lo = np.full((3, 3), np.inf)
+    hi = np.full((3, 3), -np.inf)
+    for k in range(n):
+        for i in range(3):
+            w0 = x[k, i] - xb[k, i]
+            w1 = x[k, i] + dx[k, i] - xb[k, i]
+            w2 = dx[k, i]
+            lo[0, i], hi[0, i] = min(lo[0, i], w0), max(hi[0, i], w0)
+            lo[1, i], hi[1, i] = min(lo[1, i], w1), max(hi[1, i], w1)
+            lo[2, i], hi[2, i] = min(lo[2, i], w2), max(hi[2, i], w2)
+    mid = 0.5 * (lo + hi)
+    big0 = big1 = big2 = 0.0
+    for k in range(n):
+        r0 = r1 = r2 = 0.0
+        for i in range(3):
+            w = x[k, i] - xb[k, i] - mid[0, i]
+            r0 += w * w
+            w = x[k, i] + dx[k, i] - xb[k, i] - mid[1, i]
+            r1 += w * w
+            w = dx[k, i] - mid[2, i]
+            r2 += w * w
+        r0, r1, r2 = np.sqrt(r0), np.sqrt(r1), np.sqrt(r2)
+        m[k] = r0
+        spread[k] = r2
+        big0, big1, big2 = max(big0, r0), max(big1, r1), max(big2, r2)
+    return big0, big1, big2
+
+
+def largest_norm(v):
+    """``max_k |v_k|`` of ``v (N, 3)`` (0 for no row)."""
+    big = 0.0
+    for k in range(v.shape[0]):
+        big = max(big, v[k, 0] * v[k, 0] + v[k, 1] * v[k, 1] + v[k, 2] * v[k, 2])
+    return np.sqrt(big)
