@@ -198,7 +198,10 @@ def _cell_size(lo_t, hi_t):
 
 DENSE_CELLS = 8
 """The compiled cell list keeps an array over every grid cell (a counting sort) when the grid has at
-most this many cells per box entry (or 65,536 in all), else it sorts the occupied cells."""
+most this many cells per box entry (or :data:`DENSE_MIN_CELLS` in all), else it sorts the occupied cells."""
+
+DENSE_MIN_CELLS = 1 << 16
+"""A grid of at most this many cells always gets the dense cell array (:data:`DENSE_CELLS`)."""
 
 
 def _find_pairs_compiled(prims, x0, radius, x1):
@@ -222,7 +225,7 @@ def _find_pairs_compiled(prims, x0, radius, x1):
         entries[k] = cell_ranges(lo, hi, origin, cell, *c[k])
     out = []
     for a, b, na, nb_, same in (("n", "t", nodes, tri, False), ("e", "e", edges, edges, True)):
-        dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries[b], 1 << 16)
+        dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries[b], DENSE_MIN_CELLS)
         cl = cell_list(c[b][0], c[b][1], dims, dense)
         args = (c[a][0], c[a][1], *box[a], na, *box[b], nb_, *cl, dims, dense, same)
         out.append(_join_on_threads(join, args, len(na)))
