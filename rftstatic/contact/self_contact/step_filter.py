@@ -131,7 +131,8 @@ class StepFilter:
         if self._quick_pass(cache, v, dt):
             return 0.0
         removed, m_max = self._full(sc, cache, x, v, dt, stats)
-        self._bound = (cache, cache.builds, m_max, _largest(v, self.sc.compiled) * dt)  # for the quick passes that follow
+        step = _largest(v, self.sc.compiled) * dt
+        self._bound = (cache, cache.builds, m_max, step)  # for the quick passes that follow
         return removed
 
     def _quick_pass(self, cache, v, dt) -> bool:
