@@ -11,8 +11,8 @@ boxes, swept ones for a swept test). Two paths, same pairs in the same order:
 
 * compiled (numba installed, :func:`.distance.compiled_for`; loops in :mod:`.grid`): the entries of
   one kind are counting-sorted by cell (or ``argsort``-ed on a sparse grid); every box of the other
-  kind visits its cells and keeps a listed box if the boxes overlap, share no node, and the cell is
-  the lowest common cell of the two (each pair once, no deduplication pass);
+  kind visits its cells and keeps a listed box if the boxes overlap and share no node, once (a stamp
+  per box marks the pairs met in an earlier common cell: no deduplication pass);
 * numpy: cell keys sorted (``argsort``), every pair of entries of the two kinds that share a cell a
   candidate, kept as above and deduplicated by ``np.unique`` on the pair key (a loop over the three
   axes only).
