@@ -162,10 +162,10 @@ class StepFilter:
         """Tests 1-4 (module docstring); the kinetic energy removed [J] and the largest motion since the build [m]."""
         d, half = sc.thickness, 0.5 * cache.margin
         dx = dt * v
-        m, m_max, end_max, spread, spread_max = cache.step_motions(sc.prims, x, dx, d)  # m_max <= margin / 2 now
+        m_max, end_max, spread_max = cache.step_motions(sc.prims, x, dx, d)  # m_max <= margin / 2 now
         if end_max > half:
             cache.rebuild(sc.prims, x, d)  # 1. the list must cover the whole step
-            m, m_max = np.zeros(len(x)), 0.0
+            m_max = 0.0
         extra = None
         if spread_max > half:
             stats.swept += 1
@@ -174,6 +174,8 @@ class StepFilter:
         beta, g = 1.0 - self.approach, self.gap_floor
         if extra is None and 2.0 * spread_max <= beta * (lb_min - g):  # 2. quick test
             return 0.0, m_max
+        m = cache.motion(x)[0]  # per node, since the build (zero after one at x)
+        spread = translation_free_motion(dx, self._zero(dx), compiled=sc.compiled)[0]
         lb = cache.lower_bounds(m)
         pick = 2.0 * spread[cache.nodes].max(axis=1) > beta * (lb - g)
         nodes, is_pt = cache.nodes[pick], np.flatnonzero(pick) < len(cache.npt)
