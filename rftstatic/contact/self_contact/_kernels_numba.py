@@ -23,8 +23,9 @@ _INLINE = {geometry: ("_unit_clamp", "segment_param", "_end_point_param", "pt_cl
                       "pt_classify", "ee_classify", "pair_derivatives"),
            kernels: (), grid: ("_grow",)}
 _LOOPS = {geometry: ("distances_all", "derivatives_all", "ccd_all", "distances_by_index"),
-          kernels: ("jacobi_eigen", "psd_project_one", "psd_project_all", "midrange_motion"),
-          grid: ("boxes", "cell_list", "join")}
+          kernels: ("jacobi_eigen", "psd_project_one", "psd_project_all", "midrange_motion", "step_motions",
+                    "largest_norm"),
+          grid: ("boxes", "frame", "cell_ranges", "cell_list", "join")}
 
 
 def _compile(f, name, scope, **options):
@@ -54,7 +55,11 @@ derivatives_all = _scopes[geometry]["derivatives_all"]
 psd_project_all = _scopes[kernels]["psd_project_all"]
 ccd_all = _scopes[geometry]["ccd_all"]
 midrange_motion = _scopes[kernels]["midrange_motion"]
+step_motions = _scopes[kernels]["step_motions"]
+largest_norm = _scopes[kernels]["largest_norm"]
 distances_by_index = _scopes[geometry]["distances_by_index"]
 boxes = _scopes[grid]["boxes"]
+frame = _scopes[grid]["frame"]
+cell_ranges = _scopes[grid]["cell_ranges"]
 cell_list = _scopes[grid]["cell_list"]
 join = _scopes[grid]["join"]

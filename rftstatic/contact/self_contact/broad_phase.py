@@ -11,8 +11,8 @@ boxes, swept ones for a swept test). Two paths, same pairs in the same order:
 
 * compiled (numba installed, :func:`.distance.compiled_for`; loops in :mod:`.grid`): the entries of
   one kind are counting-sorted by cell (or ``argsort``-ed on a sparse grid); every box of the other
-  kind visits its cells and keeps a listed box if the boxes overlap, share no node, and the cell is
-  the lowest common cell of the two (each pair once, no deduplication pass);
+  kind visits its cells and keeps a listed box if the boxes overlap and share no node, once (a stamp
+  per box marks the pairs met in an earlier common cell: no deduplication pass);
 * numpy: cell keys sorted (``argsort``), every pair of entries of the two kinds that share a cell a
   candidate, kept as above and deduplicated by ``np.unique`` on the pair key (a loop over the three
   axes only).
@@ -196,18 +196,17 @@ def _cell_size(lo_t, hi_t):
     return float(np.mean(np.max(hi_t - lo_t, axis=1)))
 
 
-def _cell_range(lo, hi, origin, cell):
-    return np.floor((lo - origin) / cell).astype(np.int64), np.floor((hi - origin) / cell).astype(np.int64)
-
-
 DENSE_CELLS = 8
 """The compiled cell list keeps an array over every grid cell (a counting sort) when the grid has at
-most this many cells per box entry (or 65,536 in all), else it sorts the occupied cells."""
+most this many cells per box entry (or :data:`DENSE_MIN_CELLS` in all), else it sorts the occupied cells."""
+
+DENSE_MIN_CELLS = 1 << 16
+"""A grid of at most this many cells always gets the dense cell array (:data:`DENSE_CELLS`)."""
 
 
 def _find_pairs_compiled(prims, x0, radius, x1):
     """:func:`find_pairs` by the compiled cell list (:mod:`.grid`)."""
-    from rftstatic.contact.self_contact._kernels_numba import boxes, cell_list, join
+    from rftstatic.contact.self_contact._kernels_numba import boxes, cell_list, cell_ranges, frame, join
 
     tri, edges = np.ascontiguousarray(prims.tri), np.ascontiguousarray(prims.edges)
     nodes = np.arange(prims.n_nodes, dtype=np.int64)[:, None]
@@ -218,17 +217,17 @@ def _find_pairs_compiled(prims, x0, radius, x1):
         lo, hi = np.empty((len(prim), 3)), np.empty((len(prim), 3))
         boxes(x0, x1, prim, inflate, lo, hi)
         box[name] = lo, hi
-    lo_t, hi_t = box["t"]
-    cell = _cell_size(lo_t, hi_t)
-    origin = lo_t.min(axis=0) - cell
-    dims = np.floor((hi_t.max(axis=0) - origin) / cell).astype(np.int64) + 2
-    c = {k: _cell_range(*v, origin, cell) for k, v in box.items()}
+    origin, dims = np.empty(3), np.empty(3, dtype=np.int64)
+    cell = frame(*box["t"], origin, dims)
+    c, entries = {}, {}
+    for k, (lo, hi) in box.items():
+        c[k] = np.empty((len(lo), 3), dtype=np.int64), np.empty((len(lo), 3), dtype=np.int64)
+        entries[k] = cell_ranges(lo, hi, origin, cell, *c[k])
     out = []
     for a, b, na, nb_, same in (("n", "t", nodes, tri, False), ("e", "e", edges, edges, True)):
-        entries = int(np.prod(c[b][1] - c[b][0] + 1, axis=1).sum())
-        dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries, 1 << 16)
+        dense = int(np.prod(dims)) <= max(DENSE_CELLS * entries[b], DENSE_MIN_CELLS)
         cl = cell_list(c[b][0], c[b][1], dims, dense)
-        args = (c[a][0], c[a][1], *box[a], na, c[b][0], *box[b], nb_, *cl, dims, dense, same)
+        args = (c[a][0], c[a][1], *box[a], na, *box[b], nb_, *cl, dims, dense, same)
         out.append(_join_on_threads(join, args, len(na)))
     return Pairs(out[0], out[1])
 

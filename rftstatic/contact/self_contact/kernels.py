@@ -158,25 +158,70 @@ def psd_project_all(H, out):
 def midrange_motion(a, b, s, c, out):
     """Translation-free motion (Eq. 1 of :mod:`.near_pairs`) of ``w = a + s b - c`` (``a, b, c (N, 3)``
     [m], ``s`` a scalar): ``out[k] = |w_k - m|`` ``(N,)`` [m] with ``m`` the midrange of ``w`` over the
-    nodes; returns ``max_k out[k]`` (0 for no node). Two passes over the nodes, no temporary array:
-    the motion since a build (``a = x``, ``s = 0``, ``c = x_build``), at the end of a step
+    nodes; returns ``max_k out[k]`` (0 for no node). Two passes over the nodes, no temporary array, the
+    bounds in scalars: the motion since a build (``a = x``, ``s = 0``, ``c = x_build``), at the end of a step
     (``b = dx``, ``s = 1``) or a step's own spread (``a = dx``, ``c = 0``)."""
     n = a.shape[0]
-    lo = np.full(3, np.inf)
-    hi = np.full(3, -np.inf)
+    lo0 = lo1 = lo2 = np.inf
+    hi0 = hi1 = hi2 = -np.inf
     for k in range(n):
-        for i in range(3):
-            w = a[k, i] + s * b[k, i] - c[k, i]
-            lo[i] = min(lo[i], w)
-            hi[i] = max(hi[i], w)
-    mid = 0.5 * (lo + hi)
+        w0 = a[k, 0] + s * b[k, 0] - c[k, 0]
+        w1 = a[k, 1] + s * b[k, 1] - c[k, 1]
+        w2 = a[k, 2] + s * b[k, 2] - c[k, 2]
+        lo0, hi0 = min(lo0, w0), max(hi0, w0)
+        lo1, hi1 = min(lo1, w1), max(hi1, w1)
+        lo2, hi2 = min(lo2, w2), max(hi2, w2)
+    m0, m1, m2 = 0.5 * (lo0 + hi0), 0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2)
     big = 0.0
     for k in range(n):
-        r = 0.0
-        for i in range(3):
-            w = a[k, i] + s * b[k, i] - c[k, i] - mid[i]
-            r += w * w
-        r = np.sqrt(r)
+        w0 = a[k, 0] + s * b[k, 0] - c[k, 0] - m0
+        w1 = a[k, 1] + s * b[k, 1] - c[k, 1] - m1
+        w2 = a[k, 2] + s * b[k, 2] - c[k, 2] - m2
+        r = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
         out[k] = r
         big = max(big, r)
     return big
+
+
+def step_motions(x, xb, dx):
+    """The largest translation-free motions (Eq. 1 of :mod:`.near_pairs`) of an explicit step's filter, in two passes:
+    since the build ``xb`` at ``x`` (``w = x - xb``), at the step's end (``w = x + dx - xb``) and of the step ``dx``
+    itself (``w = dx``); ``x, xb, dx (N, 3)`` [m]. Returns the three maxima [m], each the square root of the largest
+    squared norm: the values of three :func:`midrange_motion` calls (the same arithmetic: ``a + s b - c`` with
+    ``s = 0`` is ``a - c``; a correctly rounded square root keeps the order), without a root per node."""
+    n = x.shape[0]
+    lo = np.full((3, 3), np.inf)  # rows: since the build, at the step's end, the step; columns: axes
+    hi = np.full((3, 3), -np.inf)
+    for i in range(3):
+        la, lb, lc, ha, hb, hc = np.inf, np.inf, np.inf, -np.inf, -np.inf, -np.inf
+        for k in range(n):
+            w0 = x[k, i] - xb[k, i]
+            w1 = x[k, i] + dx[k, i] - xb[k, i]
+            w2 = dx[k, i]
+            la, ha = min(la, w0), max(ha, w0)
+            lb, hb = min(lb, w1), max(hb, w1)
+            lc, hc = min(lc, w2), max(hc, w2)
+        lo[0, i], lo[1, i], lo[2, i], hi[0, i], hi[1, i], hi[2, i] = la, lb, lc, ha, hb, hc
+    mid = 0.5 * (lo + hi)
+    a0, a1, a2 = mid[0, 0], mid[0, 1], mid[0, 2]
+    b0, b1, b2 = mid[1, 0], mid[1, 1], mid[1, 2]
+    c0, c1, c2 = mid[2, 0], mid[2, 1], mid[2, 2]
+    big0 = big1 = big2 = 0.0
+    for k in range(n):
+        w0, w1, w2 = x[k, 0] - xb[k, 0] - a0, x[k, 1] - xb[k, 1] - a1, x[k, 2] - xb[k, 2] - a2
+        big0 = max(big0, w0 * w0 + w1 * w1 + w2 * w2)
+        w0 = x[k, 0] + dx[k, 0] - xb[k, 0] - b0
+        w1 = x[k, 1] + dx[k, 1] - xb[k, 1] - b1
+        w2 = x[k, 2] + dx[k, 2] - xb[k, 2] - b2
+        big1 = max(big1, w0 * w0 + w1 * w1 + w2 * w2)
+        w0, w1, w2 = dx[k, 0] - c0, dx[k, 1] - c1, dx[k, 2] - c2
+        big2 = max(big2, w0 * w0 + w1 * w1 + w2 * w2)
+    return np.sqrt(big0), np.sqrt(big1), np.sqrt(big2)
+
+
+def largest_norm(v):
+    """``max_k |v_k|`` of ``v (N, 3)`` (0 for no row)."""
+    big = 0.0
+    for k in range(v.shape[0]):
+        big = max(big, v[k, 0] * v[k, 0] + v[k, 1] * v[k, 1] + v[k, 2] * v[k, 2])
+    return np.sqrt(big)

@@ -178,6 +178,25 @@ class NearPairCache(PairCache):
             return np.zeros(len(x)), 0.0
         return m, big
 
+    def step_motions(self, prims: SheetPrimitives, x: np.ndarray, dx: np.ndarray, thickness: float):
+        """For an explicit step ``x -> x + dx`` (``(N, 3)`` [m]): the list made valid for ``x`` as :meth:`current`,
+        and ``(m_max, end_max, spread_max)`` [m], the largest translation-free motions since its build at ``x``
+        (:meth:`current`'s) and at ``x + dx`` (:meth:`motion`'s), and of the step itself
+        (:func:`translation_free_motion` of ``dx``), the same values; compiled, one two-pass loop without a root per
+        node (:func:`.kernels.step_motions`) instead of three (a step filter's test at every step: the per-node
+        motions are wanted only by the steps that test pairs)."""
+        if self._x is None or self._x.shape != x.shape or not distance.compiled_for(len(x), self.compiled):
+            m_max = self.current(prims, x, thickness)[1]
+            spread_max = translation_free_motion(dx, np.zeros_like(dx), compiled=self.compiled)[1]
+            return m_max, self.motion(x, dx)[1], spread_max
+        from rftstatic.contact.self_contact._kernels_numba import step_motions
+
+        m_max, end_max, spread_max = step_motions(x, self._x, dx)
+        if m_max > 0.5 * self.margin:
+            self.rebuild(prims, x, thickness)
+            m_max, end_max = 0.0, self.motion(x, dx)[1]
+        return float(m_max), float(end_max), float(spread_max)
+
     def rebuild(self, prims: SheetPrimitives, x: np.ndarray, thickness: float) -> Pairs:
         """Build the list at ``x (N, 3)`` [m] now."""
         t0 = time.perf_counter()

@@ -95,3 +95,43 @@ def test_bad_input():
         find_pairs(prims, X, 0.0)
     with pytest.raises(ValueError, match="shape"):
         find_pairs(prims, X[:-1], 0.1)
+
+
+@pytest.mark.parametrize("dense", [True, False])
+def test_grid_equals_brute_force_on_random_folded_sheets(monkeypatch, dense):
+    """The same pairs in the same (sorted) order as brute force on folded sheets of several seeds and radii,
+    with the dense cell array and with the sorted occupied cells."""
+    from rftstatic.contact.self_contact import broad_phase
+
+    if not dense:
+        monkeypatch.setattr(broad_phase, "DENSE_CELLS", 0)
+        monkeypatch.setattr(broad_phase, "DENSE_MIN_CELLS", 0)
+    for seed in range(4):
+        mesh, X = crumpled(11 + 2 * seed, seed=seed, amp=0.2 + 0.2 * seed)
+        prims = SheetPrimitives.of_mesh(mesh)
+        for r in (0.005, 0.03, 0.12):
+            got, ref = find_pairs(prims, X, r), brute_force_pairs(prims, X, r)
+            np.testing.assert_array_equal(got.pt, ref.pt)
+            np.testing.assert_array_equal(got.ee, ref.ee)
+
+
+def test_near_list_holds_every_pair_within_the_radius():
+    """The near list of a build (:class:`NearPairCache`) is every admissible pair whose exact distance is below
+    ``thickness + margin``, by an all-pairs search on folded sheets, with its build distances."""
+    from rftstatic.contact.self_contact.distance import edge_edge_distance2, point_triangle_distance2
+    from rftstatic.contact.self_contact.near_pairs import NearPairCache, pair_nodes
+
+    for seed in range(3):
+        mesh, X = crumpled(9 + 3 * seed, seed=seed + 10)
+        prims = SheetPrimitives.of_mesh(mesh)
+        d, margin = 0.01, 0.03
+        cache = NearPairCache(margin)
+        cache.rebuild(prims, X, d)
+        allp = brute_force_pairs(prims, X, 10.0)  # every admissible pair
+        npt, nee = pair_nodes(prims, allp)
+        dpt, dee = np.sqrt(point_triangle_distance2(X[npt])), np.sqrt(edge_edge_distance2(X[nee]))
+        want = np.concatenate([npt[dpt < d + margin], nee[dee < d + margin]])
+        assert len(want) > 0
+        np.testing.assert_array_equal(cache.nodes, want)
+        np.testing.assert_allclose(cache.dist, np.concatenate([dpt[dpt < d + margin], dee[dee < d + margin]]),
+                                   rtol=1e-12)

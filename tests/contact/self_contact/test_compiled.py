@@ -143,3 +143,38 @@ def test_near_pair_distances_by_index_agree(monkeypatch):
     assert len(pa) == len(pairs.pt) and len(eb) == len(pairs.ee) and len(pa) and len(ea)
     np.testing.assert_allclose(pb, pa, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(eb, ea, rtol=1e-12, atol=1e-15)
+
+
+def test_step_motions_are_the_three_motions_of_the_filter(monkeypatch):
+    """:meth:`NearPairCache.step_motions` gives, compiled in one loop, the largest of three compiled translation-free
+    motions (since the build at x and at x + dx, the step's spread) bit for bit, and the numpy path's to round-off;
+    a motion past half the margin rebuilds the list at x."""
+    from rftstatic.bench.self_contact import crumpled
+    from rftstatic.contact.self_contact.near_pairs import NearPairCache, translation_free_motion
+
+    mesh, X = crumpled(21)
+    prims = SheetPrimitives.of_mesh(mesh)
+    rng = np.random.default_rng(3)
+    _on(monkeypatch, True)
+    for scale, builds in ((1e-4, 1), (2e-2, 2)):
+        x, dx = X + scale * rng.standard_normal(X.shape), 1e-4 * rng.standard_normal(X.shape)
+        caches = []
+        for compiled in (False, True, True):
+            cache = NearPairCache(0.02, compiled=compiled)
+            cache.rebuild(prims, X, 0.002)
+            caches.append(cache)
+        numpy_path, fused = (c.step_motions(prims, x, dx, 0.002) for c in caches[:2])
+        three = (caches[2].current(prims, x, 0.002)[1], caches[2].motion(x, dx)[1],
+                 translation_free_motion(dx, np.zeros_like(dx), compiled=True)[1])
+        assert fused == three
+        np.testing.assert_allclose(numpy_path, three, rtol=1e-13)
+        assert [c.builds for c in caches] == [builds] * 3
+
+
+def test_largest_norm_agrees(monkeypatch):
+    from rftstatic.contact.self_contact.step_filter import _largest
+
+    v = np.random.default_rng(2).standard_normal((3000, 3))
+    a, b = _largest(v, False), _largest(v, True)
+    assert b == pytest.approx(a, rel=1e-15) and a == pytest.approx(np.linalg.norm(v, axis=1).max(), rel=1e-15)
+    assert _largest(np.zeros((0, 3)), True) == 0.0
