@@ -31,6 +31,24 @@ ones (numba). They agree to round-off only, so a run uses one, chosen before it 
 (:func:`choose_kernels`), whatever ran before it in the process."""
 
 
+
+def compiled_twin(f, name: str, scope: dict, **options):
+    """Put a numba-compiled copy of the kernel ``f`` into ``scope`` as ``name`` and return it: the compiled twins of
+    a kernel module (``_*_numba.py``) are copies of its functions whose globals are ``scope`` (the module's names,
+    with each compiled twin replacing its source as it is made, so the loops call the compiled helpers; ``options``
+    e.g. ``inline="always"`` for a per-point helper). Cached on disk (numba keys the cache on ``f``'s source file and
+    ``name``); ``error_model="numpy"``: no zero-division checks (the kernels divide only by values kept away from
+    zero). Imports numba: call it from a module loaded only when numba is used."""
+    import types
+
+    import numba
+
+    copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
+    copy.__qualname__ = name  # numba's cache entry is named after it
+    copy.__doc__ = f.__doc__
+    scope[name] = numba.njit(copy, cache=True, nogil=True, error_model="numpy", **options)
+    return scope[name]
+
 @cache
 def numba_available() -> bool:
     """True when numba is installed (the ``fast`` extra); the kernels' numpy twins are used otherwise.

@@ -4,23 +4,12 @@ compiled twins; :func:`~.penalty_kernels.slope_one` inlined into :func:`~.penalt
 from the one source file numba's cache is keyed on). Imported only when numba is installed and a call is large
 enough (:func:`rftstatic.contact.penalty_compiled.compiled_force`)."""
 
-import types
-
-import numba as nb
-
+from rftstatic.compiled import compiled_twin
 from rftstatic.contact import penalty_kernels
 
 _scope = dict(vars(penalty_kernels))
-
-
-def _compile(f, name, **options):
-    copy = types.FunctionType(f.__code__, _scope, name, f.__defaults__, f.__closure__)
-    copy.__qualname__ = name  # numba's cache entry is named after it
-    _scope[name] = nb.njit(copy, cache=True, nogil=True, error_model="numpy", **options)
-
-
-_compile(penalty_kernels.slope_one, "slope_one", inline="always")
-_compile(penalty_kernels.near_nodes, "near_nodes")
-_compile(penalty_kernels.penalty_scatter, "penalty_scatter")
+compiled_twin(penalty_kernels.slope_one, "slope_one", _scope, inline="always")
+compiled_twin(penalty_kernels.near_nodes, "near_nodes", _scope)
+compiled_twin(penalty_kernels.penalty_scatter, "penalty_scatter", _scope)
 near_nodes = _scope["near_nodes"]
 penalty_scatter = _scope["penalty_scatter"]

@@ -6,27 +6,16 @@ compiled twins; :func:`~.pedestal_kernels.vertical_one`, :func:`~.pedestal_kerne
 on). Imported only when numba is installed and a call is large enough
 (:func:`rftstatic.contact.obstacles.pedestal_kernels.compiled_for`)."""
 
-import types
-
-import numba as nb
-
+from rftstatic.compiled import compiled_twin
 from rftstatic.contact.obstacles import pedestal_kernels
 
 _scope = dict(vars(pedestal_kernels))
-
-
-def _compile(f, name, **options):
-    copy = types.FunctionType(f.__code__, _scope, name, f.__defaults__, f.__closure__)
-    copy.__qualname__ = name  # numba's cache entry is named after it
-    _scope[name] = nb.njit(copy, cache=True, nogil=True, error_model="numpy", **options)
-
-
-_compile(pedestal_kernels.vertical_one, "vertical_one", inline="always")
-_compile(pedestal_kernels.rounded_box_one, "rounded_box_one", inline="always")
+compiled_twin(pedestal_kernels.vertical_one, "vertical_one", _scope, inline="always")
+compiled_twin(pedestal_kernels.rounded_box_one, "rounded_box_one", _scope, inline="always")
 for _name in ("square_one", "round_one", "distance_one"):
-    _compile(getattr(pedestal_kernels, _name), _name, inline="always")
+    compiled_twin(getattr(pedestal_kernels, _name), _name, _scope, inline="always")
 for _name in ("square_all", "round_all", "distances_at"):
-    _compile(getattr(pedestal_kernels, _name), _name)
+    compiled_twin(getattr(pedestal_kernels, _name), _name, _scope)
 square_all = _scope["square_all"]
 round_all = _scope["round_all"]
 distances_at = _scope["distances_at"]

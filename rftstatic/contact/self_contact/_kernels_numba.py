@@ -7,16 +7,15 @@ global names resolve to the compiled twins, so the loops call the compiled per-p
 (inlined) and the plain source stays plain Python; the geometry's ``select`` resolves to the compiled
 :func:`.geometry.select_one` (``a if c else b``). Each loop inlines only functions of its own file, the
 one numba's cache is keyed on (its source hash), so that an edit of that file recompiles the loop.
-The key holds no compile options: after changing the ``njit`` options here, delete the index files
-``__pycache__/<module>.*.nbi`` of the three modules, or the old machine code is loaded again. Serial: the machines share their cores, and the loops are short next to the solver's (the broad phase's join alone
+The key holds no compile options: after changing the ``njit`` options
+(:func:`rftstatic.compiled.compiled_twin`), delete the index files
+``__pycache__/<module>.*.nbi`` of the three modules, or the old machine code is loaded again. Serial: the
+machines share their cores, and the loops are short next to the solver's (the broad phase's join alone
 runs ranges of its boxes on threads for a large sheet, :func:`.broad_phase._join_on_threads`). Imported only
 when numba is installed and chosen (:func:`rftstatic.contact.self_contact.distance.compiled_for`).
 """
 
-import types
-
-import numba as nb
-
+from rftstatic.compiled import compiled_twin
 from rftstatic.contact.self_contact import geometry, grid, kernels
 
 _INLINE = {geometry: ("_unit_clamp", "segment_param", "_end_point_param", "pt_closest", "ee_closest",
@@ -27,27 +26,15 @@ _LOOPS = {geometry: ("distances_all", "derivatives_all", "ccd_all", "distances_b
                     "largest_norm"),
           grid: ("boxes", "frame", "cell_ranges", "cell_list", "join")}
 
-
-def _compile(f, name, scope, **options):
-    """Put a compiled copy of ``f`` into ``scope`` (the copies' globals) as ``name``.
-
-    ``error_model="numpy"``: no zero-division checks (every division is by a value kept away from
-    zero: a selected 1.0, a determinant above a tolerance), as in the membrane's kernels."""
-    copy = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
-    copy.__qualname__ = name  # numba's cache entry is named after it
-    copy.__doc__ = f.__doc__
-    scope[name] = nb.njit(copy, cache=True, nogil=True, error_model="numpy", **options)
-
-
 _scopes = {}
 for _module in (geometry, kernels, grid):
     _scope = dict(vars(_module))
     if _module is geometry:
-        _compile(geometry.select_one, "select", _scope, inline="always")
+        compiled_twin(geometry.select_one, "select", _scope, inline="always")
     for _name in _INLINE[_module]:
-        _compile(getattr(_module, _name), _name, _scope, inline="always")
+        compiled_twin(getattr(_module, _name), _name, _scope, inline="always")
     for _name in _LOOPS[_module]:
-        _compile(getattr(_module, _name), _name, _scope)
+        compiled_twin(getattr(_module, _name), _name, _scope)
     _scopes[_module] = _scope
 
 distances_all = _scopes[geometry]["distances_all"]
